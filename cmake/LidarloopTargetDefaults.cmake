@@ -1,0 +1,35 @@
+# lidarloop_target_defaults(<target>): language standard, warnings and sanitizers for our targets.
+function(lidarloop_target_defaults target)
+    target_compile_features(${target} PUBLIC cxx_std_20)
+    set_target_properties(${target} PROPERTIES CXX_EXTENSIONS OFF POSITION_INDEPENDENT_CODE ON)
+    target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wconversion
+        -Wno-sign-conversion $<$<BOOL:${LIDARLOOP_WERROR}>:-Werror>)
+    # GCC 12 reports false -Wrestrict positives inside libstdc++'s std::string operator+ at -O3
+    # (GCC bug 105329); the warning says nothing about our code there.
+    if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_CXX_COMPILER_VERSION VERSION_LESS 13)
+        target_compile_options(${target} PRIVATE -Wno-restrict)
+    endif()
+    if(LIDARLOOP_SANITIZE)
+        target_compile_options(${target} PRIVATE -fsanitize=address,undefined
+            -fno-sanitize-recover=all -fno-omit-frame-pointer)
+        target_link_options(${target} PUBLIC -fsanitize=address,undefined)
+    endif()
+endfunction()
+
+# lidarloop_add_library(<name> SOURCES ... PUBLIC_DEPS ... PRIVATE_DEPS ...): one folder, one
+# target lidarloop_<name>, exported as lidarloop::<name>.
+function(lidarloop_add_library name)
+    cmake_parse_arguments(ARG "" "" "SOURCES;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
+    set(target lidarloop_${name})
+    add_library(${target} ${ARG_SOURCES})
+    add_library(lidarloop::${name} ALIAS ${target})
+    set_target_properties(${target} PROPERTIES EXPORT_NAME ${name} OUTPUT_NAME lidarloop_${name})
+    target_include_directories(${target} PUBLIC
+        $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/cpp> $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
+    target_link_libraries(${target} PUBLIC ${ARG_PUBLIC_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
+    lidarloop_target_defaults(${target})
+    install(TARGETS ${target} EXPORT lidarloopTargets
+        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+    install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/lidarloop/${name}
+        FILES_MATCHING PATTERN "*.hpp")
+endfunction()

@@ -1,0 +1,121 @@
+#include "lidarloop/core/histogram.hpp"
+
+#include <cmath>
+#include <string>
+
+#include "lidarloop/core/error.hpp"
+
+namespace lidarloop::core {
+namespace {
+
+void RequireFinite(double value, const char* field) {
+    if (!std::isfinite(value)) {
+        throw ConfigError(std::string("histogram.") + field + " must be a finite number");
+    }
+}
+
+void RequireRange(double min_value, double max_value, const char* min_field,
+                  const char* max_field) {
+    RequireFinite(min_value, min_field);
+    RequireFinite(max_value, max_field);
+    if (!(min_value < max_value)) {
+        throw ConfigError(std::string("histogram.") + min_field + " (" + std::to_string(min_value) +
+                          ") must be smaller than histogram." + max_field + " (" +
+                          std::to_string(max_value) + ")");
+    }
+}
+
+// Counts the values of `cloud` into buckets; `value_of` is the projection v(p).
+template <typename ValueOf>
+void CountValues(const PointCloud& cloud, ValueOf value_of, const HistogramConfig& config,
+                 std::vector<std::size_t>& counts, Histogram& histogram) {
+    const double min_value = histogram.min_value;
+    const double max_value = histogram.max_value;
+    const auto bins = static_cast<long>(counts.size());
+    const double buckets_per_unit = static_cast<double>(bins) / (max_value - min_value);
+    const bool clamp = config.out_of_range == OutOfRangePolicy::kClamp;
+    for (const auto& p : cloud) {
+        if (!p.allFinite()) {
+            ++histogram.points_skipped;
+            continue;
+        }
+        const double v = value_of(p);
+        if (v < min_value || v > max_value) {
+            ++histogram.points_out_of_range;
+            if (!clamp) continue;
+        }
+        // The clamp also puts v == v_max into the last bucket (eq. 2's closed upper end).
+        const long k = static_cast<long>(std::floor((v - min_value) * buckets_per_unit));
+        ++counts[static_cast<std::size_t>(std::clamp(k, 0L, bins - 1))];
+        ++histogram.points_used;
+    }
+}
+
+}  // namespace
+
+std::string ToString(OutOfRangePolicy policy) {
+    return policy == OutOfRangePolicy::kClamp ? "clamp" : "drop";
+}
+
+OutOfRangePolicy ParseOutOfRangePolicy(std::string_view name) {
+    if (name == "clamp") return OutOfRangePolicy::kClamp;
+    if (name == "drop") return OutOfRangePolicy::kDrop;
+    throw ConfigError("unknown out-of-range policy '" + std::string(name) +
+                      "' (valid: clamp, drop)");
+}
+
+void HistogramConfig::Validate() const {
+    if (bins < 1 || bins > 1'000'000) {
+        throw ConfigError("histogram.bins must be between 1 and 1000000, got " +
+                          std::to_string(bins));
+    }
+    RequireFinite(sensor_height_m, "sensor_height_m");
+    RequireRange(height_min_m, height_max_m, "height_min_m", "height_max_m");
+    RequireRange(range_min_m, range_max_m, "range_min_m", "range_max_m");
+    if (range_min_m < 0.0) throw ConfigError("histogram.range_min_m must be >= 0 (a range)");
+    RequireFinite(threshold, "threshold");
+    if (threshold < 0.0 || threshold > 1.0) {
+        throw ConfigError("histogram.threshold must be in [0, 1] (the range of W), got " +
+                          std::to_string(threshold));
+    }
+}
+
+Histogram ComputeHistogram(const PointCloud& cloud, Projection projection,
+                           const HistogramConfig& config) {
+    config.Validate();
+    if (cloud.empty()) throw EmptyInputError("the scan has no points");
+    Histogram histogram;
+    histogram.projection = projection;
+    std::vector<std::size_t> counts(static_cast<std::size_t>(config.bins), 0);
+    if (projection == Projection::kHeight) {
+        histogram.min_value = config.height_min_m;
+        histogram.max_value = config.height_max_m;
+        if (config.up_vector == UpVectorMode::kPca) histogram.up = EstimateUpVectorPca(cloud);
+        const Eigen::Vector3d up = histogram.up;
+        const double offset_m = config.sensor_height_m;
+        CountValues(
+            cloud, [&](const Eigen::Vector3f& p) { return p.cast<double>().dot(up) + offset_m; },
+            config, counts, histogram);
+    } else {
+        histogram.min_value = config.range_min_m;
+        histogram.max_value = config.range_max_m;
+        CountValues(
+            cloud, [](const Eigen::Vector3f& p) { return p.cast<double>().norm(); }, config,
+            counts, histogram);
+    }
+    if (histogram.points_used == 0) {
+        throw EmptyInputError("no point of the scan is usable (" +
+                              std::to_string(histogram.points_skipped) + " non-finite, " +
+                              std::to_string(histogram.points_out_of_range) +
+                              " outside the value range and dropped)");
+    }
+    // Röhling eq. (4); with kDrop, |S| is the number of points kept so that sum_k h_k = 1.
+    histogram.mass.resize(counts.size());
+    const double inverse_total = 1.0 / static_cast<double>(histogram.points_used);
+    for (std::size_t k = 0; k < counts.size(); ++k) {
+        histogram.mass[k] = static_cast<double>(counts[k]) * inverse_total;
+    }
+    return histogram;
+}
+
+}  // namespace lidarloop::core

@@ -1,0 +1,68 @@
+#pragma once
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "lidarloop/core/point_cloud.hpp"
+
+namespace lidarloop::test {
+
+/// A fresh temporary folder per test, removed at the end of the test.
+class TempDir {
+public:
+    TempDir() {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        std::string name = "lidarloop_test";
+        if (info != nullptr) name += std::string("_") + info->test_suite_name() + "_" + info->name();
+        for (char& c : name) {
+            if (c == '/') c = '_';
+        }
+        path_ = std::filesystem::temp_directory_path() / name;
+        std::filesystem::remove_all(path_);
+        std::filesystem::create_directories(path_);
+    }
+    ~TempDir() {
+        std::error_code ignored;
+        std::filesystem::remove_all(path_, ignored);
+    }
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+
+    std::filesystem::path operator/(const std::string& file) const { return path_ / file; }
+    const std::filesystem::path& path() const { return path_; }
+
+private:
+    std::filesystem::path path_;
+};
+
+/// Writes `bytes` verbatim to `file`.
+inline void WriteFile(const std::filesystem::path& file, const std::string& bytes) {
+    std::ofstream out(file, std::ios::binary);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+/// Reads a whole file into a string.
+inline std::string ReadFile(const std::filesystem::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+/// `count` points uniform in a cube of half-side `half_side_m`, seeded.
+inline core::PointCloud RandomCloud(std::size_t count, unsigned seed, float half_side_m = 20.0f) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> coordinate(-half_side_m, half_side_m);
+    core::PointCloud cloud(count);
+    for (auto& p : cloud) p = {coordinate(rng), coordinate(rng), coordinate(rng)};
+    return cloud;
+}
+
+/// Path of a fixture under tests/data.
+inline std::filesystem::path DataFile(const std::string& name) {
+    return std::filesystem::path(LIDARLOOP_TEST_DATA_DIR) / name;
+}
+
+}  // namespace lidarloop::test
