@@ -1,1 +1,70 @@
+#include <random>
+
 #include <gtest/gtest.h>
+
+#include "lidarloop/core/error.hpp"
+#include "lidarloop/core/projection.hpp"
+
+namespace lidarloop::core {
+namespace {
+
+// A ground plane with normal `normal` through (0, 0, -1.7), sampled with noise, plus a wall and a
+// pole so that the scan is not just the plane.
+PointCloud TiltedGroundScan(const Eigen::Vector3f& normal, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> uniform(-25.0f, 25.0f);
+    std::normal_distribution<float> noise(0.0f, 0.03f);
+    const Eigen::Vector3f u = normal.unitOrthogonal();
+    const Eigen::Vector3f v = normal.cross(u);
+    const Eigen::Vector3f origin(0.0f, 0.0f, -1.7f);
+    PointCloud cloud;
+    for (int i = 0; i < 30000; ++i) {
+        cloud.push_back(origin + uniform(rng) * u + uniform(rng) * v + noise(rng) * normal);
+    }
+    for (int i = 0; i < 1500; ++i) {
+        cloud.push_back(origin + 8.0f * u + uniform(rng) * v + (std::abs(uniform(rng)) / 8) * normal);
+        cloud.push_back(origin - 5.0f * v + (std::abs(uniform(rng)) / 5) * normal);
+    }
+    return cloud;
+}
+
+TEST(Projection, PcaRecoversTiltedGroundNormal) {
+    for (const Eigen::Vector3f& normal : {Eigen::Vector3f(0, 0, 1), Eigen::Vector3f(0.1f, 0, 1),
+                                         Eigen::Vector3f(-0.2f, 0.15f, 1)}) {
+        const Eigen::Vector3d truth = normal.normalized().cast<double>();
+        const Eigen::Vector3d up = EstimateUpVectorPca(TiltedGroundScan(normal.normalized(), 3));
+        EXPECT_GT(up.dot(truth), std::cos(0.5 * M_PI / 180.0)) << up.transpose();
+        EXPECT_NEAR(up.norm(), 1.0, 1e-12);
+    }
+}
+
+TEST(Projection, PcaUpVectorPointsUpEvenForUpsideDownInput) {
+    PointCloud cloud = TiltedGroundScan(Eigen::Vector3f(0, 0, 1), 4);
+    for (auto& p : cloud) p = -p;  // any sign the solver returns must be flipped to z >= 0
+    EXPECT_GT(EstimateUpVectorPca(cloud).z(), 0.99);
+}
+
+TEST(Projection, PcaNeedsThreeFinitePoints) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_THROW(EstimateUpVectorPca({}), EmptyInputError);
+    EXPECT_THROW(EstimateUpVectorPca({{1, 2, 3}, {4, 5, 6}, {nan, 0, 0}}), EmptyInputError);
+}
+
+TEST(Projection, PcaOfDegenerateCloudGivesUnitVector) {
+    const PointCloud same(10, Eigen::Vector3f(1, 2, 3));  // no spread at all
+    const Eigen::Vector3d up = EstimateUpVectorPca(same);
+    EXPECT_NEAR(up.norm(), 1.0, 1e-12);
+    EXPECT_GE(up.z(), 0.0);
+}
+
+TEST(Projection, NamesRoundTripAndUnknownNamesAreErrors) {
+    EXPECT_EQ(ParseProjection(ToString(Projection::kHeight)), Projection::kHeight);
+    EXPECT_EQ(ParseProjection(ToString(Projection::kRange)), Projection::kRange);
+    EXPECT_EQ(ParseUpVectorMode(ToString(UpVectorMode::kPca)), UpVectorMode::kPca);
+    EXPECT_EQ(ParseUpVectorMode(ToString(UpVectorMode::kFixed)), UpVectorMode::kFixed);
+    EXPECT_THROW(ParseProjection("heigth"), ConfigError);
+    EXPECT_THROW(ParseUpVectorMode(""), ConfigError);
+}
+
+}  // namespace
+}  // namespace lidarloop::core
