@@ -1,1 +1,205 @@
-// Implementation pending.
+#include "lidarloop/io/dataset.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <set>
+
+#include "lidarloop/io/osnabrueck.hpp"
+#include "lidarloop/io/poses.hpp"
+#include "lidarloop/io/read_error.hpp"
+#include "lidarloop/io/scan_reader.hpp"
+#include "lidarloop/io/text_parsing.hpp"
+
+namespace lidarloop::io {
+namespace fs = std::filesystem;
+namespace {
+
+// "scan2" < "scan10": runs of digits compare by value, so unpadded numbering sorts as expected.
+bool NaturalLess(const std::string& a, const std::string& b) {
+    std::size_t i = 0;
+    std::size_t j = 0;
+    while (i < a.size() && j < b.size()) {
+        if (std::isdigit(static_cast<unsigned char>(a[i])) &&
+            std::isdigit(static_cast<unsigned char>(b[j]))) {
+            std::size_t i_end = i;
+            std::size_t j_end = j;
+            while (i_end < a.size() && std::isdigit(static_cast<unsigned char>(a[i_end]))) ++i_end;
+            while (j_end < b.size() && std::isdigit(static_cast<unsigned char>(b[j_end]))) ++j_end;
+            std::string_view da = std::string_view(a).substr(i, i_end - i);
+            std::string_view db = std::string_view(b).substr(j, j_end - j);
+            while (da.size() > 1 && da.front() == '0') da.remove_prefix(1);
+            while (db.size() > 1 && db.front() == '0') db.remove_prefix(1);
+            if (da.size() != db.size()) return da.size() < db.size();
+            if (da != db) return da < db;
+            i = i_end;
+            j = j_end;
+        } else {
+            if (a[i] != b[j]) return a[i] < b[j];
+            ++i;
+            ++j;
+        }
+    }
+    return a.size() - i < b.size() - j;
+}
+
+std::vector<fs::path> ListFiles(const fs::path& folder, bool (*accept)(const fs::path&)) {
+    std::vector<fs::path> files;
+    std::error_code ec;
+    if (!fs::is_directory(folder, ec)) return files;
+    for (const auto& entry : fs::directory_iterator(folder)) {
+        if (entry.is_regular_file() && accept(entry.path())) files.push_back(entry.path());
+    }
+    std::sort(files.begin(), files.end(), [](const fs::path& a, const fs::path& b) {
+        return NaturalLess(a.filename().string(), b.filename().string());
+    });
+    return files;
+}
+
+bool IsKittiBin(const fs::path& file) { return file.extension() == ".bin"; }
+
+bool IsOsnabrueckScan(const fs::path& file) {
+    return file.extension() == ".3d" && file.filename().string().rfind("scan", 0) == 0;
+}
+
+// Text files beside the scans that hold poses or calibration, not points.
+bool IsSidecarFile(const fs::path& file) {
+    static const std::set<std::string> kNames = {"poses.txt", "times.txt", "calib.txt"};
+    return kNames.count(file.filename().string()) != 0;
+}
+
+bool IsFolderScan(const fs::path& file) {
+    return IsScanFile(file) && !IsSidecarFile(file) && file.extension() != ".3d";
+}
+
+fs::path ExistingOr(const fs::path& given, const fs::path& fallback) {
+    if (!given.empty()) return given;
+    std::error_code ec;
+    return fs::exists(fallback, ec) ? fallback : fs::path();
+}
+
+// KITTI poses have 12 numbers per line, TUM poses 8; tell them apart by the first data line.
+std::vector<core::StampedPose> ReadPosesFile(const fs::path& file, const core::Transform& T_cam0_velo,
+                                             const fs::path& times_file) {
+    detail::LineReader reader(file);
+    std::string line;
+    while (reader.Next(line)) {
+        const auto fields = detail::SplitFields(line);
+        if (fields.empty() || fields.front().front() == '#') continue;
+        if (fields.size() == 12) return ReadKittiPoses(file, T_cam0_velo, times_file);
+        if (fields.size() == 8) return ReadTumPoses(file);
+        reader.Fail("cannot tell the pose format: expected 12 numbers (KITTI) or 8 (TUM), got " +
+                    std::to_string(fields.size()));
+    }
+    return {};
+}
+
+Dataset OpenKitti(const fs::path& root, const DatasetOptions& options) {
+    auto scans = ListFiles(root / "velodyne", IsKittiBin);
+    const fs::path poses_file = ExistingOr(options.poses_file, root / "poses.txt");
+    const fs::path calib_file = ExistingOr(options.calib_file, root / "calib.txt");
+    const fs::path times_file = ExistingOr({}, root / "times.txt");
+    std::vector<core::StampedPose> poses;
+    if (!poses_file.empty()) {
+        const core::Transform T_cam0_velo =
+            calib_file.empty() ? core::Transform::Identity() : ReadKittiCalibTr(calib_file);
+        poses = ReadPosesFile(poses_file, T_cam0_velo, times_file);
+    }
+    return {DatasetFormat::kKitti, root, std::move(scans), std::move(poses)};
+}
+
+Dataset OpenOsnabrueck(const fs::path& root, const DatasetOptions& options) {
+    auto scans = ListFiles(root, IsOsnabrueckScan);
+    std::vector<core::StampedPose> poses;
+    if (!options.poses_file.empty()) {
+        poses = ReadPosesFile(options.poses_file, core::Transform::Identity(), {});
+    } else {
+        // Prefer the registered .frames poses (the repository's ground truth) over .pose guesses.
+        for (std::size_t i = 0; i < scans.size(); ++i) {
+            fs::path frames = scans[i];
+            fs::path pose = scans[i];
+            frames.replace_extension(".frames");
+            pose.replace_extension(".pose");
+            std::error_code ec;
+            core::StampedPose stamped;
+            stamped.time_s = static_cast<double>(i);
+            if (fs::exists(frames, ec)) {
+                stamped.T_world_sensor = ReadOsnabrueckFrames(frames);
+            } else if (fs::exists(pose, ec)) {
+                stamped.T_world_sensor = ReadOsnabrueckPose(pose);
+            } else {
+                if (!poses.empty()) throw ReadError(scans[i], "has no .frames or .pose file");
+                break;
+            }
+            poses.push_back(stamped);
+        }
+    }
+    return {DatasetFormat::kOsnabrueck, root, std::move(scans), std::move(poses)};
+}
+
+Dataset OpenFolder(const fs::path& root, const DatasetOptions& options) {
+    auto scans = ListFiles(root, IsFolderScan);
+    std::vector<core::StampedPose> poses;
+    const fs::path poses_file = ExistingOr(options.poses_file, root / "poses.txt");
+    if (!poses_file.empty()) {
+        const fs::path calib_file = ExistingOr(options.calib_file, {});
+        const core::Transform T_cam0_velo =
+            calib_file.empty() ? core::Transform::Identity() : ReadKittiCalibTr(calib_file);
+        poses = ReadPosesFile(poses_file, T_cam0_velo, ExistingOr({}, root / "times.txt"));
+    }
+    return {DatasetFormat::kFolder, root, std::move(scans), std::move(poses)};
+}
+
+DatasetFormat DetectFormat(const fs::path& root) {
+    if (!ListFiles(root / "velodyne", IsKittiBin).empty()) return DatasetFormat::kKitti;
+    if (!ListFiles(root, IsOsnabrueckScan).empty()) return DatasetFormat::kOsnabrueck;
+    if (!ListFiles(root, IsFolderScan).empty()) return DatasetFormat::kFolder;
+    throw ReadError(root,
+                    "cannot tell the dataset format: found no velodyne/*.bin (KITTI), no "
+                    "scanNNN.3d (Osnabrueck) and no .pcd/.ply/.xyz/.txt/.pts/.bin scans (folder)");
+}
+
+}  // namespace
+
+Dataset::Dataset(DatasetFormat format, fs::path root, std::vector<fs::path> scan_files,
+                 std::vector<core::StampedPose> poses)
+    : format_(format),
+      root_(std::move(root)),
+      scan_files_(std::move(scan_files)),
+      poses_(std::move(poses)) {}
+
+std::string Dataset::FormatName() const {
+    switch (format_) {
+        case DatasetFormat::kKitti: return "kitti";
+        case DatasetFormat::kFolder: return "folder";
+        case DatasetFormat::kOsnabrueck: return "osnabrueck";
+        case DatasetFormat::kAuto: break;
+    }
+    return "auto";
+}
+
+const fs::path& Dataset::ScanPath(std::size_t index) const { return scan_files_.at(index); }
+
+core::PointCloud Dataset::LoadScan(std::size_t index) const { return ReadScan(ScanPath(index)); }
+
+Dataset OpenDataset(const fs::path& path, const DatasetOptions& options) {
+    std::error_code ec;
+    if (!fs::exists(path, ec)) throw ReadError(path, "no such dataset folder");
+    if (!fs::is_directory(path, ec)) {
+        throw ReadError(path, "is a file; a dataset is a folder of scans");
+    }
+    const DatasetFormat format =
+        options.format == DatasetFormat::kAuto ? DetectFormat(path) : options.format;
+    Dataset dataset = format == DatasetFormat::kKitti        ? OpenKitti(path, options)
+                      : format == DatasetFormat::kOsnabrueck ? OpenOsnabrueck(path, options)
+                                                             : OpenFolder(path, options);
+    if (dataset.size() == 0) {
+        throw ReadError(path, "holds no scans of the " + dataset.FormatName() + " layout");
+    }
+    if (dataset.HasPoses() && dataset.poses().size() != dataset.size()) {
+        throw ReadError(path, "has " + std::to_string(dataset.size()) + " scans but " +
+                                  std::to_string(dataset.poses().size()) + " poses");
+    }
+    return dataset;
+}
+
+}  // namespace lidarloop::io

@@ -1,1 +1,59 @@
-// Implementation pending.
+#include "lidarloop/io/scan_reader.hpp"
+
+#include <algorithm>
+#include <cctype>
+
+#include "lidarloop/io/kitti_bin.hpp"
+#include "lidarloop/io/osnabrueck.hpp"
+#include "lidarloop/io/pcd.hpp"
+#include "lidarloop/io/ply.hpp"
+#include "lidarloop/io/read_error.hpp"
+#include "lidarloop/io/xyz.hpp"
+
+namespace lidarloop::io {
+namespace {
+
+using Reader = core::PointCloud (*)(const std::filesystem::path&);
+
+struct FormatEntry {
+    const char* extension;
+    Reader reader;
+};
+
+constexpr FormatEntry kFormats[] = {
+    {".bin", ReadKittiBin}, {".pcd", ReadPcd}, {".ply", ReadPly},         {".xyz", ReadXyz},
+    {".txt", ReadXyz},      {".pts", ReadXyz}, {".3d", ReadOsnabrueck3d},
+};
+
+std::string LowerExtension(const std::filesystem::path& file) {
+    std::string extension = file.extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return extension;
+}
+
+Reader FindReader(const std::filesystem::path& file) {
+    const std::string extension = LowerExtension(file);
+    for (const auto& format : kFormats) {
+        if (extension == format.extension) return format.reader;
+    }
+    return nullptr;
+}
+
+}  // namespace
+
+bool IsScanFile(const std::filesystem::path& file) { return FindReader(file) != nullptr; }
+
+core::PointCloud ReadScan(const std::filesystem::path& file) {
+    const Reader reader = FindReader(file);
+    if (reader == nullptr) {
+        std::string known;
+        for (const auto& format : kFormats) known += std::string(known.empty() ? "" : " ") +
+                                                     format.extension;
+        throw ReadError(file, "unknown scan format '" + file.extension().string() +
+                                  "' (known extensions: " + known + ")");
+    }
+    return reader(file);
+}
+
+}  // namespace lidarloop::io

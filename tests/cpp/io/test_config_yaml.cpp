@@ -1,1 +1,100 @@
+#include <string>
+
 #include <gtest/gtest.h>
+
+#include "lidarloop/io/config_yaml.hpp"
+#include "lidarloop/io/read_error.hpp"
+#include "test_utils.hpp"
+
+namespace lidarloop::io {
+namespace {
+
+std::string ErrorOf(const std::string& yaml) {
+    RunConfig config;
+    try {
+        ApplyConfigYaml(yaml, "my.yaml", config);
+    } catch (const ReadError& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+TEST(ConfigYaml, DumpThenLoadGivesTheSameConfig) {
+    RunConfig changed;
+    changed.descriptor.method = core::Method::kRange;
+    changed.descriptor.histogram.bins = 250;
+    changed.descriptor.histogram.up_vector = core::UpVectorMode::kPca;
+    changed.descriptor.histogram.sensor_height_m = 1.73;
+    changed.descriptor.histogram.range_max_m = 120.5;
+    changed.descriptor.histogram.out_of_range = core::OutOfRangePolicy::kDrop;
+    changed.descriptor.histogram.threshold = 0.0033;
+    RunConfig loaded;
+    ApplyConfigYaml(DumpConfigYaml(changed), "dump", loaded);
+    EXPECT_EQ(DumpConfigYaml(loaded), DumpConfigYaml(changed));
+    EXPECT_EQ(loaded.descriptor.method, core::Method::kRange);
+    EXPECT_EQ(loaded.descriptor.histogram.bins, 250);
+    EXPECT_EQ(loaded.descriptor.histogram.sensor_height_m, 1.73);
+    EXPECT_EQ(loaded.descriptor.histogram.threshold, 0.0033);
+    EXPECT_EQ(loaded.descriptor.histogram.out_of_range, core::OutOfRangePolicy::kDrop);
+}
+
+TEST(ConfigYaml, DumpNamesEveryKeyWithItsDefault) {
+    const std::string dump = DumpConfigYaml({});
+    for (const char* key : {"method: height", "bins: 100", "up_vector: fixed", "sensor_height_m: 0",
+                            "height_min_m: -3", "height_max_m: 7", "range_min_m: 0",
+                            "range_max_m: 80", "out_of_range: clamp", "threshold: 0.005"}) {
+        EXPECT_NE(dump.find(key), std::string::npos) << key << " missing in\n" << dump;
+    }
+}
+
+TEST(ConfigYaml, OverridesOnlyTheNamedKeys) {
+    RunConfig config;
+    config.descriptor.histogram.range_max_m = 42.0;  // as if set by an earlier file
+    ApplyConfigYaml("histogram:\n  bins: 64\n", "x.yaml", config);
+    EXPECT_EQ(config.descriptor.histogram.bins, 64);
+    EXPECT_EQ(config.descriptor.histogram.range_max_m, 42.0);
+    EXPECT_EQ(config.descriptor.method, core::Method::kHeight);
+}
+
+TEST(ConfigYaml, EmptyDocumentChangesNothing) {
+    RunConfig config;
+    ApplyConfigYaml("", "empty.yaml", config);
+    EXPECT_EQ(DumpConfigYaml(config), DumpConfigYaml({}));
+}
+
+TEST(ConfigYaml, BadInputNamesFileKeyAndProblem) {
+    const auto expect_error = [](const std::string& yaml, const std::string& phrase) {
+        const std::string message = ErrorOf(yaml);
+        EXPECT_NE(message.find("my.yaml"), std::string::npos) << message;
+        EXPECT_NE(message.find(phrase), std::string::npos) << message;
+    };
+    expect_error("histogram:\n  binz: 3\n", "key 'histogram.binz': unknown key");
+    expect_error("colour: red\n", "key 'colour': unknown key");
+    expect_error("histogram:\n  bins: many\n", "expected an integer, got 'many'");
+    expect_error("histogram:\n  bins: 2.5\n", "expected an integer");
+    expect_error("histogram:\n  threshold: [1, 2]\n", "expected a single value");
+    expect_error("histogram: 5\n", "expected a section");
+    expect_error("method: sift\n", "unknown method 'sift'");
+    expect_error("histogram:\n  bins: 0\n", "histogram.bins must be between");
+    expect_error("histogram:\n  height_min_m: 10\n", "must be smaller than");
+    expect_error("histogram: {bins: 3\n", "line");
+    expect_error("- a\n- b\n", "expected a map");
+}
+
+TEST(ConfigYaml, FailedApplyLeavesConfigUnchanged) {
+    RunConfig config;
+    EXPECT_THROW(ApplyConfigYaml("histogram:\n  bins: 7\n  oops: 1\n", "f", config), ReadError);
+    EXPECT_EQ(config.descriptor.histogram.bins, 100);
+}
+
+TEST(ConfigYaml, FileRoundTripAndMissingFile) {
+    test::TempDir dir;
+    RunConfig config;
+    config.descriptor.histogram.bins = 33;
+    WriteConfigYaml(dir / "config.yaml", config);
+    EXPECT_EQ(LoadConfigYaml(dir / "config.yaml").descriptor.histogram.bins, 33);
+    EXPECT_THROW(LoadConfigYaml(dir / "missing.yaml"), ReadError);
+}
+
+}  // namespace
+}  // namespace lidarloop::io

@@ -1,0 +1,32 @@
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include "lidarloop/core/descriptor_config.hpp"
+
+namespace lidarloop::io {
+
+/// Every setting of a lidarloop run. The defaults live in the C++ config structs it holds; YAML
+/// files and command-line flags override only the keys they name.
+struct RunConfig {
+    core::DescriptorConfig descriptor;  ///< keys `method` and `histogram.*` at the YAML top level
+
+    void Validate() const { descriptor.Validate(); }
+};
+
+/// The whole configuration as YAML, every key present, with a comment line per key.
+std::string DumpConfigYaml(const RunConfig& config);
+
+/// Overrides the keys that `yaml_text` names in `config` and validates the result. `source`
+/// (a file name) prefixes error messages. Throws ReadError for YAML syntax errors, unknown keys
+/// (naming the key path and the valid keys), values of the wrong type, and invalid values.
+void ApplyConfigYaml(const std::string& yaml_text, const std::string& source, RunConfig& config);
+
+/// Reads `file` and applies it on top of `base` (default: the built-in defaults).
+RunConfig LoadConfigYaml(const std::filesystem::path& file, RunConfig base = {});
+
+/// Writes DumpConfigYaml(config) to `file` (the effective config written beside results).
+void WriteConfigYaml(const std::filesystem::path& file, const RunConfig& config);
+
+}  // namespace lidarloop::io
