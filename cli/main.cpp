@@ -1,1 +1,28 @@
-int main() { return 0; }
+#include <exception>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "commands.hpp"
+#include "lidarloop/core/error.hpp"
+
+int main(int argc, char** argv) {
+    CLI::App app{"lidarloop: loop closure detection in sequences of 3-D LiDAR scans"};
+    app.set_version_flag("--version", std::string("lidarloop ") + LIDARLOOP_VERSION);
+    app.require_subcommand(1);
+    lidarloop::cli::AddDescribeCommand(app);
+    lidarloop::cli::AddDistanceCommand(app);
+    lidarloop::cli::AddDumpConfigCommand(app);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    } catch (const lidarloop::core::Error& e) {
+        std::cerr << "lidarloop: error: " << e.what() << "\n";
+        return 1;
+    } catch (const std::exception& e) {
+        std::cerr << "lidarloop: internal error: " << e.what() << "\n";
+        return 2;
+    }
+    return 0;
+}

@@ -1,0 +1,12 @@
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace lidarloop::cli {
+
+// One function per subcommand; each lives in the file of the same name.
+void AddDescribeCommand(CLI::App& app);
+void AddDistanceCommand(CLI::App& app);
+void AddDumpConfigCommand(CLI::App& app);
+
+}  // namespace lidarloop::cli

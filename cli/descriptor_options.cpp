@@ -1,0 +1,52 @@
+#include "descriptor_options.hpp"
+
+#include "lidarloop/core/descriptor_config.hpp"
+#include "lidarloop/core/error.hpp"
+#include "lidarloop/io/read_error.hpp"
+#include "lidarloop/io/scan_reader.hpp"
+
+namespace lidarloop::cli {
+
+void DescriptorOptions::AddTo(CLI::App& command) {
+    command.add_option("--config", config_file_, "YAML file overriding the defaults it names")
+        ->check(CLI::ExistingFile);
+    command.add_option("--method", method_, "descriptor: height | range");
+    bins_option_ = command.add_option("--bins", bins_, "number of histogram buckets b");
+    min_option_ = command.add_option("--min", min_m_, "v_min of the chosen projection, metres");
+    max_option_ = command.add_option("--max", max_m_, "v_max of the chosen projection, metres");
+    command.add_option("--up", up_, "up vector of the height projection: fixed | pca");
+    sensor_height_option_ = command.add_option("--sensor-height", sensor_height_m_,
+                                               "sensor height above ground, metres");
+    command.add_option("--out-of-range", out_of_range_,
+                       "values outside [min, max]: clamp | drop");
+}
+
+io::RunConfig DescriptorOptions::Resolve() const {
+    io::RunConfig config;
+    if (!config_file_.empty()) config = io::LoadConfigYaml(config_file_);
+    core::DescriptorConfig& descriptor = config.descriptor;
+    core::HistogramConfig& histogram = descriptor.histogram;
+    if (!method_.empty()) descriptor.method = core::ParseMethod(method_);
+    if (*bins_option_) histogram.bins = bins_;
+    if (!up_.empty()) histogram.up_vector = core::ParseUpVectorMode(up_);
+    if (*sensor_height_option_) histogram.sensor_height_m = sensor_height_m_;
+    if (!out_of_range_.empty()) histogram.out_of_range = core::ParseOutOfRangePolicy(out_of_range_);
+    // --min/--max set the value range of the projection in use.
+    const bool height = descriptor.method == core::Method::kHeight;
+    if (*min_option_) (height ? histogram.height_min_m : histogram.range_min_m) = min_m_;
+    if (*max_option_) (height ? histogram.height_max_m : histogram.range_max_m) = max_m_;
+    config.Validate();
+    return config;
+}
+
+core::Histogram HistogramOfFile(const std::filesystem::path& file, const io::RunConfig& config) {
+    const core::PointCloud cloud = io::ReadScan(file);
+    try {
+        return core::ComputeHistogram(cloud, core::ProjectionOf(config.descriptor.method),
+                                      config.descriptor.histogram);
+    } catch (const core::EmptyInputError& e) {
+        throw io::ReadError(file, e.what());
+    }
+}
+
+}  // namespace lidarloop::cli

@@ -1,0 +1,41 @@
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "lidarloop/core/histogram.hpp"
+#include "lidarloop/io/config_yaml.hpp"
+
+namespace lidarloop::cli {
+
+/// The flags that choose and tune a descriptor, shared by every subcommand that computes one.
+/// Precedence: built-in defaults < --config FILE < individual flags.
+class DescriptorOptions {
+public:
+    /// Adds --config, --method, --bins, --min, --max, --up, --sensor-height, --out-of-range.
+    void AddTo(CLI::App& command);
+
+    /// The effective configuration; throws core::Error (or io::ReadError) when it is invalid.
+    io::RunConfig Resolve() const;
+
+private:
+    std::string config_file_;
+    std::string method_;
+    int bins_ = 0;
+    double min_m_ = 0.0;
+    double max_m_ = 0.0;
+    std::string up_;
+    double sensor_height_m_ = 0.0;
+    std::string out_of_range_;
+    CLI::Option* bins_option_ = nullptr;
+    CLI::Option* min_option_ = nullptr;
+    CLI::Option* max_option_ = nullptr;
+    CLI::Option* sensor_height_option_ = nullptr;
+};
+
+/// Reads `file` and computes its histogram under `config`; errors name the file.
+core::Histogram HistogramOfFile(const std::filesystem::path& file, const io::RunConfig& config);
+
+}  // namespace lidarloop::cli

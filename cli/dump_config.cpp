@@ -1,0 +1,24 @@
+#include <iostream>
+#include <memory>
+
+#include <CLI/CLI.hpp>
+
+#include "commands.hpp"
+#include "lidarloop/io/config_yaml.hpp"
+
+namespace lidarloop::cli {
+
+void AddDumpConfigCommand(CLI::App& app) {
+    auto* command = app.add_subcommand(
+        "dump-config", "Print the configuration as YAML (the defaults, or --config applied)");
+    auto config_file = std::make_shared<std::string>();
+    command->add_option("--config", *config_file, "YAML file to apply before printing")
+        ->check(CLI::ExistingFile);
+    command->callback([config_file] {
+        const io::RunConfig config =
+            config_file->empty() ? io::RunConfig{} : io::LoadConfigYaml(*config_file);
+        std::cout << io::DumpConfigYaml(config);
+    });
+}
+
+}  // namespace lidarloop::cli

@@ -1,0 +1,126 @@
+#!/usr/bin/env bash
+# CLI smoke and bad-input tests. Usage: cli_test.sh LIDARLOOP SAMPLES_DIR COMMITTED_SAMPLES_DIR
+# Every case checks the exit code and a phrase of the output; the last line is "N passed, N failed".
+set -u
+cli="$1"
+samples="$2"
+committed="$3"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+passed=0
+failed=0
+
+pass() { passed=$((passed + 1)); }
+fail() { failed=$((failed + 1)); echo "FAIL: $*"; }
+
+# expect_ok NAME PHRASE CMD...: exit 0 and stdout contains PHRASE.
+expect_ok() {
+    local name="$1" phrase="$2"
+    shift 2
+    local out
+    if out="$("$@" 2>"$work/stderr")" && grep -qF -- "$phrase" <<<"$out"; then
+        pass
+    else
+        fail "$name: expected success with '$phrase'; got: $out $(cat "$work/stderr")"
+    fi
+}
+
+# expect_error NAME PHRASE CMD...: non-zero exit (not a crash), one stderr line containing PHRASE.
+expect_error() {
+    local name="$1" phrase="$2"
+    shift 2
+    "$@" >"$work/stdout" 2>"$work/stderr"
+    local code=$?
+    if [ "$code" -eq 0 ] || [ "$code" -ge 128 ]; then
+        fail "$name: expected a clean error exit, got code $code: $(cat "$work/stderr")"
+    elif ! grep -qF -- "$phrase" "$work/stderr"; then
+        fail "$name: error message lacks '$phrase': $(cat "$work/stderr")"
+    else
+        pass
+    fi
+}
+
+# --- every format gives the same histogram for the same scan --------------------------------
+reference="$("$cli" describe "$samples/corner_a.bin")"
+for scan in corner_a.pcd corner_a_ascii.pcd corner_a_binary.pcd corner_a_ascii.ply \
+    corner_a_le64.ply corner_a_be.ply corner_a.xyz; do
+    if [ "$("$cli" describe "$samples/$scan")" = "$reference" ]; then pass; else
+        fail "describe $scan differs from the .bin of the same scan"
+    fi
+done
+expect_ok "describe osnabrueck" '"method":"height"' "$cli" describe "$samples/scan000.3d"
+expect_ok "describe json keys" '"points_used":6000' "$cli" describe "$samples/corner_a.bin"
+expect_ok "describe skipped" '"points_skipped":0' "$cli" describe "$samples/corner_a.bin"
+expect_ok "describe range" '"method":"range"' "$cli" describe --method range --bins 10 \
+    --min 0 --max 50 "$samples/corner_a.bin"
+expect_ok "describe pca" '"up":[' "$cli" describe --up pca "$samples/corner_b.ply"
+bins="$("$cli" describe --bins 7 "$samples/corner_a.bin" | grep -o '"bins":\[[^]]*\]' | tr -cd , | wc -c)"
+if [ "$bins" -eq 6 ]; then pass; else fail "--bins 7 gave $((bins + 1)) buckets"; fi
+
+# --- distance ---------------------------------------------------------------------------------
+same="$("$cli" distance "$samples/corner_a.pcd" "$samples/corner_a.bin")"
+if [ "$same" = "0" ]; then pass; else fail "distance of a scan to itself is $same, not 0"; fi
+near="$("$cli" distance "$samples/corner_a.pcd" "$samples/corner_b.ply")"
+far="$("$cli" distance "$samples/corner_a.pcd" "$samples/courtyard.bin")"
+if awk -v n="$near" -v f="$far" 'BEGIN { exit !(n > 0 && n < f && f <= 1) }'; then pass; else
+    fail "expected 0 < W(same place)=$near < W(other place)=$far <= 1"
+fi
+for method in height range; do
+    expect_ok "distance $method" "." "$cli" distance --method "$method" \
+        "$committed/corner_a.pcd" "$committed/courtyard.bin"
+done
+
+# --- config -------------------------------------------------------------------------------------
+expect_ok "dump-config" "bins: 100" "$cli" dump-config
+printf 'histogram:\n  bins: 12\n' >"$work/twelve.yaml"
+expect_ok "dump-config --config" "bins: 12" "$cli" dump-config --config "$work/twelve.yaml"
+expect_ok "dump-config keeps others" "range_max_m: 80" "$cli" dump-config --config "$work/twelve.yaml"
+twelve="$("$cli" describe --config "$work/twelve.yaml" "$samples/corner_a.bin" |
+    grep -o '"bins":\[[^]]*\]' | tr -cd , | wc -c)"
+if [ "$twelve" -eq 11 ]; then pass; else fail "--config bins: 12 gave $((twelve + 1)) buckets"; fi
+flag_wins="$("$cli" describe --config "$work/twelve.yaml" --bins 5 "$samples/corner_a.bin" |
+    grep -o '"bins":\[[^]]*\]' | tr -cd , | wc -c)"
+if [ "$flag_wins" -eq 4 ]; then pass; else fail "--bins did not override --config"; fi
+printf 'histogram:\n  binz: 12\n' >"$work/typo.yaml"
+expect_error "unknown key" "key 'histogram.binz': unknown key" "$cli" dump-config --config "$work/typo.yaml"
+expect_error "unknown key in describe" "typo.yaml" "$cli" describe --config "$work/typo.yaml" \
+    "$samples/corner_a.bin"
+printf 'histogram: [1\n' >"$work/broken.yaml"
+expect_error "broken yaml" "broken.yaml" "$cli" dump-config --config "$work/broken.yaml"
+
+# --- bad input: each a clean error naming the problem ------------------------------------------
+expect_error "missing file" "missing.pcd: no such file" "$cli" describe "$work/missing.pcd"
+printf 'hello' >"$work/odd.bin"
+expect_error "truncated bin" "odd.bin" "$cli" describe "$work/odd.bin"
+: >"$work/empty.bin"
+expect_error "empty scan" "empty.bin: the scan has no points" "$cli" describe "$work/empty.bin"
+printf 'nan nan nan\n1 inf 2\n' >"$work/nan.xyz"
+expect_error "all non-finite" "nan.xyz: no point of the scan is usable (2 non-finite" \
+    "$cli" describe "$work/nan.xyz"
+printf '1 2 3\nnan 0 0\n' >"$work/some_nan.xyz"
+expect_ok "some non-finite" '"points_skipped":1' "$cli" describe "$work/some_nan.xyz"
+printf 'ply\nformat ascii 1.0\n' >"$work/cut.ply"
+expect_error "truncated ply" "cut.ply" "$cli" describe "$work/cut.ply"
+printf 'not a pcd\n' >"$work/wrong.pcd"
+expect_error "wrong magic pcd" "wrong.pcd" "$cli" describe "$work/wrong.pcd"
+head -c 300 "$samples/corner_a_binary.pcd" >"$work/cut.pcd"
+expect_error "truncated pcd" "cut.pcd" "$cli" describe "$work/cut.pcd"
+printf 'x' >"$work/scan.las"
+expect_error "unknown format" "unknown scan format '.las'" "$cli" describe "$work/scan.las"
+expect_error "unknown method" "unknown method 'sift'" "$cli" describe --method sift \
+    "$samples/corner_a.bin"
+expect_error "zero bins" "histogram.bins must be between" "$cli" describe --bins 0 \
+    "$samples/corner_a.bin"
+expect_error "huge bins" "histogram.bins must be between" "$cli" describe --bins 999999999 \
+    "$samples/corner_a.bin"
+expect_error "min above max" "must be smaller than" "$cli" describe --min 5 --max 1 \
+    "$samples/corner_a.bin"
+expect_error "negative range" "range_min_m must be >= 0" "$cli" describe --method range \
+    --min -1 "$samples/corner_a.bin"
+expect_error "bad up" "unknown up vector mode" "$cli" describe --up sideways "$samples/corner_a.bin"
+expect_error "non-number flag" "--bins" "$cli" describe --bins many "$samples/corner_a.bin"
+expect_error "distance needs two" "SCAN_A SCAN_B" "$cli" distance "$samples/corner_a.bin"
+expect_error "no subcommand" "subcommand" "$cli"
+
+echo "cli: $passed passed, $failed failed"
+[ "$failed" -eq 0 ]
