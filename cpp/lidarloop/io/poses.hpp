@@ -8,7 +8,8 @@
 namespace lidarloop::io {
 
 /// Reads the `Tr:` line (velodyne -> camera 0, 3x4 row-major) of a KITTI odometry `calib.txt`
-/// and returns T_cam0_velo. Throws ReadError when the line is missing or malformed.
+/// and returns T_cam0_velo. Other lines (P0: ... P3:) are not read. Throws ReadError when the line
+/// is missing (also for an empty file) or malformed (not 12 finite numbers, not a rotation).
 core::Transform ReadKittiCalibTr(const std::filesystem::path& calib_file);
 
 /// Reads a KITTI odometry `poses.txt`: one 3x4 row-major matrix (12 numbers) per line giving
@@ -16,22 +17,27 @@ core::Transform ReadKittiCalibTr(const std::filesystem::path& calib_file);
 /// frame, T_velo0_veloi = T_cam0_velo^-1 * P_i * T_cam0_velo; with identity they are taken as
 /// given (files written by lidarloop's simulator are already in the LiDAR frame). time_s is the
 /// line index unless `times_file` (KITTI `times.txt`, one number per line) is given.
-/// Throws ReadError naming the line with the wrong number of values or a non-number.
+/// Blank and '#' lines are skipped; an empty file gives no poses. Rotations within 1e-3 of
+/// orthonormal are snapped to the nearest rotation. Throws ReadError naming the line with the
+/// wrong number of values, a non-number, a non-finite value or a 3x3 part that is no rotation,
+/// and when times.txt holds another count of times than there are poses.
 std::vector<core::StampedPose> ReadKittiPoses(
     const std::filesystem::path& poses_file,
     const core::Transform& T_cam0_velo = core::Transform::Identity(),
     const std::filesystem::path& times_file = {});
 
-/// Writes poses as KITTI `poses.txt` (T_world_sensor, 3x4 row-major, no calibration applied).
+/// Writes poses as KITTI `poses.txt` (T_world_sensor, 3x4 row-major, no calibration applied,
+/// full double precision). Times are not written.
 void WriteKittiPoses(const std::filesystem::path& poses_file,
                      const std::vector<core::StampedPose>& poses);
 
 /// Reads a TUM trajectory: lines "timestamp tx ty tz qx qy qz qw" (metres, Hamilton quaternion
-/// of T_world_sensor); '#' comment lines skipped. Quaternions are normalised; one whose norm is
-/// far from 1 (< 0.9 or > 1.1) or zero is an error naming the line.
+/// of T_world_sensor); blank and '#' comment lines skipped, an empty file gives no poses.
+/// Quaternions are normalised; one whose norm is far from 1 (< 0.9 or > 1.1) or zero is an error
+/// naming the line, as are a line without exactly 8 values, a non-number and a non-finite value.
 std::vector<core::StampedPose> ReadTumPoses(const std::filesystem::path& file);
 
-/// Writes poses in TUM format.
+/// Writes poses in TUM format (full double precision).
 void WriteTumPoses(const std::filesystem::path& file, const std::vector<core::StampedPose>& poses);
 
 }  // namespace lidarloop::io
