@@ -25,6 +25,36 @@ nlohmann::json HistogramJson(const core::Histogram& histogram) {
     return json;
 }
 
+nlohmann::json NdtJson(const core::NdtDescriptorSet& set) {
+    nlohmann::json json;
+    json["method"] = "ndt";
+    json["descriptors"] = nlohmann::json::array();
+    for (const core::NdtDescriptor& f : set.descriptors) {
+        nlohmann::json rows = nlohmann::json::array();
+        for (int row = 0; row < f.rows; ++row) {
+            const auto begin = f.counts.begin() + row * f.cols;
+            rows.push_back(std::vector<float>(begin, begin + f.cols));
+        }
+        nlohmann::json rotation = nlohmann::json::array();
+        for (int i = 0; i < 3; ++i) {
+            rotation.push_back({f.R_aligned_sensor(i, 0), f.R_aligned_sensor(i, 1),
+                                f.R_aligned_sensor(i, 2)});
+        }
+        json["descriptors"].push_back(
+            {{"R_aligned_sensor", rotation}, {"cells", f.total}, {"F", rows}});
+    }
+    json["points_used"] = set.cell_stats.points_used;
+    json["points_skipped"] = set.cell_stats.points_skipped;
+    json["sparse_cells"] = set.cell_stats.sparse_cells;
+    json["degenerate_cells"] = set.degenerate_cells;
+    return json;
+}
+
+nlohmann::json DescriptorJson(const core::Descriptor& descriptor) {
+    if (descriptor.method == core::Method::kNdt) return NdtJson(descriptor.ndt());
+    return HistogramJson(descriptor.histogram());
+}
+
 }  // namespace
 
 void AddDescribeCommand(CLI::App& app) {
@@ -36,7 +66,7 @@ void AddDescribeCommand(CLI::App& app) {
     options->AddTo(*command);
     command->callback([scan, options] {
         const io::RunConfig config = options->Resolve();
-        std::cout << HistogramJson(HistogramOfFile(*scan, config)).dump() << "\n";
+        std::cout << DescriptorJson(DescriptorOfFile(*scan, config)).dump() << "\n";
     });
 }
 

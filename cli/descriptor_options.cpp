@@ -10,40 +10,51 @@ namespace lidarloop::cli {
 void DescriptorOptions::AddTo(CLI::App& command) {
     command.add_option("--config", config_file_, "YAML file overriding the defaults it names")
         ->check(CLI::ExistingFile);
-    command.add_option("--method", method_, "descriptor: height | range");
+    command.add_option("--method", method_, "descriptor: height | range | ndt");
     bins_option_ = command.add_option("--bins", bins_, "number of histogram buckets b");
     min_option_ = command.add_option("--min", min_m_, "v_min of the chosen projection, metres");
     max_option_ = command.add_option("--max", max_m_, "v_max of the chosen projection, metres");
-    command.add_option("--up", up_, "up vector of the height projection: fixed | pca");
+    up_option_ = command.add_option("--up", up_, "up vector of the height projection: fixed | pca");
     sensor_height_option_ = command.add_option("--sensor-height", sensor_height_m_,
                                                "sensor height above ground, metres");
-    command.add_option("--out-of-range", out_of_range_,
-                       "values outside [min, max]: clamp | drop");
+    out_of_range_option_ = command.add_option("--out-of-range", out_of_range_,
+                                              "values outside [min, max]: clamp | drop");
 }
 
 io::RunConfig DescriptorOptions::Resolve() const {
     io::RunConfig config;
     if (!config_file_.empty()) config = io::LoadConfigYaml(config_file_);
-    core::DescriptorConfig& descriptor = config.descriptor;
-    core::HistogramConfig& histogram = descriptor.histogram;
-    if (!method_.empty()) descriptor.method = core::ParseMethod(method_);
-    if (*bins_option_) histogram.bins = bins_;
-    if (!up_.empty()) histogram.up_vector = core::ParseUpVectorMode(up_);
-    if (*sensor_height_option_) histogram.sensor_height_m = sensor_height_m_;
-    if (!out_of_range_.empty()) histogram.out_of_range = core::ParseOutOfRangePolicy(out_of_range_);
-    // --min/--max set the value range of the projection in use.
-    const bool height = descriptor.method == core::Method::kHeight;
-    if (*min_option_) (height ? histogram.height_min_m : histogram.range_min_m) = min_m_;
-    if (*max_option_) (height ? histogram.height_max_m : histogram.range_max_m) = max_m_;
+    if (!method_.empty()) config.descriptor.method = core::ParseMethod(method_);
+    ApplyHistogramFlags(config.descriptor);
     config.Validate();
     return config;
 }
 
-core::Histogram HistogramOfFile(const std::filesystem::path& file, const io::RunConfig& config) {
+void DescriptorOptions::ApplyHistogramFlags(core::DescriptorConfig& descriptor) const {
+    const CLI::Option* flags[] = {bins_option_,          min_option_, max_option_, up_option_,
+                                  sensor_height_option_, out_of_range_option_};
+    for (const CLI::Option* flag : flags) {
+        if (*flag && !core::IsHistogramMethod(descriptor.method)) {
+            throw core::ConfigError(flag->get_name() +
+                                    " applies to the height and range methods; set NDT "
+                                    "parameters in the ndt section of --config");
+        }
+    }
+    core::HistogramConfig& histogram = descriptor.histogram;
+    if (*bins_option_) histogram.bins = bins_;
+    if (*up_option_) histogram.up_vector = core::ParseUpVectorMode(up_);
+    if (*sensor_height_option_) histogram.sensor_height_m = sensor_height_m_;
+    if (*out_of_range_option_) histogram.out_of_range = core::ParseOutOfRangePolicy(out_of_range_);
+    // --min/--max set the value range of the projection in use.
+    const bool height = descriptor.method == core::Method::kHeight;
+    if (*min_option_) (height ? histogram.height_min_m : histogram.range_min_m) = min_m_;
+    if (*max_option_) (height ? histogram.height_max_m : histogram.range_max_m) = max_m_;
+}
+
+core::Descriptor DescriptorOfFile(const std::filesystem::path& file, const io::RunConfig& config) {
     const core::PointCloud cloud = io::ReadScan(file);
     try {
-        return core::ComputeHistogram(cloud, core::ProjectionOf(config.descriptor.method),
-                                      config.descriptor.histogram);
+        return core::ComputeDescriptor(cloud, config.descriptor);
     } catch (const core::EmptyInputError& e) {
         throw io::ReadError(file, e.what());
     }

@@ -5,7 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "lidarloop/core/histogram.hpp"
+#include "lidarloop/core/descriptor.hpp"
 #include "lidarloop/io/config_yaml.hpp"
 
 namespace lidarloop::cli {
@@ -14,13 +14,16 @@ namespace lidarloop::cli {
 /// Precedence: built-in defaults < --config FILE < individual flags.
 class DescriptorOptions {
 public:
-    /// Adds --config, --method, --bins, --min, --max, --up, --sensor-height, --out-of-range.
+    /// Adds --config, --method, and the histogram flags --bins, --min, --max, --up,
+    /// --sensor-height, --out-of-range (NDT parameters come from --config).
     void AddTo(CLI::App& command);
 
     /// The effective configuration; throws core::Error (or io::ReadError) when it is invalid.
     io::RunConfig Resolve() const;
 
 private:
+    void ApplyHistogramFlags(core::DescriptorConfig& descriptor) const;
+
     std::string config_file_;
     std::string method_;
     int bins_ = 0;
@@ -33,9 +36,11 @@ private:
     CLI::Option* min_option_ = nullptr;
     CLI::Option* max_option_ = nullptr;
     CLI::Option* sensor_height_option_ = nullptr;
+    CLI::Option* up_option_ = nullptr;
+    CLI::Option* out_of_range_option_ = nullptr;
 };
 
-/// Reads `file` and computes its histogram under `config`; errors name the file.
-core::Histogram HistogramOfFile(const std::filesystem::path& file, const io::RunConfig& config);
+/// Reads `file` and computes its descriptor under `config`; errors name the file.
+core::Descriptor DescriptorOfFile(const std::filesystem::path& file, const io::RunConfig& config);
 
 }  // namespace lidarloop::cli

@@ -5,23 +5,23 @@
 
 #include "commands.hpp"
 #include "descriptor_options.hpp"
-#include "lidarloop/core/wasserstein.hpp"
 
 namespace lidarloop::cli {
 
 void AddDistanceCommand(CLI::App& app) {
     auto* command = app.add_subcommand(
-        "distance", "Print the distance between the descriptors of two scans (Roehling eq. 6)");
+        "distance",
+        "Print the distance between two scans: W (Roehling eq. 6) or sigma' (Magnusson eq. 9)");
     auto scans = std::make_shared<std::vector<std::string>>();
     auto options = std::make_shared<DescriptorOptions>();
     command->add_option("SCAN_A SCAN_B", *scans, "two scan files")->required()->expected(2);
     options->AddTo(*command);
     command->callback([scans, options] {
         const io::RunConfig config = options->Resolve();
-        const core::Histogram a = HistogramOfFile((*scans)[0], config);
-        const core::Histogram b = HistogramOfFile((*scans)[1], config);
+        const core::Descriptor a = DescriptorOfFile((*scans)[0], config);
+        const core::Descriptor b = DescriptorOfFile((*scans)[1], config);
         // %.9g keeps enough digits to compare against thresholds near 1e-3.
-        std::printf("%.9g\n", core::WassersteinDistance(a.mass, b.mass));
+        std::printf("%.9g\n", core::DescriptorDistance(a, b));
     });
 }
 

@@ -4,16 +4,28 @@
 
 namespace lidarloop::core {
 
-std::string ToString(Method method) { return method == Method::kHeight ? "height" : "range"; }
+std::string ToString(Method method) {
+    switch (method) {
+        case Method::kHeight: return "height";
+        case Method::kRange: return "range";
+        case Method::kNdt: return "ndt";
+    }
+    return "unknown";
+}
 
 Method ParseMethod(std::string_view name) {
     if (name == "height") return Method::kHeight;
     if (name == "range") return Method::kRange;
-    throw ConfigError("unknown method '" + std::string(name) + "' (valid: height, range)");
+    if (name == "ndt") return Method::kNdt;
+    throw ConfigError("unknown method '" + std::string(name) + "' (valid: height, range, ndt)");
 }
 
+bool IsHistogramMethod(Method method) { return method != Method::kNdt; }
+
 Projection ProjectionOf(Method method) {
-    return method == Method::kHeight ? Projection::kHeight : Projection::kRange;
+    if (method == Method::kHeight) return Projection::kHeight;
+    if (method == Method::kRange) return Projection::kRange;
+    throw ConfigError("method '" + ToString(method) + "' is not a histogram projection");
 }
 
 }  // namespace lidarloop::core

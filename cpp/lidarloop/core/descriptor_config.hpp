@@ -4,6 +4,7 @@
 #include <string_view>
 
 #include "lidarloop/core/histogram.hpp"
+#include "lidarloop/core/ndt_config.hpp"
 
 namespace lidarloop::core {
 
@@ -11,22 +12,30 @@ namespace lidarloop::core {
 enum class Method {
     kHeight,  ///< Röhling 2015 histogram of heights above the ground plane
     kRange,   ///< Röhling 2015 histogram of ranges
+    kNdt,     ///< Magnusson 2009 NDT appearance descriptor
 };
 
 std::string ToString(Method method);
-/// Parses "height" / "range"; throws ConfigError listing the valid names.
+/// Parses "height" / "range" / "ndt"; throws ConfigError listing the valid names.
 Method ParseMethod(std::string_view name);
 
-/// The projection a histogram method uses.
+/// True for the methods built on Röhling's histograms (height, range).
+bool IsHistogramMethod(Method method);
+
+/// The projection a histogram method uses; throws ConfigError for kNdt.
 Projection ProjectionOf(Method method);
 
 /// Everything that decides how a scan becomes a descriptor. The single home of the defaults.
 struct DescriptorConfig {
     Method method = Method::kHeight;
     HistogramConfig histogram;
+    NdtConfig ndt;
 
     /// Throws ConfigError naming the first invalid field.
-    void Validate() const { histogram.Validate(); }
+    void Validate() const {
+        histogram.Validate();
+        ndt.Validate();
+    }
 };
 
 }  // namespace lidarloop::core

@@ -5,6 +5,7 @@
 #include <set>
 #include <sstream>
 #include <type_traits>
+#include <vector>
 
 #include <yaml-cpp/yaml.h>
 
@@ -31,9 +32,28 @@ void VisitFields(core::HistogramConfig& c, Visitor& v) {
 }
 
 template <typename Visitor>
+void VisitFields(core::NdtConfig& c, Visitor& v) {
+    v.Field("cell_size_m", c.cell_size_m, "q, side of an NDT cell; cells overlap by q/2");
+    v.Field("min_points_per_cell", c.min_points_per_cell, "sparser cells are not classified");
+    v.Field("eigen_ratio_threshold", c.eigen_ratio_threshold, "t_e of the shape classes");
+    v.Field("spherical_classes", c.spherical_classes, "s, sub-classes by l2/l1");
+    v.Field("planar_classes", c.planar_classes, "p, sub-classes by normal orientation");
+    v.Field("linear_classes", c.linear_classes, "l, sub-classes by axis orientation");
+    v.Field("range_limits_m", c.range_limits_m, "borders of the range intervals");
+    v.Field("normalise_rotation", c.normalise_rotation, "align dominant planes (section II-C)");
+    v.Field("ambiguity_ratio", c.ambiguity_ratio, "t_a, peaks this close are ambiguous");
+    v.Field("align_to_mean_direction", c.align_to_mean_direction,
+            "align peaks by their cells' mean normal (true) or partition line (false)");
+    v.Field("regrid_rotations", c.regrid_rotations,
+            "new grid per rotation (paper) vs rotated cells");
+    v.Field("threshold", c.threshold, "t_d: similar when sigma' < t_d (Magnusson II-E)");
+}
+
+template <typename Visitor>
 void VisitFields(RunConfig& c, Visitor& v) {
-    v.Field("method", c.descriptor.method, "descriptor: height | range");
+    v.Field("method", c.descriptor.method, "descriptor: height | range | ndt");
     v.Section("histogram", c.descriptor.histogram);
+    v.Section("ndt", c.descriptor.ndt);
 }
 
 std::string EnumName(core::Method m) { return core::ToString(m); }
@@ -52,13 +72,26 @@ public:
         out_ << indent_ << key << ": ";
         if constexpr (std::is_enum_v<T>) {
             out_ << EnumName(value);
+        } else if constexpr (std::is_same_v<T, bool>) {
+            out_ << (value ? "true" : "false");
+        } else if constexpr (std::is_same_v<T, std::vector<double>>) {
+            out_ << "[";
+            for (std::size_t i = 0; i < value.size(); ++i) {
+                out_ << (i > 0 ? ", " : "");
+                WriteNumber(value[i]);
+            }
+            out_ << "]";
         } else {
-            // Shortest text that reads back to the same value (0.005, not 0.005000000000000001).
-            char buffer[64];
-            const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-            out_.write(buffer, result.ptr - buffer);
+            WriteNumber(value);
         }
         out_ << "  # " << help << "\n";
+    }
+    template <typename Number>
+    void WriteNumber(Number value) {
+        // Shortest text that reads back to the same value (0.005, not 0.005000000000000001).
+        char buffer[64];
+        const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+        out_.write(buffer, result.ptr - buffer);
     }
     template <typename Struct>
     void Section(const char* key, Struct& section) {
@@ -75,6 +108,14 @@ private:
     std::string indent_;
 };
 
+template <typename T>
+const char* ExpectedKind() {
+    if constexpr (std::is_same_v<T, bool>) return "true or false";
+    if constexpr (std::is_same_v<T, std::vector<double>>) return "a list of numbers";
+    if constexpr (std::is_integral_v<T>) return "an integer";
+    return "a number";
+}
+
 class YamlReader {
 public:
     YamlReader(const YAML::Node& node, std::string source, std::string prefix)
@@ -85,16 +126,20 @@ public:
         known_.insert(key);
         const YAML::Node child = node_[key];
         if (!child) return;
-        if (!child.IsScalar()) Fail(key, "expected a single value");
+        constexpr bool kIsList = std::is_same_v<T, std::vector<double>>;
+        if (kIsList && !child.IsSequence()) Fail(key, "expected a list of numbers like [3, 6]");
+        if (!kIsList && !child.IsScalar()) Fail(key, "expected a single value");
         try {
-            if constexpr (std::is_enum_v<T>) {
+            if constexpr (kIsList) {
+                value = child.as<std::vector<double>>();
+            } else if constexpr (std::is_enum_v<T>) {
                 ParseEnum(child.as<std::string>(), value);
             } else {
                 value = child.as<T>();
             }
         } catch (const YAML::BadConversion&) {
-            Fail(key, std::string("expected ") + (std::is_integral_v<T> ? "an integer" : "a number") +
-                          ", got '" + child.as<std::string>() + "'");
+            Fail(key, std::string("expected ") + ExpectedKind<T>() + ", got '" + YAML::Dump(child) +
+                          "'");
         } catch (const core::ConfigError& e) {
             Fail(key, e.what());
         }

@@ -7,11 +7,14 @@ namespace lidarloop::core {
 namespace {
 
 TEST(DescriptorConfig, MethodNamesRoundTrip) {
-    for (Method method : {Method::kHeight, Method::kRange}) {
+    for (Method method : {Method::kHeight, Method::kRange, Method::kNdt}) {
         EXPECT_EQ(ParseMethod(ToString(method)), method);
     }
     EXPECT_EQ(ProjectionOf(Method::kHeight), Projection::kHeight);
     EXPECT_EQ(ProjectionOf(Method::kRange), Projection::kRange);
+    EXPECT_THROW(ProjectionOf(Method::kNdt), ConfigError);
+    EXPECT_TRUE(IsHistogramMethod(Method::kRange));
+    EXPECT_FALSE(IsHistogramMethod(Method::kNdt));
 }
 
 TEST(DescriptorConfig, UnknownMethodNamesTheValidOnes) {
@@ -19,7 +22,7 @@ TEST(DescriptorConfig, UnknownMethodNamesTheValidOnes) {
         ParseMethod("sift");
         FAIL() << "accepted an unknown method";
     } catch (const ConfigError& e) {
-        EXPECT_NE(std::string(e.what()).find("height, range"), std::string::npos);
+        EXPECT_NE(std::string(e.what()).find("height, range, ndt"), std::string::npos);
     }
 }
 
@@ -27,6 +30,9 @@ TEST(DescriptorConfig, ValidateChecksNestedHistogramConfig) {
     DescriptorConfig config;
     EXPECT_NO_THROW(config.Validate());
     config.histogram.bins = 0;
+    EXPECT_THROW(config.Validate(), ConfigError);
+    config.histogram.bins = 10;
+    config.ndt.cell_size_m = -1.0;
     EXPECT_THROW(config.Validate(), ConfigError);
 }
 

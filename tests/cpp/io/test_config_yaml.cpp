@@ -40,9 +40,12 @@ TEST(ConfigYaml, DumpThenLoadGivesTheSameConfig) {
 
 TEST(ConfigYaml, DumpNamesEveryKeyWithItsDefault) {
     const std::string dump = DumpConfigYaml({});
-    for (const char* key : {"method: height", "bins: 100", "up_vector: fixed", "sensor_height_m: 0",
-                            "height_min_m: -3", "height_max_m: 7", "range_min_m: 0",
-                            "range_max_m: 80", "out_of_range: clamp", "threshold: 0.005"}) {
+    for (const char* key :
+         {"method: height", "bins: 100", "up_vector: fixed", "sensor_height_m: 0",
+          "height_min_m: -3", "height_max_m: 7", "range_min_m: 0", "range_max_m: 80",
+          "out_of_range: clamp", "threshold: 0.005", "cell_size_m: 0.5", "planar_classes: 9",
+          "eigen_ratio_threshold: 0.1", "ambiguity_ratio: 0.6", "range_limits_m: [3, 6, 9, 15]",
+          "threshold: 0.0737", "normalise_rotation: true"}) {
         EXPECT_NE(dump.find(key), std::string::npos) << key << " missing in\n" << dump;
     }
 }
@@ -79,6 +82,29 @@ TEST(ConfigYaml, BadInputNamesFileKeyAndProblem) {
     expect_error("histogram:\n  height_min_m: 10\n", "must be smaller than");
     expect_error("histogram: {bins: 3\n", "line");
     expect_error("- a\n- b\n", "expected a map");
+}
+
+TEST(ConfigYaml, NdtSectionWithListsAndBooleans) {
+    RunConfig config;
+    ApplyConfigYaml("method: ndt\nndt:\n  range_limits_m: [2, 4.5]\n  regrid_rotations: true\n",
+                    "ndt.yaml", config);
+    EXPECT_EQ(config.descriptor.method, core::Method::kNdt);
+    EXPECT_EQ(config.descriptor.ndt.range_limits_m, (std::vector<double>{2.0, 4.5}));
+    EXPECT_TRUE(config.descriptor.ndt.regrid_rotations);
+    const std::string dump = DumpConfigYaml(config);
+    EXPECT_NE(dump.find("range_limits_m: [2, 4.5]"), std::string::npos) << dump;
+    EXPECT_NE(dump.find("regrid_rotations: true"), std::string::npos) << dump;
+    RunConfig reloaded;
+    ApplyConfigYaml(dump, "dump", reloaded);
+    EXPECT_EQ(DumpConfigYaml(reloaded), dump);
+    EXPECT_NE(ErrorOf("ndt:\n  range_limits_m: 3\n").find("expected a list of numbers"),
+              std::string::npos);
+    EXPECT_NE(ErrorOf("ndt:\n  range_limits_m: [3, x]\n").find("expected a list of numbers"),
+              std::string::npos);
+    EXPECT_NE(ErrorOf("ndt:\n  regrid_rotations: maybe\n").find("expected true or false"),
+              std::string::npos);
+    EXPECT_NE(ErrorOf("ndt:\n  range_limits_m: [6, 3]\n").find("strictly increasing"),
+              std::string::npos);
 }
 
 TEST(ConfigYaml, FailedApplyLeavesConfigUnchanged) {

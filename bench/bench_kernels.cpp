@@ -1,0 +1,101 @@
+// Google Benchmark kernels of the descriptors. Run: ./build/bench/bench_kernels
+#include <random>
+
+#include <benchmark/benchmark.h>
+
+#include "lidarloop/core/histogram.hpp"
+#include "lidarloop/core/ndt_cells.hpp"
+#include "lidarloop/core/ndt_descriptor.hpp"
+#include "lidarloop/core/wasserstein.hpp"
+#include "synthetic_scan.hpp"
+
+namespace lidarloop::bench {
+namespace {
+
+const core::PointCloud& Scan() {
+    static const core::PointCloud scan = SyntheticHdl64Scan(1);
+    return scan;
+}
+
+void SetPointCounters(benchmark::State& state) {
+    state.counters["points"] = static_cast<double>(Scan().size());
+    state.counters["per_point"] = benchmark::Counter(
+        static_cast<double>(Scan().size()),
+        benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
+void BM_HeightHistogram(benchmark::State& state) {
+    const core::HistogramConfig config;
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(core::ComputeHistogram(Scan(), core::Projection::kHeight, config));
+    }
+    SetPointCounters(state);
+}
+BENCHMARK(BM_HeightHistogram)->Unit(benchmark::kMicrosecond);
+
+void BM_RangeHistogram(benchmark::State& state) {
+    const core::HistogramConfig config;
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(core::ComputeHistogram(Scan(), core::Projection::kRange, config));
+    }
+    SetPointCounters(state);
+}
+BENCHMARK(BM_RangeHistogram)->Unit(benchmark::kMicrosecond);
+
+void BM_Wasserstein(benchmark::State& state) {
+    std::mt19937 rng(2);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::vector<double> g(static_cast<std::size_t>(state.range(0)));
+    std::vector<double> h(g.size());
+    for (auto& v : g) v = u(rng);
+    for (auto& v : h) v = u(rng);
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(core::WassersteinDistance(g, h));
+        benchmark::ClobberMemory();
+    }
+}
+BENCHMARK(BM_Wasserstein)->Arg(100)->Unit(benchmark::kNanosecond);
+
+void BM_NdtCells(benchmark::State& state) {
+    for (auto _ : state) benchmark::DoNotOptimize(core::ComputeNdtCells(Scan(), 0.5, 5));
+    SetPointCounters(state);
+}
+BENCHMARK(BM_NdtCells)->Unit(benchmark::kMillisecond);
+
+void BM_NdtDescriptorSet(benchmark::State& state) {
+    core::NdtConfig config;
+    config.regrid_rotations = state.range(0) != 0;
+    std::size_t descriptors = 0;
+    for (auto _ : state) {
+        const auto set = core::ComputeNdtDescriptorSet(Scan(), config);
+        descriptors = set.descriptors.size();
+        benchmark::DoNotOptimize(set);
+    }
+    state.counters["descriptors"] = static_cast<double>(descriptors);
+    SetPointCounters(state);
+}
+BENCHMARK(BM_NdtDescriptorSet)->Arg(0)->Arg(1)->ArgName("regrid")->Unit(benchmark::kMillisecond);
+
+void BM_NdtDifference(benchmark::State& state) {
+    const core::NdtConfig config;
+    const auto a = core::ComputeNdtDescriptorSet(Scan(), config);
+    const auto b = core::ComputeNdtDescriptorSet(SyntheticHdl64Scan(3), config);
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(core::NdtDifference(a.descriptors[0], b.descriptors[0]));
+    }
+}
+BENCHMARK(BM_NdtDifference)->Unit(benchmark::kNanosecond);
+
+void BM_NdtSetDifference(benchmark::State& state) {
+    const core::NdtConfig config;
+    const auto a = core::ComputeNdtDescriptorSet(Scan(), config);
+    const auto b = core::ComputeNdtDescriptorSet(SyntheticHdl64Scan(3), config);
+    for (auto _ : state) benchmark::DoNotOptimize(core::NdtSetDifference(a, b));
+    state.counters["pairs"] = static_cast<double>(a.descriptors.size() * b.descriptors.size());
+}
+BENCHMARK(BM_NdtSetDifference)->Unit(benchmark::kNanosecond);
+
+}  // namespace
+}  // namespace lidarloop::bench
+
+BENCHMARK_MAIN();

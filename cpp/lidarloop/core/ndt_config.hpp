@@ -1,0 +1,42 @@
+#pragma once
+
+#include <vector>
+
+namespace lidarloop::core {
+
+/// Parameters of the NDT appearance descriptor (Magnusson et al. 2009, section II-E). Defaults
+/// are the paper's, except where a comment says otherwise.
+struct NdtConfig {
+    double cell_size_m = 0.5;  ///< q, side of an NDT cell; cell corners are q/2 apart
+    /// Cells with fewer points are not classified. The paper does not state its minimum; 5 is
+    /// the smallest count whose 3x3 covariance is not dominated by sampling noise for planes.
+    int min_points_per_cell = 5;
+    double eigen_ratio_threshold = 0.10;  ///< t_e: linear if l2/l1 < t_e, planar if l3/l2 < t_e
+    int spherical_classes = 1;            ///< s, sub-classes by l2/l1 over [t_e, 1]
+    int planar_classes = 9;               ///< p, sub-classes by the line of the normal e3
+    int linear_classes = 1;               ///< l, sub-classes by the line of the axis e1
+    /// Borders of the range intervals R, metres from the sensor to the cell mean; the paper's
+    /// {[0,3), [3,6), [6,9), [9,15), [15,inf)}.
+    std::vector<double> range_limits_m = {3.0, 6.0, 9.0, 15.0};
+    bool normalise_rotation = true;  ///< section II-C; false gives one unrotated descriptor
+    double ambiguity_ratio = 0.60;   ///< t_a, peaks >= t_a * the highest are ambiguous
+    /// true: align a peak class by the mean line of its cells' normals (principal axis of their
+    /// scatter), which makes the normalisation rotation invariant up to the grid. false: align
+    /// by the class's partition line P_i as the paper writes; the alignment is then quantised to
+    /// the partition (~40 degrees for p = 9) and a rotated scan can get a different descriptor.
+    bool align_to_mean_direction = true;
+    /// false: rotate each cell's axes (the grid turns with the scan; exact rotation invariance,
+    /// one grid per scan). true: rotate the points and build a new axis-aligned grid per rotation,
+    /// as the paper does; slower, and results differ only by the grid's discretisation.
+    bool regrid_rotations = false;
+    /// t_d: scans are similar when sigma' < t_d. 0.0737 is the paper's Hannover2 value (table II);
+    /// it depends on the data, so estimate it (EM) or learn it for yours.
+    double threshold = 0.0737;
+
+    int FeatureCount() const { return spherical_classes + planar_classes + linear_classes; }
+    int RangeCount() const { return static_cast<int>(range_limits_m.size()) + 1; }
+    /// Throws ConfigError naming the first invalid field.
+    void Validate() const;
+};
+
+}  // namespace lidarloop::core

@@ -1,0 +1,59 @@
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "lidarloop/core/ndt_cells.hpp"
+#include "lidarloop/core/ndt_config.hpp"
+#include "lidarloop/core/point_cloud.hpp"
+
+namespace lidarloop::core {
+
+/// Shape classes of an NDT cell (Magnusson II-B).
+enum class CellShape { kSpherical, kPlanar, kLinear, kDegenerate };
+
+/// The shape of one covariance and the axis that carries its orientation.
+struct CellShapeInfo {
+    CellShape shape = CellShape::kDegenerate;
+    Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  ///< planar: normal e3; linear: e1
+    double l2_over_l1 = 0.0;                          ///< for spherical sub-classes
+};
+
+/// Classifies a covariance by its sorted eigenvalues l1 >= l2 >= l3: linear if l2/l1 < t_e,
+/// planar if not linear and l3/l2 < t_e, spherical otherwise. A covariance with l1 ~ 0 (all
+/// points equal) or a non-finite entry is kDegenerate. Uses Eigen's closed-form 3x3 solver.
+CellShapeInfo ClassifyCovariance(const Eigen::Matrix3d& covariance_m2, double t_e);
+
+/// One appearance descriptor F (eq. 3): rows = range intervals, columns = the feature vector f
+/// of eq. (1) (s spherical, p planar, l linear classes), entries = cell counts.
+struct NdtDescriptor {
+    int rows = 0;
+    int cols = 0;
+    std::vector<float> counts;      ///< row-major rows x cols
+    std::vector<float> normalised;  ///< counts / total, what eq. (8) compares
+    double total = 0.0;             ///< ||F||_1, number of classified cells
+    Eigen::Matrix3d R_aligned_sensor = Eigen::Matrix3d::Identity();  ///< rotation R_y R_z used
+};
+
+/// The descriptors of one scan, one per rotation candidate (section II-C).
+struct NdtDescriptorSet {
+    std::vector<NdtDescriptor> descriptors;
+    NdtCellStats cell_stats;
+    std::size_t degenerate_cells = 0;
+};
+
+/// Builds the descriptor set of `cloud`. Throws EmptyInputError when no cell can be classified
+/// (too few points), ConfigError for an invalid config. Thread-safe.
+NdtDescriptorSet ComputeNdtDescriptorSet(const PointCloud& cloud, const NdtConfig& config);
+
+/// sigma of eq. (8): sum over range intervals of the Euclidean distance between the rows of the
+/// 1-norm-normalised descriptors, times max(|F|,|G|)/min(|F|,|G|). Symmetric, 0 for equal input.
+/// The descriptors must have the same shape (ConfigError otherwise).
+double NdtDifference(const NdtDescriptor& f, const NdtDescriptor& g);
+
+/// sigma' of eq. (9): the smallest sigma over all pairs of the two sets.
+double NdtSetDifference(const NdtDescriptorSet& f, const NdtDescriptorSet& g);
+
+}  // namespace lidarloop::core

@@ -1,0 +1,317 @@
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <random>
+#include <tuple>
+
+#include <gtest/gtest.h>
+
+#include "lidarloop/core/error.hpp"
+#include "lidarloop/core/ndt_cells.hpp"
+#include "lidarloop/core/ndt_descriptor.hpp"
+#include "lidarloop/core/sphere_partition.hpp"
+#include "test_utils.hpp"
+
+namespace lidarloop::core {
+namespace {
+
+using CellIndex = std::tuple<long, long, long>;
+
+// Reference: every point into each of the 8 cells [i h, i h + q) that contain it, by definition.
+std::map<CellIndex, std::vector<Eigen::Vector3d>> BruteForceCells(const PointCloud& cloud,
+                                                                  double q) {
+    std::map<CellIndex, std::vector<Eigen::Vector3d>> cells;
+    const double h = q / 2.0;
+    for (const auto& pf : cloud) {
+        const Eigen::Vector3d p = pf.cast<double>();
+        const long x = static_cast<long>(std::floor(p.x() * (1.0 / h)));
+        const long y = static_cast<long>(std::floor(p.y() * (1.0 / h)));
+        const long z = static_cast<long>(std::floor(p.z() * (1.0 / h)));
+        for (long dx = 0; dx < 2; ++dx)
+            for (long dy = 0; dy < 2; ++dy)
+                for (long dz = 0; dz < 2; ++dz) cells[{x - dx, y - dy, z - dz}].push_back(p);
+    }
+    return cells;
+}
+
+TEST(NdtCells, MatchBruteForceStatisticsOnRandomClouds) {
+    for (unsigned seed : {1U, 2U, 3U}) {
+        const PointCloud cloud = test::RandomCloud(4000, seed, 2.0f);
+        const double q = 0.8;
+        const int min_points = 4;
+        const auto reference = BruteForceCells(cloud, q);
+        std::vector<NdtCell> expected;
+        for (const auto& [index, points] : reference) {
+            if (static_cast<int>(points.size()) < min_points) continue;
+            NdtCell cell;
+            cell.point_count = static_cast<int>(points.size());
+            for (const auto& p : points) cell.mean_m += p / static_cast<double>(points.size());
+            for (const auto& p : points) {
+                cell.covariance_m2 += (p - cell.mean_m) * (p - cell.mean_m).transpose() /
+                                      static_cast<double>(points.size() - 1);
+            }
+            expected.push_back(cell);
+        }
+        const auto cells = ComputeNdtCells(cloud, q, min_points);
+        ASSERT_EQ(cells.size(), expected.size()) << "seed " << seed;
+        // Both lists are sorted by (z, y, x) cell index: the map's order is (x, y, z), so match
+        // by mean instead of position.
+        auto by_mean = [](const NdtCell& a, const NdtCell& b) {
+            return std::lexicographical_compare(a.mean_m.data(), a.mean_m.data() + 3,
+                                                b.mean_m.data(), b.mean_m.data() + 3);
+        };
+        auto sorted_cells = cells;
+        std::sort(sorted_cells.begin(), sorted_cells.end(), by_mean);
+        std::sort(expected.begin(), expected.end(), by_mean);
+        for (std::size_t i = 0; i < expected.size(); ++i) {
+            EXPECT_EQ(sorted_cells[i].point_count, expected[i].point_count);
+            EXPECT_LT((sorted_cells[i].mean_m - expected[i].mean_m).norm(), 1e-9);
+            EXPECT_LT((sorted_cells[i].covariance_m2 - expected[i].covariance_m2).norm(), 1e-9);
+        }
+    }
+}
+
+TEST(NdtCells, EveryPointIsInEightCells) {
+    const PointCloud cloud = test::RandomCloud(3000, 4, 3.0f);
+    NdtCellStats stats;
+    const auto cells = ComputeNdtCells(cloud, 0.5, 2, &stats);
+    std::size_t total = 0;
+    for (const auto& cell : cells) total += static_cast<std::size_t>(cell.point_count);
+    // With a minimum of 2, every dropped (sparse) cell held exactly one point.
+    EXPECT_EQ(total + stats.sparse_cells, 8 * cloud.size());
+    EXPECT_EQ(stats.points_used, cloud.size());
+    const PointCloud pair = {{0.1f, 0.1f, 0.1f}, {0.12f, 0.1f, 0.1f}};
+    EXPECT_EQ(ComputeNdtCells(pair, 0.5, 2).size(), 8U);  // both points share all 8 cells
+}
+
+TEST(NdtCells, SkipsNonFiniteAndRejectsBadParameters) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    NdtCellStats stats;
+    const auto cells = ComputeNdtCells({{nan, 0, 0}, {1e9f, 0, 0}, {0, 0, 0}, {0, 0, 0.1f}}, 0.5, 2,
+                                       &stats);
+    EXPECT_EQ(stats.points_skipped, 2U);
+    EXPECT_EQ(stats.points_used, 2U);
+    EXPECT_THROW(ComputeNdtCells({}, 0.0, 5), ConfigError);
+    EXPECT_THROW(ComputeNdtCells({}, NAN, 5), ConfigError);
+    EXPECT_THROW(ComputeNdtCells({}, 0.5, 1), ConfigError);
+    EXPECT_TRUE(ComputeNdtCells({}, 0.5, 5).empty());
+}
+
+PointCloud PlanePoints(const Eigen::Vector3d& normal, int count, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-3.0, 3.0);
+    const Eigen::Vector3d a = normal.unitOrthogonal();
+    const Eigen::Vector3d b = normal.cross(a);
+    PointCloud cloud;
+    for (int i = 0; i < count; ++i) {
+        cloud.push_back((Eigen::Vector3d(4, 2, 1) + u(rng) * a + u(rng) * b).cast<float>());
+    }
+    return cloud;
+}
+
+TEST(NdtClassify, PlaneIsPlanarWithItsNormal) {
+    const Eigen::Vector3d normal = Eigen::Vector3d(1, 2, 3).normalized();
+    const auto cells = ComputeNdtCells(PlanePoints(normal, 20000, 5), 0.5, 5);
+    ASSERT_FALSE(cells.empty());
+    for (const auto& cell : cells) {
+        const auto info = ClassifyCovariance(cell.covariance_m2, 0.1);
+        ASSERT_EQ(info.shape, CellShape::kPlanar);
+        EXPECT_GT(std::abs(info.axis.dot(normal)), 0.999);
+    }
+}
+
+TEST(NdtClassify, LineIsLinearAlongItsAxis) {
+    const Eigen::Vector3d axis = Eigen::Vector3d(-1, 0.5, 0.2).normalized();
+    std::mt19937 rng(6);
+    std::uniform_real_distribution<double> u(-5.0, 5.0);
+    PointCloud cloud;
+    for (int i = 0; i < 5000; ++i) cloud.push_back((u(rng) * axis).cast<float>());
+    const auto cells = ComputeNdtCells(cloud, 0.5, 5);
+    ASSERT_FALSE(cells.empty());
+    for (const auto& cell : cells) {
+        const auto info = ClassifyCovariance(cell.covariance_m2, 0.1);
+        ASSERT_EQ(info.shape, CellShape::kLinear);
+        EXPECT_GT(std::abs(info.axis.dot(axis)), 0.999);
+    }
+}
+
+TEST(NdtClassify, IsotropicBlobIsSpherical) {
+    const auto info = ClassifyCovariance(Eigen::Vector3d(1.0, 0.9, 0.8).asDiagonal(), 0.1);
+    EXPECT_EQ(info.shape, CellShape::kSpherical);
+    const PointCloud blob = test::RandomCloud(20000, 7, 0.2f);  // a cube fills its cells evenly
+    const auto cells = ComputeNdtCells(blob, 0.5, 50);
+    std::size_t spherical = 0;
+    for (const auto& cell : cells) {
+        spherical += ClassifyCovariance(cell.covariance_m2, 0.1).shape == CellShape::kSpherical;
+    }
+    EXPECT_EQ(spherical, cells.size());
+}
+
+TEST(NdtClassify, ThresholdBordersAndDegenerateInput) {
+    // Just above and below t_e on each ratio (the paper's tests are strict '<').
+    EXPECT_EQ(ClassifyCovariance(Eigen::Vector3d(1.0, 0.1001, 0.05).asDiagonal(), 0.1).shape,
+              CellShape::kSpherical);
+    EXPECT_EQ(ClassifyCovariance(Eigen::Vector3d(1.0, 0.099, 0.05).asDiagonal(), 0.1).shape,
+              CellShape::kLinear);
+    EXPECT_EQ(ClassifyCovariance(Eigen::Vector3d(1.0, 0.5, 0.049).asDiagonal(), 0.1).shape,
+              CellShape::kPlanar);
+    EXPECT_EQ(ClassifyCovariance(Eigen::Matrix3d::Zero(), 0.1).shape, CellShape::kDegenerate);
+    Eigen::Matrix3d nan = Eigen::Matrix3d::Identity();
+    nan(0, 1) = NAN;
+    EXPECT_EQ(ClassifyCovariance(nan, 0.1).shape, CellShape::kDegenerate);
+}
+
+// A synthetic scan with floor, walls at uneven angles, poles and clutter.
+PointCloud StructuredScan(unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    std::normal_distribution<float> noise(0.0f, 0.01f);
+    PointCloud cloud;
+    for (int i = 0; i < 30000; ++i) {
+        cloud.push_back({-20 + 40 * u(rng), -20 + 40 * u(rng), -1.7f + noise(rng)});
+    }
+    for (int i = 0; i < 15000; ++i) {  // a long wall at x = 6
+        cloud.push_back({6.0f + noise(rng), -15 + 30 * u(rng), -1.7f + 4 * u(rng)});
+    }
+    for (int i = 0; i < 8000; ++i) {  // a shorter wall at 60 degrees
+        const float t = 12 * u(rng);
+        cloud.push_back({-3 - 0.5f * t + noise(rng), 4 + 0.866f * t, -1.7f + 3 * u(rng)});
+    }
+    for (int i = 0; i < 3000; ++i) {  // a pole
+        cloud.push_back({2.0f + noise(rng), -4.0f + noise(rng), -1.7f + 5 * u(rng)});
+    }
+    return cloud;
+}
+
+TEST(NdtDescriptor, RotatedScanHasSmallSigmaWhileUnnormalisedDiffers) {
+    const PointCloud cloud = StructuredScan(8);
+    std::mt19937 rng(9);
+    NdtConfig config;
+    NdtConfig unnormalised = config;
+    unnormalised.normalise_rotation = false;
+    const auto reference = ComputeNdtDescriptorSet(cloud, config);
+    const auto reference_raw = ComputeNdtDescriptorSet(cloud, unnormalised);
+    for (int trial = 0; trial < 5; ++trial) {
+        const Eigen::Matrix3f R = Eigen::Quaternionf::UnitRandom().toRotationMatrix();
+        PointCloud rotated = cloud;
+        for (auto& p : rotated) p = R * p;
+        const double sigma = NdtSetDifference(reference, ComputeNdtDescriptorSet(rotated, config));
+        const double raw = NdtSetDifference(reference_raw,
+                                            ComputeNdtDescriptorSet(rotated, unnormalised));
+        EXPECT_LT(sigma, 0.02) << "trial " << trial;
+        EXPECT_GT(raw, 5 * sigma + 0.05) << "trial " << trial;
+    }
+}
+
+TEST(NdtDescriptor, RegriddingAgreesWithRotatingCells) {
+    const PointCloud cloud = StructuredScan(10);
+    NdtConfig config;
+    NdtConfig regrid = config;
+    regrid.regrid_rotations = true;
+    const Eigen::Matrix3f R = Eigen::AngleAxisf(0.7f, Eigen::Vector3f(1, 2, 3).normalized()).matrix();
+    PointCloud rotated = cloud;
+    for (auto& p : rotated) p = R * p;
+    const auto a = ComputeNdtDescriptorSet(rotated, config);
+    const auto b = ComputeNdtDescriptorSet(rotated, regrid);
+    EXPECT_EQ(a.descriptors.size(), b.descriptors.size());
+    EXPECT_LT(NdtSetDifference(a, b), 0.15);
+}
+
+TEST(NdtDescriptor, SigmaIsSymmetricAndZeroOnIdenticalInput) {
+    const auto a = ComputeNdtDescriptorSet(StructuredScan(11), NdtConfig{});
+    const auto b = ComputeNdtDescriptorSet(StructuredScan(12), NdtConfig{});
+    EXPECT_EQ(NdtSetDifference(a, a), 0.0);
+    EXPECT_EQ(NdtDifference(a.descriptors[0], a.descriptors[0]), 0.0);
+    EXPECT_DOUBLE_EQ(NdtSetDifference(a, b), NdtSetDifference(b, a));
+    EXPECT_GT(NdtSetDifference(a, b), 0.0);
+}
+
+TEST(NdtDescriptor, SigmaMatchesEquationEightByHand) {
+    NdtDescriptor f;
+    f.rows = 2;
+    f.cols = 2;
+    f.counts = {1, 1, 2, 0};
+    f.total = 4;
+    f.normalised = {0.25f, 0.25f, 0.5f, 0.0f};
+    NdtDescriptor g = f;
+    g.counts = {0, 2, 0, 0};
+    g.total = 2;
+    g.normalised = {0.0f, 1.0f, 0.0f, 0.0f};
+    // Row 0: |(0.25, -0.75)| = 0.7906; row 1: |(0.5, 0)| = 0.5; times 4/2.
+    EXPECT_NEAR(NdtDifference(f, g), (std::sqrt(0.625) + 0.5) * 2.0, 1e-6);
+    NdtDescriptor other_shape = g;
+    other_shape.cols = 4;
+    other_shape.rows = 1;
+    EXPECT_THROW(NdtDifference(f, other_shape), ConfigError);
+}
+
+TEST(NdtDescriptor, FeatureLayoutFollowsEquationOne) {
+    NdtConfig config;
+    config.normalise_rotation = false;
+    const Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+    const auto set = ComputeNdtDescriptorSet(PlanePoints(normal, 20000, 13), config);
+    ASSERT_EQ(set.descriptors.size(), 1U);
+    const NdtDescriptor& f = set.descriptors[0];
+    EXPECT_EQ(f.rows, 5);
+    EXPECT_EQ(f.cols, 11);
+    // Every cell is planar with normal z: all counts in the planar column of z's line.
+    const int z_class = HalfSpherePartition(9).NearestLine(normal);
+    double in_column = 0.0;
+    for (int row = 0; row < f.rows; ++row) in_column += f.counts[row * f.cols + 1 + z_class];
+    EXPECT_EQ(in_column, f.total);
+    EXPECT_GT(f.total, 100.0);
+}
+
+TEST(NdtDescriptor, DegenerateScansGiveDefinedResults) {
+    NdtConfig config;
+    const PointCloud same(100, Eigen::Vector3f(1, 2, 3));
+    EXPECT_THROW(ComputeNdtDescriptorSet(same, config), EmptyInputError);
+    EXPECT_THROW(ComputeNdtDescriptorSet({{1, 2, 3}}, config), EmptyInputError);
+    EXPECT_THROW(ComputeNdtDescriptorSet({}, config), EmptyInputError);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_THROW(ComputeNdtDescriptorSet(PointCloud(50, Eigen::Vector3f(nan, 0, 0)), config),
+                 EmptyInputError);
+    // Collinear points: only linear cells, no plane to align: one descriptor, no crash.
+    PointCloud line;
+    for (int i = 0; i < 2000; ++i) line.push_back({0.01f * static_cast<float>(i), 0, 0});
+    const auto line_set = ComputeNdtDescriptorSet(line, config);
+    EXPECT_EQ(line_set.descriptors.size(), 1U);
+    // A single plane: one orientation only, so R_z alone, turning its normal onto z.
+    const Eigen::Vector3d normal = Eigen::Vector3d(1.0, 0.3, 0.2).normalized();
+    const auto plane_set = ComputeNdtDescriptorSet(PlanePoints(normal, 20000, 14), config);
+    ASSERT_EQ(plane_set.descriptors.size(), 1U);
+    EXPECT_NEAR(std::abs((plane_set.descriptors[0].R_aligned_sensor * normal).z()), 1.0, 1e-6);
+    // The paper's literal alignment turns the partition line of the normal onto z instead.
+    config.align_to_mean_direction = false;
+    const auto literal = ComputeNdtDescriptorSet(PlanePoints(normal, 20000, 14), config);
+    ASSERT_EQ(literal.descriptors.size(), 1U);
+    const HalfSpherePartition partition(9);
+    const Eigen::Vector3d normal_line = partition.centres()[static_cast<std::size_t>(
+        partition.NearestLine(normal))];
+    EXPECT_NEAR(std::abs((literal.descriptors[0].R_aligned_sensor * normal_line).z()), 1.0, 1e-9);
+}
+
+TEST(NdtConfig, DefaultsAreThePapersAndAbsurdValuesAreRejected) {
+    NdtConfig config;
+    EXPECT_NO_THROW(config.Validate());
+    EXPECT_EQ(config.FeatureCount(), 11);
+    EXPECT_EQ(config.RangeCount(), 5);
+    const auto invalid = [](auto mutate) {
+        NdtConfig c;
+        mutate(c);
+        EXPECT_THROW(c.Validate(), ConfigError);
+    };
+    invalid([](NdtConfig& c) { c.cell_size_m = 0; });
+    invalid([](NdtConfig& c) { c.min_points_per_cell = 2; });
+    invalid([](NdtConfig& c) { c.eigen_ratio_threshold = 1.0; });
+    invalid([](NdtConfig& c) { c.spherical_classes = c.planar_classes = c.linear_classes = 0; });
+    invalid([](NdtConfig& c) { c.planar_classes = -1; });
+    invalid([](NdtConfig& c) { c.range_limits_m = {3, 3}; });
+    invalid([](NdtConfig& c) { c.range_limits_m = {-1}; });
+    invalid([](NdtConfig& c) { c.ambiguity_ratio = 1.5; });
+    invalid([](NdtConfig& c) { c.threshold = NAN; });
+}
+
+}  // namespace
+}  // namespace lidarloop::core
