@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <climits>
 #include <cmath>
 #include <cstdint>
@@ -39,12 +40,6 @@ struct KeyedMoments {
     Moments moments;
 };
 
-// The point travels with its key so that the moments are summed in one sequential sweep.
-struct KeyedPoint {
-    std::uint64_t key;
-    Eigen::Vector3f point;
-};
-
 // Packs voxel indices (z, y, x from high to low bits, each shifted to start at 1) into one key,
 // so that sorting keys sorts by (z, y, x) and a shift by one voxel along an axis is a constant
 // step. The margin of 1 lets the box sums step one voxel below the lowest without borrowing.
@@ -76,66 +71,91 @@ struct KeyLayout {
     }
 };
 
-// LSD radix sort by key on the low `key_bits` bits, 11 bits per pass.
-void RadixSortByKey(std::vector<KeyedPoint>& items, int key_bits) {
-    constexpr int kDigitBits = 11;
-    constexpr std::size_t kBuckets = std::size_t{1} << kDigitBits;
-    std::vector<KeyedPoint> buffer(items.size());
-    std::vector<std::size_t> offsets(kBuckets);
-    for (int shift = 0; shift < key_bits; shift += kDigitBits) {
-        std::fill(offsets.begin(), offsets.end(), 0);
-        for (const KeyedPoint& item : items) ++offsets[(item.key >> shift) & (kBuckets - 1)];
-        std::size_t running = 0;
-        for (std::size_t& offset : offsets) running += std::exchange(offset, running);
-        for (const KeyedPoint& item : items) {
-            buffer[offsets[(item.key >> shift) & (kBuckets - 1)]++] = item;
-        }
-        items.swap(buffer);
-    }
-}
-
 bool IsUsable(const Eigen::Vector3f& p, float max_coordinate_m) {
-    return p.allFinite() && p.cwiseAbs().maxCoeff() <= max_coordinate_m;
+    return std::abs(p.x()) <= max_coordinate_m && std::abs(p.y()) <= max_coordinate_m &&
+           std::abs(p.z()) <= max_coordinate_m;  // false for NaN, too
 }
 
-Eigen::Array3i VoxelIndex(const Eigen::Vector3f& p, double inverse_voxel_size) {
-    return (p.cast<double>().array() * inverse_voxel_size).floor().cast<int>();
+int FloorToInt(double value) {
+    const auto truncated = static_cast<int>(value);
+    return truncated - (value < static_cast<double>(truncated) ? 1 : 0);
 }
+
+// Open-addressing map from voxel key to a dense voxel number. Scans arrive ring by ring, so
+// consecutive points usually share a voxel: the last lookup is remembered.
+class VoxelTable {
+public:
+    explicit VoxelTable(std::size_t max_entries) {
+        std::size_t capacity = 16;
+        while (capacity < 2 * max_entries) capacity *= 2;
+        slots_.assign(capacity, kEmpty);
+        keys_.reserve(max_entries / 4 + 16);
+        shift_ = 64 - static_cast<int>(std::countr_zero(capacity));
+    }
+
+    /// Dense number of `key`, inserting it if new.
+    std::size_t Find(std::uint64_t key) {
+        if (key == last_key_) return last_id_;
+        std::size_t slot = (key * 0x9E3779B97F4A7C15ULL) >> shift_;
+        const std::size_t mask = slots_.size() - 1;
+        while (slots_[slot] != kEmpty && keys_[slots_[slot]] != key) slot = (slot + 1) & mask;
+        if (slots_[slot] == kEmpty) {
+            slots_[slot] = static_cast<std::uint32_t>(keys_.size());
+            keys_.push_back(key);
+        }
+        last_key_ = key;
+        last_id_ = slots_[slot];
+        return last_id_;
+    }
+    const std::vector<std::uint64_t>& keys() const { return keys_; }
+
+private:
+    static constexpr std::uint32_t kEmpty = UINT32_MAX;
+    std::vector<std::uint32_t> slots_;
+    std::vector<std::uint64_t> keys_;
+    int shift_ = 0;
+    std::uint64_t last_key_ = UINT64_MAX;
+    std::size_t last_id_ = 0;
+};
 
 std::vector<KeyedMoments> BinIntoVoxels(const PointCloud& cloud, double voxel_size_m,
                                         NdtCellStats& stats, KeyLayout& layout) {
     const double inverse_voxel_size = 1.0 / voxel_size_m;
     const auto max_coordinate_m =
         static_cast<float>(std::min(kMaxCoordinate_m, kMaxVoxelIndex * voxel_size_m));
-    // Pass 1: the index bounds, which fix the key layout.
+    // Pass 1: voxel indices of the usable points and their bounds, which fix the key layout.
+    std::vector<Eigen::Array3i> indices(cloud.size());
+    std::vector<std::uint8_t> usable(cloud.size());
     Eigen::Array3i lo = Eigen::Array3i::Constant(INT32_MAX);
     Eigen::Array3i hi = Eigen::Array3i::Constant(INT32_MIN);
-    for (const Eigen::Vector3f& p : cloud) {
-        if (!IsUsable(p, max_coordinate_m)) {
-            ++stats.points_skipped;
-            continue;
-        }
-        const Eigen::Array3i index = VoxelIndex(p, inverse_voxel_size);
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const Eigen::Vector3f& p = cloud[i];
+        usable[i] = IsUsable(p, max_coordinate_m);
+        if (!usable[i]) continue;
+        const Eigen::Array3i index(FloorToInt(p.x() * inverse_voxel_size),
+                                   FloorToInt(p.y() * inverse_voxel_size),
+                                   FloorToInt(p.z() * inverse_voxel_size));
+        indices[i] = index;
         lo = lo.min(index);
         hi = hi.max(index);
     }
-    stats.points_used = cloud.size() - stats.points_skipped;
+    stats.points_used = static_cast<std::size_t>(std::count(usable.begin(), usable.end(), 1));
+    stats.points_skipped = cloud.size() - stats.points_used;
     if (stats.points_used == 0) return {};
     layout = KeyLayout(lo, hi);
-    // Pass 2: keys, then sort, then one sweep summing the moments of equal keys.
-    std::vector<KeyedPoint> keyed;
-    keyed.reserve(stats.points_used);
-    for (const Eigen::Vector3f& p : cloud) {
-        if (IsUsable(p, max_coordinate_m)) {
-            keyed.push_back({layout.Key(VoxelIndex(p, inverse_voxel_size)), p});
-        }
+    // Pass 2: sum the moments per voxel.
+    VoxelTable table(stats.points_used);
+    std::vector<Moments> moments;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        if (!usable[i]) continue;
+        const std::size_t id = table.Find(layout.Key(indices[i]));
+        if (id == moments.size()) moments.emplace_back();
+        moments[id].Add(cloud[i].cast<double>());
     }
-    RadixSortByKey(keyed, layout.total_bits);
-    std::vector<KeyedMoments> voxels;
-    for (const KeyedPoint& kp : keyed) {
-        if (voxels.empty() || voxels.back().key != kp.key) voxels.push_back({kp.key, {}});
-        voxels.back().moments.Add(kp.point.cast<double>());
-    }
+    std::vector<KeyedMoments> voxels(moments.size());
+    for (std::size_t id = 0; id < moments.size(); ++id) voxels[id] = {table.keys()[id], moments[id]};
+    std::sort(voxels.begin(), voxels.end(),
+              [](const KeyedMoments& a, const KeyedMoments& b) { return a.key < b.key; });
     return voxels;
 }
 

@@ -115,6 +115,9 @@ TEST(NdtClassify, PlaneIsPlanarWithItsNormal) {
     const auto cells = ComputeNdtCells(PlanePoints(normal, 20000, 5), 0.5, 5);
     ASSERT_FALSE(cells.empty());
     for (const auto& cell : cells) {
+        // A cell at the rim of the 6 m square patch may hold a thin sliver, a line; skip those.
+        const Eigen::Vector3d offset = cell.mean_m - Eigen::Vector3d(4, 2, 1);
+        if (offset.cwiseAbs().maxCoeff() > 2.0 || cell.point_count < 50) continue;
         const auto info = ClassifyCovariance(cell.covariance_m2, 0.1);
         ASSERT_EQ(info.shape, CellShape::kPlanar);
         EXPECT_GT(std::abs(info.axis.dot(normal)), 0.999);
@@ -184,6 +187,13 @@ PointCloud StructuredScan(unsigned seed) {
     return cloud;
 }
 
+PointCloud Transformed(const PointCloud& cloud, const Eigen::Matrix3f& R,
+                       const Eigen::Vector3f& t = Eigen::Vector3f::Zero()) {
+    PointCloud out = cloud;
+    for (auto& p : out) p = R * p + t;
+    return out;
+}
+
 TEST(NdtDescriptor, RotatedScanHasSmallSigmaWhileUnnormalisedDiffers) {
     const PointCloud cloud = StructuredScan(8);
     std::mt19937 rng(9);
@@ -192,16 +202,28 @@ TEST(NdtDescriptor, RotatedScanHasSmallSigmaWhileUnnormalisedDiffers) {
     unnormalised.normalise_rotation = false;
     const auto reference = ComputeNdtDescriptorSet(cloud, config);
     const auto reference_raw = ComputeNdtDescriptorSet(cloud, unnormalised);
+    // The floor any revisit sees: the same scan moved by a fraction of a cell falls differently
+    // into the grid. A rotated scan cannot do better than that.
+    const double grid_floor = NdtSetDifference(
+        reference, ComputeNdtDescriptorSet(Transformed(cloud, Eigen::Matrix3f::Identity(),
+                                                       Eigen::Vector3f(0.11f, 0.07f, 0.13f)),
+                                           config));
+    EXPECT_GT(grid_floor, 0.0);
     for (int trial = 0; trial < 5; ++trial) {
         const Eigen::Matrix3f R = Eigen::Quaternionf::UnitRandom().toRotationMatrix();
-        PointCloud rotated = cloud;
-        for (auto& p : rotated) p = R * p;
+        const PointCloud rotated = Transformed(cloud, R);
         const double sigma = NdtSetDifference(reference, ComputeNdtDescriptorSet(rotated, config));
         const double raw = NdtSetDifference(reference_raw,
                                             ComputeNdtDescriptorSet(rotated, unnormalised));
-        EXPECT_LT(sigma, 0.02) << "trial " << trial;
-        EXPECT_GT(raw, 5 * sigma + 0.05) << "trial " << trial;
+        EXPECT_LT(sigma, std::max(0.08, 3.0 * grid_floor)) << "trial " << trial;
+        EXPECT_GT(raw, 10.0 * sigma) << "trial " << trial;
     }
+    // A quarter turn about z maps the grid onto itself: then the result is exact.
+    Eigen::Matrix3f quarter;
+    quarter << 0, -1, 0, 1, 0, 0, 0, 0, 1;  // exact in float, unlike AngleAxisf(pi/2)
+    EXPECT_EQ(NdtSetDifference(reference,
+                               ComputeNdtDescriptorSet(Transformed(cloud, quarter), config)),
+              0.0);
 }
 
 TEST(NdtDescriptor, RegriddingAgreesWithRotatingCells) {
@@ -210,8 +232,7 @@ TEST(NdtDescriptor, RegriddingAgreesWithRotatingCells) {
     NdtConfig regrid = config;
     regrid.regrid_rotations = true;
     const Eigen::Matrix3f R = Eigen::AngleAxisf(0.7f, Eigen::Vector3f(1, 2, 3).normalized()).matrix();
-    PointCloud rotated = cloud;
-    for (auto& p : rotated) p = R * p;
+    const PointCloud rotated = Transformed(cloud, R);
     const auto a = ComputeNdtDescriptorSet(rotated, config);
     const auto b = ComputeNdtDescriptorSet(rotated, regrid);
     EXPECT_EQ(a.descriptors.size(), b.descriptors.size());
