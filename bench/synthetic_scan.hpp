@@ -46,8 +46,8 @@ inline core::PointCloud SyntheticHdl64Scan(unsigned seed) {
                 const double along = (pole[0] * dx + pole[1] * dy) / horizontal;
                 const double miss = std::abs(pole[0] * dy - pole[1] * dx) / horizontal;
                 if (along > 0.0 && miss < pole[2]) {
-                    t = std::min(t, (along - std::sqrt(pole[2] * pole[2] - miss * miss)) /
-                                        horizontal);
+                    t = std::min(t,
+                                 (along - std::sqrt(pole[2] * pole[2] - miss * miss)) / horizontal);
                 }
             }
             if (t >= kMaxRange_m) continue;  // no return

@@ -37,8 +37,8 @@ nlohmann::json NdtJson(const core::NdtDescriptorSet& set) {
         }
         nlohmann::json rotation = nlohmann::json::array();
         for (int i = 0; i < 3; ++i) {
-            rotation.push_back({f.R_aligned_sensor(i, 0), f.R_aligned_sensor(i, 1),
-                                f.R_aligned_sensor(i, 2)});
+            rotation.push_back(
+                {f.R_aligned_sensor(i, 0), f.R_aligned_sensor(i, 1), f.R_aligned_sensor(i, 2)});
         }
         json["descriptors"].push_back(
             {{"R_aligned_sensor", rotation}, {"cells", f.total}, {"F", rows}});
@@ -61,8 +61,7 @@ void AddDescribeCommand(CLI::App& app) {
     auto* command = app.add_subcommand("describe", "Print the descriptor of one scan as JSON");
     auto scan = std::make_shared<std::string>();
     auto options = std::make_shared<DescriptorOptions>();
-    command->add_option("SCAN", *scan, "scan file (.bin .pcd .ply .xyz .txt .pts .3d)")
-        ->required();
+    command->add_option("SCAN", *scan, "scan file (.bin .pcd .ply .xyz .txt .pts .3d)")->required();
     options->AddTo(*command);
     command->callback([scan, options] {
         const io::RunConfig config = options->Resolve();

@@ -31,8 +31,8 @@ io::RunConfig DescriptorOptions::Resolve() const {
 }
 
 void DescriptorOptions::ApplyHistogramFlags(core::DescriptorConfig& descriptor) const {
-    const CLI::Option* flags[] = {bins_option_,          min_option_, max_option_, up_option_,
-                                  sensor_height_option_, out_of_range_option_};
+    const CLI::Option* flags[] = {bins_option_, min_option_,           max_option_,
+                                  up_option_,   sensor_height_option_, out_of_range_option_};
     for (const CLI::Option* flag : flags) {
         if (*flag && !core::IsHistogramMethod(descriptor.method)) {
             throw core::ConfigError(flag->get_name() +

@@ -17,7 +17,8 @@ public:
     TempDir() {
         const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
         std::string name = "lidarloop_test";
-        if (info != nullptr) name += std::string("_") + info->test_suite_name() + "_" + info->name();
+        if (info != nullptr)
+            name += std::string("_") + info->test_suite_name() + "_" + info->name();
         for (char& c : name) {
             if (c == '/') c = '_';
         }

@@ -28,7 +28,8 @@ struct Box {  // axis-aligned, world frame, metres
 
 // Samples `count` candidate points on the ground and on the boxes' faces and keeps each with a
 // probability falling with range from `sensor` (a LiDAR's beam spacing grows with range).
-PointCloud SampleScene(const std::vector<Box>& boxes, const Eigen::Vector3f& sensor, unsigned seed) {
+PointCloud SampleScene(const std::vector<Box>& boxes, const Eigen::Vector3f& sensor,
+                       unsigned seed) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<float> unit(0.0f, 1.0f);
     std::normal_distribution<float> noise(0.0f, 0.02f);
@@ -42,8 +43,8 @@ PointCloud SampleScene(const std::vector<Box>& boxes, const Eigen::Vector3f& sen
                  ground_z};
         } else {
             const Box& box = boxes[surface];
-            p = box.min + (box.max - box.min).cwiseProduct(
-                              Eigen::Vector3f(unit(rng), unit(rng), unit(rng)));
+            p = box.min +
+                (box.max - box.min).cwiseProduct(Eigen::Vector3f(unit(rng), unit(rng), unit(rng)));
             const int axis = static_cast<int>(rng() % 2);  // a vertical face
             p[axis] = (rng() % 2 == 0) ? box.min[axis] : box.max[axis];
         }
@@ -56,13 +57,19 @@ PointCloud SampleScene(const std::vector<Box>& boxes, const Eigen::Vector3f& sen
 }
 
 std::vector<Box> Corner() {
-    return {{{-20, 6, 0}, {15, 14, 9}},   {{8, -20, 0}, {16, 4, 14}}, {{-3, -5, 0}, {-2.7f, -4.7f, 6}},
-            {{2, -5, 0}, {2.3f, -4.7f, 6}}, {{-12, -4, 0}, {-8, -2, 1.5f}}};
+    return {{{-20, 6, 0}, {15, 14, 9}},
+            {{8, -20, 0}, {16, 4, 14}},
+            {{-3, -5, 0}, {-2.7f, -4.7f, 6}},
+            {{2, -5, 0}, {2.3f, -4.7f, 6}},
+            {{-12, -4, 0}, {-8, -2, 1.5f}}};
 }
 
 std::vector<Box> Courtyard() {
-    return {{{-25, 12, 0}, {25, 20, 4}},  {{-25, -20, 0}, {25, -12, 4}}, {{-25, -12, 0}, {-18, 12, 4}},
-            {{5, 2, 0}, {5.5f, 2.5f, 2}}, {{-6, -7, 0}, {-1, -5, 1.2f}}};
+    return {{{-25, 12, 0}, {25, 20, 4}},
+            {{-25, -20, 0}, {25, -12, 4}},
+            {{-25, -12, 0}, {-18, 12, 4}},
+            {{5, 2, 0}, {5.5f, 2.5f, 2}},
+            {{-6, -7, 0}, {-1, -5, 1.2f}}};
 }
 
 }  // namespace

@@ -6,9 +6,12 @@ namespace lidarloop::core {
 
 std::string ToString(Method method) {
     switch (method) {
-        case Method::kHeight: return "height";
-        case Method::kRange: return "range";
-        case Method::kNdt: return "ndt";
+        case Method::kHeight:
+            return "height";
+        case Method::kRange:
+            return "range";
+        case Method::kNdt:
+            return "ndt";
     }
     return "unknown";
 }

@@ -100,8 +100,8 @@ Histogram ComputeHistogram(const PointCloud& cloud, Projection projection,
         histogram.min_value = config.range_min_m;
         histogram.max_value = config.range_max_m;
         CountValues(
-            cloud, [](const Eigen::Vector3f& p) { return p.cast<double>().norm(); }, config,
-            counts, histogram);
+            cloud, [](const Eigen::Vector3f& p) { return p.cast<double>().norm(); }, config, counts,
+            histogram);
     }
     if (histogram.points_used == 0) {
         throw EmptyInputError("no point of the scan is usable (" +

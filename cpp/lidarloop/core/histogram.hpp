@@ -29,7 +29,7 @@ OutOfRangePolicy ParseOutOfRangePolicy(std::string_view name);
 /// 360° LiDAR (10 cm height buckets, 0.8 m range buckets). The threshold tau depends on b and on
 /// the value range, so learn it on your data (`lidarloop evaluate`) when you change them.
 struct HistogramConfig {
-    int bins = 100;                                ///< b, number of buckets, 1..1'000'000
+    int bins = 100;                                 ///< b, number of buckets, 1..1'000'000
     UpVectorMode up_vector = UpVectorMode::kFixed;  ///< up vector of the height projection
     /// Added to <p, u> so that 0 is the ground (Röhling footnote 1: the plane of the height
     /// projection passes through the sensor). 0 keeps heights relative to the sensor.
@@ -50,11 +50,11 @@ struct HistogramConfig {
 /// A normalised histogram H_b (Röhling eq. 3–4) with the bookkeeping of how it was made.
 struct Histogram {
     Projection projection = Projection::kHeight;
-    double min_value = 0.0;               ///< v_min, metres
-    double max_value = 0.0;               ///< v_max, metres
-    std::vector<double> mass;             ///< h_k, k = 0..b-1, non-negative, sums to 1
+    double min_value = 0.0;                         ///< v_min, metres
+    double max_value = 0.0;                         ///< v_max, metres
+    std::vector<double> mass;                       ///< h_k, k = 0..b-1, non-negative, sums to 1
     Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  ///< u used by the height projection
-    std::size_t points_used = 0;          ///< points counted in the buckets
+    std::size_t points_used = 0;                    ///< points counted in the buckets
     std::size_t points_skipped = 0;       ///< non-finite points (no return, corrupt values)
     std::size_t points_out_of_range = 0;  ///< finite points outside [v_min, v_max]
 };

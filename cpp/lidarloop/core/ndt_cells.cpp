@@ -24,7 +24,7 @@ struct Moments {
     std::array<double, 10> m{};  // n, sx, sy, sz, sxx, sxy, sxz, syy, syz, szz
 
     void Add(const Eigen::Vector3d& p) {
-        const double values[10] = {1.0,         p.x(),       p.y(),       p.z(),
+        const double values[10] = {1.0,           p.x(),         p.y(),         p.z(),
                                    p.x() * p.x(), p.x() * p.y(), p.x() * p.z(), p.y() * p.y(),
                                    p.y() * p.z(), p.z() * p.z()};
         for (int i = 0; i < 10; ++i) m[i] += values[i];
@@ -153,7 +153,8 @@ std::vector<KeyedMoments> BinIntoVoxels(const PointCloud& cloud, double voxel_si
         moments[id].Add(cloud[i].cast<double>());
     }
     std::vector<KeyedMoments> voxels(moments.size());
-    for (std::size_t id = 0; id < moments.size(); ++id) voxels[id] = {table.keys()[id], moments[id]};
+    for (std::size_t id = 0; id < moments.size(); ++id)
+        voxels[id] = {table.keys()[id], moments[id]};
     std::sort(voxels.begin(), voxels.end(),
               [](const KeyedMoments& a, const KeyedMoments& b) { return a.key < b.key; });
     return voxels;
@@ -201,7 +202,8 @@ std::vector<NdtCell> ComputeNdtCells(const PointCloud& cloud, double cell_size_m
                           std::to_string(cell_size_m));
     }
     if (min_points < 2) {
-        throw ConfigError("ndt.min_points_per_cell must be >= 2, got " + std::to_string(min_points));
+        throw ConfigError("ndt.min_points_per_cell must be >= 2, got " +
+                          std::to_string(min_points));
     }
     NdtCellStats local_stats;
     NdtCellStats& s = stats != nullptr ? *stats : local_stats;

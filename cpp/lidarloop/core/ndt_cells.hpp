@@ -12,18 +12,18 @@ namespace lidarloop::core {
 /// One cell of the normal distributions transform: the mean and covariance of the points inside
 /// a cube of side q (Magnusson et al. 2009, section II-A).
 struct NdtCell {
-    Eigen::Vector3d mean_m = Eigen::Vector3d::Zero();          ///< sensor frame, metres
-    Eigen::Matrix3d covariance_m2 = Eigen::Matrix3d::Zero();   ///< unbiased (n-1), square metres
+    Eigen::Vector3d mean_m = Eigen::Vector3d::Zero();         ///< sensor frame, metres
+    Eigen::Matrix3d covariance_m2 = Eigen::Matrix3d::Zero();  ///< unbiased (n-1), square metres
     int point_count = 0;
 };
 
 /// Bookkeeping of a cell computation.
 struct NdtCellStats {
-    std::size_t points_used = 0;     ///< finite points binned into the grid
+    std::size_t points_used = 0;  ///< finite points binned into the grid
     /// Non-finite points, and points farther than min(100 km, 2^20 half-cells) from the sensor
     /// on some axis (beyond any LiDAR's reach; the grid index would overflow).
     std::size_t points_skipped = 0;
-    std::size_t sparse_cells = 0;    ///< occupied cells with fewer than the minimum point count
+    std::size_t sparse_cells = 0;  ///< occupied cells with fewer than the minimum point count
 };
 
 /// Computes the overlapping NDT grid of Magnusson II-A: cubic cells of side `cell_size_m` whose

@@ -26,7 +26,8 @@ void NdtConfig::Validate() const {
             "ndt.planar_classes must be in [0, 10000]");
     Require(linear_classes >= 0 && linear_classes <= 10'000,
             "ndt.linear_classes must be in [0, 10000]");
-    Require(FeatureCount() >= 1, "ndt: at least one of spherical, planar, linear classes is needed");
+    Require(FeatureCount() >= 1,
+            "ndt: at least one of spherical, planar, linear classes is needed");
     Require(range_limits_m.size() <= 64, "ndt.range_limits_m holds at most 64 borders");
     for (std::size_t i = 0; i < range_limits_m.size(); ++i) {
         Require(std::isfinite(range_limits_m[i]) && range_limits_m[i] > 0.0,

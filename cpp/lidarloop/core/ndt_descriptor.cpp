@@ -45,8 +45,8 @@ int RangeRow(const Eigen::Vector3d& mean_m, const std::vector<double>& limits_m)
 
 int SphericalColumn(double l2_over_l1, const NdtConfig& config) {
     // s equal sub-intervals of [t_e, 1], the values l2/l1 a spherical cell can have.
-    const double t = (l2_over_l1 - config.eigen_ratio_threshold) /
-                     (1.0 - config.eigen_ratio_threshold);
+    const double t =
+        (l2_over_l1 - config.eigen_ratio_threshold) / (1.0 - config.eigen_ratio_threshold);
     const int s = config.spherical_classes;
     return std::clamp(static_cast<int>(t * s), 0, s - 1);
 }
@@ -280,15 +280,15 @@ NdtDescriptorSet ComputeNdtDescriptorSet(const PointCloud& cloud, const NdtConfi
     NdtDescriptorSet set;
     const Partitions partitions = MakePartitions(config);
     const auto cells_of = [&](const PointCloud& points) {
-        return ClassifyCells(ComputeNdtCells(points, config.cell_size_m,
-                                             config.min_points_per_cell, &set.cell_stats),
+        return ClassifyCells(ComputeNdtCells(points, config.cell_size_m, config.min_points_per_cell,
+                                             &set.cell_stats),
                              config, set.degenerate_cells);
     };
     const std::vector<ClassifiedCell> cells = cells_of(cloud);
     for (const Eigen::Matrix3d& R : CandidateRotations(cells, config, partitions)) {
         if (config.regrid_rotations && !R.isIdentity()) {
-            NdtDescriptor f = CountFeatures(cells_of(Rotated(cloud, R)), Eigen::Matrix3d::Identity(),
-                                            config, partitions);
+            NdtDescriptor f = CountFeatures(cells_of(Rotated(cloud, R)),
+                                            Eigen::Matrix3d::Identity(), config, partitions);
             f.R_aligned_sensor = R;
             set.descriptors.push_back(std::move(f));
         } else {
@@ -296,10 +296,10 @@ NdtDescriptorSet ComputeNdtDescriptorSet(const PointCloud& cloud, const NdtConfi
         }
     }
     if (set.descriptors.front().total <= 0.0) {
-        throw EmptyInputError("no NDT cell could be classified (" +
-                              std::to_string(set.cell_stats.points_used) + " usable points, " +
-                              std::to_string(set.cell_stats.sparse_cells) + " cells with fewer than " +
-                              std::to_string(config.min_points_per_cell) + " points)");
+        throw EmptyInputError(
+            "no NDT cell could be classified (" + std::to_string(set.cell_stats.points_used) +
+            " usable points, " + std::to_string(set.cell_stats.sparse_cells) +
+            " cells with fewer than " + std::to_string(config.min_points_per_cell) + " points)");
     }
     return set;
 }

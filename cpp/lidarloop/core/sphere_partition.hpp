@@ -29,7 +29,7 @@ struct SphereRegion {
 /// numbered zone by zone from the pole, and by increasing longitude from the zone's offset within
 /// a zone. Immutable after construction, so every member is safe to call from many threads.
 class HalfSpherePartition {
-  public:
+public:
     /// Builds the partition into `regions` cells, 1..10000. Throws ConfigError otherwise.
     explicit HalfSpherePartition(int regions);
 
@@ -66,7 +66,7 @@ class HalfSpherePartition {
     /// region boundaries. O(n), no allocation, no exception; meant for hot loops.
     int NearestLine(const Eigen::Vector3d& direction) const;
 
-  private:
+private:
     std::vector<Eigen::Vector3d> centres_;
     std::vector<SphereRegion> regions_;
     std::vector<double> zone_colatitudes_;

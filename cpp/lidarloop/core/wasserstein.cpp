@@ -9,9 +9,10 @@ namespace lidarloop::core {
 
 double WassersteinDistance(std::span<const double> g, std::span<const double> h) {
     if (g.size() != h.size() || g.empty()) {
-        throw ConfigError("Wasserstein distance needs two histograms with the same, non-zero "
-                          "number of buckets (got " + std::to_string(g.size()) + " and " +
-                          std::to_string(h.size()) + ")");
+        throw ConfigError(
+            "Wasserstein distance needs two histograms with the same, non-zero "
+            "number of buckets (got " +
+            std::to_string(g.size()) + " and " + std::to_string(h.size()) + ")");
     }
     double prefix_difference = 0.0;
     double total = 0.0;

@@ -78,7 +78,8 @@ fs::path ExistingOr(const fs::path& given, const fs::path& fallback) {
 }
 
 // KITTI poses have 12 numbers per line, TUM poses 8; tell them apart by the first data line.
-std::vector<core::StampedPose> ReadPosesFile(const fs::path& file, const core::Transform& T_cam0_velo,
+std::vector<core::StampedPose> ReadPosesFile(const fs::path& file,
+                                             const core::Transform& T_cam0_velo,
                                              const fs::path& times_file) {
     detail::LineReader reader(file);
     std::string line;
@@ -169,10 +170,14 @@ Dataset::Dataset(DatasetFormat format, fs::path root, std::vector<fs::path> scan
 
 std::string Dataset::FormatName() const {
     switch (format_) {
-        case DatasetFormat::kKitti: return "kitti";
-        case DatasetFormat::kFolder: return "folder";
-        case DatasetFormat::kOsnabrueck: return "osnabrueck";
-        case DatasetFormat::kAuto: break;
+        case DatasetFormat::kKitti:
+            return "kitti";
+        case DatasetFormat::kFolder:
+            return "folder";
+        case DatasetFormat::kOsnabrueck:
+            return "osnabrueck";
+        case DatasetFormat::kAuto:
+            break;
     }
     return "auto";
 }

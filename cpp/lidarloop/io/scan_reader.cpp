@@ -48,8 +48,8 @@ core::PointCloud ReadScan(const std::filesystem::path& file) {
     const Reader reader = FindReader(file);
     if (reader == nullptr) {
         std::string known;
-        for (const auto& format : kFormats) known += std::string(known.empty() ? "" : " ") +
-                                                     format.extension;
+        for (const auto& format : kFormats)
+            known += std::string(known.empty() ? "" : " ") + format.extension;
         throw ReadError(file, "unknown scan format '" + file.extension().string() +
                                   "' (known extensions: " + known + ")");
     }

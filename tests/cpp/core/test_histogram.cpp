@@ -166,14 +166,14 @@ TEST(Histogram, PcaHeightIsInvariantToAnyRotation) {
     std::normal_distribution<float> noise(0.0f, 0.02f);
     PointCloud cloud;
     for (int i = 0; i < 20000; ++i) cloud.push_back({xy(rng), xy(rng), -1.8f + noise(rng)});
-    for (int i = 0; i < 500; ++i) cloud.push_back({xy(rng) / 10, 10.0f, 3.0f * static_cast<float>(i % 7)});
+    for (int i = 0; i < 500; ++i)
+        cloud.push_back({xy(rng) / 10, 10.0f, 3.0f * static_cast<float>(i % 7)});
     HistogramConfig config;
     config.up_vector = UpVectorMode::kPca;
     const Histogram reference = ComputeHistogram(cloud, Projection::kHeight, config);
-    const Eigen::Matrix3f tilt =
-        (Eigen::AngleAxisf(0.8f, Eigen::Vector3f::UnitZ()) *
-         Eigen::AngleAxisf(0.15f, Eigen::Vector3f(1, 1, 0).normalized()))
-            .matrix();
+    const Eigen::Matrix3f tilt = (Eigen::AngleAxisf(0.8f, Eigen::Vector3f::UnitZ()) *
+                                  Eigen::AngleAxisf(0.15f, Eigen::Vector3f(1, 1, 0).normalized()))
+                                     .matrix();
     for (auto& p : cloud) p = tilt * p;
     const Histogram rotated = ComputeHistogram(cloud, Projection::kHeight, config);
     EXPECT_LT(WassersteinDistance(reference.mass, rotated.mass), 1e-4);

@@ -88,8 +88,8 @@ TEST(NdtCells, EveryPointIsInEightCells) {
 TEST(NdtCells, SkipsNonFiniteAndRejectsBadParameters) {
     const float nan = std::numeric_limits<float>::quiet_NaN();
     NdtCellStats stats;
-    const auto cells = ComputeNdtCells({{nan, 0, 0}, {1e9f, 0, 0}, {0, 0, 0}, {0, 0, 0.1f}}, 0.5, 2,
-                                       &stats);
+    const auto cells =
+        ComputeNdtCells({{nan, 0, 0}, {1e9f, 0, 0}, {0, 0, 0}, {0, 0, 0.1f}}, 0.5, 2, &stats);
     EXPECT_EQ(stats.points_skipped, 2U);
     EXPECT_EQ(stats.points_used, 2U);
     EXPECT_THROW(ComputeNdtCells({}, 0.0, 5), ConfigError);
@@ -213,17 +213,17 @@ TEST(NdtDescriptor, RotatedScanHasSmallSigmaWhileUnnormalisedDiffers) {
         const Eigen::Matrix3f R = Eigen::Quaternionf::UnitRandom().toRotationMatrix();
         const PointCloud rotated = Transformed(cloud, R);
         const double sigma = NdtSetDifference(reference, ComputeNdtDescriptorSet(rotated, config));
-        const double raw = NdtSetDifference(reference_raw,
-                                            ComputeNdtDescriptorSet(rotated, unnormalised));
+        const double raw =
+            NdtSetDifference(reference_raw, ComputeNdtDescriptorSet(rotated, unnormalised));
         EXPECT_LT(sigma, std::max(0.08, 3.0 * grid_floor)) << "trial " << trial;
         EXPECT_GT(raw, 10.0 * sigma) << "trial " << trial;
     }
     // A quarter turn about z maps the grid onto itself: then the result is exact.
     Eigen::Matrix3f quarter;
     quarter << 0, -1, 0, 1, 0, 0, 0, 0, 1;  // exact in float, unlike AngleAxisf(pi/2)
-    EXPECT_EQ(NdtSetDifference(reference,
-                               ComputeNdtDescriptorSet(Transformed(cloud, quarter), config)),
-              0.0);
+    EXPECT_EQ(
+        NdtSetDifference(reference, ComputeNdtDescriptorSet(Transformed(cloud, quarter), config)),
+        0.0);
 }
 
 TEST(NdtDescriptor, RegriddingAgreesWithRotatingCells) {
@@ -231,7 +231,8 @@ TEST(NdtDescriptor, RegriddingAgreesWithRotatingCells) {
     NdtConfig config;
     NdtConfig regrid = config;
     regrid.regrid_rotations = true;
-    const Eigen::Matrix3f R = Eigen::AngleAxisf(0.7f, Eigen::Vector3f(1, 2, 3).normalized()).matrix();
+    const Eigen::Matrix3f R =
+        Eigen::AngleAxisf(0.7f, Eigen::Vector3f(1, 2, 3).normalized()).matrix();
     const PointCloud rotated = Transformed(cloud, R);
     const auto a = ComputeNdtDescriptorSet(rotated, config);
     const auto b = ComputeNdtDescriptorSet(rotated, regrid);
@@ -308,8 +309,8 @@ TEST(NdtDescriptor, DegenerateScansGiveDefinedResults) {
     const auto literal = ComputeNdtDescriptorSet(PlanePoints(normal, 20000, 14), config);
     ASSERT_EQ(literal.descriptors.size(), 1U);
     const HalfSpherePartition partition(9);
-    const Eigen::Vector3d normal_line = partition.centres()[static_cast<std::size_t>(
-        partition.NearestLine(normal))];
+    const Eigen::Vector3d normal_line =
+        partition.centres()[static_cast<std::size_t>(partition.NearestLine(normal))];
     EXPECT_NEAR(std::abs((literal.descriptors[0].R_aligned_sensor * normal_line).z()), 1.0, 1e-9);
 }
 

@@ -22,7 +22,8 @@ PointCloud TiltedGroundScan(const Eigen::Vector3f& normal, unsigned seed) {
         cloud.push_back(origin + uniform(rng) * u + uniform(rng) * v + noise(rng) * normal);
     }
     for (int i = 0; i < 1500; ++i) {
-        cloud.push_back(origin + 8.0f * u + uniform(rng) * v + (std::abs(uniform(rng)) / 8) * normal);
+        cloud.push_back(origin + 8.0f * u + uniform(rng) * v +
+                        (std::abs(uniform(rng)) / 8) * normal);
         cloud.push_back(origin - 5.0f * v + (std::abs(uniform(rng)) / 5) * normal);
     }
     return cloud;
@@ -30,7 +31,7 @@ PointCloud TiltedGroundScan(const Eigen::Vector3f& normal, unsigned seed) {
 
 TEST(Projection, PcaRecoversTiltedGroundNormal) {
     for (const Eigen::Vector3f& normal : {Eigen::Vector3f(0, 0, 1), Eigen::Vector3f(0.1f, 0, 1),
-                                         Eigen::Vector3f(-0.2f, 0.15f, 1)}) {
+                                          Eigen::Vector3f(-0.2f, 0.15f, 1)}) {
         const Eigen::Vector3d truth = normal.normalized().cast<double>();
         const Eigen::Vector3d up = EstimateUpVectorPca(TiltedGroundScan(normal.normalized(), 3));
         EXPECT_GT(up.dot(truth), std::cos(0.5 * M_PI / 180.0)) << up.transpose();
