@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "lidarloop/core/error.hpp"
 
@@ -85,11 +86,13 @@ int FloorToInt(double value) {
 // consecutive points usually share a voxel: the last lookup is remembered.
 class VoxelTable {
 public:
-    explicit VoxelTable(std::size_t max_entries) {
+    VoxelTable(std::size_t max_entries, std::vector<std::uint32_t>& slots,
+               std::vector<std::uint64_t>& keys)
+        : slots_(slots), keys_(keys) {
         std::size_t capacity = 16;
         while (capacity < 2 * max_entries) capacity *= 2;
         slots_.assign(capacity, kEmpty);
-        keys_.reserve(max_entries / 4 + 16);
+        keys_.clear();
         shift_ = 64 - static_cast<int>(std::countr_zero(capacity));
     }
 
@@ -111,61 +114,84 @@ public:
 
 private:
     static constexpr std::uint32_t kEmpty = UINT32_MAX;
-    std::vector<std::uint32_t> slots_;
-    std::vector<std::uint64_t> keys_;
+    std::vector<std::uint32_t>& slots_;
+    std::vector<std::uint64_t>& keys_;
     int shift_ = 0;
     std::uint64_t last_key_ = UINT64_MAX;
     std::size_t last_id_ = 0;
 };
 
-std::vector<KeyedMoments> BinIntoVoxels(const PointCloud& cloud, double voxel_size_m,
-                                        NdtCellStats& stats, KeyLayout& layout) {
+// Scratch memory reused by later calls on the same thread: a scan's grid needs a few MB, and
+// fresh allocations of that size cost more in page faults than the arithmetic on them.
+struct Workspace {
+    std::vector<std::uint32_t> slots;
+    std::vector<std::uint64_t> keys;
+    std::vector<Moments> moments;
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> order;
+    std::vector<KeyedMoments> blocks;
+    std::vector<KeyedMoments> scratch;
+};
+
+Workspace& ThreadWorkspace() {
+    thread_local Workspace workspace;
+    return workspace;
+}
+
+// Fills ws.blocks with the moments of every occupied voxel, sorted by key.
+void BinIntoVoxels(const PointCloud& cloud, double voxel_size_m, NdtCellStats& stats,
+                   KeyLayout& layout, Workspace& ws) {
     const double inverse_voxel_size = 1.0 / voxel_size_m;
     const auto max_coordinate_m =
         static_cast<float>(std::min(kMaxCoordinate_m, kMaxVoxelIndex * voxel_size_m));
-    // Pass 1: voxel indices of the usable points and their bounds, which fix the key layout.
-    std::vector<Eigen::Array3i> indices(cloud.size());
-    std::vector<std::uint8_t> usable(cloud.size());
+    const auto index_of = [inverse_voxel_size](const Eigen::Vector3f& p) {
+        return Eigen::Array3i(FloorToInt(p.x() * inverse_voxel_size),
+                              FloorToInt(p.y() * inverse_voxel_size),
+                              FloorToInt(p.z() * inverse_voxel_size));
+    };
+    // Pass 1: the bounds of the voxel indices, which fix the key layout. Recomputing the indices
+    // in pass 2 is cheaper than storing them.
     Eigen::Array3i lo = Eigen::Array3i::Constant(INT32_MAX);
     Eigen::Array3i hi = Eigen::Array3i::Constant(INT32_MIN);
-    for (std::size_t i = 0; i < cloud.size(); ++i) {
-        const Eigen::Vector3f& p = cloud[i];
-        usable[i] = IsUsable(p, max_coordinate_m);
-        if (!usable[i]) continue;
-        const Eigen::Array3i index(FloorToInt(p.x() * inverse_voxel_size),
-                                   FloorToInt(p.y() * inverse_voxel_size),
-                                   FloorToInt(p.z() * inverse_voxel_size));
-        indices[i] = index;
+    for (const Eigen::Vector3f& p : cloud) {
+        if (!IsUsable(p, max_coordinate_m)) {
+            ++stats.points_skipped;
+            continue;
+        }
+        const Eigen::Array3i index = index_of(p);
         lo = lo.min(index);
         hi = hi.max(index);
     }
-    stats.points_used = static_cast<std::size_t>(std::count(usable.begin(), usable.end(), 1));
-    stats.points_skipped = cloud.size() - stats.points_used;
-    if (stats.points_used == 0) return {};
+    stats.points_used = cloud.size() - stats.points_skipped;
+    ws.blocks.clear();
+    if (stats.points_used == 0) return;
     layout = KeyLayout(lo, hi);
     // Pass 2: sum the moments per voxel.
-    VoxelTable table(stats.points_used);
-    std::vector<Moments> moments;
-    for (std::size_t i = 0; i < cloud.size(); ++i) {
-        if (!usable[i]) continue;
-        const std::size_t id = table.Find(layout.Key(indices[i]));
+    VoxelTable table(stats.points_used, ws.slots, ws.keys);
+    std::vector<Moments>& moments = ws.moments;
+    moments.clear();
+    for (const Eigen::Vector3f& p : cloud) {
+        if (!IsUsable(p, max_coordinate_m)) continue;
+        const std::size_t id = table.Find(layout.Key(index_of(p)));
         if (id == moments.size()) moments.emplace_back();
-        moments[id].Add(cloud[i].cast<double>());
+        moments[id].Add(p.cast<double>());
     }
-    std::vector<KeyedMoments> voxels(moments.size());
-    for (std::size_t id = 0; id < moments.size(); ++id)
-        voxels[id] = {table.keys()[id], moments[id]};
-    std::sort(voxels.begin(), voxels.end(),
-              [](const KeyedMoments& a, const KeyedMoments& b) { return a.key < b.key; });
-    return voxels;
+    // Sort small (key, id) pairs rather than the 88-byte moments.
+    ws.order.resize(moments.size());
+    for (std::size_t id = 0; id < moments.size(); ++id) {
+        ws.order[id] = {table.keys()[id], static_cast<std::uint32_t>(id)};
+    }
+    std::sort(ws.order.begin(), ws.order.end());
+    ws.blocks.resize(moments.size());
+    for (std::size_t i = 0; i < ws.order.size(); ++i) {
+        ws.blocks[i] = {ws.order[i].first, moments[ws.order[i].second]};
+    }
 }
 
 // Box sum of width 2 along one axis: out[k] = in[k] + in[k + step], for every k where either is
 // present. Both `in` and `in` shifted by -step are sorted, so one merge pass suffices.
-std::vector<KeyedMoments> PairSumAlongAxis(const std::vector<KeyedMoments>& in,
-                                           std::uint64_t step) {
-    std::vector<KeyedMoments> out;
-    out.reserve(in.size() * 2);
+void PairSumAlongAxis(const std::vector<KeyedMoments>& in, std::uint64_t step,
+                      std::vector<KeyedMoments>& out) {
+    out.clear();
     std::size_t a = 0;  // walks keys k = in[a].key   (the cell's own voxel)
     std::size_t b = 0;  // walks keys k = in[b].key - step (the cell's upper neighbour)
     while (a < in.size() || b < in.size()) {
@@ -177,7 +203,6 @@ std::vector<KeyedMoments> PairSumAlongAxis(const std::vector<KeyedMoments>& in,
         if (key_b == key) cell.moments += in[b++].moments;
         out.push_back(cell);
     }
-    return out;
 }
 
 NdtCell CellFromMoments(const Moments& moments) {
@@ -209,11 +234,15 @@ std::vector<NdtCell> ComputeNdtCells(const PointCloud& cloud, double cell_size_m
     NdtCellStats& s = stats != nullptr ? *stats : local_stats;
     s = {};
     KeyLayout layout(Eigen::Array3i::Zero(), Eigen::Array3i::Zero());
-    std::vector<KeyedMoments> blocks = BinIntoVoxels(cloud, cell_size_m / 2.0, s, layout);
-    for (const std::uint64_t step : layout.step) blocks = PairSumAlongAxis(blocks, step);
+    Workspace& ws = ThreadWorkspace();
+    BinIntoVoxels(cloud, cell_size_m / 2.0, s, layout, ws);
+    for (const std::uint64_t step : layout.step) {
+        PairSumAlongAxis(ws.blocks, step, ws.scratch);
+        ws.blocks.swap(ws.scratch);
+    }
     std::vector<NdtCell> cells;
-    cells.reserve(blocks.size() / 4);
-    for (const KeyedMoments& block : blocks) {
+    cells.reserve(ws.blocks.size());
+    for (const KeyedMoments& block : ws.blocks) {
         if (block.moments.m[0] < static_cast<double>(min_points)) {
             ++s.sparse_cells;
             continue;

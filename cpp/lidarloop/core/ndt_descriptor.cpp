@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
+#include "lidarloop/core/eigen3x3.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/core/sphere_partition.hpp"
 
@@ -70,19 +71,49 @@ std::vector<ClassifiedCell> ClassifyCells(const std::vector<NdtCell>& cells,
     return classified;
 }
 
-// Feature column of a cell seen after rotating the scan by R (eq. 1 and 2); -1: not counted.
-int FeatureColumn(const ClassifiedCell& cell, const Eigen::Matrix3d& R, const NdtConfig& config,
-                  const Partitions& partitions) {
+// Nearest-line classification (eq. 2) of many axes seen after rotating the scan by R. Because
+// (R a) . c_j = a . (R^T c_j), the few centres are rotated once instead of every cell's axis.
+class RotatedLines {
+public:
+    RotatedLines(const std::optional<HalfSpherePartition>& partition, const Eigen::Matrix3d& R) {
+        if (!partition) return;
+        for (const Eigen::Vector3d& centre : partition->centres()) {
+            const Eigen::Vector3d c = R.transpose() * centre;
+            x_.push_back(c.x());
+            y_.push_back(c.y());
+            z_.push_back(c.z());
+        }
+    }
+    bool empty() const { return x_.empty(); }
+    int Classify(const Eigen::Vector3d& axis) const {
+        int best = 0;
+        double best_dot = -1.0;
+        for (std::size_t j = 0; j < x_.size(); ++j) {
+            const double dot = std::abs(axis.x() * x_[j] + axis.y() * y_[j] + axis.z() * z_[j]);
+            if (dot > best_dot) {  // strict: ties keep the lowest index, as NearestLine does
+                best_dot = dot;
+                best = static_cast<int>(j);
+            }
+        }
+        return best;
+    }
+
+private:
+    std::vector<double> x_, y_, z_;
+};
+
+// Feature column of a cell (eq. 1 and 2); -1 when its class is not counted (s, p or l is 0).
+int FeatureColumn(const ClassifiedCell& cell, const NdtConfig& config, const RotatedLines& planes,
+                  const RotatedLines& lines) {
     switch (cell.shape) {
         case CellShape::kSpherical:
             return config.spherical_classes > 0 ? cell.spherical_column : -1;
         case CellShape::kPlanar:
-            if (!partitions.planar) return -1;
-            return config.spherical_classes + partitions.planar->NearestLine(R * cell.axis);
+            if (planes.empty()) return -1;
+            return config.spherical_classes + planes.Classify(cell.axis);
         case CellShape::kLinear:
-            if (!partitions.linear) return -1;
-            return config.spherical_classes + config.planar_classes +
-                   partitions.linear->NearestLine(R * cell.axis);
+            if (lines.empty()) return -1;
+            return config.spherical_classes + config.planar_classes + lines.Classify(cell.axis);
         case CellShape::kDegenerate:
             break;
     }
@@ -96,8 +127,10 @@ NdtDescriptor CountFeatures(const std::vector<ClassifiedCell>& cells, const Eige
     f.cols = config.FeatureCount();
     f.counts.assign(static_cast<std::size_t>(f.rows * f.cols), 0.0f);
     f.R_aligned_sensor = R;
+    const RotatedLines planes(partitions.planar, R);
+    const RotatedLines lines(partitions.linear, R);
     for (const ClassifiedCell& cell : cells) {
-        const int column = FeatureColumn(cell, R, config, partitions);
+        const int column = FeatureColumn(cell, config, planes, lines);
         if (column < 0) continue;
         f.counts[static_cast<std::size_t>(cell.row * f.cols + column)] += 1.0f;
         f.total += 1.0;
@@ -255,20 +288,19 @@ PointCloud Rotated(const PointCloud& cloud, const Eigen::Matrix3d& R) {
 CellShapeInfo ClassifyCovariance(const Eigen::Matrix3d& covariance_m2, double t_e) {
     CellShapeInfo info;
     if (!covariance_m2.allFinite()) return info;
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-    solver.computeDirect(covariance_m2);  // eigenvalues ascending: l3, l2, l1
-    const Eigen::Vector3d lambda = solver.eigenvalues().cwiseMax(0.0);
-    const double l1 = lambda[2];
+    // Eigenvalues first; only the one eigenvector the shape needs is computed (the hot loop).
+    const Eigen::Vector3d lambda = SymmetricEigenvaluesDescending(covariance_m2).cwiseMax(0.0);
+    const double l1 = lambda[0];
     const double l2 = lambda[1];
-    const double l3 = lambda[0];
+    const double l3 = lambda[2];
     if (!(l1 > 1e-12 * std::max(1.0, covariance_m2.trace()))) return info;  // no spread
     info.l2_over_l1 = l2 / l1;
     if (l2 / l1 < t_e) {
         info.shape = CellShape::kLinear;
-        info.axis = solver.eigenvectors().col(2);
+        info.axis = SymmetricEigenvector(covariance_m2, lambda[0]);
     } else if (l3 / l2 < t_e) {
         info.shape = CellShape::kPlanar;
-        info.axis = solver.eigenvectors().col(0);
+        info.axis = SymmetricEigenvector(covariance_m2, lambda[2]);
     } else {
         info.shape = CellShape::kSpherical;
     }

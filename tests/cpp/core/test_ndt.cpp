@@ -6,7 +6,9 @@
 #include <tuple>
 
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 
+#include "lidarloop/core/eigen3x3.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/core/ndt_cells.hpp"
 #include "lidarloop/core/ndt_descriptor.hpp"
@@ -333,6 +335,45 @@ TEST(NdtConfig, DefaultsAreThePapersAndAbsurdValuesAreRejected) {
     invalid([](NdtConfig& c) { c.range_limits_m = {-1}; });
     invalid([](NdtConfig& c) { c.ambiguity_ratio = 1.5; });
     invalid([](NdtConfig& c) { c.threshold = NAN; });
+}
+
+}  // namespace
+}  // namespace lidarloop::core
+
+namespace lidarloop::core {
+namespace {
+
+TEST(Eigen3x3, MatchesEigensIterativeSolverOnRandomCovariances) {
+    std::mt19937 rng(21);
+    std::uniform_real_distribution<double> log_scale(-4.0, 1.0);
+    for (int trial = 0; trial < 2000; ++trial) {
+        // Random orientation, eigenvalues spread over 5 decades: planes, lines, blobs.
+        const Eigen::Matrix3d R = Eigen::Quaterniond::UnitRandom().toRotationMatrix();
+        const Eigen::Vector3d lambda(std::pow(10.0, log_scale(rng)), std::pow(10.0, log_scale(rng)),
+                                     std::pow(10.0, log_scale(rng)));
+        const Eigen::Matrix3d a = R * lambda.asDiagonal() * R.transpose();
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> reference(a);
+        const Eigen::Vector3d expected = reference.eigenvalues().reverse();
+        const Eigen::Vector3d actual = SymmetricEigenvaluesDescending(a);
+        EXPECT_LT((actual - expected).cwiseAbs().maxCoeff(), 1e-10 * expected[0]) << a;
+        for (int k : {0, 2}) {
+            const bool separated = std::abs(expected[k] - expected[1]) > 0.05 * expected[0];
+            if (!separated) continue;
+            const Eigen::Vector3d v = SymmetricEigenvector(a, actual[k]);
+            EXPECT_NEAR(std::abs(v.dot(reference.eigenvectors().col(2 - k))), 1.0, 1e-9) << a;
+        }
+    }
+}
+
+TEST(Eigen3x3, DiagonalAndRepeatedEigenvalues) {
+    EXPECT_EQ(SymmetricEigenvaluesDescending(Eigen::Vector3d(1, 3, 2).asDiagonal()),
+              Eigen::Vector3d(3, 2, 1));
+    const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
+    EXPECT_LT((SymmetricEigenvaluesDescending(identity) - Eigen::Vector3d::Ones()).norm(), 1e-15);
+    const Eigen::Vector3d v = SymmetricEigenvector(identity, 1.0);  // any unit vector will do
+    EXPECT_NEAR(v.norm(), 1.0, 1e-12);
+    Eigen::Matrix3d plane = Eigen::Vector3d(1, 1, 0).asDiagonal();
+    EXPECT_NEAR(std::abs(SymmetricEigenvector(plane, 0.0).z()), 1.0, 1e-12);
 }
 
 }  // namespace
