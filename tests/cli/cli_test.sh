@@ -70,6 +70,28 @@ for method in height range; do
         "$committed/corner_a.pcd" "$committed/courtyard.bin"
 done
 
+# --- NDT (Magnusson 2009) ---------------------------------------------------------------------
+expect_ok "describe ndt" '"method":"ndt"' "$cli" describe --method ndt "$samples/corner_a.bin"
+expect_ok "describe ndt matrix" '"F":[[' "$cli" describe --method ndt "$samples/corner_a.bin"
+ndt_same="$("$cli" distance --method ndt "$samples/corner_a.pcd" "$samples/corner_a.bin")"
+if [ "$ndt_same" = "0" ]; then pass; else fail "ndt sigma' of a scan to itself is $ndt_same"; fi
+ndt_near="$("$cli" distance --method ndt "$samples/corner_a.pcd" "$samples/corner_b.ply")"
+ndt_far="$("$cli" distance --method ndt "$samples/corner_a.pcd" "$samples/courtyard.bin")"
+if awk -v n="$ndt_near" -v f="$ndt_far" 'BEGIN { exit !(n > 0 && n < f) }'; then pass; else
+    fail "expected 0 < sigma'(same place)=$ndt_near < sigma'(other place)=$ndt_far"
+fi
+printf 'method: ndt\nndt:\n  cell_size_m: 1.0\n  planar_classes: 4\n' >"$work/ndt.yaml"
+expect_ok "ndt from config" '"method":"ndt"' "$cli" describe --config "$work/ndt.yaml" \
+    "$samples/corner_a.bin"
+printf 'ndt:\n  cell_size_m: 0\n' >"$work/ndt_bad.yaml"
+expect_error "ndt absurd cell size" "ndt.cell_size_m must be in" "$cli" describe --method ndt \
+    --config "$work/ndt_bad.yaml" "$samples/corner_a.bin"
+expect_error "histogram flag with ndt" "--bins applies to the height and range methods" \
+    "$cli" describe --method ndt --bins 10 "$samples/corner_a.bin"
+printf '1 2 3\n1 2 3\n' >"$work/two.xyz"
+expect_error "ndt too few points" "two.xyz: no NDT cell could be classified" "$cli" describe \
+    --method ndt "$work/two.xyz"
+
 # --- config -------------------------------------------------------------------------------------
 expect_ok "dump-config" "bins: 100" "$cli" dump-config
 printf 'histogram:\n  bins: 12\n' >"$work/twelve.yaml"
