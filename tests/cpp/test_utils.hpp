@@ -1,13 +1,19 @@
 #pragma once
 
+#include <bit>
+#include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <random>
 #include <string>
+#include <string_view>
 
 #include <gtest/gtest.h>
 
 #include "lidarloop/core/point_cloud.hpp"
+#include "lidarloop/io/read_error.hpp"
 
 namespace lidarloop::test {
 
@@ -64,6 +70,70 @@ inline core::PointCloud RandomCloud(std::size_t count, unsigned seed, float half
 /// Path of a fixture under tests/data.
 inline std::filesystem::path DataFile(const std::string& name) {
     return std::filesystem::path(LIDARLOOP_TEST_DATA_DIR) / name;
+}
+
+/// Replaces the first `from` in `text` by `to`; fails the test when `text` has no `from`.
+inline void ReplaceOnce(std::string& text, const std::string& from, const std::string& to) {
+    const auto at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+}
+
+/// Exact equality per coordinate: bit patterns for numbers (so -0 differs from +0), any NaN for
+/// NaN.
+inline void ExpectSameCloud(const core::PointCloud& actual, const core::PointCloud& expected) {
+    ASSERT_EQ(actual.size(), expected.size());
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+        for (int axis = 0; axis < 3; ++axis) {
+            const float a = actual[i][axis];
+            const float e = expected[i][axis];
+            const bool same =
+                std::isnan(e) ? std::isnan(a)
+                              : std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(e);
+            EXPECT_TRUE(same) << "point " << i << " axis " << axis << ": read " << a
+                              << ", expected " << e;
+        }
+    }
+}
+
+/// The io::ReadError that `read()` throws; nullopt when it returns. Any other exception escapes
+/// and fails the test.
+template <typename Read>
+std::optional<io::ReadError> CatchReadError(Read&& read) {
+    try {
+        read();
+    } catch (const io::ReadError& e) {
+        return e;
+    }
+    return std::nullopt;
+}
+
+/// The message of the io::ReadError that `read()` throws; "no ReadError" when it returns.
+template <typename Read>
+std::string ReadErrorOf(Read&& read) {
+    const auto error = CatchReadError(read);
+    return error ? error->what() : "no ReadError";
+}
+
+/// Success when `message` contains `phrase`; the failure shows both.
+inline ::testing::AssertionResult Contains(const std::string& message, std::string_view phrase) {
+    if (message.find(phrase) != std::string::npos) return ::testing::AssertionSuccess();
+    return ::testing::AssertionFailure() << "'" << phrase << "' not in: " << message;
+}
+
+/// Expects `read(file)` (e.g. `read` = io::ReadPcd) to throw an io::ReadError for `file` whose
+/// message names the file and contains `phrase`.
+template <typename Read>
+void ExpectReadError(Read&& read, const std::filesystem::path& file, const std::string& phrase) {
+    const auto error = CatchReadError([&] { read(file); });
+    if (!error) {
+        ADD_FAILURE() << "no ReadError for " << file;
+        return;
+    }
+    const std::string message = error->what();
+    EXPECT_NE(message.find(phrase), std::string::npos) << message;
+    EXPECT_NE(message.find(file.string()), std::string::npos) << message;
+    EXPECT_EQ(error->file(), file);
 }
 
 }  // namespace lidarloop::test

@@ -33,10 +33,7 @@
 
 #include "lidarloop/io/osnabrueck.hpp"
 
-#include <algorithm>
-#include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <numbers>
 #include <optional>
 #include <string>
@@ -46,6 +43,7 @@
 #include <Eigen/Geometry>
 
 #include "lidarloop/io/read_error.hpp"
+#include "lidarloop/io/rotation_check.hpp"
 #include "lidarloop/io/text_parsing.hpp"
 
 namespace lidarloop::io {
@@ -89,49 +87,11 @@ Eigen::Vector3d RotationToEuler(const Eigen::Matrix3d& R) {
     return {rx, ry, rz};
 }
 
-std::string Short(double value) {
-    char text[32];
-    std::snprintf(text, sizeof(text), "%.3g", value);
-    return text;
-}
-
 // Reads the next line; text files hold no control characters but tabs, so one means binary input.
 bool NextTextLine(detail::LineReader& reader, std::string& line) {
     if (!reader.Next(line)) return false;
-    const auto bad = std::find_if(line.begin(), line.end(), [](char c) {
-        const auto code = static_cast<unsigned char>(c);
-        return (code < 0x20 && c != '\t') || code == 0x7f;
-    });
-    if (bad != line.end()) {
-        char code[8];
-        std::snprintf(code, sizeof(code), "0x%02x", static_cast<unsigned char>(*bad));
-        reader.Fail(std::string("holds control character ") + code +
-                    " (binary data?); not a 3DTK text file");
-    }
+    detail::RejectControlCharacters(reader, line, "3DTK text file");
     return true;
-}
-
-// A pose with a non-finite value is unusable (points, in contrast, may be NaN).
-void ParseFiniteNumbers(const detail::LineReader& reader,
-                        const std::vector<std::string_view>& fields, std::size_t count,
-                        double* out) {
-    reader.ParseNumbers(fields, count, out);
-    for (std::size_t i = 0; i < count; ++i) {
-        if (!std::isfinite(out[i])) {
-            reader.Fail("'" + std::string(fields[i]) + "' is not a finite number");
-        }
-    }
-}
-
-// Files print matrices with ~6 digits: accept small deviations and snap to the nearest rotation,
-// reject what is no rotation at all (scaled, mirrored, garbage).
-Eigen::Matrix3d NearestRotationOrFail(const detail::LineReader& reader, const Eigen::Matrix3d& m) {
-    const double error = (m.transpose() * m - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
-    if (error > 1e-3 || m.determinant() <= 0.0) {
-        reader.Fail("the 3x3 part is not a rotation (max |R^T R - I| = " + Short(error) +
-                    ", det = " + Short(m.determinant()) + ")");
-    }
-    return Eigen::Quaterniond(m).normalized().toRotationMatrix();
 }
 
 core::Transform FramesLineToTransform(const detail::LineReader& reader, const double* values) {
@@ -142,7 +102,7 @@ core::Transform FramesLineToTransform(const detail::LineReader& reader, const do
             "bottom row of the column-major 4x4 matrix (values 4, 8, 12, 16) is not "
             "0 0 0 1; not a rigid transform");
     }
-    return FromOsnabrueckTransform(NearestRotationOrFail(reader, M.topLeftCorner<3, 3>()),
+    return FromOsnabrueckTransform(detail::NearestRotationOrFail(reader, M.topLeftCorner<3, 3>()),
                                    M.topRightCorner<3, 1>());
 }
 
@@ -151,24 +111,10 @@ bool IsDimensionsHeader(const std::vector<std::string_view>& fields) {
            detail::ParseSize(fields[2]);
 }
 
-void AppendNumber(std::string& text, double value, char separator) {
-    char number[32];
-    const auto end = std::to_chars(number, number + sizeof(number), value).ptr;
-    text.append(number, end);
-    text.push_back(separator);
-}
-
 void AppendVector(std::string& text, const Eigen::Vector3d& v) {
-    AppendNumber(text, v.x(), ' ');
-    AppendNumber(text, v.y(), ' ');
-    AppendNumber(text, v.z(), '\n');
-}
-
-void WriteText(const std::filesystem::path& file, const std::string& text) {
-    std::ofstream out = detail::OpenForWriting(file, /*binary=*/false);
-    out << text;
-    out.close();
-    if (!out) throw WriteError(file, "writing failed");
+    detail::AppendNumber(text, v.x(), ' ');
+    detail::AppendNumber(text, v.y(), ' ');
+    detail::AppendNumber(text, v.z(), '\n');
 }
 
 }  // namespace
@@ -193,10 +139,7 @@ core::PointCloud ReadOsnabrueck3d(const std::filesystem::path& file) {
         first_data_line = false;
         if (is_header) continue;
         double p[3];
-        // Numbers before the count, so "VERSION 0.7" (a PCD header) reads "'VERSION' is not a
-        // number" rather than "got 2".
-        reader.ParseNumbers(fields, std::min<std::size_t>(fields.size(), 3), p);
-        if (fields.size() < 3) reader.ParseNumbers(fields, 3, p);
+        reader.ParseXyz(fields, p);
         cloud.push_back(FromOsnabrueckCoordinates({p[0], p[1], p[2]}).cast<float>());
     }
     return cloud;
@@ -208,7 +151,7 @@ void WriteOsnabrueck3d(const std::filesystem::path& file, const core::PointCloud
     // Full double digits of the cm values, so reading back gives the same float metres.
     for (const auto& point : cloud)
         AppendVector(text, ToOsnabrueckCoordinates(point.cast<double>()));
-    WriteText(file, text);
+    detail::WriteTextFile(file, text);
 }
 
 core::Transform ReadOsnabrueckPose(const std::filesystem::path& file) {
@@ -218,7 +161,7 @@ core::Transform ReadOsnabrueckPose(const std::filesystem::path& file) {
     while (NextTextLine(reader, line)) {
         const auto fields = detail::SplitFields(line);
         std::vector<double> parsed(fields.size());
-        ParseFiniteNumbers(reader, fields, fields.size(), parsed.data());
+        reader.ParseFiniteNumbers(fields, fields.size(), parsed.data());
         if (values.size() + parsed.size() > 6) {
             reader.Fail("more than 6 numbers; a .pose file holds x y z (cm) and rx ry rz (deg)");
         }
@@ -239,7 +182,7 @@ void WriteOsnabrueckPose(const std::filesystem::path& file, const core::Transfor
     std::string text;
     AppendVector(text, ToOsnabrueckCoordinates(T_world_sensor.translation()));
     AppendVector(text, RotationToEuler(R_3dtk) / kRadPerDeg);
-    WriteText(file, text);
+    detail::WriteTextFile(file, text);
 }
 
 core::Transform ReadOsnabrueckFrames(const std::filesystem::path& file) {
@@ -254,7 +197,7 @@ core::Transform ReadOsnabrueckFrames(const std::filesystem::path& file) {
                         std::to_string(fields.size()) + " values");
         }
         double values[17];
-        ParseFiniteNumbers(reader, fields, fields.size(), values);
+        reader.ParseFiniteNumbers(fields, fields.size(), values);
         last = FramesLineToTransform(reader, values);
     }
     if (!last) throw ReadError(file, "holds no frames (lines of 16 matrix values and a code)");

@@ -4,28 +4,33 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cerrno>
-#include <charconv>
-#include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <fstream>
 #include <limits>
 #include <optional>
 #include <span>
 #include <string>
 #include <string_view>
-#include <system_error>
 #include <vector>
 
+#include "lidarloop/io/binary_io.hpp"
 #include "lidarloop/io/read_error.hpp"
 #include "lidarloop/io/text_parsing.hpp"
 
 namespace lidarloop::io {
 namespace {
 
+using detail::BytesText;
+using detail::CheckedMul;
+using detail::DataStream;
+using detail::FileSize;
 using detail::LineReader;
+using detail::LoadLittle;
+using detail::Quoted;
+using detail::ReadDataBytes;
+using detail::StoreLittle;
+using detail::ToFloat;
 
 // A 3-byte LZF back reference expands to at most 264 bytes; no valid block grows more than that.
 constexpr std::uint64_t kMaxLzfExpansion = 88;
@@ -66,59 +71,6 @@ struct CoordinateSource {
     std::size_t stride = 0;
     std::size_t size = 4;  ///< 4 (float) or 8 (double).
 };
-
-std::optional<std::size_t> CheckedMul(std::size_t a, std::size_t b) {
-    if (a != 0 && b > std::numeric_limits<std::size_t>::max() / a) return std::nullopt;
-    return a * b;
-}
-
-std::string BytesText(std::optional<std::size_t> bytes) {
-    if (!bytes) return "more than " + std::to_string(std::numeric_limits<std::size_t>::max());
-    return std::to_string(*bytes);
-}
-
-// Quotes a token for a message, shortened so that binary garbage does not flood it.
-std::string Quoted(std::string_view token) {
-    constexpr std::size_t kMaxChars = 40;
-    if (token.size() <= kMaxChars) return "'" + std::string(token) + "'";
-    return "'" + std::string(token.substr(0, kMaxChars)) + "...'";
-}
-
-template <typename T>
-T LoadLittle(const char* bytes) {
-    std::array<char, sizeof(T)> buffer;
-    std::memcpy(buffer.data(), bytes, sizeof(T));
-    if constexpr (std::endian::native == std::endian::big)
-        std::reverse(buffer.begin(), buffer.end());
-    return std::bit_cast<T>(buffer);
-}
-
-template <typename T>
-void StoreLittle(T value, char* bytes) {
-    auto buffer = std::bit_cast<std::array<char, sizeof(T)>>(value);
-    if constexpr (std::endian::native == std::endian::big)
-        std::reverse(buffer.begin(), buffer.end());
-    std::memcpy(bytes, buffer.data(), sizeof(T));
-}
-
-// Narrowing a double beyond the float range is undefined behaviour, so the IEEE rounding is done
-// here: up to half an ulp above FLT_MAX rounds down to it (9-digit text of FLT_MAX reads back as
-// such a value), from there on to infinity.
-float ToFloat(double value) {
-    constexpr double kFloatMax = std::numeric_limits<float>::max();
-    if (std::isnan(value) || std::abs(value) <= kFloatMax) return static_cast<float>(value);
-    const double overflow = std::ldexp(1.0, 128) - std::ldexp(1.0, 103);  // FLT_MAX + ulp / 2
-    const float magnitude = std::abs(value) < overflow ? std::numeric_limits<float>::max()
-                                                       : std::numeric_limits<float>::infinity();
-    return value > 0 ? magnitude : -magnitude;
-}
-
-std::size_t FileSize(const std::filesystem::path& file) {
-    std::error_code ec;
-    const auto size = std::filesystem::file_size(file, ec);
-    if (ec) throw ReadError(file, "cannot get the file size (" + ec.message() + ")");
-    return static_cast<std::size_t>(size);
-}
 
 // ---------------------------------------------------------------------------------------------
 // Header
@@ -378,36 +330,6 @@ core::PointCloud ReadAsciiData(LineReader& reader, const PcdHeader& header) {
     return cloud;
 }
 
-// The binary file positioned after the header, and the number of bytes left in it.
-struct DataStream {
-    std::ifstream in;
-    std::size_t remaining = 0;
-};
-
-DataStream OpenData(const std::filesystem::path& file, std::size_t header_lines) {
-    DataStream data{detail::OpenForReading(file, /*binary=*/true)};
-    for (std::size_t i = 0; i < header_lines; ++i) {
-        data.in.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
-    }
-    const std::size_t size = FileSize(file);
-    const auto offset = data.in.eof() ? size : static_cast<std::size_t>(data.in.tellg());
-    data.remaining = size - std::min(size, offset);
-    return data;
-}
-
-// Reads `count` bytes that the caller has checked to be present.
-std::vector<char> ReadBytes(const std::filesystem::path& file, DataStream& data,
-                            std::size_t count) {
-    std::vector<char> bytes(count);
-    data.in.read(bytes.data(), static_cast<std::streamsize>(count));
-    if (static_cast<std::size_t>(data.in.gcount()) != count) {
-        throw ReadError(file, "read failed after " + std::to_string(data.in.gcount()) + " of " +
-                                  std::to_string(count) + " data bytes");
-    }
-    data.remaining -= count;
-    return bytes;
-}
-
 core::PointCloud ReadBinaryData(const std::filesystem::path& file, DataStream& data,
                                 const PcdHeader& header) {
     std::size_t record = 0;
@@ -426,7 +348,7 @@ core::PointCloud ReadBinaryData(const std::filesystem::path& file, DataStream& d
                                   " bytes, but " + std::to_string(data.remaining) +
                                   " follow the header");
     }
-    return GatherPoints(ReadBytes(file, data, *need), header.points, sources);
+    return GatherPoints(ReadDataBytes(file, data, *need), header.points, sources);
 }
 
 void Decompress(const std::filesystem::path& file, const std::vector<char>& compressed,
@@ -497,11 +419,11 @@ core::PointCloud ReadCompressedData(const std::filesystem::path& file, DataStrea
                         "header, but " +
                             std::to_string(data.remaining) + " bytes follow the header");
     }
-    const auto sizes = ReadBytes(file, data, 8);
+    const auto sizes = ReadDataBytes(file, data, 8);
     const std::size_t compressed = CheckBlockSizes(file, sizes, data.remaining, *expected);
     if (*expected == 0) return {};
     std::vector<char> unpacked(*expected);
-    Decompress(file, ReadBytes(file, data, compressed), unpacked);
+    Decompress(file, ReadDataBytes(file, data, compressed), unpacked);
     for (auto& source : sources) source.offset *= header.points;
     return GatherPoints(unpacked, header.points, sources);
 }
@@ -533,23 +455,6 @@ void WriteHeader(std::ostream& out, std::size_t points, PcdEncoding encoding) {
         << "VIEWPOINT 0 0 0 1 0 0 0\n"
         << "POINTS " << points << "\n"
         << "DATA " << EncodingName(encoding) << "\n";
-}
-
-void WriteAsciiPoints(std::ostream& out, const core::PointCloud& cloud) {
-    // max_digits10 = 9 significant digits: the shortest form can fail to round-trip through the
-    // double that ParseDouble reads, 9 digits never do (checked for all 2^32 floats).
-    constexpr int kDigits = std::numeric_limits<float>::max_digits10;
-    std::array<char, 3 * 32> line{};
-    for (const auto& point : cloud) {
-        char* end = line.data();
-        for (int axis = 0; axis < 3; ++axis) {
-            end = std::to_chars(end, line.data() + line.size(), point[axis],
-                                std::chars_format::general, kDigits)
-                      .ptr;
-            *end++ = axis < 2 ? ' ' : '\n';
-        }
-        out.write(line.data(), end - line.data());
-    }
 }
 
 std::vector<char> PackPoints(const core::PointCloud& cloud, bool field_major) {
@@ -590,7 +495,7 @@ core::PointCloud ReadPcd(const std::filesystem::path& file) {
     LineReader reader(file);
     const PcdHeader header = ReadHeader(reader);
     if (header.encoding == PcdEncoding::kAscii) return ReadAsciiData(reader, header);
-    DataStream data = OpenData(file, header.line_count);
+    DataStream data = detail::OpenDataAfterHeader(file, header.line_count);
     if (header.encoding == PcdEncoding::kBinary) return ReadBinaryData(file, data, header);
     return ReadCompressedData(file, data, header);
 }
@@ -600,7 +505,7 @@ void WritePcd(const std::filesystem::path& file, const core::PointCloud& cloud,
     std::ofstream out = detail::OpenForWriting(file, encoding != PcdEncoding::kAscii);
     WriteHeader(out, cloud.size(), encoding);
     if (encoding == PcdEncoding::kAscii) {
-        WriteAsciiPoints(out, cloud);
+        detail::WriteXyzLines<float>(out, cloud);
     } else if (encoding == PcdEncoding::kBinary) {
         const std::vector<char> bytes = PackPoints(cloud, /*field_major=*/false);
         out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));

@@ -3,25 +3,28 @@
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <charconv>
-#include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <fstream>
 #include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
-#include <system_error>
 #include <vector>
 
+#include "lidarloop/io/binary_io.hpp"
 #include "lidarloop/io/read_error.hpp"
 #include "lidarloop/io/text_parsing.hpp"
 
 namespace lidarloop::io {
 namespace {
 
+using detail::BytesText;
+using detail::CheckedMul;
+using detail::FileSize;
 using detail::LineReader;
+using detail::Load;
+using detail::Quoted;
+using detail::ToFloat;
 
 enum class PlyType { kInt8, kUint8, kInt16, kUint16, kInt32, kUint32, kFloat32, kFloat64 };
 
@@ -103,78 +106,29 @@ struct PlyHeader {
     std::size_t line_count = 0;  ///< Header lines up to and including end_header.
 };
 
-std::optional<std::size_t> CheckedMul(std::size_t a, std::size_t b) {
-    if (a != 0 && b > std::numeric_limits<std::size_t>::max() / a) return std::nullopt;
-    return a * b;
+// Byte order of the binary data of a file in `encoding`.
+std::endian ByteOrder(PlyEncoding encoding) {
+    return encoding == PlyEncoding::kBinaryBigEndian ? std::endian::big : std::endian::little;
 }
 
-std::string BytesText(std::optional<std::size_t> bytes) {
-    if (!bytes) return "more than " + std::to_string(std::numeric_limits<std::size_t>::max());
-    return std::to_string(*bytes);
-}
-
-// Quotes a token for a message, shortened so that binary garbage does not flood it.
-std::string Quoted(std::string_view token) {
-    constexpr std::size_t kMaxChars = 40;
-    if (token.size() <= kMaxChars) return "'" + std::string(token) + "'";
-    return "'" + std::string(token.substr(0, kMaxChars)) + "...'";
-}
-
-// Narrowing a double beyond the float range is undefined behaviour, so the IEEE rounding is done
-// here: up to half an ulp above FLT_MAX rounds down to it (9-digit text of FLT_MAX reads back as
-// such a value), from there on to infinity.
-float ToFloat(double value) {
-    constexpr double kFloatMax = std::numeric_limits<float>::max();
-    if (std::isnan(value) || std::abs(value) <= kFloatMax) return static_cast<float>(value);
-    const double overflow = std::ldexp(1.0, 128) - std::ldexp(1.0, 103);  // FLT_MAX + ulp / 2
-    const float magnitude = std::abs(value) < overflow ? std::numeric_limits<float>::max()
-                                                       : std::numeric_limits<float>::infinity();
-    return value > 0 ? magnitude : -magnitude;
-}
-
-std::size_t FileSize(const std::filesystem::path& file) {
-    std::error_code ec;
-    const auto size = std::filesystem::file_size(file, ec);
-    if (ec) throw ReadError(file, "cannot get the file size (" + ec.message() + ")");
-    return static_cast<std::size_t>(size);
-}
-
-// Byte order of the file differs from the machine's: values are reversed on load and store.
-bool NeedsSwap(bool big_endian) { return big_endian != (std::endian::native == std::endian::big); }
-
-template <typename T>
-T Load(const char* bytes, bool big_endian) {
-    std::array<char, sizeof(T)> buffer;
-    std::memcpy(buffer.data(), bytes, sizeof(T));
-    if (NeedsSwap(big_endian)) std::reverse(buffer.begin(), buffer.end());
-    return std::bit_cast<T>(buffer);
-}
-
-template <typename T>
-void Store(T value, char* bytes, bool big_endian) {
-    auto buffer = std::bit_cast<std::array<char, sizeof(T)>>(value);
-    if (NeedsSwap(big_endian)) std::reverse(buffer.begin(), buffer.end());
-    std::memcpy(bytes, buffer.data(), sizeof(T));
-}
-
-double LoadScalar(const char* bytes, PlyType type, bool big_endian) {
+double LoadScalar(const char* bytes, PlyType type, std::endian order) {
     switch (type) {
         case PlyType::kInt8:
-            return Load<std::int8_t>(bytes, big_endian);
+            return Load<std::int8_t>(bytes, order);
         case PlyType::kUint8:
-            return Load<std::uint8_t>(bytes, big_endian);
+            return Load<std::uint8_t>(bytes, order);
         case PlyType::kInt16:
-            return Load<std::int16_t>(bytes, big_endian);
+            return Load<std::int16_t>(bytes, order);
         case PlyType::kUint16:
-            return Load<std::uint16_t>(bytes, big_endian);
+            return Load<std::uint16_t>(bytes, order);
         case PlyType::kInt32:
-            return Load<std::int32_t>(bytes, big_endian);
+            return Load<std::int32_t>(bytes, order);
         case PlyType::kUint32:
-            return Load<std::uint32_t>(bytes, big_endian);
+            return Load<std::uint32_t>(bytes, order);
         case PlyType::kFloat32:
-            return Load<float>(bytes, big_endian);
+            return Load<float>(bytes, order);
         case PlyType::kFloat64:
-            return Load<double>(bytes, big_endian);
+            return Load<double>(bytes, order);
     }
     return 0.0;
 }
@@ -370,8 +324,8 @@ core::PointCloud ReadAsciiPly(LineReader& reader, const PlyHeader& header) {
 
 class BinaryReader {
 public:
-    BinaryReader(const std::filesystem::path& file, std::vector<char> bytes, bool big_endian)
-        : file_(file), bytes_(std::move(bytes)), big_endian_(big_endian) {}
+    BinaryReader(const std::filesystem::path& file, std::vector<char> bytes, std::endian order)
+        : file_(file), bytes_(std::move(bytes)), order_(order) {}
 
     void SkipElement(const PlyElement& element) {
         CheckFits(element);
@@ -396,7 +350,7 @@ public:
                     SkipProperty(property, vertex, i);
                 } else {
                     const char* bytes = Take(TypeSize(property.type), vertex, i);
-                    cloud[i][axis] = ToFloat(LoadScalar(bytes, property.type, big_endian_));
+                    cloud[i][axis] = ToFloat(LoadScalar(bytes, property.type, order_));
                 }
             }
         }
@@ -437,7 +391,7 @@ private:
             return;
         }
         const double count = LoadScalar(Take(TypeSize(*property.count_type), element, index),
-                                        *property.count_type, big_endian_);
+                                        *property.count_type, order_);
         if (count < 0) {
             throw ReadError(file_,
                             "negative list count in " + element.name + " " + std::to_string(index));
@@ -449,25 +403,8 @@ private:
     std::filesystem::path file_;
     std::vector<char> bytes_;
     std::size_t pos_ = 0;
-    bool big_endian_ = false;
+    std::endian order_ = std::endian::little;
 };
-
-// The binary data: all bytes after the first `header_lines` lines.
-std::vector<char> ReadDataBytes(const std::filesystem::path& file, std::size_t header_lines) {
-    std::ifstream in = detail::OpenForReading(file, /*binary=*/true);
-    for (std::size_t i = 0; i < header_lines; ++i) {
-        in.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
-    }
-    const std::size_t size = FileSize(file);
-    const auto offset = in.eof() ? size : static_cast<std::size_t>(in.tellg());
-    std::vector<char> bytes(size - std::min(size, offset));
-    in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    if (static_cast<std::size_t>(in.gcount()) != bytes.size()) {
-        throw ReadError(file, "read failed after " + std::to_string(in.gcount()) + " of " +
-                                  std::to_string(bytes.size()) + " data bytes");
-    }
-    return bytes;
-}
 
 // ---------------------------------------------------------------------------------------------
 // Writing
@@ -497,30 +434,12 @@ void WriteHeader(std::ostream& out, std::size_t count, PlyEncoding encoding, Ply
 }
 
 template <typename T>
-void WriteAsciiVertices(std::ostream& out, const core::PointCloud& cloud) {
-    // max_digits10 significant digits read back to the same value (through a double for float).
-    constexpr int kDigits = std::numeric_limits<T>::max_digits10;
-    std::array<char, 3 * 32> line{};
-    for (const auto& point : cloud) {
-        char* end = line.data();
-        for (int axis = 0; axis < 3; ++axis) {
-            const T value = static_cast<T>(point[axis]);
-            end = std::to_chars(end, line.data() + line.size(), value, std::chars_format::general,
-                                kDigits)
-                      .ptr;
-            *end++ = axis < 2 ? ' ' : '\n';
-        }
-        out.write(line.data(), end - line.data());
-    }
-}
-
-template <typename T>
-void WriteBinaryVertices(std::ostream& out, const core::PointCloud& cloud, bool big_endian) {
+void WriteBinaryVertices(std::ostream& out, const core::PointCloud& cloud, std::endian order) {
     std::vector<char> bytes(cloud.size() * 3 * sizeof(T));
     char* next = bytes.data();
     for (const auto& point : cloud) {
         for (int axis = 0; axis < 3; ++axis, next += sizeof(T)) {
-            Store(static_cast<T>(point[axis]), next, big_endian);
+            detail::Store(static_cast<T>(point[axis]), next, order);
         }
     }
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
@@ -529,9 +448,9 @@ void WriteBinaryVertices(std::ostream& out, const core::PointCloud& cloud, bool 
 template <typename T>
 void WriteVertices(std::ostream& out, const core::PointCloud& cloud, PlyEncoding encoding) {
     if (encoding == PlyEncoding::kAscii) {
-        WriteAsciiVertices<T>(out, cloud);
+        detail::WriteXyzLines<T>(out, cloud);
     } else {
-        WriteBinaryVertices<T>(out, cloud, encoding == PlyEncoding::kBinaryBigEndian);
+        WriteBinaryVertices<T>(out, cloud, ByteOrder(encoding));
     }
 }
 
@@ -541,8 +460,9 @@ core::PointCloud ReadPly(const std::filesystem::path& file) {
     LineReader reader(file);
     const PlyHeader header = ReadHeader(reader);
     if (header.encoding == PlyEncoding::kAscii) return ReadAsciiPly(reader, header);
-    BinaryReader binary(file, ReadDataBytes(file, header.line_count),
-                        header.encoding == PlyEncoding::kBinaryBigEndian);
+    detail::DataStream data = detail::OpenDataAfterHeader(file, header.line_count);
+    BinaryReader binary(file, detail::ReadDataBytes(file, data, data.remaining),
+                        ByteOrder(header.encoding));
     // Elements after the vertices are never read.
     for (std::size_t e = 0; e < header.vertex; ++e) binary.SkipElement(header.elements[e]);
     return binary.ReadVertices(header);

@@ -1,8 +1,13 @@
 #include "lidarloop/io/text_parsing.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cerrno>
 #include <charconv>
+#include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <limits>
 #include <system_error>
 
 #include "lidarloop/io/read_error.hpp"
@@ -57,6 +62,65 @@ std::optional<std::size_t> ParseSize(std::string_view token) {
     return value;
 }
 
+std::string Quoted(std::string_view token) {
+    constexpr std::size_t kMaxChars = 40;
+    if (token.size() <= kMaxChars) return "'" + std::string(token) + "'";
+    return "'" + std::string(token.substr(0, kMaxChars)) + "...'";
+}
+
+std::string ShortNumber(double value) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "%.3g", value);
+    return text;
+}
+
+void AppendNumber(std::string& text, double value, char separator) {
+    char number[32];
+    const auto end = std::to_chars(number, number + sizeof(number), value).ptr;
+    text.append(number, end);
+    text.push_back(separator);
+}
+
+// The float's own shortest text nearly always reads back as the same float through the double
+// parser; where double rounding breaks it (7.038531e-26f and its negative, the only such floats in
+// an exhaustive check with libstdc++) the double's shortest text is exact.
+void AppendFloat(std::string& text, float value, char separator) {
+    char number[32];
+    char* end = std::to_chars(number, number + sizeof(number), value).ptr;
+    const auto parsed = ParseDouble(std::string_view(number, end - number));
+    const bool exact = std::isnan(value) || (parsed && static_cast<float>(*parsed) == value);
+    if (!exact) end = std::to_chars(number, number + sizeof(number), double{value}).ptr;
+    text.append(number, end);
+    text.push_back(separator);
+}
+
+template <typename T>
+void WriteXyzLines(std::ostream& out, const core::PointCloud& cloud) {
+    constexpr int kDigits = std::numeric_limits<T>::max_digits10;
+    std::array<char, 3 * 32> line{};
+    for (const auto& point : cloud) {
+        char* end = line.data();
+        for (int axis = 0; axis < 3; ++axis) {
+            const T value = static_cast<T>(point[axis]);
+            end = std::to_chars(end, line.data() + line.size(), value, std::chars_format::general,
+                                kDigits)
+                      .ptr;
+            *end++ = axis < 2 ? ' ' : '\n';
+        }
+        out.write(line.data(), end - line.data());
+    }
+}
+
+template void WriteXyzLines<float>(std::ostream& out, const core::PointCloud& cloud);
+template void WriteXyzLines<double>(std::ostream& out, const core::PointCloud& cloud);
+
+void WriteTextFile(const std::filesystem::path& file, const std::string& text) {
+    std::ofstream out = OpenForWriting(file, /*binary=*/false);
+    out << text;
+    out.close();
+    if (!out) throw WriteError(file, "writing failed");
+}
+
 LineReader::LineReader(const std::filesystem::path& file)
     : file_(file), in_(OpenForReading(file, /*binary=*/false)) {}
 
@@ -82,6 +146,32 @@ void LineReader::ParseNumbers(const std::vector<std::string_view>& fields, std::
         if (!value) Fail("'" + std::string(fields[i]) + "' is not a number");
         out[i] = *value;
     }
+}
+
+void LineReader::ParseFiniteNumbers(const std::vector<std::string_view>& fields, std::size_t count,
+                                    double* out) const {
+    ParseNumbers(fields, count, out);
+    for (std::size_t i = 0; i < count; ++i) {
+        if (!std::isfinite(out[i])) Fail("'" + std::string(fields[i]) + "' is not a finite number");
+    }
+}
+
+void LineReader::ParseXyz(const std::vector<std::string_view>& fields, double* xyz) const {
+    ParseNumbers(fields, std::min<std::size_t>(fields.size(), 3), xyz);
+    if (fields.size() < 3) ParseNumbers(fields, 3, xyz);
+}
+
+void RejectControlCharacters(const LineReader& reader, std::string_view line,
+                             std::string_view file_kind) {
+    const auto bad = std::find_if(line.begin(), line.end(), [](char c) {
+        const auto code = static_cast<unsigned char>(c);
+        return (code < 0x20 && c != '\t') || code == 0x7f;
+    });
+    if (bad == line.end()) return;
+    char code[8];
+    std::snprintf(code, sizeof(code), "0x%02x", static_cast<unsigned char>(*bad));
+    reader.Fail(std::string("holds control character ") + code + " (binary data?); not a " +
+                std::string(file_kind));
 }
 
 }  // namespace lidarloop::io::detail

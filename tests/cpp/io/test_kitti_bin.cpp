@@ -2,32 +2,17 @@
 #include <limits>
 #include <random>
 #include <string>
-#include <string_view>
 
 #include <gtest/gtest.h>
 
 #include "lidarloop/io/kitti_bin.hpp"
-#include "lidarloop/io/read_error.hpp"
 #include "test_utils.hpp"
 
 namespace lidarloop::io {
 namespace {
 
-// The message of the ReadError that `read` throws; any other exception fails the test.
-template <typename Read>
-std::string ReadErrorOf(Read read) {
-    try {
-        read();
-    } catch (const ReadError& e) {
-        return e.what();
-    }
-    return "no ReadError";
-}
-
-::testing::AssertionResult Contains(const std::string& message, std::string_view phrase) {
-    if (message.find(phrase) != std::string::npos) return ::testing::AssertionSuccess();
-    return ::testing::AssertionFailure() << "'" << phrase << "' not in: " << message;
-}
+using test::Contains;
+using test::ReadErrorOf;
 
 // Little-endian float32 bytes of the fixture's first record: 1.5, -2.25, 3, intensity 0.5.
 const std::string kFirstRecord("\x00\x00\xc0\x3f\x00\x00\x10\xc0\x00\x00\x40\x40\x00\x00\x00\x3f",

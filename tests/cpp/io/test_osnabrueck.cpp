@@ -4,14 +4,12 @@
 #include <random>
 #include <sstream>
 #include <string>
-#include <string_view>
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 
 #include "lidarloop/io/osnabrueck.hpp"
-#include "lidarloop/io/read_error.hpp"
 #include "test_utils.hpp"
 
 namespace lidarloop::io {
@@ -19,21 +17,8 @@ namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-// The message of the ReadError that `read` throws; any other exception fails the test.
-template <typename Read>
-std::string ReadErrorOf(Read read) {
-    try {
-        read();
-    } catch (const ReadError& e) {
-        return e.what();
-    }
-    return "no ReadError";
-}
-
-::testing::AssertionResult Contains(const std::string& message, std::string_view phrase) {
-    if (message.find(phrase) != std::string::npos) return ::testing::AssertionSuccess();
-    return ::testing::AssertionFailure() << "'" << phrase << "' not in: " << message;
-}
+using test::Contains;
+using test::ReadErrorOf;
 
 // 3DTK's rotation of a .pose file, written out element by element as EulerToMatrix4 in
 // 3DTK/3DTK include/slam6d/globals.icc fills it (there column-major; here row by row). Kept

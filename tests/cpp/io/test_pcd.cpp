@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -13,10 +14,30 @@
 #include "test_utils.hpp"
 
 namespace lidarloop::io {
+
+// gtest prints an enum as its bytes ("4-byte object <01-00 00-00>") unless it finds a PrintTo by
+// argument-dependent lookup, that is in the enum's namespace. The name also names the test.
+void PrintTo(PcdEncoding encoding, std::ostream* os) {
+    switch (encoding) {
+        case PcdEncoding::kAscii:
+            *os << "Ascii";
+            return;
+        case PcdEncoding::kBinary:
+            *os << "Binary";
+            return;
+        case PcdEncoding::kBinaryCompressed:
+            *os << "BinaryCompressed";
+            return;
+    }
+    *os << "Unknown";
+}
+
 namespace {
 
 using core::PointCloud;
+using test::ExpectSameCloud;
 using test::ReadFile;
+using test::ReplaceOnce;
 using test::TempDir;
 using test::WriteFile;
 
@@ -24,33 +45,9 @@ static_assert(std::endian::native == std::endian::little, "the byte builders ass
 
 constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
 
-// Exact equality per coordinate: bit patterns for numbers (so -0 differs from +0), any NaN for NaN.
-void ExpectSameCloud(const PointCloud& actual, const PointCloud& expected) {
-    ASSERT_EQ(actual.size(), expected.size());
-    for (std::size_t i = 0; i < expected.size(); ++i) {
-        for (int axis = 0; axis < 3; ++axis) {
-            const float a = actual[i][axis];
-            const float e = expected[i][axis];
-            const bool same =
-                std::isnan(e) ? std::isnan(a)
-                              : std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(e);
-            EXPECT_TRUE(same) << "point " << i << " axis " << axis << ": read " << a
-                              << ", expected " << e;
-        }
-    }
-}
-
 // Asserts that reading `file` throws a ReadError naming the file and containing `phrase`.
 void ExpectReadError(const std::filesystem::path& file, const std::string& phrase) {
-    try {
-        ReadPcd(file);
-        ADD_FAILURE() << "no ReadError for " << file;
-    } catch (const ReadError& e) {
-        const std::string message = e.what();
-        EXPECT_NE(message.find(phrase), std::string::npos) << message;
-        EXPECT_NE(message.find(file.string()), std::string::npos) << message;
-        EXPECT_EQ(e.file(), file);
-    }
+    test::ExpectReadError(ReadPcd, file, phrase);
 }
 
 template <typename T>
@@ -58,12 +55,6 @@ void Append(std::string& bytes, T value) {
     char buffer[sizeof(T)];
     std::memcpy(buffer, &value, sizeof(T));
     bytes.append(buffer, sizeof(T));
-}
-
-void ReplaceOnce(std::string& text, const std::string& from, const std::string& to) {
-    const auto at = text.find(from);
-    ASSERT_NE(at, std::string::npos) << from;
-    text.replace(at, from.size(), to);
 }
 
 // The header of an x y z float cloud with `points` points; data starts on line 11.
@@ -130,22 +121,10 @@ TEST_P(PcdRoundTrip, ExtremeValuesAreExact) {
     ExpectSameCloud(RoundTrip(cloud), cloud);
 }
 
-std::string EncodingName(const ::testing::TestParamInfo<PcdEncoding>& param) {
-    switch (param.param) {
-        case PcdEncoding::kAscii:
-            return "Ascii";
-        case PcdEncoding::kBinary:
-            return "Binary";
-        case PcdEncoding::kBinaryCompressed:
-            return "BinaryCompressed";
-    }
-    return "Unknown";
-}
-
 INSTANTIATE_TEST_SUITE_P(AllEncodings, PcdRoundTrip,
                          ::testing::Values(PcdEncoding::kAscii, PcdEncoding::kBinary,
                                            PcdEncoding::kBinaryCompressed),
-                         EncodingName);
+                         ::testing::PrintToStringParamName());
 
 // ---------------------------------------------------------------------------------------------
 // Writer output

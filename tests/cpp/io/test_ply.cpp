@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <ostream>
 #include <sstream>
 #include <string>
 #include <tuple>
@@ -17,10 +18,25 @@
 #include "test_utils.hpp"
 
 namespace lidarloop::io {
+
+// gtest prints an enum as its bytes ("4-byte object <01-00 00-00>") unless it finds a PrintTo by
+// argument-dependent lookup, that is in the enum's namespace. The names also name the tests.
+void PrintTo(PlyEncoding encoding, std::ostream* os) {
+    *os << (encoding == PlyEncoding::kAscii                ? "Ascii"
+            : encoding == PlyEncoding::kBinaryLittleEndian ? "LittleEndian"
+                                                           : "BigEndian");
+}
+
+void PrintTo(PlyScalar scalar, std::ostream* os) {
+    *os << (scalar == PlyScalar::kFloat32 ? "Float32" : "Float64");
+}
+
 namespace {
 
 using core::PointCloud;
+using test::ExpectSameCloud;
 using test::ReadFile;
+using test::ReplaceOnce;
 using test::TempDir;
 using test::WriteFile;
 
@@ -28,39 +44,9 @@ static_assert(std::endian::native == std::endian::little, "the byte builders ass
 
 constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
 
-// Exact equality per coordinate: bit patterns for numbers (so -0 differs from +0), any NaN for NaN.
-void ExpectSameCloud(const PointCloud& actual, const PointCloud& expected) {
-    ASSERT_EQ(actual.size(), expected.size());
-    for (std::size_t i = 0; i < expected.size(); ++i) {
-        for (int axis = 0; axis < 3; ++axis) {
-            const float a = actual[i][axis];
-            const float e = expected[i][axis];
-            const bool same =
-                std::isnan(e) ? std::isnan(a)
-                              : std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(e);
-            EXPECT_TRUE(same) << "point " << i << " axis " << axis << ": read " << a
-                              << ", expected " << e;
-        }
-    }
-}
-
 // Asserts that reading `file` throws a ReadError naming the file and containing `phrase`.
 void ExpectReadError(const std::filesystem::path& file, const std::string& phrase) {
-    try {
-        ReadPly(file);
-        ADD_FAILURE() << "no ReadError for " << file;
-    } catch (const ReadError& e) {
-        const std::string message = e.what();
-        EXPECT_NE(message.find(phrase), std::string::npos) << message;
-        EXPECT_NE(message.find(file.string()), std::string::npos) << message;
-        EXPECT_EQ(e.file(), file);
-    }
-}
-
-void ReplaceOnce(std::string& text, const std::string& from, const std::string& to) {
-    const auto at = text.find(from);
-    ASSERT_NE(at, std::string::npos) << from;
-    text.replace(at, from.size(), to);
+    test::ExpectReadError(ReadPly, file, phrase);
 }
 
 std::string FormatLine(PlyEncoding encoding) {
@@ -169,10 +155,7 @@ TEST_P(PlyRoundTrip, ExtremeValuesAreExact) {
 
 std::string FormatName(const ::testing::TestParamInfo<PlyFormat>& param) {
     const auto [encoding, scalar] = param.param;
-    std::string name = encoding == PlyEncoding::kAscii                ? "Ascii"
-                       : encoding == PlyEncoding::kBinaryLittleEndian ? "LittleEndian"
-                                                                      : "BigEndian";
-    return name + (scalar == PlyScalar::kFloat32 ? "Float32" : "Float64");
+    return ::testing::PrintToString(encoding) + ::testing::PrintToString(scalar);
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -312,16 +295,10 @@ TEST_P(PlyRead, DoublesBeyondTheFloatRangeRound) {
     ExpectSameCloud(ReadPly(dir / "huge.ply"), {{inf, -inf, std::numeric_limits<float>::max()}});
 }
 
-std::string EncodingName(const ::testing::TestParamInfo<PlyEncoding>& param) {
-    return param.param == PlyEncoding::kAscii                ? "Ascii"
-           : param.param == PlyEncoding::kBinaryLittleEndian ? "LittleEndian"
-                                                             : "BigEndian";
-}
-
 INSTANTIATE_TEST_SUITE_P(AllEncodings, PlyRead,
                          ::testing::Values(PlyEncoding::kAscii, PlyEncoding::kBinaryLittleEndian,
                                            PlyEncoding::kBinaryBigEndian),
-                         EncodingName);
+                         ::testing::PrintToStringParamName());
 
 TEST(PlyReadHeader, AcceptsCrlfLinesAndSynonymTypes) {
     TempDir dir;

@@ -1,7 +1,6 @@
 #include <cmath>
 #include <random>
 #include <string>
-#include <string_view>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -9,27 +8,13 @@
 #include <Eigen/Geometry>
 
 #include "lidarloop/io/poses.hpp"
-#include "lidarloop/io/read_error.hpp"
 #include "test_utils.hpp"
 
 namespace lidarloop::io {
 namespace {
 
-// The message of the ReadError that `read` throws; any other exception fails the test.
-template <typename Read>
-std::string ReadErrorOf(Read read) {
-    try {
-        read();
-    } catch (const ReadError& e) {
-        return e.what();
-    }
-    return "no ReadError";
-}
-
-::testing::AssertionResult Contains(const std::string& message, std::string_view phrase) {
-    if (message.find(phrase) != std::string::npos) return ::testing::AssertionSuccess();
-    return ::testing::AssertionFailure() << "'" << phrase << "' not in: " << message;
-}
+using test::Contains;
+using test::ReadErrorOf;
 
 core::Transform MakeTransform(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
     core::Transform T = core::Transform::Identity();

@@ -4,32 +4,17 @@
 #include <limits>
 #include <random>
 #include <string>
-#include <string_view>
 
 #include <gtest/gtest.h>
 
-#include "lidarloop/io/read_error.hpp"
 #include "lidarloop/io/xyz.hpp"
 #include "test_utils.hpp"
 
 namespace lidarloop::io {
 namespace {
 
-// The message of the ReadError that `read` throws; any other exception fails the test.
-template <typename Read>
-std::string ReadErrorOf(Read read) {
-    try {
-        read();
-    } catch (const ReadError& e) {
-        return e.what();
-    }
-    return "no ReadError";
-}
-
-::testing::AssertionResult Contains(const std::string& message, std::string_view phrase) {
-    if (message.find(phrase) != std::string::npos) return ::testing::AssertionSuccess();
-    return ::testing::AssertionFailure() << "'" << phrase << "' not in: " << message;
-}
+using test::Contains;
+using test::ReadErrorOf;
 
 std::string XyzErrorOf(const test::TempDir& dir, const std::string& text) {
     test::WriteFile(dir / "bad.xyz", text);
