@@ -30,6 +30,7 @@ function(lidarloop_add_library name)
     lidarloop_target_defaults(${target})
     install(TARGETS ${target} EXPORT lidarloopTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+    # Public headers only: detail/ holds the module's internal helpers.
     install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/lidarloop/${name}
-        FILES_MATCHING PATTERN "*.hpp")
+        FILES_MATCHING PATTERN "*.hpp" PATTERN "detail" EXCLUDE)
 endfunction()

@@ -13,7 +13,6 @@
 #include <gtest/gtest.h>
 
 #include "lidarloop/core/point_cloud.hpp"
-#include "lidarloop/io/read_error.hpp"
 
 namespace lidarloop::test {
 
@@ -94,46 +93,6 @@ inline void ExpectSameCloud(const core::PointCloud& actual, const core::PointClo
                               << ", expected " << e;
         }
     }
-}
-
-/// The io::ReadError that `read()` throws; nullopt when it returns. Any other exception escapes
-/// and fails the test.
-template <typename Read>
-std::optional<io::ReadError> CatchReadError(Read&& read) {
-    try {
-        read();
-    } catch (const io::ReadError& e) {
-        return e;
-    }
-    return std::nullopt;
-}
-
-/// The message of the io::ReadError that `read()` throws; "no ReadError" when it returns.
-template <typename Read>
-std::string ReadErrorOf(Read&& read) {
-    const auto error = CatchReadError(read);
-    return error ? error->what() : "no ReadError";
-}
-
-/// Success when `message` contains `phrase`; the failure shows both.
-inline ::testing::AssertionResult Contains(const std::string& message, std::string_view phrase) {
-    if (message.find(phrase) != std::string::npos) return ::testing::AssertionSuccess();
-    return ::testing::AssertionFailure() << "'" << phrase << "' not in: " << message;
-}
-
-/// Expects `read(file)` (e.g. `read` = io::ReadPcd) to throw an io::ReadError for `file` whose
-/// message names the file and contains `phrase`.
-template <typename Read>
-void ExpectReadError(Read&& read, const std::filesystem::path& file, const std::string& phrase) {
-    const auto error = CatchReadError([&] { read(file); });
-    if (!error) {
-        ADD_FAILURE() << "no ReadError for " << file;
-        return;
-    }
-    const std::string message = error->what();
-    EXPECT_NE(message.find(phrase), std::string::npos) << message;
-    EXPECT_NE(message.find(file.string()), std::string::npos) << message;
-    EXPECT_EQ(error->file(), file);
 }
 
 }  // namespace lidarloop::test

@@ -1,9 +1,9 @@
-#include "lidarloop/io/binary_io.hpp"
+#include "lidarloop/io/detail/binary_io.hpp"
 
 #include <system_error>
 
 #include "lidarloop/io/read_error.hpp"
-#include "lidarloop/io/text_parsing.hpp"
+#include "lidarloop/io/detail/text_parsing.hpp"
 
 namespace lidarloop::io::detail {
 

@@ -11,7 +11,7 @@
 
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/io/read_error.hpp"
-#include "lidarloop/io/text_parsing.hpp"
+#include "lidarloop/io/detail/text_parsing.hpp"
 
 namespace lidarloop::io {
 namespace {

@@ -6,9 +6,9 @@
 #include <string_view>
 #include <vector>
 
-#include "lidarloop/io/binary_io.hpp"
+#include "lidarloop/io/detail/binary_io.hpp"
 #include "lidarloop/io/read_error.hpp"
-#include "lidarloop/io/text_parsing.hpp"
+#include "lidarloop/io/detail/text_parsing.hpp"
 
 namespace lidarloop::io {
 namespace {

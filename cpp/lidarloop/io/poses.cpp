@@ -7,8 +7,8 @@
 #include <Eigen/Geometry>
 
 #include "lidarloop/io/read_error.hpp"
-#include "lidarloop/io/rotation_check.hpp"
-#include "lidarloop/io/text_parsing.hpp"
+#include "lidarloop/io/detail/rotation_check.hpp"
+#include "lidarloop/io/detail/text_parsing.hpp"
 
 namespace lidarloop::io {
 namespace {

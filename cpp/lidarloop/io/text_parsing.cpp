@@ -1,4 +1,4 @@
-#include "lidarloop/io/text_parsing.hpp"
+#include "lidarloop/io/detail/text_parsing.hpp"
 
 #include <algorithm>
 #include <array>

@@ -4,7 +4,7 @@
 #include <string_view>
 
 #include "lidarloop/io/read_error.hpp"
-#include "lidarloop/io/text_parsing.hpp"
+#include "lidarloop/io/detail/text_parsing.hpp"
 
 namespace lidarloop::io {
 namespace {

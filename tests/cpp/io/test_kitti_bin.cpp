@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "lidarloop/io/kitti_bin.hpp"
-#include "test_utils.hpp"
+#include "io/io_test_utils.hpp"
 
 namespace lidarloop::io {
 namespace {

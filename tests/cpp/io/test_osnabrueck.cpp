@@ -10,7 +10,7 @@
 #include <Eigen/Geometry>
 
 #include "lidarloop/io/osnabrueck.hpp"
-#include "test_utils.hpp"
+#include "io/io_test_utils.hpp"
 
 namespace lidarloop::io {
 namespace {

@@ -11,7 +11,7 @@
 
 #include "lidarloop/io/pcd.hpp"
 #include "lidarloop/io/read_error.hpp"
-#include "test_utils.hpp"
+#include "io/io_test_utils.hpp"
 
 namespace lidarloop::io {
 

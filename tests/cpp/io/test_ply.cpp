@@ -15,7 +15,7 @@
 
 #include "lidarloop/io/ply.hpp"
 #include "lidarloop/io/read_error.hpp"
-#include "test_utils.hpp"
+#include "io/io_test_utils.hpp"
 
 namespace lidarloop::io {
 

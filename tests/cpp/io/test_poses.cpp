@@ -8,7 +8,7 @@
 #include <Eigen/Geometry>
 
 #include "lidarloop/io/poses.hpp"
-#include "test_utils.hpp"
+#include "io/io_test_utils.hpp"
 
 namespace lidarloop::io {
 namespace {

@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "lidarloop/io/xyz.hpp"
-#include "test_utils.hpp"
+#include "io/io_test_utils.hpp"
 
 namespace lidarloop::io {
 namespace {

@@ -6,7 +6,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "lidarloop/io/text_parsing.hpp"
+#include "lidarloop/io/detail/text_parsing.hpp"
 
 namespace lidarloop::io::detail {
 
