@@ -2,8 +2,8 @@
 
 #include <system_error>
 
-#include "lidarloop/io/read_error.hpp"
 #include "lidarloop/io/detail/text_parsing.hpp"
+#include "lidarloop/io/read_error.hpp"
 
 namespace lidarloop::io::detail {
 

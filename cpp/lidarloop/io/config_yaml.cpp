@@ -10,8 +10,8 @@
 #include <yaml-cpp/yaml.h>
 
 #include "lidarloop/core/error.hpp"
-#include "lidarloop/io/read_error.hpp"
 #include "lidarloop/io/detail/text_parsing.hpp"
+#include "lidarloop/io/read_error.hpp"
 
 namespace lidarloop::io {
 namespace {

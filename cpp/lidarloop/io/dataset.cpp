@@ -4,11 +4,11 @@
 #include <cctype>
 #include <set>
 
+#include "lidarloop/io/detail/text_parsing.hpp"
 #include "lidarloop/io/osnabrueck.hpp"
 #include "lidarloop/io/poses.hpp"
 #include "lidarloop/io/read_error.hpp"
 #include "lidarloop/io/scan_reader.hpp"
-#include "lidarloop/io/detail/text_parsing.hpp"
 
 namespace lidarloop::io {
 namespace fs = std::filesystem;

@@ -42,9 +42,9 @@
 
 #include <Eigen/Geometry>
 
-#include "lidarloop/io/read_error.hpp"
 #include "lidarloop/io/detail/rotation_check.hpp"
 #include "lidarloop/io/detail/text_parsing.hpp"
+#include "lidarloop/io/read_error.hpp"
 
 namespace lidarloop::io {
 namespace {

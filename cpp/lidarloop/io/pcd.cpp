@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "lidarloop/io/detail/binary_io.hpp"
-#include "lidarloop/io/read_error.hpp"
 #include "lidarloop/io/detail/text_parsing.hpp"
+#include "lidarloop/io/read_error.hpp"
 
 namespace lidarloop::io {
 namespace {

@@ -3,8 +3,8 @@
 #include <string>
 #include <string_view>
 
-#include "lidarloop/io/read_error.hpp"
 #include "lidarloop/io/detail/text_parsing.hpp"
+#include "lidarloop/io/read_error.hpp"
 
 namespace lidarloop::io {
 namespace {

@@ -5,8 +5,8 @@
 
 #include <gtest/gtest.h>
 
-#include "lidarloop/io/kitti_bin.hpp"
 #include "io/io_test_utils.hpp"
+#include "lidarloop/io/kitti_bin.hpp"
 
 namespace lidarloop::io {
 namespace {

@@ -9,8 +9,8 @@
 
 #include <Eigen/Geometry>
 
-#include "lidarloop/io/osnabrueck.hpp"
 #include "io/io_test_utils.hpp"
+#include "lidarloop/io/osnabrueck.hpp"
 
 namespace lidarloop::io {
 namespace {

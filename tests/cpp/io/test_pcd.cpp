@@ -9,9 +9,9 @@
 
 #include <gtest/gtest.h>
 
+#include "io/io_test_utils.hpp"
 #include "lidarloop/io/pcd.hpp"
 #include "lidarloop/io/read_error.hpp"
-#include "io/io_test_utils.hpp"
 
 namespace lidarloop::io {
 

@@ -7,8 +7,8 @@
 
 #include <Eigen/Geometry>
 
-#include "lidarloop/io/poses.hpp"
 #include "io/io_test_utils.hpp"
+#include "lidarloop/io/poses.hpp"
 
 namespace lidarloop::io {
 namespace {

@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "lidarloop/io/xyz.hpp"
 #include "io/io_test_utils.hpp"
+#include "lidarloop/io/xyz.hpp"
 
 namespace lidarloop::io {
 namespace {
