@@ -1,0 +1,150 @@
+#include "lidarloop/pipeline/loop_detector.hpp"
+
+#include <algorithm>
+#include <string>
+
+#include "lidarloop/core/error.hpp"
+
+namespace lidarloop::pipeline {
+namespace {
+
+double SecondRatio(double best, double second) {
+    if (second == 0.0) return 1.0;
+    return best / second;
+}
+
+// Fills second_ratio and accepted from the candidates and a search for the best candidate
+// outside the gap around the best match.
+void Finish(LoopQuery& result, const core::MinGap& gap, const std::vector<double>& times_s,
+            core::Method method, double threshold,
+            const std::function<std::vector<Neighbor>(const std::function<bool(std::size_t)>&)>&
+                search_one) {
+    if (!result.has_match()) return;
+    const Neighbor best = result.candidates.front();
+    result.accepted = core::IsMatch(method, best.distance, threshold);
+    const auto other_place = [&](std::size_t j) {
+        return gap.Allows(best.index, j, times_s[best.index], times_s[j]);
+    };
+    const std::vector<Neighbor> second = search_one(other_place);
+    if (!second.empty()) result.second_ratio = SecondRatio(best.distance, second.front().distance);
+}
+
+}  // namespace
+
+void DetectorConfig::Validate() const {
+    min_gap.Validate("detection.min_gap");
+    if (top_k < 1 || top_k > 1000) {
+        throw core::ConfigError("detection.top_k must be in [1, 1000], got " +
+                                std::to_string(top_k));
+    }
+}
+
+std::vector<Neighbor> NearestCandidates(std::size_t count, std::size_t k,
+                                        const std::function<double(std::size_t)>& distance_of,
+                                        const std::function<bool(std::size_t)>& eligible) {
+    std::vector<Neighbor> all;
+    for (std::size_t j = 0; j < count; ++j) {
+        if (!eligible || eligible(j)) all.push_back({j, distance_of(j)});
+    }
+    const auto before = [](const Neighbor& a, const Neighbor& b) {
+        return a.distance < b.distance || (a.distance == b.distance && a.index < b.index);
+    };
+    const std::size_t keep = std::min(k, all.size());
+    std::partial_sort(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(keep), all.end(),
+                      before);
+    all.resize(keep);
+    // A missing scan (+inf) is never a candidate.
+    while (!all.empty() && !(all.back().distance < std::numeric_limits<double>::infinity())) {
+        all.pop_back();
+    }
+    return all;
+}
+
+LoopDetector::LoopDetector(const core::DescriptorConfig& descriptor, const DetectorConfig& detector,
+                           double threshold)
+    : LoopDetector(DescriptorDatabase(descriptor), detector, threshold) {}
+
+LoopDetector::LoopDetector(DescriptorDatabase database, const DetectorConfig& detector,
+                           double threshold)
+    : database_(std::move(database)), detector_(detector), threshold_(threshold) {
+    detector_.Validate();
+    if (database_.histograms() != nullptr) {
+        index_.emplace(*database_.histograms());
+        for (std::size_t i = 0; i < database_.size(); ++i) {
+            if (database_.IsValid(i)) index_->Insert(i);
+        }
+    }
+}
+
+LoopQuery LoopDetector::Search(const PreparedQuery& query, std::size_t query_index,
+                               const std::function<bool(std::size_t)>& eligible) const {
+    const auto k = static_cast<std::size_t>(detector_.top_k);
+    const auto search = [&](std::size_t count, const std::function<bool(std::size_t)>& filter) {
+        if (index_) return index_->Search(query.cumulative_row.data(), count, filter);
+        return NearestCandidates(
+            database_.size(), count, [&](std::size_t j) { return database_.Distance(query, j); },
+            filter);
+    };
+    LoopQuery result;
+    result.query = query_index;
+    result.candidates = search(k, eligible);
+    Finish(result, detector_.min_gap, database_.times_s(), database_.method(), threshold_,
+           [&](const std::function<bool(std::size_t)>& other_place) {
+               return search(1, [&](std::size_t j) { return eligible(j) && other_place(j); });
+           });
+    return result;
+}
+
+LoopQuery LoopDetector::Process(const core::PointCloud& scan, double time_s) {
+    return Process(core::ComputeDescriptor(scan, database_.config()), time_s);
+}
+
+LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_s) {
+    const PreparedQuery query = database_.Prepare(descriptor);
+    const std::size_t query_index = database_.size();
+    const auto& times_s = database_.times_s();
+    const core::MinGap gap = detector_.min_gap;
+    const LoopQuery result = Search(query, query_index, [&](std::size_t j) {
+        return j < query_index && database_.IsValid(j) &&
+               gap.Allows(query_index, j, time_s, times_s[j]);
+    });
+    database_.Add(descriptor, time_s);
+    if (index_) index_->Insert(query_index);
+    return result;
+}
+
+LoopQuery LoopDetector::Query(const core::Descriptor& descriptor) const {
+    const PreparedQuery query = database_.Prepare(descriptor);
+    return Search(query, database_.size(), [&](std::size_t j) { return database_.IsValid(j); });
+}
+
+std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,
+                                        const std::vector<double>& times_s,
+                                        const DetectorConfig& detector, core::Method method,
+                                        double threshold) {
+    detector.Validate();
+    if (times_s.size() != matrix.size()) {
+        throw core::ConfigError("DetectFromMatrix: " + std::to_string(times_s.size()) +
+                                " times for " + std::to_string(matrix.size()) + " scans");
+    }
+    const auto k = static_cast<std::size_t>(detector.top_k);
+    std::vector<LoopQuery> results(matrix.size());
+    for (std::size_t i = 0; i < matrix.size(); ++i) {
+        const auto distance_of = [&](std::size_t j) { return double{matrix.at(i, j)}; };
+        const auto eligible = [&](std::size_t j) {
+            return j < i && detector.min_gap.Allows(i, j, times_s[i], times_s[j]);
+        };
+        LoopQuery& result = results[i];
+        result.query = i;
+        result.candidates = NearestCandidates(i, k, distance_of, eligible);
+        Finish(result, detector.min_gap, times_s, method, threshold,
+               [&](const std::function<bool(std::size_t)>& other_place) {
+                   return NearestCandidates(i, 1, distance_of, [&](std::size_t j) {
+                       return eligible(j) && other_place(j);
+                   });
+               });
+    }
+    return results;
+}
+
+}  // namespace lidarloop::pipeline

@@ -1,0 +1,85 @@
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <limits>
+#include <optional>
+#include <vector>
+
+#include "lidarloop/core/descriptor.hpp"
+#include "lidarloop/core/min_gap.hpp"
+#include "lidarloop/pipeline/descriptor_database.hpp"
+#include "lidarloop/pipeline/histogram_index.hpp"
+#include "lidarloop/pipeline/similarity_matrix.hpp"
+
+namespace lidarloop::pipeline {
+
+/// How loop candidates are chosen.
+struct DetectorConfig {
+    /// S: a scan's candidates are the scans at least this far back (Magnusson II-E).
+    core::MinGap min_gap;
+    int top_k = 5;  ///< candidates reported per query, nearest first; 1..1000
+
+    /// Throws ConfigError naming the first invalid field.
+    void Validate() const;
+};
+
+/// What the detector says about one query scan.
+struct LoopQuery {
+    std::size_t query = 0;
+    std::vector<Neighbor> candidates;  ///< up to top_k eligible scans, nearest first
+    /// Distinctiveness of the best match: its distance over the distance of the best candidate
+    /// that lies outside the gap around the best match (another place). Near 1: ambiguous;
+    /// near 0: distinctive. NaN when there is no such second candidate; 1 when both are 0.
+    double second_ratio = std::numeric_limits<double>::quiet_NaN();
+    bool accepted = false;  ///< the best match passes the threshold (W <= tau, sigma' < t_d)
+
+    bool has_match() const { return !candidates.empty(); }
+};
+
+/// The k nearest of the scans 0..count-1 for which `eligible(j)` holds, by (distance, index),
+/// with `distance_of(j)`: the brute-force search both detectors share.
+std::vector<Neighbor> NearestCandidates(std::size_t count, std::size_t k,
+                                        const std::function<double(std::size_t)>& distance_of,
+                                        const std::function<bool(std::size_t)>& eligible);
+
+/// Online loop detection: scans arrive one at a time; each is compared with the stored scans
+/// older than the minimum gap, then stored. Histogram methods use the exact HistogramIndex;
+/// NDT compares every eligible scan. Not thread-safe.
+class LoopDetector {
+public:
+    /// `threshold` is tau or t_d (see core::DefaultThreshold). Validates the configs.
+    LoopDetector(const core::DescriptorConfig& descriptor, const DetectorConfig& detector,
+                 double threshold);
+    /// Continues from a loaded database (e.g. a map): every stored scan becomes searchable.
+    LoopDetector(DescriptorDatabase database, const DetectorConfig& detector, double threshold);
+
+    /// Describes `scan`, finds its candidates among the stored scans, then stores it.
+    LoopQuery Process(const core::PointCloud& scan, double time_s);
+    LoopQuery Process(const core::Descriptor& descriptor, double time_s);
+    /// Localisation against the stored scans: every stored scan is eligible and the query is not
+    /// stored.
+    LoopQuery Query(const core::Descriptor& descriptor) const;
+
+    const DescriptorDatabase& database() const { return database_; }
+    const DetectorConfig& detector_config() const { return detector_; }
+    double threshold() const { return threshold_; }
+
+private:
+    LoopQuery Search(const PreparedQuery& query, std::size_t query_index,
+                     const std::function<bool(std::size_t)>& eligible) const;
+
+    DescriptorDatabase database_;
+    DetectorConfig detector_;
+    double threshold_;
+    std::optional<HistogramIndex> index_;
+};
+
+/// Offline detection from a full similarity matrix: for every scan i, the candidates among the
+/// scans j < i outside the gap, exactly as LoopDetector::Process would give them online.
+std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,
+                                        const std::vector<double>& times_s,
+                                        const DetectorConfig& detector, core::Method method,
+                                        double threshold);
+
+}  // namespace lidarloop::pipeline

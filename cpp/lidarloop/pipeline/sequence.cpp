@@ -1,0 +1,80 @@
+#include "lidarloop/pipeline/sequence.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <optional>
+
+#include <tbb/parallel_for.h>
+
+#include "lidarloop/core/descriptor.hpp"
+#include "lidarloop/core/error.hpp"
+
+namespace lidarloop::pipeline {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+struct ScanResult {
+    std::optional<core::Descriptor> descriptor;
+    std::string error;
+    double load_seconds = 0.0;
+    double describe_seconds = 0.0;
+};
+
+ScanResult DescribeOne(const ScanSource& source, const core::DescriptorConfig& config,
+                       std::size_t i, bool skip_bad) {
+    ScanResult result;
+    try {
+        const auto load_start = Clock::now();
+        const core::PointCloud cloud = source.load(i);
+        result.load_seconds = SecondsSince(load_start);
+        const auto describe_start = Clock::now();
+        result.descriptor = core::ComputeDescriptor(cloud, config);
+        result.describe_seconds = SecondsSince(describe_start);
+    } catch (const core::ConfigError&) {
+        throw;  // a bad configuration is not a bad scan
+    } catch (const core::Error& e) {
+        const std::string message = "scan " + std::to_string(i) + ": " + e.what();
+        if (!skip_bad) throw core::Error(message);
+        result.error = message;
+    }
+    return result;
+}
+
+}  // namespace
+
+SequenceDescriptors DescribeSequence(const ScanSource& source, const core::DescriptorConfig& config,
+                                     const DescribeOptions& options) {
+    SequenceDescriptors out{DescriptorDatabase(config), {}, {}, {}};
+    std::vector<ScanResult> results(source.count);
+    std::atomic<std::size_t> done{0};
+    const auto run = [&](std::size_t i) {
+        results[i] = DescribeOne(source, config, i, options.skip_bad);
+        const std::size_t finished = ++done;
+        if (options.progress) options.progress(finished, source.count);
+    };
+    if (options.execution == Execution::kParallel) {
+        tbb::parallel_for(std::size_t{0}, source.count, run);
+    } else {
+        for (std::size_t i = 0; i < source.count; ++i) run(i);
+    }
+    for (std::size_t i = 0; i < source.count; ++i) {
+        const double time_s = source.time_s ? source.time_s(i) : static_cast<double>(i);
+        ScanResult& r = results[i];
+        out.load_seconds.push_back(r.load_seconds);
+        out.describe_seconds.push_back(r.describe_seconds);
+        if (r.descriptor) {
+            out.database.Add(*r.descriptor, time_s);
+        } else {
+            out.database.AddMissing(time_s);
+            out.skipped.push_back(r.error);
+        }
+    }
+    return out;
+}
+
+}  // namespace lidarloop::pipeline

@@ -1,0 +1,201 @@
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "lidarloop/core/error.hpp"
+#include "lidarloop/pipeline/loop_detector.hpp"
+#include "lidarloop/pipeline/sequence.hpp"
+#include "pipeline/pipeline_test_utils.hpp"
+#include "test_utils.hpp"
+
+namespace lidarloop::pipeline {
+namespace {
+
+core::DescriptorConfig HeightConfig(int bins) {
+    core::DescriptorConfig config;
+    config.histogram.bins = bins;
+    return config;
+}
+
+void ExpectSameQueries(const LoopQuery& online, const LoopQuery& offline) {
+    EXPECT_EQ(online.query, offline.query);
+    ASSERT_EQ(online.candidates.size(), offline.candidates.size()) << "query " << online.query;
+    for (std::size_t r = 0; r < online.candidates.size(); ++r) {
+        EXPECT_EQ(online.candidates[r].index, offline.candidates[r].index) << online.query;
+        // The matrix stores float; the online path keeps double.
+        EXPECT_NEAR(online.candidates[r].distance, offline.candidates[r].distance,
+                    1e-6 * online.candidates[r].distance + 1e-9);
+    }
+    EXPECT_EQ(online.accepted, offline.accepted) << online.query;
+    if (std::isnan(online.second_ratio)) {
+        EXPECT_TRUE(std::isnan(offline.second_ratio)) << online.query;
+    } else {
+        EXPECT_NEAR(online.second_ratio, offline.second_ratio, 1e-5) << online.query;
+    }
+}
+
+void CheckOnlineEqualsOffline(const DetectorConfig& detector, unsigned seed) {
+    const auto histograms = test::ClusteredHistograms(400, 40, 25, seed);
+    const core::DescriptorConfig config = HeightConfig(40);
+    LoopDetector online(config, detector, 0.01);
+    std::vector<LoopQuery> online_results;
+    std::vector<double> times;
+    for (std::size_t i = 0; i < histograms.size(); ++i) {
+        times.push_back(0.1 * static_cast<double>(i) + (i % 3 == 0 ? 0.05 : 0.0));
+        online_results.push_back(
+            online.Process(test::HistogramDescriptor(histograms[i]), times[i]));
+    }
+    const SimilarityMatrix matrix = ComputeSimilarityMatrix(online.database());
+    const auto offline =
+        DetectFromMatrix(matrix, times, detector, core::Method::kHeight, online.threshold());
+    ASSERT_EQ(offline.size(), online_results.size());
+    std::size_t with_match = 0;
+    for (std::size_t i = 0; i < offline.size(); ++i) {
+        ExpectSameQueries(online_results[i], offline[i]);
+        with_match += offline[i].has_match();
+    }
+    EXPECT_GT(with_match, 300U);
+}
+
+TEST(LoopDetector, OnlineEqualsOfflineWithGapInScans) {
+    DetectorConfig detector;
+    detector.min_gap = {30.0, core::MinGap::Unit::kScans};
+    detector.top_k = 5;
+    CheckOnlineEqualsOffline(detector, 5);
+}
+
+TEST(LoopDetector, OnlineEqualsOfflineWithGapInSeconds) {
+    DetectorConfig detector;
+    detector.min_gap = {2.5, core::MinGap::Unit::kSeconds};
+    detector.top_k = 3;
+    CheckOnlineEqualsOffline(detector, 6);
+}
+
+TEST(LoopDetector, CandidatesRespectTheGapAndThreshold) {
+    const auto histograms = test::ClusteredHistograms(100, 20, 3, 7);
+    DetectorConfig detector;
+    detector.min_gap = {10.0, core::MinGap::Unit::kScans};
+    LoopDetector online(HeightConfig(20), detector, 1.0);  // tau = 1 accepts everything
+    for (std::size_t i = 0; i < histograms.size(); ++i) {
+        const LoopQuery q = online.Process(test::HistogramDescriptor(histograms[i]), 0.0);
+        EXPECT_EQ(q.has_match(), i > 10) << i;
+        for (const Neighbor& n : q.candidates) EXPECT_GT(i - n.index, 10U);
+        if (q.has_match()) {
+            EXPECT_TRUE(q.accepted);
+        }
+    }
+    LoopDetector strict(HeightConfig(20), detector, 0.0);  // tau = 0 accepts only equal scans
+    for (std::size_t i = 0; i < 30; ++i) {
+        const LoopQuery q = strict.Process(test::HistogramDescriptor(histograms[i]), 0.0);
+        if (q.has_match()) {
+            EXPECT_EQ(q.accepted, q.candidates.front().distance == 0.0);
+        }
+    }
+}
+
+TEST(LoopDetector, QueryOnlyDoesNotInsertAndSeesEveryScan) {
+    const auto histograms = test::ClusteredHistograms(50, 20, 5, 8);
+    LoopDetector detector(HeightConfig(20), DetectorConfig{}, 0.01);
+    for (const auto& h : histograms) detector.Process(test::HistogramDescriptor(h), 0.0);
+    const LoopQuery q = detector.Query(test::HistogramDescriptor(histograms[49]));
+    EXPECT_EQ(detector.database().size(), 50U);
+    ASSERT_TRUE(q.has_match());
+    EXPECT_EQ(q.candidates.front().index, 49U);  // itself, which the gap would exclude online
+    EXPECT_EQ(q.candidates.front().distance, 0.0);
+}
+
+TEST(LoopDetector, NdtUsesTheSameRules) {
+    core::DescriptorConfig config;
+    config.method = core::Method::kNdt;
+    DetectorConfig detector;
+    detector.min_gap = {2.0, core::MinGap::Unit::kScans};
+    LoopDetector online(config, detector, config.ndt.threshold);
+    std::vector<double> times;
+    std::vector<LoopQuery> results;
+    for (unsigned i = 0; i < 10; ++i) {
+        times.push_back(i);
+        results.push_back(online.Process(test::RandomCloud(2000, i % 4, 3.0f), times.back()));
+    }
+    const auto offline = DetectFromMatrix(ComputeSimilarityMatrix(online.database()), times,
+                                          detector, core::Method::kNdt, online.threshold());
+    for (std::size_t i = 0; i < results.size(); ++i) ExpectSameQueries(results[i], offline[i]);
+    // Scan 4 repeats scan 0 (same seed): found with distance 0.
+    ASSERT_TRUE(results[4].has_match());
+    EXPECT_EQ(results[4].candidates.front().index, 0U);
+    EXPECT_EQ(results[4].candidates.front().distance, 0.0);
+}
+
+TEST(LoopDetector, RejectsBadConfigAndMixedMethods) {
+    DetectorConfig detector;
+    detector.top_k = 0;
+    EXPECT_THROW(LoopDetector(HeightConfig(10), detector, 0.01), core::ConfigError);
+    detector.top_k = 1;
+    detector.min_gap.value = -1;
+    EXPECT_THROW(LoopDetector(HeightConfig(10), detector, 0.01), core::ConfigError);
+    LoopDetector ok(HeightConfig(10), DetectorConfig{}, 0.01);
+    core::Descriptor range = test::HistogramDescriptor(std::vector<double>(10, 0.1));
+    range.method = core::Method::kRange;
+    EXPECT_THROW(ok.Process(range, 0.0), core::ConfigError);
+    EXPECT_THROW(ok.Process(test::HistogramDescriptor(std::vector<double>(9, 0.1)), 0.0),
+                 core::ConfigError);
+}
+
+ScanSource SourceWithBadScan(std::size_t count, std::size_t bad) {
+    ScanSource source;
+    source.count = count;
+    source.load = [bad](std::size_t i) -> core::PointCloud {
+        if (i == bad) throw core::Error("scans/000007.bin: size 13 bytes is not a multiple of 16");
+        return test::RandomCloud(500, static_cast<unsigned>(i));
+    };
+    source.time_s = [](std::size_t i) { return 0.1 * static_cast<double>(i); };
+    return source;
+}
+
+TEST(DescribeSequence, StopsAtABadScanNamingIt) {
+    try {
+        DescribeSequence(SourceWithBadScan(20, 7), HeightConfig(50));
+        FAIL() << "a bad scan went unnoticed";
+    } catch (const core::Error& e) {
+        EXPECT_NE(std::string(e.what()).find("scan 7: scans/000007.bin: size 13"),
+                  std::string::npos)
+            << e.what();
+    }
+}
+
+TEST(DescribeSequence, SkipsABadScanWhenAskedAndItNeverMatches) {
+    DescribeOptions options;
+    options.skip_bad = true;
+    std::size_t last_progress = 0;
+    options.execution = Execution::kSerial;
+    options.progress = [&](std::size_t done, std::size_t total) {
+        EXPECT_EQ(total, 20U);
+        last_progress = done;
+    };
+    const SequenceDescriptors result =
+        DescribeSequence(SourceWithBadScan(20, 7), HeightConfig(50), options);
+    EXPECT_EQ(last_progress, 20U);
+    ASSERT_EQ(result.skipped.size(), 1U);
+    EXPECT_NE(result.skipped[0].find("scan 7:"), std::string::npos);
+    EXPECT_EQ(result.database.size(), 20U);
+    EXPECT_FALSE(result.database.IsValid(7));
+    EXPECT_DOUBLE_EQ(result.database.TimeS(19), 1.9);
+    EXPECT_EQ(result.database.Distance(7, 3), std::numeric_limits<double>::infinity());
+    LoopDetector detector(result.database, DetectorConfig{}, 1.0);
+    const LoopQuery q =
+        detector.Query(core::ComputeDescriptor(test::RandomCloud(500, 7), HeightConfig(50)));
+    ASSERT_TRUE(q.has_match());
+    EXPECT_NE(q.candidates.front().index, 7U);
+}
+
+TEST(DescribeSequence, ParallelEqualsSerial) {
+    DescribeOptions serial;
+    serial.execution = Execution::kSerial;
+    ScanSource source = SourceWithBadScan(30, 1000);
+    const auto a = DescribeSequence(source, HeightConfig(64), serial);
+    const auto b = DescribeSequence(source, HeightConfig(64));
+    EXPECT_EQ(a.database.histograms()->data(), b.database.histograms()->data());
+}
+
+}  // namespace
+}  // namespace lidarloop::pipeline
