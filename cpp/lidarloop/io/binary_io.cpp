@@ -19,6 +19,24 @@ std::size_t FileSize(const std::filesystem::path& file) {
     return static_cast<std::size_t>(size);
 }
 
+std::string ReadWholeFile(const std::filesystem::path& file) {
+    std::ifstream in = OpenForReading(file, /*binary=*/true);
+    std::string bytes(FileSize(file), '\0');
+    in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    if (in.gcount() != static_cast<std::streamsize>(bytes.size())) {
+        throw ReadError(file, "read " + std::to_string(in.gcount()) + " of " +
+                                  std::to_string(bytes.size()) + " bytes");
+    }
+    return bytes;
+}
+
+void WriteWholeFile(const std::filesystem::path& file, const std::string& bytes) {
+    std::ofstream out = OpenForWriting(file, /*binary=*/true);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    out.close();
+    if (!out) throw WriteError(file, "writing " + std::to_string(bytes.size()) + " bytes failed");
+}
+
 DataStream OpenDataAfterHeader(const std::filesystem::path& file, std::size_t header_lines) {
     DataStream data{OpenForReading(file, /*binary=*/true)};
     for (std::size_t i = 0; i < header_lines; ++i) {

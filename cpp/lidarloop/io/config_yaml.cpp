@@ -50,17 +50,27 @@ void VisitFields(core::NdtConfig& c, Visitor& v) {
 }
 
 template <typename Visitor>
+void VisitFields(pipeline::DetectorConfig& c, Visitor& v) {
+    v.Field("min_gap", c.min_gap.value, "S: candidates are at least this far back (Magnusson)");
+    v.Field("min_gap_unit", c.min_gap.unit, "unit of min_gap: scans | seconds");
+    v.Field("top_k", c.top_k, "candidates reported per query scan");
+}
+
+template <typename Visitor>
 void VisitFields(RunConfig& c, Visitor& v) {
     v.Field("method", c.descriptor.method, "descriptor: height | range | ndt");
     v.Section("histogram", c.descriptor.histogram);
     v.Section("ndt", c.descriptor.ndt);
+    v.Section("detection", c.detection);
 }
 
 std::string EnumName(core::Method m) { return core::ToString(m); }
 std::string EnumName(core::UpVectorMode m) { return core::ToString(m); }
 std::string EnumName(core::OutOfRangePolicy m) { return core::ToString(m); }
+std::string EnumName(core::MinGap::Unit u) { return core::ToString(u); }
 void ParseEnum(const std::string& s, core::Method& m) { m = core::ParseMethod(s); }
 void ParseEnum(const std::string& s, core::UpVectorMode& m) { m = core::ParseUpVectorMode(s); }
+void ParseEnum(const std::string& s, core::MinGap::Unit& u) { u = core::ParseMinGapUnit(s); }
 void ParseEnum(const std::string& s, core::OutOfRangePolicy& m) {
     m = core::ParseOutOfRangePolicy(s);
 }

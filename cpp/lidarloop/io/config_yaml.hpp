@@ -4,15 +4,20 @@
 #include <string>
 
 #include "lidarloop/core/descriptor_config.hpp"
+#include "lidarloop/pipeline/loop_detector.hpp"
 
 namespace lidarloop::io {
 
 /// Every setting of a lidarloop run. The defaults live in the C++ config structs it holds; YAML
 /// files and command-line flags override only the keys they name.
 struct RunConfig {
-    core::DescriptorConfig descriptor;  ///< keys `method` and `histogram.*` at the YAML top level
+    core::DescriptorConfig descriptor;   ///< keys `method`, `histogram.*`, `ndt.*` at the top level
+    pipeline::DetectorConfig detection;  ///< keys `detection.*`
 
-    void Validate() const { descriptor.Validate(); }
+    void Validate() const {
+        descriptor.Validate();
+        detection.Validate();
+    }
 };
 
 /// The whole configuration as YAML, every key present, with a comment line per key.

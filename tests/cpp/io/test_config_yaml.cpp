@@ -40,12 +40,26 @@ TEST(ConfigYaml, DumpThenLoadGivesTheSameConfig) {
 
 TEST(ConfigYaml, DumpNamesEveryKeyWithItsDefault) {
     const std::string dump = DumpConfigYaml({});
-    for (const char* key :
-         {"method: height", "bins: 100", "up_vector: fixed", "sensor_height_m: 0",
-          "height_min_m: -3", "height_max_m: 7", "range_min_m: 0", "range_max_m: 80",
-          "out_of_range: clamp", "threshold: 0.005", "cell_size_m: 0.5", "planar_classes: 9",
-          "eigen_ratio_threshold: 0.1", "ambiguity_ratio: 0.6", "range_limits_m: [3, 6, 9, 15]",
-          "threshold: 0.0737", "normalise_rotation: true"}) {
+    for (const char* key : {"method: height",
+                            "bins: 100",
+                            "up_vector: fixed",
+                            "sensor_height_m: 0",
+                            "height_min_m: -3",
+                            "height_max_m: 7",
+                            "range_min_m: 0",
+                            "range_max_m: 80",
+                            "out_of_range: clamp",
+                            "threshold: 0.005",
+                            "cell_size_m: 0.5",
+                            "planar_classes: 9",
+                            "eigen_ratio_threshold: 0.1",
+                            "ambiguity_ratio: 0.6",
+                            "range_limits_m: [3, 6, 9, 15]",
+                            "threshold: 0.0737",
+                            "normalise_rotation: true",
+                            "min_gap: 30",
+                            "min_gap_unit: scans",
+                            "top_k: 5"}) {
         EXPECT_NE(dump.find(key), std::string::npos) << key << " missing in\n" << dump;
     }
 }
@@ -82,6 +96,9 @@ TEST(ConfigYaml, BadInputNamesFileKeyAndProblem) {
     expect_error("histogram:\n  height_min_m: 10\n", "must be smaller than");
     expect_error("histogram: {bins: 3\n", "line");
     expect_error("- a\n- b\n", "expected a map");
+    expect_error("detection:\n  min_gap_unit: hours\n", "unknown gap unit 'hours'");
+    expect_error("detection:\n  top_k: 0\n", "detection.top_k must be in [1, 1000]");
+    expect_error("detection:\n  min_gap: -3\n", "detection.min_gap must be");
 }
 
 TEST(ConfigYaml, NdtSectionWithListsAndBooleans) {

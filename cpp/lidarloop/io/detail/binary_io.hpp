@@ -30,6 +30,12 @@ std::string BytesText(std::optional<std::size_t> bytes);
 /// Size of `file` in bytes; throws ReadError "cannot get the file size (<reason>)".
 std::size_t FileSize(const std::filesystem::path& file);
 
+/// The whole content of `file`; ReadError when it cannot be opened or read.
+std::string ReadWholeFile(const std::filesystem::path& file);
+
+/// Replaces `file` by `bytes`; WriteError when it cannot be written.
+void WriteWholeFile(const std::filesystem::path& file, const std::string& bytes);
+
 /// Rounds a double to float as IEEE does, also beyond the float range, where a plain narrowing
 /// conversion is undefined behaviour: up to half an ulp above FLT_MAX rounds down to it (9-digit
 /// text of FLT_MAX reads back as such a value), from there on to infinity. NaN stays NaN.

@@ -1,0 +1,131 @@
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "io/io_test_utils.hpp"
+#include "lidarloop/core/descriptor.hpp"
+#include "lidarloop/core/error.hpp"
+#include "lidarloop/io/database_file.hpp"
+#include "lidarloop/io/png.hpp"
+#include "lidarloop/io/similarity_file.hpp"
+#include "lidarloop/pipeline/loop_detector.hpp"
+#include "test_utils.hpp"
+
+namespace lidarloop::io {
+namespace {
+
+pipeline::DescriptorDatabase SmallDatabase(core::Method method) {
+    core::DescriptorConfig config;
+    config.method = method;
+    config.histogram.bins = 24;
+    pipeline::DescriptorDatabase database(config);
+    for (unsigned i = 0; i < 6; ++i) {
+        database.Add(core::ComputeDescriptor(test::RandomCloud(3000, i, 5.0f), config), 0.5 * i);
+    }
+    database.AddMissing(3.0);
+    return database;
+}
+
+TEST(SimilarityFile, RoundTripsExactly) {
+    test::TempDir dir;
+    const auto database = SmallDatabase(core::Method::kRange);
+    const auto matrix = pipeline::ComputeSimilarityMatrix(database);
+    WriteSimilarityMatrix(dir / "s.bin", matrix, core::Method::kRange);
+    const StoredSimilarity stored = ReadSimilarityMatrix(dir / "s.bin");
+    EXPECT_EQ(stored.method, core::Method::kRange);
+    EXPECT_EQ(stored.matrix.size(), 7U);
+    EXPECT_EQ(stored.matrix.condensed(), matrix.condensed());
+    EXPECT_EQ(test::ReadFile(dir / "s.bin").size(), 8 + 8 + 5 + 8 + 21 * 4U);
+}
+
+TEST(SimilarityFile, BadFilesAreClearErrors) {
+    test::TempDir dir;
+    WriteSimilarityMatrix(dir / "s.bin", pipeline::SimilarityMatrix(40), core::Method::kHeight);
+    const std::string good = test::ReadFile(dir / "s.bin");
+    test::WriteFile(dir / "cut.bin", good.substr(0, good.size() - 3));
+    test::ExpectReadError(ReadSimilarityMatrix, dir / "cut.bin", "truncated: distances");
+    test::WriteFile(dir / "long.bin", good + "x");
+    test::ExpectReadError(ReadSimilarityMatrix, dir / "long.bin", "trailing bytes");
+    test::WriteFile(dir / "magic.bin", "PK\x03\x04" + good);
+    test::ExpectReadError(ReadSimilarityMatrix, dir / "magic.bin", "wrong magic");
+    std::string method = good;
+    method.replace(16, 6, "heigth");
+    test::WriteFile(dir / "method.bin", method);
+    test::ExpectReadError(ReadSimilarityMatrix, dir / "method.bin", "unknown method 'heigth'");
+    std::string huge = good;
+    huge.replace(22, 8, std::string("\0\0\0\0\0\x01\0\0", 8));  // 2^40 scans
+    test::WriteFile(dir / "huge.bin", huge);
+    test::ExpectReadError(ReadSimilarityMatrix, dir / "huge.bin", "absurd scan count");
+    test::ExpectReadError(ReadSimilarityMatrix, dir / "missing.bin", "no such file");
+}
+
+void ExpectSameDatabase(const pipeline::DescriptorDatabase& a,
+                        const pipeline::DescriptorDatabase& b) {
+    ASSERT_EQ(a.size(), b.size());
+    EXPECT_EQ(a.method(), b.method());
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        EXPECT_EQ(a.IsValid(i), b.IsValid(i));
+        EXPECT_EQ(a.TimeS(i), b.TimeS(i));
+        for (std::size_t j = 0; j < a.size(); ++j) EXPECT_EQ(a.Distance(i, j), b.Distance(i, j));
+    }
+}
+
+TEST(DatabaseFile, RoundTripsHistogramAndNdtDatabases) {
+    test::TempDir dir;
+    for (core::Method method : {core::Method::kHeight, core::Method::kNdt}) {
+        const auto database = SmallDatabase(method);
+        SaveDatabase(dir / "db.bin", database);
+        const auto loaded = LoadDatabase(dir / "db.bin");
+        ExpectSameDatabase(database, loaded);
+        EXPECT_EQ(loaded.config().histogram.bins, 24);
+        // A detector continued from the loaded map finds the stored scans again.
+        pipeline::LoopDetector detector(loaded, pipeline::DetectorConfig{}, 1.0);
+        const auto query = detector.Query(
+            core::ComputeDescriptor(test::RandomCloud(3000, 2, 5.0f), loaded.config()));
+        ASSERT_TRUE(query.has_match());
+        EXPECT_EQ(query.candidates.front().index, 2U);
+        EXPECT_EQ(query.candidates.front().distance, 0.0);
+    }
+}
+
+TEST(DatabaseFile, BadFilesAreClearErrors) {
+    test::TempDir dir;
+    SaveDatabase(dir / "db.bin", SmallDatabase(core::Method::kNdt));
+    const std::string good = test::ReadFile(dir / "db.bin");
+    test::WriteFile(dir / "cut.bin", good.substr(0, good.size() / 2));
+    test::ExpectReadError(LoadDatabase, dir / "cut.bin", "truncated");
+    test::WriteFile(dir / "magic.bin", "LLSIM001" + good.substr(8));
+    test::ExpectReadError(LoadDatabase, dir / "magic.bin", "not a lidarloop database");
+    std::string config = good;
+    const auto at = config.find("bins: 24");
+    ASSERT_NE(at, std::string::npos);
+    config.replace(at, 8, "binz: 24");
+    test::WriteFile(dir / "config.bin", config);
+    test::ExpectReadError(LoadDatabase, dir / "config.bin", "key 'histogram.binz': unknown key");
+    test::WriteFile(dir / "long.bin", good + "\x01");
+    test::ExpectReadError(LoadDatabase, dir / "long.bin", "trailing bytes");
+}
+
+TEST(Png, WritesAValidFileWithTheRightSize) {
+    test::TempDir dir;
+    Image image{3, 2, 1, {0, 128, 255, 255, 128, 0}};
+    WritePng(dir / "a.png", image);
+    const std::string bytes = test::ReadFile(dir / "a.png");
+    ASSERT_GT(bytes.size(), 33U);
+    EXPECT_EQ(bytes.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+    EXPECT_EQ(bytes.substr(12, 4), "IHDR");
+    EXPECT_EQ(bytes.substr(16, 8), std::string("\0\0\0\x03\0\0\0\x02", 8));  // width, height
+    Image rgb{2, 2, 3, std::vector<std::uint8_t>(12, 7)};
+    EXPECT_NO_THROW(WritePng(dir / "rgb.png", rgb));
+}
+
+TEST(Png, BadImagesAndPathsAreErrors) {
+    test::TempDir dir;
+    EXPECT_THROW(WritePng(dir / "a.png", Image{3, 2, 1, {1, 2, 3}}), core::ConfigError);
+    EXPECT_THROW(WritePng(dir / "a.png", Image{0, 0, 1, {}}), core::ConfigError);
+    EXPECT_THROW(WritePng(dir / "a.png", Image{1, 1, 2, {1, 2}}), core::ConfigError);
+    EXPECT_THROW(WritePng(dir / "no" / "such" / "a.png", Image{1, 1, 1, {0}}), WriteError);
+}
+
+}  // namespace
+}  // namespace lidarloop::io
