@@ -5,7 +5,9 @@
 namespace lidarloop::cli {
 
 // One function per subcommand; each lives in the file of the same name.
+void AddBenchCommand(CLI::App& app);
 void AddDescribeCommand(CLI::App& app);
+void AddDetectCommand(CLI::App& app);
 void AddDistanceCommand(CLI::App& app);
 void AddDumpConfigCommand(CLI::App& app);
 

@@ -11,8 +11,10 @@ int main(int argc, char** argv) {
     app.set_version_flag("--version", std::string("lidarloop ") + LIDARLOOP_VERSION);
     app.require_subcommand(1);
     lidarloop::cli::AddDescribeCommand(app);
+    lidarloop::cli::AddDetectCommand(app);
     lidarloop::cli::AddDistanceCommand(app);
     lidarloop::cli::AddDumpConfigCommand(app);
+    lidarloop::cli::AddBenchCommand(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -92,6 +92,42 @@ printf '1 2 3\n1 2 3\n' >"$work/two.xyz"
 expect_error "ndt too few points" "two.xyz: no NDT cell could be classified" "$cli" describe \
     --method ndt "$work/two.xyz"
 
+# --- detect and bench over a small sequence ------------------------------------------------------
+seq="$work/seq"
+mkdir -p "$seq"
+for i in 0 1 2 3 4 5; do cp "$samples/corner_a.bin" "$seq/scan$i.bin"; done
+cp "$samples/corner_b.ply" "$seq/scan6.ply"
+cp "$samples/courtyard.bin" "$seq/scan7.bin"
+expect_ok "detect" "8 scans (folder)" "$cli" detect "$seq" --min-gap 2 --quiet --out "$work/det"
+for file in loops.csv candidates.csv similarity.png similarity_distance.png similarity.bin \
+    config.yaml timings.json; do
+    if [ -s "$work/det/$file" ]; then pass; else fail "detect did not write $file"; fi
+done
+if head -1 "$work/det/loops.csv" | grep -qx "query,match,distance,second_ratio,accepted"; then
+    pass
+else fail "loops.csv header: $(head -1 "$work/det/loops.csv")"; fi
+if grep -q "^3,0,0,.*,1$" "$work/det/loops.csv"; then pass; else
+    fail "scan 3 (a copy of scan 0) is not an accepted loop: $(cat "$work/det/loops.csv")"
+fi
+if grep -q "min_gap: 2" "$work/det/config.yaml"; then pass; else fail "config.yaml lacks the gap"; fi
+expect_ok "detect ndt" "method ndt" "$cli" detect "$seq" --method ndt --min-gap 2 --quiet \
+    --out "$work/det_ndt"
+printf 'garbage' >"$seq/scan3.bin"
+expect_error "detect bad scan" "scan 3: $seq/scan3.bin" "$cli" detect "$seq" --quiet --out "$work/det2"
+expect_ok "detect --skip-bad" "1 skipped" "$cli" detect "$seq" --skip-bad --quiet --min-gap 2 \
+    --out "$work/det3"
+if grep -q "scan3.bin" "$work/det3/skipped.txt"; then pass; else fail "skipped.txt lacks scan3"; fi
+if grep -q "^3," "$work/det3/loops.csv"; then fail "a skipped scan got a match"; else pass; fi
+rm "$seq/scan3.bin"
+expect_error "detect seconds without times" "needs scan times" "$cli" detect "$seq" \
+    --min-gap 1 --min-gap-unit seconds --quiet --out "$work/det4"
+expect_error "detect bad top-k" "detection.top_k must be in" "$cli" detect "$seq" --top-k 0 \
+    --quiet --out "$work/det5"
+expect_error "detect missing dataset" "no such dataset folder" "$cli" detect "$work/none" \
+    --quiet --out "$work/det6"
+expect_ok "bench" '"ns_per_comparison_one_core"' "$cli" bench "$seq" --queries 3 --quiet
+expect_ok "bench scaled" '"scaled_queries"' "$cli" bench "$seq" --queries 3 --scale-to 500 --quiet
+
 # --- config -------------------------------------------------------------------------------------
 expect_ok "dump-config" "bins: 100" "$cli" dump-config
 printf 'histogram:\n  bins: 12\n' >"$work/twelve.yaml"

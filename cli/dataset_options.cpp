@@ -1,0 +1,38 @@
+#include "dataset_options.hpp"
+
+#include "lidarloop/core/error.hpp"
+
+namespace lidarloop::cli {
+
+void DatasetOptions::AddTo(CLI::App& command) {
+    command.add_option("DATASET", path_, "folder of scans (KITTI layout, scan files, Osnabrueck)")
+        ->required();
+    command.add_option("--format", format_, "dataset layout: auto | kitti | folder | osnabrueck")
+        ->check(CLI::IsMember({"auto", "kitti", "folder", "osnabrueck"}));
+    command.add_option("--poses", poses_, "poses file (KITTI or TUM) instead of the usual one")
+        ->check(CLI::ExistingFile);
+    command.add_option("--calib", calib_, "KITTI calib.txt whose Tr converts the poses")
+        ->check(CLI::ExistingFile);
+}
+
+io::Dataset DatasetOptions::Open() const {
+    io::DatasetOptions options;
+    if (format_ == "kitti") options.format = io::DatasetFormat::kKitti;
+    if (format_ == "folder") options.format = io::DatasetFormat::kFolder;
+    if (format_ == "osnabrueck") options.format = io::DatasetFormat::kOsnabrueck;
+    options.poses_file = poses_;
+    options.calib_file = calib_;
+    return io::OpenDataset(path_, options);
+}
+
+pipeline::ScanSource SourceOf(const io::Dataset& dataset) {
+    pipeline::ScanSource source;
+    source.count = dataset.size();
+    source.load = [&dataset](std::size_t i) { return dataset.LoadScan(i); };
+    source.time_s = [&dataset](std::size_t i) {
+        return dataset.HasPoses() ? dataset.poses()[i].time_s : static_cast<double>(i);
+    };
+    return source;
+}
+
+}  // namespace lidarloop::cli

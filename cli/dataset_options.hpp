@@ -1,0 +1,30 @@
+#pragma once
+
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "lidarloop/io/dataset.hpp"
+#include "lidarloop/pipeline/sequence.hpp"
+
+namespace lidarloop::cli {
+
+/// DATASET and the flags that say how to open it, shared by the commands that read sequences.
+class DatasetOptions {
+public:
+    /// Adds the DATASET positional and --format, --poses, --calib.
+    void AddTo(CLI::App& command);
+    io::Dataset Open() const;
+    const std::string& path() const { return path_; }
+
+private:
+    std::string path_;
+    std::string format_ = "auto";
+    std::string poses_;
+    std::string calib_;
+};
+
+/// The scans of `dataset` as a pipeline source; times from its poses, else the scan index.
+pipeline::ScanSource SourceOf(const io::Dataset& dataset);
+
+}  // namespace lidarloop::cli
