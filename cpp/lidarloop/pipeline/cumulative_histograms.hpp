@@ -32,9 +32,9 @@ public:
 
     const float* Row(std::size_t i) const { return data_.data() + i * stride_; }
     /// W between stored scans i and j.
-    double Distance(std::size_t i, std::size_t j) const { return Distance(Row(i), j); }
+    double Distance(std::size_t i, std::size_t j) const { return DistanceToRow(Row(i), j); }
     /// W between a query row (from MakeRow) and stored scan j.
-    double Distance(const float* query_row, std::size_t j) const {
+    double DistanceToRow(const float* query_row, std::size_t j) const {
         return static_cast<double>(L1(query_row, Row(j), stride_)) / bins_;
     }
     const std::vector<float>& data() const { return data_; }

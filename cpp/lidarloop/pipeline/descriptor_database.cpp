@@ -73,7 +73,7 @@ PreparedQuery DescriptorDatabase::Prepare(const core::Descriptor& descriptor) co
 
 double DescriptorDatabase::Distance(const PreparedQuery& query, std::size_t j) const {
     if (!IsValid(j)) return kInfinity;
-    if (histograms_) return histograms_->Distance(query.cumulative_row.data(), j);
+    if (histograms_) return histograms_->DistanceToRow(query.cumulative_row.data(), j);
     return core::NdtSetDifference(query.ndt, ndt_sets_[j]);
 }
 
