@@ -6,6 +6,7 @@
 #include "lidarloop/core/descriptor.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/io/database_file.hpp"
+#include "lidarloop/io/plot.hpp"
 #include "lidarloop/io/png.hpp"
 #include "lidarloop/io/similarity_file.hpp"
 #include "lidarloop/pipeline/loop_detector.hpp"
@@ -125,6 +126,32 @@ TEST(Png, BadImagesAndPathsAreErrors) {
     EXPECT_THROW(WritePng(dir / "a.png", Image{0, 0, 1, {}}), core::ConfigError);
     EXPECT_THROW(WritePng(dir / "a.png", Image{1, 1, 2, {1, 2}}), core::ConfigError);
     EXPECT_THROW(WritePng(dir / "no" / "such" / "a.png", Image{1, 1, 1, {0}}), WriteError);
+}
+
+TEST(Plot, ScriptHoldsDataTitlesAndQuotesEscaped) {
+    Plot plot;
+    plot.title = "ROC of Roehling's height";
+    plot.x_label = "FPR";
+    plot.y_label = "TPR";
+    plot.series.push_back({"height", {0.0, 0.5, 1.0}, {0.0, 0.9, 1.0}, PlotSeries::Style::kLines});
+    plot.vertical_lines = {0.25};
+    const std::string script = GnuplotScript("out.png", plot);
+    EXPECT_NE(script.find("'ROC of Roehling''s height'"), std::string::npos) << script;
+    EXPECT_NE(script.find("$data0 << EOD\n0 0\n0.5 0.9\n1 1\nEOD"), std::string::npos);
+    EXPECT_NE(script.find("set arrow from 0.25"), std::string::npos);
+    EXPECT_NE(script.find("with lines lw 2 title 'height'"), std::string::npos);
+}
+
+TEST(Plot, RendersAPngWithGnuplot) {
+    if (!GnuplotAvailable()) GTEST_SKIP() << "gnuplot is not installed (scripts/setup installs it)";
+    test::TempDir dir;
+    Plot plot;
+    plot.title = "test";
+    plot.series.push_back({"a", {1, 2, 3}, {3, 1, 2}, PlotSeries::Style::kPoints});
+    RenderPlot(dir / "plot.png", plot);
+    EXPECT_EQ(test::ReadFile(dir / "plot.png").substr(1, 3), "PNG");
+    EXPECT_NE(test::ReadFile(dir / "plot.gp").find("$data0"), std::string::npos);
+    EXPECT_THROW(RenderPlot(dir / "no" / "such" / "plot.png", plot), WriteError);
 }
 
 }  // namespace

@@ -1,0 +1,95 @@
+#include "lidarloop/io/plot.hpp"
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+
+#include "lidarloop/io/detail/binary_io.hpp"
+#include "lidarloop/io/read_error.hpp"
+
+namespace lidarloop::io {
+namespace {
+
+// gnuplot strings are single-quoted; a quote inside is doubled.
+std::string Quote(const std::string& text) {
+    std::string quoted = "'";
+    for (char c : text) quoted += c == '\'' ? std::string("''") : std::string(1, c);
+    return quoted + "'";
+}
+
+const char* StyleName(PlotSeries::Style style) {
+    switch (style) {
+        case PlotSeries::Style::kLines: return "lines lw 2";
+        case PlotSeries::Style::kSteps: return "steps lw 2";
+        case PlotSeries::Style::kPoints: return "points pt 7 ps 0.6";
+        case PlotSeries::Style::kBoxes: return "boxes fs solid 0.35 noborder";
+    }
+    return "lines";
+}
+
+void WriteRange(std::ostringstream& script, const char* axis, double min, double max) {
+    if (min < max) script << "set " << axis << "range [" << min << ":" << max << "]\n";
+}
+
+}  // namespace
+
+bool GnuplotAvailable() {
+    return std::system("gnuplot --version > /dev/null 2>&1") == 0;
+}
+
+std::string GnuplotScript(const std::filesystem::path& png, const Plot& plot) {
+    std::ostringstream script;
+    script.precision(10);
+    for (std::size_t s = 0; s < plot.series.size(); ++s) {
+        script << "$data" << s << " << EOD\n";
+        const PlotSeries& series = plot.series[s];
+        for (std::size_t i = 0; i < std::min(series.x.size(), series.y.size()); ++i) {
+            script << series.x[i] << ' ' << series.y[i] << '\n';
+        }
+        script << "EOD\n";
+    }
+    script << "set terminal pngcairo size 1000,700 enhanced font 'sans,12'\n"
+           << "set output " << Quote(png.string()) << "\n"
+           << "set title " << Quote(plot.title) << " noenhanced\n"
+           << "set xlabel " << Quote(plot.x_label) << " noenhanced\n"
+           << "set ylabel " << Quote(plot.y_label) << " noenhanced\n"
+           << "set grid\nset key outside right top noenhanced\n";
+    if (plot.x_log) script << "set logscale x\n";
+    WriteRange(script, "x", plot.x_min, plot.x_max);
+    WriteRange(script, "y", plot.y_min, plot.y_max);
+    for (double x : plot.vertical_lines) {
+        script << "set arrow from " << x << ", graph 0 to " << x
+               << ", graph 1 nohead dt 2 lc rgb 'black'\n";
+    }
+    script << "plot ";
+    for (std::size_t s = 0; s < plot.series.size(); ++s) {
+        script << (s > 0 ? ", " : "") << "$data" << s << " using 1:2 with "
+               << StyleName(plot.series[s].style) << " title " << Quote(plot.series[s].title);
+    }
+    if (plot.series.empty()) script << "NaN notitle";
+    script << "\n";
+    return script.str();
+}
+
+void RenderPlot(const std::filesystem::path& png, const Plot& plot) {
+    const std::string script = GnuplotScript(png, plot);
+    std::filesystem::path script_file = png;
+    script_file.replace_extension(".gp");
+    detail::WriteWholeFile(script_file, script);
+    const std::string command = "gnuplot " + std::string("'") + script_file.string() + "' 2>&1";
+    FILE* pipe = popen(command.c_str(), "r");
+    if (pipe == nullptr) throw WriteError(png, "cannot run gnuplot");
+    std::string output;
+    char buffer[256];
+    while (std::fgets(buffer, sizeof(buffer), pipe) != nullptr) output += buffer;
+    const int status = pclose(pipe);
+    if (status != 0) {
+        const bool missing = WIFEXITED(status) && WEXITSTATUS(status) == 127;
+        throw WriteError(png, missing ? "gnuplot is not installed (apt-get install gnuplot-nox)"
+                                      : "gnuplot failed: " + output);
+    }
+}
+
+}  // namespace lidarloop::io
