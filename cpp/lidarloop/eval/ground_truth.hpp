@@ -1,0 +1,98 @@
+#pragma once
+
+#include <cstddef>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "lidarloop/core/min_gap.hpp"
+#include "lidarloop/core/point_cloud.hpp"
+
+namespace lidarloop::eval {
+
+/// "No such scan" in per-scan results (no partner outside the gap, no match).
+inline constexpr std::size_t kNoScan = std::numeric_limits<std::size_t>::max();
+
+/// When two scans of a sequence show the same place (a "loop" pair, a positive).
+///
+/// Röhling et al. 2015 (IV-B): two scans are the same place when their ground-truth positions
+/// are less than d = 10 m apart; every pair of scans is evaluated. Magnusson et al. 2009 (II-E,
+/// III-B): a scan overlaps when some scan outside the minimum loop size S is closer than t_r
+/// (10 m Hannover2, 5 m Kvarntorp); for the 180° scanner of Kvarntorp only scans whose
+/// orientation differs by less than 20° count.
+struct GroundTruthConfig {
+    /// d (Röhling) or t_r (Magnusson): a pair is positive when the 3-D distance between the
+    /// sensor positions is strictly below this, metres, > 0.
+    double distance_m = 10.0;
+    /// Largest heading difference of a positive pair, degrees in [0, 180]; a pair is positive
+    /// only when the difference is strictly below it. 0 disables the rule (omnidirectional
+    /// scanners); Magnusson uses 20 for Kvarntorp. See HeadingDifferenceDeg for the angle.
+    double max_heading_deg = 0.0;
+    /// Pairs closer than this in the sequence are never evaluated (neither positive nor
+    /// negative). Röhling evaluates every pair (0 scans, the default); Magnusson uses S = 30.
+    core::MinGap min_gap{0.0, core::MinGap::Unit::kScans};
+
+    /// Throws core::ConfigError naming the first invalid field (prefix "ground_truth.").
+    void Validate() const;
+    /// The rule in one English sentence, for reports.
+    std::string Describe() const;
+};
+
+/// Angle between the headings of two sensor poses, degrees in [0, 180]: the angle between the
+/// sensors' forward (x) axes after projecting them on the world ground plane (world z up).
+/// Chosen over the full rotation angle because Magnusson's rule is about where a ground robot's
+/// 180° scanner points; roll and pitch from uneven ground do not change the view much. A sensor
+/// looking straight up or down (within ~1e-6 rad) has no heading and is 0° from every other
+/// heading. Thread-safe.
+double HeadingDifferenceDeg(const core::Transform& T_world_a, const core::Transform& T_world_b);
+
+/// One positive pair: scans i < j, and the distance between their sensor positions.
+struct LoopPair {
+    std::size_t i = 0;
+    std::size_t j = 0;
+    double distance_m = 0.0;
+};
+
+/// The ground truth of one sequence under one GroundTruthConfig. Plain data; the member
+/// functions are O(1) or O(log degree) queries. Build with BuildGroundTruth.
+struct GroundTruth {
+    GroundTruthConfig config;
+    std::vector<double> times_s;  ///< per scan, the pose times (used by a gap in seconds)
+    std::vector<LoopPair> loops;  ///< all positive pairs, i < j, sorted by (i, j)
+    /// Per scan, the nearest scan outside the gap that also passes the heading rule (Magnusson
+    /// table I: Ŝ), or kNoScan when there is none.
+    std::vector<std::size_t> nearest;
+    /// Per scan, the distance to `nearest`, metres (+inf when there is none).
+    std::vector<double> nearest_distance_m;
+    /// CSR adjacency of `loops`: the partners of scan i are
+    /// partners[partner_offsets[i] .. partner_offsets[i + 1]), sorted ascending.
+    std::vector<std::size_t> partner_offsets;
+    std::vector<std::size_t> partners;
+
+    std::size_t size() const { return times_s.size(); }
+    /// True when scans i and j are far enough apart in the sequence to be evaluated.
+    bool Comparable(std::size_t i, std::size_t j) const {
+        return i != j && config.min_gap.Allows(i, j, times_s[i], times_s[j]);
+    }
+    /// True when (i, j), in either order, is a positive pair.
+    bool IsLoop(std::size_t i, std::size_t j) const;
+    /// True when scan i has at least one positive partner (Magnusson: an "overlapping" scan;
+    /// nearest_distance_m[i] < distance_m, up to rounding exactly at the boundary).
+    bool Overlapping(std::size_t i) const { return partner_offsets[i + 1] > partner_offsets[i]; }
+    /// Number of overlapping scans.
+    std::size_t OverlappingCount() const;
+    /// Number of pairs i < j that are Comparable (positives + negatives of the pair-wise
+    /// evaluation).
+    std::size_t ComparablePairCount() const;
+    /// config.Describe() plus the counts, for reports.
+    std::string Describe() const;
+};
+
+/// Builds the ground truth from the scans' poses with a k-d tree radius search (not all pairs):
+/// O(n log n + P) for P positive pairs, plus the nearest-partner search. Throws
+/// core::ConfigError for an invalid config and core::Error when a pose or time is not finite.
+/// Thread-safe.
+GroundTruth BuildGroundTruth(const std::vector<core::StampedPose>& poses,
+                             const GroundTruthConfig& config);
+
+}  // namespace lidarloop::eval

@@ -1,0 +1,61 @@
+#include "lidarloop/eval/threshold_learning.hpp"
+
+#include <cmath>
+
+#include "lidarloop/core/error.hpp"
+
+namespace lidarloop::eval {
+
+std::string ToString(Criterion criterion) { return criterion == Criterion::kMcc ? "mcc" : "f1"; }
+
+Criterion ParseCriterion(std::string_view name) {
+    if (name == "mcc") return Criterion::kMcc;
+    if (name == "f1") return Criterion::kF1;
+    throw core::ConfigError("unknown threshold criterion '" + std::string(name) +
+                            "' (valid: mcc, f1)");
+}
+
+ThresholdTransfer LearnAndTest(std::span<const ScoredPair> train, std::span<const ScoredPair> test,
+                               Criterion criterion) {
+    if (train.empty()) throw core::EmptyInputError("threshold learning: no training pairs");
+    if (test.empty()) throw core::EmptyInputError("threshold learning: no test pairs");
+    // Only the optimum is needed; the smallest curve keeps the sweep cheap.
+    const PairwiseEvaluation learnt = EvaluatePairs(train, PairwiseConfig{3});
+    const BestThreshold& best = criterion == Criterion::kMcc ? learnt.best_mcc : learnt.best_f1;
+    ThresholdTransfer result;
+    result.criterion = criterion;
+    result.threshold = best.threshold;
+    result.train_score = best.score;
+    result.train = best.confusion;
+    result.test = ConfusionAt(test, best.threshold);
+    result.test_f1 = F1(result.test);
+    result.test_mcc = Mcc(result.test);
+    return result;
+}
+
+PairSplit SplitByQuery(std::span<const ScoredPair> pairs, std::size_t first_test_scan) {
+    PairSplit split;
+    split.first_test_scan = first_test_scan;
+    for (const auto& pair : pairs) {
+        (pair.j < first_test_scan ? split.train : split.test).push_back(pair);
+    }
+    return split;
+}
+
+void ThresholdLearningConfig::Validate() const {
+    if (!(train_fraction > 0.0 && train_fraction < 1.0)) {
+        throw core::ConfigError("threshold_learning.train_fraction must be in (0, 1), got " +
+                                std::to_string(train_fraction));
+    }
+}
+
+ThresholdTransfer LearnOnFirstPart(std::span<const ScoredPair> pairs, std::size_t scan_count,
+                                   const ThresholdLearningConfig& config) {
+    config.Validate();
+    const auto first_test_scan = static_cast<std::size_t>(
+        std::llround(config.train_fraction * static_cast<double>(scan_count)));
+    const PairSplit split = SplitByQuery(pairs, first_test_scan);
+    return LearnAndTest(split.train, split.test, config.criterion);
+}
+
+}  // namespace lidarloop::eval

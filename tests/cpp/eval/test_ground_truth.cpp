@@ -1,0 +1,215 @@
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "eval/eval_test_utils.hpp"
+#include "lidarloop/core/error.hpp"
+#include "lidarloop/eval/ground_truth.hpp"
+
+namespace lidarloop::eval {
+namespace {
+
+using core::MinGap;
+using test::MakePose;
+using test::RandomTrajectory;
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// The O(n^2) reference: every pair, the rules written out again.
+struct BruteTruth {
+    std::vector<LoopPair> loops;
+    std::vector<std::size_t> nearest;
+    std::vector<double> nearest_distance_m;
+    std::size_t comparable_pairs = 0;
+};
+
+BruteTruth BruteForce(const std::vector<core::StampedPose>& poses, const GroundTruthConfig& c) {
+    const std::size_t n = poses.size();
+    std::vector<Eigen::Vector3d> position(n);
+    for (std::size_t i = 0; i < n; ++i) position[i] = poses[i].T_world_sensor.translation();
+    const auto rules = [&](std::size_t i, std::size_t j) {
+        if (i == j || !c.min_gap.Allows(i, j, poses[i].time_s, poses[j].time_s)) return false;
+        return c.max_heading_deg == 0.0 ||
+               HeadingDifferenceDeg(poses[i].T_world_sensor, poses[j].T_world_sensor) <
+                   c.max_heading_deg;
+    };
+    BruteTruth truth;
+    truth.nearest.assign(n, kNoScan);
+    truth.nearest_distance_m.assign(n, std::numeric_limits<double>::infinity());
+    for (std::size_t i = 0; i < n; ++i) {
+        double best = std::numeric_limits<double>::infinity();
+        for (std::size_t j = 0; j < n; ++j) {
+            if (i < j && c.min_gap.Allows(i, j, poses[i].time_s, poses[j].time_s)) {
+                ++truth.comparable_pairs;
+            }
+            const double squared = (position[i] - position[j]).squaredNorm();
+            const bool near = i < j && squared < c.distance_m * c.distance_m;
+            // The rules are the expensive part; a pair that can change nothing skips them.
+            if (!(near || squared < best) || !rules(i, j)) continue;
+            if (near) truth.loops.push_back({i, j, (position[i] - position[j]).norm()});
+            if (squared < best) {
+                best = squared;
+                truth.nearest[i] = j;
+                truth.nearest_distance_m[i] = std::sqrt(squared);
+            }
+        }
+    }
+    return truth;
+}
+
+void ExpectSameAsBruteForce(const std::vector<core::StampedPose>& poses,
+                            const GroundTruthConfig& config) {
+    const GroundTruth truth = BuildGroundTruth(poses, config);
+    const BruteTruth expected = BruteForce(poses, config);
+    ASSERT_EQ(truth.loops.size(), expected.loops.size()) << config.Describe();
+    for (std::size_t k = 0; k < truth.loops.size(); ++k) {
+        EXPECT_EQ(truth.loops[k].i, expected.loops[k].i);
+        EXPECT_EQ(truth.loops[k].j, expected.loops[k].j);
+        EXPECT_EQ(truth.loops[k].distance_m, expected.loops[k].distance_m);
+    }
+    EXPECT_EQ(truth.nearest, expected.nearest) << config.Describe();
+    EXPECT_EQ(truth.nearest_distance_m, expected.nearest_distance_m);
+    EXPECT_EQ(truth.ComparablePairCount(), expected.comparable_pairs);
+    // The adjacency, Overlapping and the nearest distance tell the same story.
+    std::size_t overlapping = 0;
+    for (std::size_t i = 0; i < truth.size(); ++i) {
+        EXPECT_EQ(truth.Overlapping(i), truth.nearest_distance_m[i] < config.distance_m);
+        overlapping += truth.Overlapping(i) ? 1 : 0;
+    }
+    EXPECT_EQ(truth.OverlappingCount(), overlapping);
+    for (const auto& loop : expected.loops) {
+        EXPECT_TRUE(truth.IsLoop(loop.i, loop.j));
+        EXPECT_TRUE(truth.IsLoop(loop.j, loop.i));
+    }
+    EXPECT_EQ(truth.partners.size(), 2 * expected.loops.size());
+}
+
+TEST(GroundTruth, KdTreeEqualsBruteForceOnRandomTrajectories) {
+    std::vector<GroundTruthConfig> configs(6);
+    configs[1].min_gap = {30.0, MinGap::Unit::kScans};
+    configs[2].min_gap = {12.5, MinGap::Unit::kSeconds};
+    configs[3].distance_m = 5.0;
+    configs[3].max_heading_deg = 20.0;
+    configs[3].min_gap = {10.0, MinGap::Unit::kScans};
+    configs[4].distance_m = 3.0;
+    configs[4].max_heading_deg = 45.0;
+    configs[4].min_gap = {4.0, MinGap::Unit::kSeconds};
+    configs[5].distance_m = 25.0;
+    configs[5].min_gap = {2.5, MinGap::Unit::kScans};  // fractional S: |i - j| >= 3
+    for (const unsigned seed : {1u, 2u, 3u}) {
+        const auto poses = RandomTrajectory(seed, 500);
+        for (const auto& config : configs) {
+            SCOPED_TRACE("seed " + std::to_string(seed) + ": " + config.Describe());
+            ExpectSameAsBruteForce(poses, config);
+        }
+    }
+}
+
+TEST(GroundTruth, HandMadeSequence) {
+    // Scans 0..5 on a line 4 m apart, then scan 6 back at scan 1 facing the other way.
+    std::vector<core::StampedPose> poses;
+    for (int i = 0; i < 6; ++i) poses.push_back(MakePose(i, 4.0 * i, 0.0));
+    poses.push_back(MakePose(6, 4.0, 1.0, std::numbers::pi));
+    GroundTruthConfig config;
+    config.distance_m = 5.0;
+    config.min_gap = {2.0, MinGap::Unit::kScans};
+    const GroundTruth truth = BuildGroundTruth(poses, config);
+    ASSERT_EQ(truth.loops.size(), 3u);  // (0,6) 4.12 m, (1,6) 1 m, (2,6) 4.12 m
+    EXPECT_EQ(truth.loops[0].i, 0u);
+    EXPECT_EQ(truth.loops[1].i, 1u);
+    EXPECT_DOUBLE_EQ(truth.loops[1].distance_m, 1.0);
+    EXPECT_EQ(truth.loops[2].i, 2u);
+    EXPECT_EQ(truth.nearest[6], 1u);
+    EXPECT_EQ(truth.nearest[3], 6u);  // 3 is 2 scans from 1 and 5: only 0 and 6 are outside
+    EXPECT_DOUBLE_EQ(truth.nearest_distance_m[3], std::sqrt(64.0 + 1.0));
+    EXPECT_FALSE(truth.Overlapping(3));
+    EXPECT_TRUE(truth.Overlapping(6));
+    EXPECT_EQ(truth.OverlappingCount(), 4u);
+    // The heading rule removes them all: scan 6 faces the other way.
+    config.max_heading_deg = 20.0;
+    const GroundTruth directed = BuildGroundTruth(poses, config);
+    EXPECT_TRUE(directed.loops.empty());
+    EXPECT_EQ(directed.nearest[6], kNoScan);
+    EXPECT_EQ(directed.nearest_distance_m[6], std::numeric_limits<double>::infinity());
+    EXPECT_EQ(directed.nearest[0], 3u);
+}
+
+TEST(GroundTruth, HeadingDifferenceUsesTheGroundPlane) {
+    const auto heading = [](double yaw_a, double yaw_b, double pitch_b = 0.0, double roll_b = 0.0) {
+        return HeadingDifferenceDeg(
+            MakePose(0, 0, 0, yaw_a * kDeg).T_world_sensor,
+            MakePose(0, 0, 0, yaw_b * kDeg, pitch_b * kDeg, roll_b * kDeg).T_world_sensor);
+    };
+    EXPECT_NEAR(heading(10, 350), 20.0, 1e-9);  // across the +-180 seam
+    EXPECT_NEAR(heading(0, 180), 180.0, 1e-9);
+    EXPECT_NEAR(heading(-170, 170), 20.0, 1e-9);
+    EXPECT_NEAR(heading(30, 30, 0, 40), 0.0, 1e-9);  // roll does not change the heading
+    EXPECT_NEAR(heading(30, 30, 25, 0), 0.0, 1e-9);  // nor does pitch
+    EXPECT_NEAR(heading(0, 123, 90, 0), 0.0, 1e-6);  // looking straight down: no heading
+    EXPECT_NEAR(heading(75, 20), 55.0, 1e-9);
+}
+
+TEST(GroundTruth, DescribeNamesTheRule) {
+    GroundTruthConfig config;
+    EXPECT_NE(config.Describe().find("10 m"), std::string::npos);
+    EXPECT_NE(config.Describe().find("every pair"), std::string::npos);
+    config.distance_m = 5.0;
+    config.max_heading_deg = 20.0;
+    config.min_gap = {30.0, MinGap::Unit::kScans};
+    const std::string text = config.Describe();
+    EXPECT_NE(text.find("5 m"), std::string::npos) << text;
+    EXPECT_NE(text.find("20 deg"), std::string::npos) << text;
+    EXPECT_NE(text.find("30 scans"), std::string::npos) << text;
+    config.min_gap = {12.5, MinGap::Unit::kSeconds};
+    EXPECT_NE(config.Describe().find("12.5 s"), std::string::npos);
+    const GroundTruth truth = BuildGroundTruth(RandomTrajectory(4, 50), config);
+    EXPECT_NE(truth.Describe().find("50 scans"), std::string::npos);
+}
+
+TEST(GroundTruth, EmptyAndSingleScanSequences) {
+    const GroundTruth empty = BuildGroundTruth({}, GroundTruthConfig{});
+    EXPECT_EQ(empty.size(), 0u);
+    EXPECT_EQ(empty.ComparablePairCount(), 0u);
+    const GroundTruth one = BuildGroundTruth({MakePose(0, 0, 0)}, GroundTruthConfig{});
+    EXPECT_EQ(one.nearest[0], kNoScan);
+    EXPECT_FALSE(one.Overlapping(0));
+}
+
+void ExpectConfigError(const GroundTruthConfig& config, const std::string& field) {
+    try {
+        config.Validate();
+        ADD_FAILURE() << "accepted " << field;
+    } catch (const core::ConfigError& e) {
+        EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+}
+
+TEST(GroundTruth, RejectsAbsurdConfigsAndPoses) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const double inf = std::numeric_limits<double>::infinity();
+    for (const double distance : {0.0, -1.0, nan, inf}) {
+        GroundTruthConfig config;
+        config.distance_m = distance;
+        ExpectConfigError(config, "ground_truth.distance_m");
+    }
+    for (const double heading : {-1.0, 181.0, nan}) {
+        GroundTruthConfig config;
+        config.max_heading_deg = heading;
+        ExpectConfigError(config, "ground_truth.max_heading_deg");
+    }
+    GroundTruthConfig gap;
+    gap.min_gap.value = -3.0;
+    ExpectConfigError(gap, "ground_truth.min_gap");
+    EXPECT_THROW(BuildGroundTruth({}, gap), core::ConfigError);
+    std::vector<core::StampedPose> poses{MakePose(0, 0, 0), MakePose(1, nan, 0)};
+    EXPECT_THROW(BuildGroundTruth(poses, GroundTruthConfig{}), core::Error);
+    poses[1] = MakePose(nan, 1, 0);
+    EXPECT_THROW(BuildGroundTruth(poses, GroundTruthConfig{}), core::Error);
+}
+
+}  // namespace
+}  // namespace lidarloop::eval

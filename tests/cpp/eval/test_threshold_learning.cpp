@@ -1,0 +1,91 @@
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "lidarloop/core/error.hpp"
+#include "lidarloop/eval/threshold_learning.hpp"
+
+namespace lidarloop::eval {
+namespace {
+
+// Scans 0..19; loops have distance 0.1 + 0.01 j in the first half and 0.3 in the second (the
+// detector drifts), non-loops 0.5 + 0.01 j.
+std::vector<ScoredPair> DriftingPairs() {
+    std::vector<ScoredPair> pairs;
+    for (std::uint32_t j = 1; j < 20; ++j) {
+        for (std::uint32_t i = 0; i < j; ++i) {
+            const bool loop = (i + j) % 4 == 0;
+            const auto step = 0.01f * static_cast<float>(j);
+            const float base = loop ? (j < 10 ? 0.1f + step : 0.3f) : 0.5f + step;
+            pairs.push_back({i, j, base, loop});
+        }
+    }
+    return pairs;
+}
+
+TEST(ThresholdLearning, SplitByQueryPartitionsThePairs) {
+    const auto pairs = DriftingPairs();
+    const PairSplit split = SplitByQuery(pairs, 10);
+    EXPECT_EQ(split.first_test_scan, 10u);
+    EXPECT_EQ(split.train.size() + split.test.size(), pairs.size());
+    EXPECT_EQ(split.train.size(), 45u);  // pairs with j < 10
+    for (const auto& p : split.train) EXPECT_LT(p.j, 10u);
+    for (const auto& p : split.test) EXPECT_GE(p.j, 10u);
+}
+
+TEST(ThresholdLearning, LearnAndTestGivesATableIRow) {
+    const auto pairs = DriftingPairs();
+    const PairSplit split = SplitByQuery(pairs, 10);
+    const ThresholdTransfer row = LearnAndTest(split.train, split.test, Criterion::kMcc);
+    // Training loops end at 0.1 + 0.01 * 9 (scan 9's loops), non-loops start at 0.51.
+    EXPECT_EQ(row.threshold, static_cast<double>(0.1f + 0.01f * 9));
+    EXPECT_DOUBLE_EQ(row.train_score, 1.0);
+    EXPECT_EQ(row.train.fp, 0u);
+    EXPECT_EQ(row.train.fn, 0u);
+    // On the test part every loop sits at 0.3 > tau: nothing is detected.
+    EXPECT_EQ(row.test.tp, 0u);
+    EXPECT_EQ(row.test.fp, 0u);
+    EXPECT_EQ(row.test, ConfusionAt(split.test, row.threshold));
+    EXPECT_DOUBLE_EQ(row.test_f1, 0.0);
+    EXPECT_DOUBLE_EQ(row.test_mcc, 0.0);
+    // Learning on the test part itself recovers a perfect threshold there.
+    const ThresholdTransfer self = LearnAndTest(split.test, split.test, Criterion::kF1);
+    EXPECT_DOUBLE_EQ(self.test_f1, 1.0);
+    EXPECT_EQ(self.threshold, static_cast<double>(0.3f));
+}
+
+TEST(ThresholdLearning, LearnOnFirstPart) {
+    const auto pairs = DriftingPairs();
+    ThresholdLearningConfig config;
+    config.train_fraction = 0.5;
+    const ThresholdTransfer row = LearnOnFirstPart(pairs, 20, config);
+    const PairSplit split = SplitByQuery(pairs, 10);
+    const ThresholdTransfer expected = LearnAndTest(split.train, split.test, Criterion::kMcc);
+    EXPECT_EQ(row.threshold, expected.threshold);
+    EXPECT_EQ(row.test, expected.test);
+    config.train_fraction = 0.01;  // round(0.2) = 0: no training pair
+    EXPECT_THROW(LearnOnFirstPart(pairs, 20, config), core::EmptyInputError);
+    EXPECT_THROW(LearnAndTest(pairs, {}, Criterion::kMcc), core::EmptyInputError);
+}
+
+TEST(ThresholdLearning, RejectsAbsurdConfigs) {
+    for (const double fraction : {0.0, 1.0, -0.5, 2.0, std::numeric_limits<double>::quiet_NaN()}) {
+        ThresholdLearningConfig config;
+        config.train_fraction = fraction;
+        try {
+            config.Validate();
+            ADD_FAILURE() << "accepted " << fraction;
+        } catch (const core::ConfigError& e) {
+            EXPECT_NE(std::string(e.what()).find("threshold_learning.train_fraction"),
+                      std::string::npos);
+        }
+    }
+    EXPECT_EQ(ParseCriterion("mcc"), Criterion::kMcc);
+    EXPECT_EQ(ParseCriterion(ToString(Criterion::kF1)), Criterion::kF1);
+    EXPECT_THROW(ParseCriterion("auc"), core::ConfigError);
+}
+
+}  // namespace
+}  // namespace lidarloop::eval
