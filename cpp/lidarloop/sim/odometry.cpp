@@ -1,0 +1,39 @@
+#include "lidarloop/sim/odometry.hpp"
+
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include "lidarloop/core/error.hpp"
+#include "lidarloop/sim/detail/random.hpp"
+#include "lidarloop/sim/detail/text.hpp"
+
+namespace lidarloop::sim {
+
+void OdometryConfig::Validate() const {
+    if (!(yaw_noise_deg >= 0.0 && yaw_noise_deg <= 10.0)) {
+        throw core::ConfigError("odometry.yaw_noise_deg must be in [0, 10], got " +
+                                detail::NumberText(yaw_noise_deg));
+    }
+    if (!(translation_noise >= 0.0 && translation_noise <= 0.5)) {
+        throw core::ConfigError("odometry.translation_noise must be in [0, 0.5], got " +
+                                detail::NumberText(translation_noise));
+    }
+}
+
+core::Transform MeasureStep(const core::Transform& T_prev_next, const OdometryConfig& config,
+                            std::uint64_t seed, std::size_t index) {
+    detail::Random rng(
+        detail::StreamSeed(seed, detail::Stream::kOdometry, {static_cast<std::int64_t>(index)}));
+    const double yaw_error = rng.Normal() * config.yaw_noise_deg * std::numbers::pi / 180.0;
+    const double length_error = rng.Normal() * config.translation_noise;
+    const double side_error = rng.Normal() * config.translation_noise;
+    const Eigen::Vector3d t = T_prev_next.translation();
+    core::Transform measured = T_prev_next;
+    measured.translation() =
+        t * (1.0 + length_error) + Eigen::Vector3d::UnitY() * (side_error * t.norm());
+    measured.prerotate(Eigen::AngleAxisd(yaw_error, Eigen::Vector3d::UnitZ()));
+    return measured;
+}
+
+}  // namespace lidarloop::sim

@@ -1,0 +1,213 @@
+#include "lidarloop/sim/simulator.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+
+#include "lidarloop/core/error.hpp"
+#include "lidarloop/sim/detail/random.hpp"
+#include "lidarloop/sim/detail/text.hpp"
+
+namespace lidarloop::sim {
+namespace {
+
+constexpr std::size_t kMaxScans = 1'000'000;
+constexpr std::size_t kCheckpointStride = 256;
+constexpr int kMaxAutoUturnBlocks = 12;
+
+// The sensor pose of a vehicle standing on the ground at `point`: x along the direction of travel
+// following the slope, z along the ground normal, the sensor mount_height_m up that normal.
+core::Transform VehiclePose(const RoutePoint& point, const Terrain& ground, double mount_height_m) {
+    const double x = point.position_m.x();
+    const double y = point.position_m.y();
+    const Eigen::Vector2d g = ground.Gradient(x, y);
+    const Eigen::Vector3d normal = Eigen::Vector3d(-g.x(), -g.y(), 1.0).normalized();
+    const Eigen::Vector2d heading(std::cos(point.heading_rad), std::sin(point.heading_rad));
+    const Eigen::Vector3d forward_guess(heading.x(), heading.y(), g.dot(heading));
+    const Eigen::Vector3d left = normal.cross(forward_guess).normalized();
+    const Eigen::Vector3d forward = left.cross(normal);
+    core::Transform T_world_sensor = core::Transform::Identity();
+    T_world_sensor.linear().col(0) = forward;
+    T_world_sensor.linear().col(1) = left;
+    T_world_sensor.linear().col(2) = normal;
+    T_world_sensor.translation() =
+        Eigen::Vector3d(x, y, ground.Height(x, y)) + mount_height_m * normal;
+    return T_world_sensor;
+}
+
+int UturnBlocks(const SimulationConfig& config, const SceneLayout& layout) {
+    if (config.route.uturn_blocks > 0) return config.route.uturn_blocks;
+    // One out-and-back within the sequence, so that the way home revisits the way out.
+    const double mean_spacing = 0.5 * (config.route.spacing_min_m + config.route.spacing_max_m);
+    const double length_m = static_cast<double>(config.scans) * mean_spacing;
+    const int blocks = static_cast<int>(length_m / (2.0 * layout.block_pitch_m));
+    return std::clamp(blocks, 1, kMaxAutoUturnBlocks);
+}
+
+NodeRange Grow(NodeRange nodes, int margin) {
+    return {nodes.i_min - margin, nodes.i_max + margin, nodes.j_min - margin, nodes.j_max + margin};
+}
+
+SensorSpec ResolveFor(const SimulationConfig& config, const SceneLayout& layout) {
+    config.Validate();
+    SensorSpec spec = Resolve(config.sensor);
+    if (layout.ceiling_height_m > 0.0 && spec.mount_height_m > layout.ceiling_height_m - 0.2) {
+        throw core::ConfigError("sensor.mount_height_m " + detail::NumberText(spec.mount_height_m) +
+                                " m does not fit under the " +
+                                detail::NumberText(layout.ceiling_height_m) + " m ceiling of the " +
+                                ToString(config.scene) + " scene");
+    }
+    return spec;
+}
+
+}  // namespace
+
+void SimulationConfig::Validate() const {
+    if (scans < 1 || scans > kMaxScans) {
+        throw core::ConfigError("scans must be in [1, 1000000], got " + std::to_string(scans));
+    }
+    route.Validate();
+    sensor.Validate();
+    odometry.Validate();
+}
+
+Simulator::Simulator(const SimulationConfig& config)
+    : config_(config),
+      sensor_(ResolveFor(config, LayoutOf(config.scene))),
+      layout_(LayoutOf(config.scene)),
+      spacing_(config.route.spacing_min_m, config.route.spacing_max_m, config.seed),
+      route_(RouteLegs(config.route.type, UturnBlocks(config, layout_)), layout_),
+      world_(GenerateWorld(config.scene, config.seed, Grow(route_.VisitedNodes(), 1))),
+      directions_(BeamDirections(sensor_)) {
+    if (config.route.type == RouteType::kUTurn) {
+        config_.route.uturn_blocks = UturnBlocks(config, layout_);
+    }
+    config_.sensor.horizontal_steps = sensor_.horizontal_steps;
+    config_.sensor.min_range_m = sensor_.min_range_m;
+    config_.sensor.max_range_m = sensor_.max_range_m;
+    config_.sensor.mount_height_m = sensor_.mount_height_m;
+    config_.sensor.scan_period_s = sensor_.scan_period_s;
+    core::Transform odometry = GroundTruthPose(0).T_world_sensor;
+    core::Transform previous = odometry;
+    odometry_checkpoints_.push_back(odometry);
+    for (std::size_t i = 1; i < size(); ++i) {
+        const core::Transform current = GroundTruthPose(i).T_world_sensor;
+        odometry =
+            odometry * MeasureStep(previous.inverse() * current, config_.odometry, config_.seed, i);
+        if (i % kCheckpointStride == 0) odometry_checkpoints_.push_back(odometry);
+        previous = current;
+    }
+}
+
+void Simulator::CheckIndex(std::size_t index) const {
+    if (index >= size()) {
+        throw std::out_of_range("scan index " + std::to_string(index) + " is not below " +
+                                std::to_string(size()));
+    }
+}
+
+core::StampedPose Simulator::GroundTruthPose(std::size_t index) const {
+    CheckIndex(index);
+    const RoutePoint point = route_.At(spacing_.ArcLength(index));
+    return {static_cast<double>(index) * sensor_.scan_period_s,
+            VehiclePose(point, world_.ground(), sensor_.mount_height_m)};
+}
+
+core::StampedPose Simulator::OdometryPose(std::size_t index) const {
+    return OdometryPoses(index, 1).front();
+}
+
+std::vector<core::StampedPose> Simulator::OdometryPoses(std::size_t first,
+                                                        std::size_t count) const {
+    if (count == 0) return {};
+    CheckIndex(first + count - 1);
+    // Replay the measured steps from the checkpoint at or before `first`.
+    const std::size_t start = first / kCheckpointStride * kCheckpointStride;
+    core::Transform odometry = odometry_checkpoints_[first / kCheckpointStride];
+    core::Transform previous = GroundTruthPose(start).T_world_sensor;
+    std::vector<core::StampedPose> poses;
+    poses.reserve(count);
+    for (std::size_t i = start; i < first + count; ++i) {
+        if (i > start) {
+            const core::Transform current = GroundTruthPose(i).T_world_sensor;
+            odometry = odometry *
+                       MeasureStep(previous.inverse() * current, config_.odometry, config_.seed, i);
+            previous = current;
+        }
+        if (i >= first) poses.push_back({static_cast<double>(i) * sensor_.scan_period_s, odometry});
+    }
+    return poses;
+}
+
+core::PointCloud Simulator::Scan(std::size_t index) const {
+    const core::Transform T_world_sensor = GroundTruthPose(index).T_world_sensor;
+    const Eigen::Matrix3d R = T_world_sensor.linear();
+    detail::Random rng(detail::StreamSeed(config_.seed, detail::Stream::kScan,
+                                          {static_cast<std::int64_t>(index)}));
+    core::PointCloud cloud;
+    cloud.reserve(directions_.size());
+    Ray ray{T_world_sensor.translation(), Eigen::Vector3d::UnitX()};
+    for (const Eigen::Vector3d& direction : directions_) {
+        ray.direction = R * direction;
+        const double range = world_.CastRay(ray, sensor_.max_range_m);
+        if (range == kNoHit || range < sensor_.min_range_m) continue;
+        // Draws only for returns; the returns are the same for the same (config, index).
+        if (rng.Uniform() < sensor_.dropout) continue;
+        const double measured = range + sensor_.noise_m * rng.Normal();
+        if (measured <= 0.0) continue;
+        cloud.push_back((measured * direction).cast<float>());
+    }
+    return cloud;
+}
+
+std::size_t CountRevisitedScans(const Simulator& simulator, std::size_t min_index_gap,
+                                double max_distance_m) {
+    const std::size_t n = simulator.size();
+    std::vector<Eigen::Vector3d> positions(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        positions[i] = simulator.GroundTruthPose(i).T_world_sensor.translation();
+    }
+    const auto key = [max_distance_m](const Eigen::Vector3d& p, int dx, int dy) {
+        const auto cx = static_cast<std::int64_t>(std::floor(p.x() / max_distance_m)) + dx;
+        const auto cy = static_cast<std::int64_t>(std::floor(p.y() / max_distance_m)) + dy;
+        return static_cast<std::uint64_t>(cx) * 0x9e3779b97f4a7c15ULL ^
+               static_cast<std::uint64_t>(cy);
+    };
+    std::unordered_map<std::uint64_t, std::vector<std::size_t>> grid;
+    std::size_t revisited = 0;
+    for (std::size_t i = min_index_gap; i < n; ++i) {
+        grid[key(positions[i - min_index_gap], 0, 0)].push_back(i - min_index_gap);
+        bool found = false;
+        for (int dx = -1; dx <= 1 && !found; ++dx) {
+            for (int dy = -1; dy <= 1 && !found; ++dy) {
+                const auto cell = grid.find(key(positions[i], dx, dy));
+                if (cell == grid.end()) continue;
+                for (const std::size_t j : cell->second) {
+                    if ((positions[j] - positions[i]).norm() <= max_distance_m) {
+                        found = true;
+                        break;
+                    }
+                }
+            }
+        }
+        if (found) ++revisited;
+    }
+    return revisited;
+}
+
+SimulationConfig DemoConfig() {
+    SimulationConfig config;
+    config.scene = SceneType::kUrban;
+    config.route.type = RouteType::kGrid;
+    config.route.spacing_min_m = 2.5;
+    config.route.spacing_max_m = 3.5;
+    config.sensor.model = SensorModel::kVlp16;
+    config.sensor.horizontal_steps = 256;
+    config.sensor.scan_period_s = 0.25;
+    config.scans = 320;
+    config.seed = 1;
+    return config;
+}
+
+}  // namespace lidarloop::sim
