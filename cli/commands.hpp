@@ -10,5 +10,7 @@ void AddDescribeCommand(CLI::App& app);
 void AddDetectCommand(CLI::App& app);
 void AddDistanceCommand(CLI::App& app);
 void AddDumpConfigCommand(CLI::App& app);
+void AddEvaluateCommand(CLI::App& app);
+void AddSimulateCommand(CLI::App& app);
 
 }  // namespace lidarloop::cli

@@ -7,10 +7,10 @@
 
 namespace lidarloop::cli {
 
-void DescriptorOptions::AddTo(CLI::App& command) {
+void DescriptorOptions::AddTo(CLI::App& command, bool with_method) {
     command.add_option("--config", config_file_, "YAML file overriding the defaults it names")
         ->check(CLI::ExistingFile);
-    command.add_option("--method", method_, "descriptor: height | range | ndt");
+    if (with_method) command.add_option("--method", method_, "descriptor: height | range | ndt");
     bins_option_ = command.add_option("--bins", bins_, "number of histogram buckets b");
     min_option_ = command.add_option("--min", min_m_, "v_min of the chosen projection, metres");
     max_option_ = command.add_option("--max", max_m_, "v_max of the chosen projection, metres");

@@ -16,7 +16,7 @@ class DescriptorOptions {
 public:
     /// Adds --config, --method, and the histogram flags --bins, --min, --max, --up,
     /// --sensor-height, --out-of-range (NDT parameters come from --config).
-    void AddTo(CLI::App& command);
+    void AddTo(CLI::App& command, bool with_method = true);
 
     /// The effective configuration; throws core::Error (or io::ReadError) when it is invalid.
     io::RunConfig Resolve() const;

@@ -12,9 +12,11 @@ int main(int argc, char** argv) {
     app.require_subcommand(1);
     lidarloop::cli::AddDescribeCommand(app);
     lidarloop::cli::AddDetectCommand(app);
+    lidarloop::cli::AddEvaluateCommand(app);
     lidarloop::cli::AddDistanceCommand(app);
     lidarloop::cli::AddDumpConfigCommand(app);
     lidarloop::cli::AddBenchCommand(app);
+    lidarloop::cli::AddSimulateCommand(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -21,10 +21,14 @@ std::string Quote(const std::string& text) {
 
 const char* StyleName(PlotSeries::Style style) {
     switch (style) {
-        case PlotSeries::Style::kLines: return "lines lw 2";
-        case PlotSeries::Style::kSteps: return "steps lw 2";
-        case PlotSeries::Style::kPoints: return "points pt 7 ps 0.6";
-        case PlotSeries::Style::kBoxes: return "boxes fs solid 0.35 noborder";
+        case PlotSeries::Style::kLines:
+            return "lines lw 2";
+        case PlotSeries::Style::kSteps:
+            return "steps lw 2";
+        case PlotSeries::Style::kPoints:
+            return "points pt 7 ps 0.6";
+        case PlotSeries::Style::kBoxes:
+            return "boxes fs solid 0.35 noborder";
     }
     return "lines";
 }
@@ -35,9 +39,7 @@ void WriteRange(std::ostringstream& script, const char* axis, double min, double
 
 }  // namespace
 
-bool GnuplotAvailable() {
-    return std::system("gnuplot --version > /dev/null 2>&1") == 0;
-}
+bool GnuplotAvailable() { return std::system("gnuplot --version > /dev/null 2>&1") == 0; }
 
 std::string GnuplotScript(const std::filesystem::path& png, const Plot& plot) {
     std::ostringstream script;

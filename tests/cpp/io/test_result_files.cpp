@@ -8,6 +8,7 @@
 #include "lidarloop/io/database_file.hpp"
 #include "lidarloop/io/plot.hpp"
 #include "lidarloop/io/png.hpp"
+#include "lidarloop/io/results_csv.hpp"
 #include "lidarloop/io/similarity_file.hpp"
 #include "lidarloop/pipeline/loop_detector.hpp"
 #include "test_utils.hpp"
@@ -126,6 +127,40 @@ TEST(Png, BadImagesAndPathsAreErrors) {
     EXPECT_THROW(WritePng(dir / "a.png", Image{0, 0, 1, {}}), core::ConfigError);
     EXPECT_THROW(WritePng(dir / "a.png", Image{1, 1, 2, {1, 2}}), core::ConfigError);
     EXPECT_THROW(WritePng(dir / "no" / "such" / "a.png", Image{1, 1, 1, {0}}), WriteError);
+}
+
+TEST(ResultsCsv, ReadsColumnsByNameAndKeepsEmptyFields) {
+    test::TempDir dir;
+    test::WriteFile(
+        dir / "loops.csv",
+        "query,match,distance,second_ratio,accepted\n3,0,0.0042,,1\n\n7,2,1e-3,0.5,0\r\n");
+    const auto results = ReadResultsCsv(dir / "loops.csv");
+    ASSERT_EQ(results.size(), 2U);
+    EXPECT_EQ(results[0].query, 3U);
+    EXPECT_EQ(results[0].match, 0U);
+    EXPECT_DOUBLE_EQ(results[0].distance, 0.0042);
+    EXPECT_EQ(results[1].query, 7U);
+    EXPECT_DOUBLE_EQ(results[1].distance, 0.001);
+    test::WriteFile(dir / "reordered.csv", "distance, match, query\n0.5, 1, 9\n");
+    const auto reordered = ReadResultsCsv(dir / "reordered.csv");
+    ASSERT_EQ(reordered.size(), 1U);
+    EXPECT_EQ(reordered[0].query, 9U);
+    EXPECT_EQ(reordered[0].match, 1U);
+}
+
+TEST(ResultsCsv, BadFilesNameTheLine) {
+    test::TempDir dir;
+    const auto expect = [&](const std::string& text, const std::string& phrase) {
+        test::WriteFile(dir / "r.csv", text);
+        test::ExpectReadError(ReadResultsCsv, dir / "r.csv", phrase);
+    };
+    expect("", "empty file");
+    expect("a,b,c\n1,2,3\n", "line 1: the header must name the columns query, match and distance");
+    expect("query,match,distance\n1,2\n", "line 2: expected at least 3 columns, got 2");
+    expect("query,match,distance\n-1,2,0.1\n", "line 2: query '-1' is not a scan number");
+    expect("query,match,distance\n1,2.5,0.1\n", "line 2: match '2.5' is not a scan number");
+    expect("query,match,distance\n1,2,nan\n", "line 2: distance 'nan' is not a number");
+    expect("query,match,distance\n1,2,close\n", "line 2: distance 'close' is not a number");
 }
 
 TEST(Plot, ScriptHoldsDataTitlesAndQuotesEscaped) {

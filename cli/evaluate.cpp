@@ -1,0 +1,184 @@
+#include <algorithm>
+#include <iostream>
+#include <memory>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "dataset_options.hpp"
+#include "descriptor_options.hpp"
+#include "evaluation_report.hpp"
+#include "evaluation_run.hpp"
+#include "lidarloop/core/descriptor.hpp"
+#include "lidarloop/core/error.hpp"
+#include "lidarloop/io/read_error.hpp"
+#include "lidarloop/io/results_csv.hpp"
+#include "progress.hpp"
+#include "run_output.hpp"
+
+namespace lidarloop::cli {
+namespace {
+
+struct EvaluateFlags {
+    DatasetOptions dataset;
+    DescriptorOptions descriptor;
+    std::vector<std::string> methods;
+    std::vector<std::string> results;
+    double distance_m = 10.0;
+    double max_heading_deg = 0.0;
+    double min_gap = 0.0;
+    std::string min_gap_unit;
+    CLI::Option* min_gap_option = nullptr;
+    double train_fraction = 0.5;
+    std::string criterion = "mcc";
+    std::string out;
+    bool skip_bad = false;
+    bool quiet = false;
+};
+
+eval::GroundTruthConfig GroundTruthRule(const EvaluateFlags& flags, const io::RunConfig& config) {
+    eval::GroundTruthConfig rule;
+    rule.distance_m = flags.distance_m;
+    rule.max_heading_deg = flags.max_heading_deg;
+    rule.min_gap = config.detection.min_gap;
+    rule.Validate();
+    return rule;
+}
+
+// The similarity matrix of an external detector: listed pairs get their distance (the smallest
+// when listed twice), every other pair +inf (never detected).
+pipeline::SimilarityMatrix MatrixOfResults(const std::string& file, std::size_t scans) {
+    pipeline::SimilarityMatrix matrix(scans);
+    std::fill(matrix.condensed().begin(), matrix.condensed().end(),
+              std::numeric_limits<float>::infinity());
+    for (const io::ExternalResult& r : io::ReadResultsCsv(file)) {
+        if (r.query >= scans || r.match >= scans) {
+            throw io::ReadError(file, "pair (" + std::to_string(r.query) + ", " +
+                                          std::to_string(r.match) + ") names a scan beyond the " +
+                                          std::to_string(scans) + " of the dataset");
+        }
+        if (r.query == r.match) continue;
+        const std::size_t i = std::min(r.query, r.match);
+        const std::size_t j = std::max(r.query, r.match);
+        matrix.set(i, j, std::min(matrix.at(i, j), static_cast<float>(r.distance)));
+    }
+    return matrix;
+}
+
+MethodEvaluation EvaluateMethod(const EvaluateFlags& flags, io::RunConfig config,
+                                core::Method method, const io::Dataset& dataset,
+                                const eval::GroundTruth& truth,
+                                const eval::ThresholdLearningConfig& learning) {
+    config.descriptor.method = method;
+    pipeline::DescribeOptions options;
+    options.skip_bad = flags.skip_bad;
+    ProgressBar bar("describing (" + core::ToString(method) + ")", flags.quiet);
+    options.progress = [&](std::size_t done, std::size_t n) { bar.Update(done, n); };
+    const auto described =
+        pipeline::DescribeSequence(SourceOf(dataset), config.descriptor, options);
+    bar.Finish();
+    Stopwatch matrix_clock;
+    pipeline::SimilarityMatrix matrix = pipeline::ComputeSimilarityMatrix(described.database);
+    const double matrix_s = matrix_clock.Seconds();
+    const double pairs = static_cast<double>(matrix.condensed().size());
+    MethodEvaluation e = EvaluateMatrix(core::ToString(method), std::move(matrix), truth, learning,
+                                        core::DefaultThreshold(config.descriptor));
+    e.describe_ms_per_scan_median = 1e3 * Quantile(described.describe_seconds, 0.5);
+    e.ns_per_comparison = pairs > 0 ? 1e9 * matrix_s / pairs : 0.0;
+    return e;
+}
+
+void RunEvaluate(const EvaluateFlags& flags) {
+    io::RunConfig config = flags.descriptor.Resolve();
+    if (*flags.min_gap_option) config.detection.min_gap.value = flags.min_gap;
+    if (!flags.min_gap_unit.empty()) {
+        config.detection.min_gap.unit = core::ParseMinGapUnit(flags.min_gap_unit);
+    }
+    config.Validate();
+    eval::ThresholdLearningConfig learning;
+    learning.train_fraction = flags.train_fraction;
+    learning.criterion = eval::ParseCriterion(flags.criterion);
+    learning.Validate();
+    const io::Dataset dataset = flags.dataset.Open();
+    if (!dataset.HasPoses()) {
+        throw core::ConfigError(dataset.root().string() +
+                                " has no poses; evaluation needs ground truth (--poses FILE)");
+    }
+    const eval::GroundTruth truth =
+        eval::BuildGroundTruth(dataset.poses(), GroundTruthRule(flags, config));
+    const std::filesystem::path out_dir = PrepareOutputFolder(flags.out);
+    io::WriteConfigYaml(out_dir / "config.yaml", config);
+
+    std::vector<MethodEvaluation> evaluations;
+    for (const std::string& name : flags.methods) {
+        evaluations.push_back(
+            EvaluateMethod(flags, config, core::ParseMethod(name), dataset, truth, learning));
+    }
+    for (const std::string& file : flags.results) {
+        evaluations.push_back(
+            EvaluateMatrix("results:" + std::filesystem::path(file).stem().string(),
+                           MatrixOfResults(file, dataset.size()), truth, learning, std::nullopt));
+    }
+
+    nlohmann::json metrics;
+    metrics["dataset"] = dataset.root().string();
+    metrics["scans"] = dataset.size();
+    metrics["ground_truth"] = {{"rule", truth.Describe()},
+                               {"distance_m", truth.config.distance_m},
+                               {"max_heading_deg", truth.config.max_heading_deg},
+                               {"min_gap", truth.config.min_gap.value},
+                               {"min_gap_unit", core::ToString(truth.config.min_gap.unit)}};
+    for (const MethodEvaluation& e : evaluations) metrics["methods"][e.name] = MetricsJson(e);
+    WriteJson(out_dir / "metrics.json", metrics);
+    WriteCurveCsvs(out_dir, evaluations);
+    const auto notes = WriteFigures(out_dir, truth, evaluations);
+    WriteReport(out_dir, {dataset.root().string(), dataset.size(), truth.Describe()}, evaluations,
+                notes);
+
+    std::cout << "lidarloop evaluate: " << dataset.size() << " scans, " << truth.Describe() << "\n";
+    for (const MethodEvaluation& e : evaluations) {
+        std::cout << "  " << e.name << ": best MCC " << e.pairwise.best_mcc.score << " (tau "
+                  << e.pairwise.best_mcc.threshold << "), best F1 " << e.pairwise.best_f1.score
+                  << ", recall at zero errors " << 100.0 * e.per_scan.zero_error.recall << " %\n";
+    }
+    for (const std::string& note : notes) std::cout << "  note: " << note << "\n";
+    std::cout << "  report: " << (out_dir / "report.md").string() << "\n";
+}
+
+}  // namespace
+
+void AddEvaluateCommand(CLI::App& app) {
+    auto* command = app.add_subcommand(
+        "evaluate", "Score loop detection against ground-truth poses, as both papers do");
+    auto flags = std::make_shared<EvaluateFlags>();
+    flags->dataset.AddTo(*command);
+    flags->descriptor.AddTo(*command, /*with_method=*/false);
+    flags->methods = {"height", "range", "ndt"};
+    command
+        ->add_option("--method", flags->methods,
+                     "methods to evaluate on the same ground truth (repeatable; default all)")
+        ->check(CLI::IsMember({"height", "range", "ndt"}));
+    command
+        ->add_option("--results", flags->results,
+                     "also score another detector's CSV (query,match,distance); repeatable")
+        ->check(CLI::ExistingFile);
+    command->add_option("--distance", flags->distance_m,
+                        "same place when closer than this, metres (Roehling 10, Magnusson 3-10)");
+    command->add_option("--max-heading", flags->max_heading_deg,
+                        "and headings differ by less than this, degrees (0: any; Kvarntorp 20)");
+    flags->min_gap_option = command->add_option(
+        "--min-gap", flags->min_gap, "S: pairs closer in the sequence are not evaluated");
+    command->add_option("--min-gap-unit", flags->min_gap_unit,
+                        "unit of --min-gap: scans | seconds");
+    command->add_option("--train-fraction", flags->train_fraction,
+                        "share of the sequence a threshold is learnt on (default 0.5)");
+    command->add_option("--criterion", flags->criterion,
+                        "what the learnt threshold maximises: mcc | f1");
+    command->add_option("--out", flags->out, "folder for the results (created)")->required();
+    command->add_flag("--skip-bad", flags->skip_bad, "skip unreadable scans instead of stopping");
+    command->add_flag("--quiet", flags->quiet, "no progress bar");
+    command->callback([flags] { RunEvaluate(*flags); });
+}
+
+}  // namespace lidarloop::cli

@@ -1,0 +1,257 @@
+#include "evaluation_report.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+#include "lidarloop/io/plot.hpp"
+#include "lidarloop/io/png.hpp"
+#include "lidarloop/io/read_error.hpp"
+
+namespace lidarloop::cli {
+namespace {
+
+constexpr std::uint8_t kBlack = 0;
+constexpr std::uint8_t kNotEvaluated = 210;  // pairs inside the minimum gap: light grey
+constexpr std::uint8_t kWhite = 255;
+
+std::string FileSafe(const std::string& name) {
+    std::string safe;
+    for (char c : name) safe += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+    return safe;
+}
+
+// One pixel per pair, as in Röhling figs. 5-7 and Magnusson figs. 3-4.
+template <typename IsBlack>
+io::Image PairImage(const eval::GroundTruth& truth, IsBlack is_black) {
+    const auto n = static_cast<int>(truth.size());
+    io::Image image{std::max(n, 1), std::max(n, 1), 1, {}};
+    image.pixels.assign(static_cast<std::size_t>(image.width) * image.height, kWhite);
+    for (int i = 0; i < n; ++i) {
+        for (int j = 0; j < n; ++j) {
+            const auto a = static_cast<std::size_t>(i);
+            const auto b = static_cast<std::size_t>(j);
+            std::uint8_t& pixel = image.pixels[a * static_cast<std::size_t>(n) + b];
+            if (i == j || !truth.Comparable(std::min(a, b), std::max(a, b))) {
+                pixel = kNotEvaluated;
+            } else if (is_black(a, b)) {
+                pixel = kBlack;
+            }
+        }
+    }
+    return image;
+}
+
+std::string Number(double value, int digits = 4) {
+    if (!std::isfinite(value)) return value > 0 ? "∞" : "–";
+    char text[64];
+    std::snprintf(text, sizeof(text), "%.*g", digits, value);
+    return text;
+}
+
+io::Plot RocPlot(const std::vector<MethodEvaluation>& evaluations, bool precision_recall) {
+    io::Plot plot;
+    plot.title = precision_recall ? "Precision-recall over all scan pairs"
+                                  : "ROC over all scan pairs (Roehling fig. 4)";
+    plot.x_label = precision_recall ? "recall" : "false positive rate";
+    plot.y_label = precision_recall ? "precision" : "true positive rate";
+    plot.x_min = plot.y_min = 0.0;
+    plot.x_max = plot.y_max = 1.0;
+    for (const MethodEvaluation& e : evaluations) {
+        io::PlotSeries series{e.name, {}, {}, io::PlotSeries::Style::kLines};
+        for (const eval::CurvePoint& p : e.pairwise.curve) {
+            if (precision_recall && p.confusion.PredictedPositives() == 0) continue;
+            series.x.push_back(precision_recall ? p.tpr : p.fpr);
+            series.y.push_back(precision_recall ? p.precision : p.tpr);
+        }
+        plot.series.push_back(std::move(series));
+    }
+    if (!precision_recall) {
+        plot.series.push_back({"chance", {0.0, 1.0}, {0.0, 1.0}, io::PlotSeries::Style::kLines});
+    }
+    return plot;
+}
+
+io::Plot EmPlot(const MethodEvaluation& e) {
+    io::Plot plot;
+    plot.title = e.name + ": smallest difference of every scan, EM fit (Magnusson fig. 2)";
+    plot.x_label = "distance to the most similar scan outside the gap";
+    plot.y_label = "density";
+    std::vector<double> finite;
+    for (double d : e.smallest_differences) {
+        if (std::isfinite(d)) finite.push_back(d);
+    }
+    if (finite.empty()) return plot;
+    const auto [lo_it, hi_it] = std::minmax_element(finite.begin(), finite.end());
+    const double lo = *lo_it;
+    const double hi = *hi_it > lo ? *hi_it : lo + 1.0;
+    constexpr int kBins = 40;
+    const double width = (hi - lo) / kBins;
+    io::PlotSeries histogram{"scans", {}, {}, io::PlotSeries::Style::kBoxes};
+    std::vector<double> counts(kBins, 0.0);
+    for (double d : finite) {
+        counts[static_cast<std::size_t>(std::min(kBins - 1, static_cast<int>((d - lo) / width)))] +=
+            1;
+    }
+    for (int b = 0; b < kBins; ++b) {
+        histogram.x.push_back(lo + (b + 0.5) * width);
+        histogram.y.push_back(counts[static_cast<std::size_t>(b)] /
+                              (static_cast<double>(finite.size()) * width));
+    }
+    plot.series.push_back(std::move(histogram));
+    io::PlotSeries mixture{"mixture", {}, {}, io::PlotSeries::Style::kLines};
+    for (int k = 0; k <= 400; ++k) {
+        const double x = lo + (hi - lo) * k / 400.0;
+        mixture.x.push_back(x);
+        mixture.y.push_back(e.em.fit.Density(x));
+    }
+    plot.series.push_back(std::move(mixture));
+    for (std::size_t c = 0; c < e.em.fit.components.size(); ++c) {
+        io::PlotSeries component{
+            "component " + std::to_string(c + 1), {}, {}, io::PlotSeries::Style::kLines};
+        for (int k = 0; k <= 400; ++k) {
+            const double x = lo + (hi - lo) * k / 400.0;
+            component.x.push_back(x);
+            component.y.push_back(e.em.fit.components[c].WeightedDensity(x));
+        }
+        plot.series.push_back(std::move(component));
+    }
+    if (e.em.t_d) plot.vertical_lines.push_back(*e.em.t_d);
+    return plot;
+}
+
+io::Plot CountsPlot(const MethodEvaluation& e) {
+    io::Plot plot;
+    plot.title = e.name + ": scans by label against t_d (Magnusson fig. 1)";
+    plot.x_label = "difference threshold t_d";
+    plot.y_label = "share of scans (%)";
+    const double scans = static_cast<double>(e.best_matches.size());
+    io::PlotSeries tp{"true positives", {}, {}, io::PlotSeries::Style::kSteps};
+    io::PlotSeries fp{"false positives", {}, {}, io::PlotSeries::Style::kSteps};
+    io::PlotSeries mismatch{"mismatches", {}, {}, io::PlotSeries::Style::kSteps};
+    for (const eval::TaxonomyPoint& p : e.per_scan.curve) {
+        if (!std::isfinite(p.t_d)) continue;
+        for (auto* s : {&tp, &fp, &mismatch}) s->x.push_back(p.t_d);
+        tp.y.push_back(100.0 * static_cast<double>(p.counts.true_positive) / scans);
+        fp.y.push_back(100.0 * static_cast<double>(p.counts.false_positive) / scans);
+        mismatch.y.push_back(100.0 * static_cast<double>(p.counts.mismatch) / scans);
+    }
+    plot.series = {tp, fp, mismatch};
+    if (std::isfinite(e.per_scan.zero_error.t_d)) {
+        plot.vertical_lines.push_back(e.per_scan.zero_error.t_d);
+    }
+    return plot;
+}
+
+}  // namespace
+
+void WriteCurveCsvs(const std::filesystem::path& folder,
+                    const std::vector<MethodEvaluation>& evaluations) {
+    std::ofstream roc(folder / "roc.csv");
+    std::ofstream pr(folder / "pr.csv");
+    roc << "method,threshold,fpr,tpr\n";
+    pr << "method,threshold,recall,precision\n";
+    roc.precision(9);
+    pr.precision(9);
+    for (const MethodEvaluation& e : evaluations) {
+        for (const eval::CurvePoint& p : e.pairwise.curve) {
+            roc << e.name << ',' << p.threshold << ',' << p.fpr << ',' << p.tpr << '\n';
+            if (p.confusion.PredictedPositives() > 0) {
+                pr << e.name << ',' << p.threshold << ',' << p.tpr << ',' << p.precision << '\n';
+            }
+        }
+    }
+    if (!roc) throw io::WriteError(folder / "roc.csv", "writing failed");
+    if (!pr) throw io::WriteError(folder / "pr.csv", "writing failed");
+}
+
+std::vector<std::string> WriteFigures(const std::filesystem::path& folder,
+                                      const eval::GroundTruth& truth,
+                                      const std::vector<MethodEvaluation>& evaluations) {
+    io::WritePng(folder / "ground_truth.png", PairImage(truth, [&](std::size_t i, std::size_t j) {
+                     return truth.IsLoop(std::min(i, j), std::max(i, j));
+                 }));
+    for (const MethodEvaluation& e : evaluations) {
+        const double tau = e.pairwise.best_mcc.threshold;
+        io::WritePng(folder / ("similarity_" + FileSafe(e.name) + ".png"),
+                     PairImage(truth, [&](std::size_t i, std::size_t j) {
+                         return e.matrix.at(i, j) <= tau;
+                     }));
+    }
+    if (!io::GnuplotAvailable()) {
+        return {
+            "gnuplot is not installed, so the curves are only in roc.csv and pr.csv "
+            "(apt-get install gnuplot-nox)"};
+    }
+    io::RenderPlot(folder / "roc.png", RocPlot(evaluations, false));
+    io::RenderPlot(folder / "pr.png", RocPlot(evaluations, true));
+    for (const MethodEvaluation& e : evaluations) {
+        io::RenderPlot(folder / ("em_" + FileSafe(e.name) + ".png"), EmPlot(e));
+        io::RenderPlot(folder / ("counts_" + FileSafe(e.name) + ".png"), CountsPlot(e));
+    }
+    return {};
+}
+
+void WriteReport(const std::filesystem::path& folder, const ReportContext& context,
+                 const std::vector<MethodEvaluation>& evaluations,
+                 const std::vector<std::string>& notes) {
+    std::ofstream out(folder / "report.md");
+    out << "# Loop detection on " << context.dataset << "\n\n"
+        << context.scans << " scans. Ground truth: " << context.ground_truth_rule << "\n\n";
+    out << "## All scan pairs (Röhling et al. 2015, tables I and II, fig. 4)\n\n"
+        << "| method | pairs (loops) | best MCC (τ) | best F1 (τ) | ROC AUC | τ learnt on the "
+           "first part → test F1 / MCC | MCC at the default τ |\n|---|---|---|---|---|---|---|\n";
+    for (const MethodEvaluation& e : evaluations) {
+        const auto& p = e.pairwise;
+        out << "| " << e.name << " | " << p.pairs << " (" << p.positives << ") | "
+            << Number(p.best_mcc.score, 3) << " (" << Number(p.best_mcc.threshold) << ") | "
+            << Number(p.best_f1.score, 3) << " (" << Number(p.best_f1.threshold) << ") | "
+            << (p.roc_auc ? Number(*p.roc_auc, 3) : "–") << " | ";
+        if (e.learnt) {
+            out << Number(e.learnt->threshold) << " → " << Number(e.learnt->test_f1, 3) << " / "
+                << Number(e.learnt->test_mcc, 3);
+        } else {
+            out << "–";
+        }
+        out << " | "
+            << (e.at_default ? Number(eval::Mcc(*e.at_default), 3) +
+                                   " (τ = " + Number(*e.default_threshold) + ")"
+                             : "–")
+            << " |\n";
+    }
+    out << "\n## Every scan and its most similar scan (Magnusson et al. 2009, tables I and II, "
+           "figs. 1 and 2)\n\n| method | overlapping / other scans | recall at zero errors "
+           "(t_d) | EM t_d | median best/second ratio |\n|---|---|---|---|---|\n";
+    for (const MethodEvaluation& e : evaluations) {
+        const auto& z = e.per_scan.zero_error;
+        out << "| " << e.name << " | " << e.per_scan.overlapping << " / "
+            << e.per_scan.non_overlapping << " | " << Number(100.0 * z.recall, 3) << " % ("
+            << Number(z.t_d) << ") | " << (e.em.t_d ? Number(*e.em.t_d) : "–") << " | "
+            << (e.distinctiveness.ratio ? Number(e.distinctiveness.ratio->median, 3) : "–")
+            << " |\n";
+    }
+    out << "\nZero errors: no false positive and no mismatch (table I). Timings on this "
+           "machine: ";
+    for (const MethodEvaluation& e : evaluations) {
+        out << e.name << " " << Number(e.describe_ms_per_scan_median, 3) << " ms per scan, "
+            << Number(e.ns_per_comparison, 3) << " ns per comparison; ";
+    }
+    out << "\n\n## Similarity matrices (black: pairs under the best-MCC threshold; grey: inside "
+           "the minimum gap, not evaluated)\n\n| ground truth |";
+    for (const MethodEvaluation& e : evaluations) out << " " << e.name << " |";
+    out << "\n|---|";
+    for (std::size_t i = 0; i < evaluations.size(); ++i) out << "---|";
+    out << "\n| ![](ground_truth.png) |";
+    for (const MethodEvaluation& e : evaluations) {
+        out << " ![](similarity_" << FileSafe(e.name) << ".png) |";
+    }
+    out << "\n\n## Curves\n\n![ROC](roc.png) ![precision-recall](pr.png)\n\n";
+    for (const MethodEvaluation& e : evaluations) {
+        out << "![EM " << e.name << "](em_" << FileSafe(e.name) << ".png) ![counts " << e.name
+            << "](counts_" << FileSafe(e.name) << ".png)\n\n";
+    }
+    for (const std::string& note : notes) out << "Note: " << note << "\n\n";
+    if (!out) throw io::WriteError(folder / "report.md", "writing failed");
+}
+
+}  // namespace lidarloop::cli

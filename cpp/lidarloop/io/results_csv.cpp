@@ -1,0 +1,91 @@
+#include "lidarloop/io/results_csv.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <string_view>
+
+#include "lidarloop/io/detail/text_parsing.hpp"
+
+namespace lidarloop::io {
+namespace {
+
+// Comma-separated fields, empty ones kept (lidarloop writes an empty second_ratio), spaces and
+// a trailing '\r' trimmed.
+std::vector<std::string_view> SplitCsv(std::string_view line) {
+    std::vector<std::string_view> fields;
+    const auto trim = [](std::string_view f) {
+        while (!f.empty() && (f.front() == ' ' || f.front() == '\t')) f.remove_prefix(1);
+        while (!f.empty() && (f.back() == ' ' || f.back() == '\t' || f.back() == '\r')) {
+            f.remove_suffix(1);
+        }
+        return f;
+    };
+    std::size_t start = 0;
+    while (true) {
+        const std::size_t comma = line.find(',', start);
+        fields.push_back(trim(line.substr(start, comma - start)));
+        if (comma == std::string_view::npos) break;
+        start = comma + 1;
+    }
+    return fields;
+}
+
+struct Columns {
+    std::size_t query = SIZE_MAX;
+    std::size_t match = SIZE_MAX;
+    std::size_t distance = SIZE_MAX;
+};
+
+Columns FindColumns(const detail::LineReader& reader, const std::vector<std::string_view>& names) {
+    Columns columns;
+    for (std::size_t c = 0; c < names.size(); ++c) {
+        if (names[c] == "query") columns.query = c;
+        if (names[c] == "match") columns.match = c;
+        if (names[c] == "distance") columns.distance = c;
+    }
+    if (columns.query == SIZE_MAX || columns.match == SIZE_MAX || columns.distance == SIZE_MAX) {
+        reader.Fail("the header must name the columns query, match and distance");
+    }
+    return columns;
+}
+
+std::size_t ParseIndex(const detail::LineReader& reader, std::string_view field, const char* name) {
+    const auto value = detail::ParseSize(field);
+    if (!value) {
+        reader.Fail(std::string(name) + " '" + std::string(field) +
+                    "' is not a scan number (an integer >= 0)");
+    }
+    return *value;
+}
+
+}  // namespace
+
+std::vector<ExternalResult> ReadResultsCsv(const std::filesystem::path& file) {
+    detail::LineReader reader(file);
+    std::string line;
+    if (!reader.Next(line)) reader.Fail("empty file; expected a header line");
+    const Columns columns = FindColumns(reader, SplitCsv(line));
+    const std::size_t needed = std::max({columns.query, columns.match, columns.distance}) + 1;
+    std::vector<ExternalResult> results;
+    while (reader.Next(line)) {
+        if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+        const auto fields = SplitCsv(line);
+        if (fields.size() < needed) {
+            reader.Fail("expected at least " + std::to_string(needed) + " columns, got " +
+                        std::to_string(fields.size()));
+        }
+        ExternalResult result;
+        result.query = ParseIndex(reader, fields[columns.query], "query");
+        result.match = ParseIndex(reader, fields[columns.match], "match");
+        const auto distance = detail::ParseDouble(fields[columns.distance]);
+        if (!distance || std::isnan(*distance)) {
+            reader.Fail("distance '" + std::string(fields[columns.distance]) + "' is not a number");
+        }
+        result.distance = *distance;
+        results.push_back(result);
+    }
+    return results;
+}
+
+}  // namespace lidarloop::io
