@@ -6,6 +6,7 @@ namespace lidarloop::cli {
 
 // One function per subcommand; each lives in the file of the same name.
 void AddBenchCommand(CLI::App& app);
+void AddDemoCommand(CLI::App& app);
 void AddDescribeCommand(CLI::App& app);
 void AddDetectCommand(CLI::App& app);
 void AddDistanceCommand(CLI::App& app);

@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "dataset_options.hpp"
 #include "descriptor_options.hpp"
+#include "evaluate.hpp"
 #include "evaluation_report.hpp"
 #include "evaluation_run.hpp"
 #include "lidarloop/core/descriptor.hpp"
@@ -37,11 +38,11 @@ struct EvaluateFlags {
     bool quiet = false;
 };
 
-eval::GroundTruthConfig GroundTruthRule(const EvaluateFlags& flags, const io::RunConfig& config) {
+eval::GroundTruthConfig GroundTruthRule(const EvaluationRequest& request) {
     eval::GroundTruthConfig rule;
-    rule.distance_m = flags.distance_m;
-    rule.max_heading_deg = flags.max_heading_deg;
-    rule.min_gap = config.detection.min_gap;
+    rule.distance_m = request.distance_m;
+    rule.max_heading_deg = request.max_heading_deg;
+    rule.min_gap = request.config.detection.min_gap;
     rule.Validate();
     return rule;
 }
@@ -66,14 +67,13 @@ pipeline::SimilarityMatrix MatrixOfResults(const std::string& file, std::size_t 
     return matrix;
 }
 
-MethodEvaluation EvaluateMethod(const EvaluateFlags& flags, io::RunConfig config,
-                                core::Method method, const io::Dataset& dataset,
-                                const eval::GroundTruth& truth,
-                                const eval::ThresholdLearningConfig& learning) {
+MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method method,
+                                const io::Dataset& dataset, const eval::GroundTruth& truth) {
+    io::RunConfig config = request.config;
     config.descriptor.method = method;
     pipeline::DescribeOptions options;
-    options.skip_bad = flags.skip_bad;
-    ProgressBar bar("describing (" + core::ToString(method) + ")", flags.quiet);
+    options.skip_bad = request.skip_bad;
+    ProgressBar bar("describing (" + core::ToString(method) + ")", request.quiet);
     options.progress = [&](std::size_t done, std::size_t n) { bar.Update(done, n); };
     const auto described =
         pipeline::DescribeSequence(SourceOf(dataset), config.descriptor, options);
@@ -82,45 +82,66 @@ MethodEvaluation EvaluateMethod(const EvaluateFlags& flags, io::RunConfig config
     pipeline::SimilarityMatrix matrix = pipeline::ComputeSimilarityMatrix(described.database);
     const double matrix_s = matrix_clock.Seconds();
     const double pairs = static_cast<double>(matrix.condensed().size());
-    MethodEvaluation e = EvaluateMatrix(core::ToString(method), std::move(matrix), truth, learning,
-                                        core::DefaultThreshold(config.descriptor));
+    MethodEvaluation e =
+        EvaluateMatrix(core::ToString(method), std::move(matrix), truth, request.learning,
+                       core::DefaultThreshold(config.descriptor));
     e.describe_ms_per_scan_median = 1e3 * Quantile(described.describe_seconds, 0.5);
     e.ns_per_comparison = pairs > 0 ? 1e9 * matrix_s / pairs : 0.0;
     return e;
 }
 
 void RunEvaluate(const EvaluateFlags& flags) {
-    io::RunConfig config = flags.descriptor.Resolve();
-    if (*flags.min_gap_option) config.detection.min_gap.value = flags.min_gap;
+    EvaluationRequest request;
+    request.config = flags.descriptor.Resolve();
+    if (*flags.min_gap_option) request.config.detection.min_gap.value = flags.min_gap;
     if (!flags.min_gap_unit.empty()) {
-        config.detection.min_gap.unit = core::ParseMinGapUnit(flags.min_gap_unit);
+        request.config.detection.min_gap.unit = core::ParseMinGapUnit(flags.min_gap_unit);
     }
-    config.Validate();
-    eval::ThresholdLearningConfig learning;
-    learning.train_fraction = flags.train_fraction;
-    learning.criterion = eval::ParseCriterion(flags.criterion);
-    learning.Validate();
+    request.config.Validate();
+    for (const std::string& name : flags.methods)
+        request.methods.push_back(core::ParseMethod(name));
+    request.results_files = flags.results;
+    request.distance_m = flags.distance_m;
+    request.max_heading_deg = flags.max_heading_deg;
+    request.learning.train_fraction = flags.train_fraction;
+    request.learning.criterion = eval::ParseCriterion(flags.criterion);
+    request.skip_bad = flags.skip_bad;
+    request.quiet = flags.quiet;
+    request.out = flags.out;
     const io::Dataset dataset = flags.dataset.Open();
+    const EvaluationOutcome outcome = RunEvaluation(dataset, request);
+    std::cout << "lidarloop evaluate: " << dataset.size() << " scans, " << outcome.truth.Describe()
+              << "\n";
+    for (const MethodEvaluation& e : outcome.methods) {
+        std::cout << "  " << e.name << ": best MCC " << e.pairwise.best_mcc.score << " (tau "
+                  << e.pairwise.best_mcc.threshold << "), best F1 " << e.pairwise.best_f1.score
+                  << ", recall at zero errors " << 100.0 * e.per_scan.zero_error.recall << " %\n";
+    }
+    for (const std::string& note : outcome.notes) std::cout << "  note: " << note << "\n";
+    std::cout << "  report: " << (request.out / "report.md").string() << "\n";
+}
+
+}  // namespace
+
+EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequest& request) {
+    request.learning.Validate();
     if (!dataset.HasPoses()) {
         throw core::ConfigError(dataset.root().string() +
                                 " has no poses; evaluation needs ground truth (--poses FILE)");
     }
-    const eval::GroundTruth truth =
-        eval::BuildGroundTruth(dataset.poses(), GroundTruthRule(flags, config));
-    const std::filesystem::path out_dir = PrepareOutputFolder(flags.out);
-    io::WriteConfigYaml(out_dir / "config.yaml", config);
-
-    std::vector<MethodEvaluation> evaluations;
-    for (const std::string& name : flags.methods) {
-        evaluations.push_back(
-            EvaluateMethod(flags, config, core::ParseMethod(name), dataset, truth, learning));
+    EvaluationOutcome outcome{
+        eval::BuildGroundTruth(dataset.poses(), GroundTruthRule(request)), {}, {}};
+    const eval::GroundTruth& truth = outcome.truth;
+    const std::filesystem::path out_dir = PrepareOutputFolder(request.out.string());
+    io::WriteConfigYaml(out_dir / "config.yaml", request.config);
+    for (core::Method method : request.methods) {
+        outcome.methods.push_back(EvaluateMethod(request, method, dataset, truth));
     }
-    for (const std::string& file : flags.results) {
-        evaluations.push_back(
-            EvaluateMatrix("results:" + std::filesystem::path(file).stem().string(),
-                           MatrixOfResults(file, dataset.size()), truth, learning, std::nullopt));
+    for (const std::string& file : request.results_files) {
+        outcome.methods.push_back(EvaluateMatrix(
+            "results:" + std::filesystem::path(file).stem().string(),
+            MatrixOfResults(file, dataset.size()), truth, request.learning, std::nullopt));
     }
-
     nlohmann::json metrics;
     metrics["dataset"] = dataset.root().string();
     metrics["scans"] = dataset.size();
@@ -129,24 +150,14 @@ void RunEvaluate(const EvaluateFlags& flags) {
                                {"max_heading_deg", truth.config.max_heading_deg},
                                {"min_gap", truth.config.min_gap.value},
                                {"min_gap_unit", core::ToString(truth.config.min_gap.unit)}};
-    for (const MethodEvaluation& e : evaluations) metrics["methods"][e.name] = MetricsJson(e);
+    for (const MethodEvaluation& e : outcome.methods) metrics["methods"][e.name] = MetricsJson(e);
     WriteJson(out_dir / "metrics.json", metrics);
-    WriteCurveCsvs(out_dir, evaluations);
-    const auto notes = WriteFigures(out_dir, truth, evaluations);
-    WriteReport(out_dir, {dataset.root().string(), dataset.size(), truth.Describe()}, evaluations,
-                notes);
-
-    std::cout << "lidarloop evaluate: " << dataset.size() << " scans, " << truth.Describe() << "\n";
-    for (const MethodEvaluation& e : evaluations) {
-        std::cout << "  " << e.name << ": best MCC " << e.pairwise.best_mcc.score << " (tau "
-                  << e.pairwise.best_mcc.threshold << "), best F1 " << e.pairwise.best_f1.score
-                  << ", recall at zero errors " << 100.0 * e.per_scan.zero_error.recall << " %\n";
-    }
-    for (const std::string& note : notes) std::cout << "  note: " << note << "\n";
-    std::cout << "  report: " << (out_dir / "report.md").string() << "\n";
+    WriteCurveCsvs(out_dir, outcome.methods);
+    outcome.notes = WriteFigures(out_dir, truth, outcome.methods);
+    WriteReport(out_dir, {dataset.root().string(), dataset.size(), truth.Describe()},
+                outcome.methods, outcome.notes);
+    return outcome;
 }
-
-}  // namespace
 
 void AddEvaluateCommand(CLI::App& app) {
     auto* command = app.add_subcommand(

@@ -20,6 +20,7 @@
 #include "lidarloop/io/read_error.hpp"
 #include "lidarloop/sim/simulator.hpp"
 #include "progress.hpp"
+#include "simulate.hpp"
 
 namespace lidarloop::cli {
 namespace {
@@ -171,30 +172,40 @@ void WritePoses(const sim::Simulator& simulator, io::KittiSequenceWriter& writer
 }
 
 void RunSimulate(const SimulateFlags& flags) {
-    const auto start = std::chrono::steady_clock::now();
     const sim::Simulator simulator(ToConfig(flags));
-    io::KittiSequenceWriter writer(flags.out, flags.overwrite);
-    ScanStats stats;
-    WriteScans(simulator, writer, flags.threads, flags.quiet, stats);
-    WritePoses(simulator, writer);
-    WriteSimulationYaml(writer.dir() / "simulation.yaml", simulator);
-    const std::size_t revisits =
-        sim::CountRevisitedScans(simulator, kRevisitGap, kRevisitDistance_m);
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const SimulationSummary summary =
+        WriteSimulation(simulator, flags.out, flags.overwrite, flags.threads, flags.quiet);
     const sim::SimulationConfig& c = simulator.config();
     char timing[32];
-    std::snprintf(timing, sizeof(timing), "%.2f s", seconds);
+    std::snprintf(timing, sizeof(timing), "%.2f s", summary.seconds);
     std::cout << "simulated " << c.scans << " scans (" << sim::ToString(c.scene) << ", "
               << sim::ToString(c.route.type) << ", " << sim::ToString(c.sensor.model) << ", seed "
-              << c.seed << ") into " << flags.out << ": " << stats.points / c.scans
-              << " points per scan (min " << stats.min_points << ", max " << stats.max_points
-              << "), " << revisits << " scans revisit a place (within "
+              << c.seed << ") into " << flags.out << ": " << summary.mean_points
+              << " points per scan (min " << summary.min_points << ", max " << summary.max_points
+              << "), " << summary.revisited_scans << " scans revisit a place (within "
               << Number(kRevisitDistance_m) << " m of a scan " << kRevisitGap << "+ earlier), "
               << timing << "\n";
 }
 
 }  // namespace
+
+SimulationSummary WriteSimulation(const sim::Simulator& simulator, const std::filesystem::path& out,
+                                  bool overwrite, int threads, bool quiet) {
+    const auto start = std::chrono::steady_clock::now();
+    io::KittiSequenceWriter writer(out, overwrite);
+    ScanStats stats;
+    WriteScans(simulator, writer, threads, quiet, stats);
+    WritePoses(simulator, writer);
+    WriteSimulationYaml(writer.dir() / "simulation.yaml", simulator);
+    SimulationSummary summary;
+    summary.mean_points = stats.points / simulator.size();
+    summary.min_points = stats.min_points;
+    summary.max_points = stats.max_points;
+    summary.revisited_scans = sim::CountRevisitedScans(simulator, kRevisitGap, kRevisitDistance_m);
+    summary.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return summary;
+}
 
 void AddSimulateCommand(CLI::App& app) {
     auto* command = app.add_subcommand(

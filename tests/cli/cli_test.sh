@@ -128,6 +128,33 @@ expect_error "detect missing dataset" "no such dataset folder" "$cli" detect "$w
 expect_ok "bench" '"ns_per_comparison_one_core"' "$cli" bench "$seq" --queries 3 --quiet
 expect_ok "bench scaled" '"scaled_queries"' "$cli" bench "$seq" --queries 3 --scale-to 500 --quiet
 
+# --- demo and evaluate --------------------------------------------------------------------------
+expect_ok "demo" "figures and tables:" "$cli" demo --out "$work/demo" --quiet
+for file in metrics.json roc.csv pr.csv report.md ground_truth.png similarity_height.png \
+    similarity_ndt.png config.yaml; do
+    if [ -s "$work/demo/evaluation/$file" ]; then pass; else fail "demo did not write $file"; fi
+done
+for key in best_mcc tau_best_mcc best_f1 tau_best_f1 roc_auc recall_at_zero_fp tau_zero_fp \
+    em_threshold; do
+    if grep -q "\"$key\"" "$work/demo/evaluation/metrics.json"; then pass; else
+        fail "metrics.json lacks $key"
+    fi
+done
+demo_seq="$work/demo/sequence"
+expect_ok "detect on demo" "320 scans (kitti)" "$cli" detect "$demo_seq" --quiet --out "$work/demo_det"
+expect_ok "evaluate results csv" "results:loops" "$cli" evaluate "$demo_seq" --method height \
+    --results "$work/demo_det/loops.csv" --distance 5 --quiet --out "$work/demo_eval"
+if grep -q "less than 5 m apart" "$work/demo_eval/report.md"; then pass; else
+    fail "report.md lacks the ground-truth rule"
+fi
+expect_error "evaluate without poses" "has no poses" "$cli" evaluate "$seq" --quiet --out "$work/e1"
+expect_error "evaluate bad method" "--method" "$cli" evaluate "$demo_seq" --method sift --out "$work/e2"
+expect_error "evaluate bad distance" "ground_truth.distance_m" "$cli" evaluate "$demo_seq" \
+    --distance 0 --quiet --out "$work/e3"
+printf 'query,match,distance\n1,999,0.1\n' >"$work/far.csv"
+expect_error "evaluate results beyond" "names a scan beyond the 320" "$cli" evaluate "$demo_seq" \
+    --method height --results "$work/far.csv" --quiet --out "$work/e4"
+
 # --- config -------------------------------------------------------------------------------------
 expect_ok "dump-config" "bins: 100" "$cli" dump-config
 printf 'histogram:\n  bins: 12\n' >"$work/twelve.yaml"
