@@ -14,7 +14,6 @@
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/pipeline/histogram_index.hpp"
 #include "lidarloop/pipeline/loop_detector.hpp"
-#include "progress.hpp"
 #include "run_output.hpp"
 
 namespace lidarloop::cli {
@@ -99,12 +98,10 @@ pipeline::DescriptorDatabase Scaled(const pipeline::DescriptorDatabase& source, 
 void RunBench(const BenchFlags& flags) {
     const io::RunConfig config = flags.descriptor.Resolve();
     const io::Dataset dataset = flags.dataset.Open();
-    pipeline::DescribeOptions serial;
-    serial.execution = pipeline::Execution::kSerial;
-    ProgressBar bar("describing", flags.quiet);
-    serial.progress = [&](std::size_t done, std::size_t n) { bar.Update(done, n); };
-    const auto described = pipeline::DescribeSequence(SourceOf(dataset), config.descriptor, serial);
-    bar.Finish();
+    // One core, so that the per-scan times are what one scan costs.
+    const auto described = DescribeDataset(
+        dataset, config.descriptor,
+        {"describing", /*skip_bad=*/false, flags.quiet, pipeline::Execution::kSerial});
     const auto& database = described.database;
 
     Stopwatch serial_clock;

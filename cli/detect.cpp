@@ -16,7 +16,6 @@
 #include "lidarloop/io/similarity_file.hpp"
 #include "lidarloop/io/similarity_image.hpp"
 #include "lidarloop/pipeline/loop_detector.hpp"
-#include "progress.hpp"
 #include "run_output.hpp"
 
 namespace lidarloop::cli {
@@ -69,15 +68,10 @@ void RunDetect(const DetectFlags& flags) {
     io::WriteConfigYaml(out_dir / "config.yaml", config);
 
     Stopwatch total;
-    pipeline::DescribeOptions options;
-    options.skip_bad = flags.skip_bad;
-    ProgressBar describe_bar("describing", flags.quiet);
-    options.progress = [&](std::size_t done, std::size_t n) { describe_bar.Update(done, n); };
     Stopwatch describe_clock;
     const pipeline::SequenceDescriptors described =
-        pipeline::DescribeSequence(SourceOf(dataset), config.descriptor, options);
+        DescribeDataset(dataset, config.descriptor, {"describing", flags.skip_bad, flags.quiet});
     const double describe_s = describe_clock.Seconds();
-    describe_bar.Finish();
 
     Stopwatch matrix_clock;
     const pipeline::SimilarityMatrix matrix = pipeline::ComputeSimilarityMatrix(described.database);

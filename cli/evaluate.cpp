@@ -15,7 +15,6 @@
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/io/read_error.hpp"
 #include "lidarloop/io/results_csv.hpp"
-#include "progress.hpp"
 #include "run_output.hpp"
 
 namespace lidarloop::cli {
@@ -33,6 +32,7 @@ struct EvaluateFlags {
     CLI::Option* min_gap_option = nullptr;
     double train_fraction = 0.5;
     std::string criterion = "mcc";
+    std::vector<double> fixed_thresholds;
     std::string out;
     bool skip_bad = false;
     bool quiet = false;
@@ -71,20 +71,16 @@ MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method m
                                 const io::Dataset& dataset, const eval::GroundTruth& truth) {
     io::RunConfig config = request.config;
     config.descriptor.method = method;
-    pipeline::DescribeOptions options;
-    options.skip_bad = request.skip_bad;
-    ProgressBar bar("describing (" + core::ToString(method) + ")", request.quiet);
-    options.progress = [&](std::size_t done, std::size_t n) { bar.Update(done, n); };
-    const auto described =
-        pipeline::DescribeSequence(SourceOf(dataset), config.descriptor, options);
-    bar.Finish();
+    const auto described = DescribeDataset(
+        dataset, config.descriptor,
+        {"describing (" + core::ToString(method) + ")", request.skip_bad, request.quiet});
     Stopwatch matrix_clock;
     pipeline::SimilarityMatrix matrix = pipeline::ComputeSimilarityMatrix(described.database);
     const double matrix_s = matrix_clock.Seconds();
     const double pairs = static_cast<double>(matrix.condensed().size());
     MethodEvaluation e =
         EvaluateMatrix(core::ToString(method), std::move(matrix), truth, request.learning,
-                       core::DefaultThreshold(config.descriptor));
+                       core::DefaultThreshold(config.descriptor), request.fixed_thresholds);
     e.describe_ms_per_scan_median = 1e3 * Quantile(described.describe_seconds, 0.5);
     e.ns_per_comparison = pairs > 0 ? 1e9 * matrix_s / pairs : 0.0;
     return e;
@@ -105,6 +101,7 @@ void RunEvaluate(const EvaluateFlags& flags) {
     request.max_heading_deg = flags.max_heading_deg;
     request.learning.train_fraction = flags.train_fraction;
     request.learning.criterion = eval::ParseCriterion(flags.criterion);
+    request.fixed_thresholds = flags.fixed_thresholds;
     request.skip_bad = flags.skip_bad;
     request.quiet = flags.quiet;
     request.out = flags.out;
@@ -138,9 +135,10 @@ EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequ
         outcome.methods.push_back(EvaluateMethod(request, method, dataset, truth));
     }
     for (const std::string& file : request.results_files) {
-        outcome.methods.push_back(EvaluateMatrix(
-            "results:" + std::filesystem::path(file).stem().string(),
-            MatrixOfResults(file, dataset.size()), truth, request.learning, std::nullopt));
+        outcome.methods.push_back(
+            EvaluateMatrix("results:" + std::filesystem::path(file).stem().string(),
+                           MatrixOfResults(file, dataset.size()), truth, request.learning,
+                           std::nullopt, request.fixed_thresholds));
     }
     nlohmann::json metrics;
     metrics["dataset"] = dataset.root().string();
@@ -186,6 +184,10 @@ void AddEvaluateCommand(CLI::App& app) {
                         "share of the sequence a threshold is learnt on (default 0.5)");
     command->add_option("--criterion", flags->criterion,
                         "what the learnt threshold maximises: mcc | f1");
+    command
+        ->add_option("--fixed-thresholds", flags->fixed_thresholds,
+                     "also report MCC and F1 at these thresholds (Roehling table II)")
+        ->delimiter(',');
     command->add_option("--out", flags->out, "folder for the results (created)")->required();
     command->add_flag("--skip-bad", flags->skip_bad, "skip unreadable scans instead of stopping");
     command->add_flag("--quiet", flags->quiet, "no progress bar");

@@ -18,6 +18,7 @@ struct EvaluationRequest {
     double distance_m = 10.0;                ///< same place when closer (Röhling d, Magnusson t_r)
     double max_heading_deg = 0.0;            ///< and headings closer than this; 0: any
     eval::ThresholdLearningConfig learning;
+    std::vector<double> fixed_thresholds;  ///< MCC at each, as Röhling's table II
     bool skip_bad = false;
     bool quiet = false;
     std::filesystem::path out;

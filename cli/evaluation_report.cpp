@@ -72,6 +72,18 @@ io::Plot RocPlot(const std::vector<MethodEvaluation>& evaluations, bool precisio
     return plot;
 }
 
+// `f` sampled at 401 points over [lo, hi].
+template <typename F>
+io::PlotSeries SampledCurve(std::string title, double lo, double hi, F f) {
+    io::PlotSeries series{std::move(title), {}, {}, io::PlotSeries::Style::kLines};
+    for (int k = 0; k <= 400; ++k) {
+        const double x = lo + (hi - lo) * k / 400.0;
+        series.x.push_back(x);
+        series.y.push_back(f(x));
+    }
+    return series;
+}
+
 io::Plot EmPlot(const MethodEvaluation& e) {
     io::Plot plot;
     plot.title = e.name + ": smallest difference of every scan, EM fit (Magnusson fig. 2)";
@@ -99,22 +111,13 @@ io::Plot EmPlot(const MethodEvaluation& e) {
                               (static_cast<double>(finite.size()) * width));
     }
     plot.series.push_back(std::move(histogram));
-    io::PlotSeries mixture{"mixture", {}, {}, io::PlotSeries::Style::kLines};
-    for (int k = 0; k <= 400; ++k) {
-        const double x = lo + (hi - lo) * k / 400.0;
-        mixture.x.push_back(x);
-        mixture.y.push_back(e.em.fit.Density(x));
-    }
-    plot.series.push_back(std::move(mixture));
-    for (std::size_t c = 0; c < e.em.fit.components.size(); ++c) {
-        io::PlotSeries component{
-            "component " + std::to_string(c + 1), {}, {}, io::PlotSeries::Style::kLines};
-        for (int k = 0; k <= 400; ++k) {
-            const double x = lo + (hi - lo) * k / 400.0;
-            component.x.push_back(x);
-            component.y.push_back(e.em.fit.components[c].WeightedDensity(x));
-        }
-        plot.series.push_back(std::move(component));
+    const eval::MixtureFit& fit = e.em.fit;
+    plot.series.push_back(
+        SampledCurve("mixture", lo, hi, [&](double x) { return fit.Density(x); }));
+    for (std::size_t c = 0; c < fit.components.size(); ++c) {
+        plot.series.push_back(
+            SampledCurve("component " + std::to_string(c + 1), lo, hi,
+                         [&](double x) { return fit.components[c].WeightedDensity(x); }));
     }
     if (e.em.t_d) plot.vertical_lines.push_back(*e.em.t_d);
     return plot;
@@ -218,6 +221,19 @@ void WriteReport(const std::filesystem::path& folder, const ReportContext& conte
                                    " (τ = " + Number(*e.default_threshold) + ")"
                              : "–")
             << " |\n";
+    }
+    if (!evaluations.empty() && !evaluations.front().fixed_thresholds.empty()) {
+        out << "\nMCC at fixed thresholds (table II):\n\n| method |";
+        for (double tau : evaluations.front().fixed_thresholds) out << " L_" << Number(tau) << " |";
+        out << "\n|---|";
+        for (std::size_t t = 0; t < evaluations.front().fixed_thresholds.size(); ++t) out << "---|";
+        out << "\n";
+        for (const MethodEvaluation& e : evaluations) {
+            out << "| " << e.name << " |";
+            for (const eval::Confusion& c : e.at_fixed)
+                out << " " << Number(eval::Mcc(c), 3) << " |";
+            out << "\n";
+        }
     }
     out << "\n## Every scan and its most similar scan (Magnusson et al. 2009, tables I and II, "
            "figs. 1 and 2)\n\n| method | overlapping / other scans | recall at zero errors "

@@ -35,7 +35,8 @@ nlohmann::json Finite(double value) {
 MethodEvaluation EvaluateMatrix(std::string name, pipeline::SimilarityMatrix matrix,
                                 const eval::GroundTruth& truth,
                                 const eval::ThresholdLearningConfig& learning,
-                                std::optional<double> default_threshold) {
+                                std::optional<double> default_threshold,
+                                const std::vector<double>& fixed_thresholds) {
     MethodEvaluation e;
     e.name = std::move(name);
     e.default_threshold = default_threshold;
@@ -48,6 +49,8 @@ MethodEvaluation EvaluateMatrix(std::string name, pipeline::SimilarityMatrix mat
         // Too short a sequence to split: the learnt row is left out of the report.
     }
     if (default_threshold) e.at_default = eval::ConfusionAt(pairs, *default_threshold);
+    e.fixed_thresholds = fixed_thresholds;
+    e.at_fixed = eval::ConfusionsAt(pairs, fixed_thresholds);
     e.best_matches = eval::BestMatchesFromCondensed(e.matrix.condensed(), truth);
     e.per_scan = eval::EvaluatePerScan(e.best_matches, truth);
     for (const eval::BestMatch& m : e.best_matches) e.smallest_differences.push_back(m.distance);
@@ -85,6 +88,12 @@ nlohmann::json MetricsJson(const MethodEvaluation& e) {
                                       {"test_f1", e.learnt->test_f1},
                                       {"test_mcc", e.learnt->test_mcc},
                                       {"test", ConfusionJson(e.learnt->test)}};
+    }
+    json["at_fixed_thresholds"] = nlohmann::json::array();
+    for (std::size_t t = 0; t < e.fixed_thresholds.size(); ++t) {
+        nlohmann::json entry = ConfusionJson(e.at_fixed[t]);
+        entry["tau"] = e.fixed_thresholds[t];
+        json["at_fixed_thresholds"].push_back(entry);
     }
     json["taxonomy_at_zero_fp"] = TaxonomyJson(e.per_scan.zero_error.counts);
     nlohmann::json components = nlohmann::json::array();

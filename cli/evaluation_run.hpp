@@ -25,6 +25,8 @@ struct MethodEvaluation {
     eval::PairwiseEvaluation pairwise;              ///< Röhling IV-B/C
     std::optional<eval::ThresholdTransfer> learnt;  ///< table I: learnt on the first part
     std::optional<eval::Confusion> at_default;      ///< L_tau at the default threshold
+    std::vector<double> fixed_thresholds;           ///< Röhling table II columns
+    std::vector<eval::Confusion> at_fixed;          ///< L_tau at each of them
     std::vector<eval::BestMatch> best_matches;      ///< per scan (Magnusson II-E)
     eval::PerScanEvaluation per_scan;               ///< table I taxonomy, fig. 1
     std::vector<double> smallest_differences;
@@ -38,7 +40,8 @@ struct MethodEvaluation {
 MethodEvaluation EvaluateMatrix(std::string name, pipeline::SimilarityMatrix matrix,
                                 const eval::GroundTruth& truth,
                                 const eval::ThresholdLearningConfig& learning,
-                                std::optional<double> default_threshold);
+                                std::optional<double> default_threshold,
+                                const std::vector<double>& fixed_thresholds = {});
 
 /// metrics.json's entry for one method.
 nlohmann::json MetricsJson(const MethodEvaluation& evaluation);

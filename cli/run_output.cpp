@@ -5,8 +5,11 @@
 #include <fstream>
 #include <thread>
 
+#include "dataset_options.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/eval/summary.hpp"
 #include "lidarloop/io/read_error.hpp"
+#include "progress.hpp"
 
 namespace lidarloop::cli {
 
@@ -54,11 +57,18 @@ std::filesystem::path PrepareOutputFolder(const std::string& folder) {
 double Quantile(std::vector<double> values, double q) {
     if (values.empty()) return 0.0;
     std::sort(values.begin(), values.end());
-    const double position = q * static_cast<double>(values.size() - 1);
-    const auto below = static_cast<std::size_t>(std::floor(position));
-    const std::size_t above = std::min(below + 1, values.size() - 1);
-    const double fraction = position - static_cast<double>(below);
-    return values[below] + fraction * (values[above] - values[below]);
+    return eval::Quantile(values, q);
+}
+
+pipeline::SequenceDescriptors DescribeDataset(const io::Dataset& dataset,
+                                              const core::DescriptorConfig& config,
+                                              const DescribeRun& run) {
+    pipeline::DescribeOptions options;
+    options.skip_bad = run.skip_bad;
+    options.execution = run.execution;
+    ProgressBar bar(run.label, run.quiet);
+    options.progress = [&](std::size_t done, std::size_t n) { bar.Update(done, n); };
+    return pipeline::DescribeSequence(SourceOf(dataset), config, options);
 }
 
 nlohmann::json TimingsJson(const pipeline::SequenceDescriptors& described, std::size_t pairs,

@@ -48,8 +48,22 @@ private:
     std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
-/// The q-quantile (0..1) of `values` by linear interpolation; 0 for an empty list.
+/// The q-quantile (0..1) of `values` (eval::Quantile after sorting); 0 for an empty list.
 double Quantile(std::vector<double> values, double q);
+
+/// How DescribeDataset runs.
+struct DescribeRun {
+    std::string label = "describing";  ///< progress bar text
+    bool skip_bad = false;
+    bool quiet = false;  ///< no progress bar
+    pipeline::Execution execution = pipeline::Execution::kParallel;
+};
+
+/// Describes every scan of `dataset` (pipeline::DescribeSequence) with a progress bar on a
+/// terminal.
+pipeline::SequenceDescriptors DescribeDataset(const io::Dataset& dataset,
+                                              const core::DescriptorConfig& config,
+                                              const DescribeRun& run);
 
 /// Per-scan and per-comparison timings of a run, in milliseconds and nanoseconds.
 nlohmann::json TimingsJson(const pipeline::SequenceDescriptors& described, std::size_t pairs,

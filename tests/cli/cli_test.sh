@@ -144,6 +144,11 @@ demo_seq="$work/demo/sequence"
 expect_ok "detect on demo" "320 scans (kitti)" "$cli" detect "$demo_seq" --quiet --out "$work/demo_det"
 expect_ok "evaluate results csv" "results:loops" "$cli" evaluate "$demo_seq" --method height \
     --results "$work/demo_det/loops.csv" --distance 5 --quiet --out "$work/demo_eval"
+expect_ok "evaluate fixed thresholds" "report:" "$cli" evaluate "$demo_seq" --method range \
+    --fixed-thresholds 0.003,0.005,0.007 --quiet --out "$work/demo_fixed"
+if grep -q "L_0.003 | L_0.005 | L_0.007" "$work/demo_fixed/report.md"; then pass; else
+    fail "report.md lacks the fixed-threshold table"
+fi
 if grep -q "less than 5 m apart" "$work/demo_eval/report.md"; then pass; else
     fail "report.md lacks the ground-truth rule"
 fi
