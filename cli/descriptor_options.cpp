@@ -21,13 +21,24 @@ void DescriptorOptions::AddTo(CLI::App& command, bool with_method) {
                                               "values outside [min, max]: clamp | drop");
 }
 
-io::RunConfig DescriptorOptions::Resolve() const {
-    io::RunConfig config;
-    if (!config_file_.empty()) config = io::LoadConfigYaml(config_file_);
+io::RunConfig DescriptorOptions::Resolve(io::RunConfig base) const {
+    io::RunConfig config = std::move(base);
+    if (!config_file_.empty()) config = io::LoadConfigYaml(config_file_, config);
     if (!method_.empty()) config.descriptor.method = core::ParseMethod(method_);
     ApplyHistogramFlags(config.descriptor);
     config.Validate();
     return config;
+}
+
+std::string DescriptorOptions::FirstGiven() const {
+    if (!config_file_.empty()) return "--config";
+    if (!method_.empty()) return "--method";
+    const CLI::Option* flags[] = {bins_option_, min_option_,           max_option_,
+                                  up_option_,   sensor_height_option_, out_of_range_option_};
+    for (const CLI::Option* flag : flags) {
+        if (*flag) return flag->get_name();
+    }
+    return "";
 }
 
 void DescriptorOptions::ApplyHistogramFlags(core::DescriptorConfig& descriptor) const {

@@ -18,8 +18,11 @@ public:
     /// --sensor-height, --out-of-range (NDT parameters come from --config).
     void AddTo(CLI::App& command, bool with_method = true);
 
-    /// The effective configuration; throws core::Error (or io::ReadError) when it is invalid.
-    io::RunConfig Resolve() const;
+    /// The effective configuration: `base` (default: the built-in defaults) with --config and
+    /// the flags applied; throws core::Error (or io::ReadError) when it is invalid.
+    io::RunConfig Resolve(io::RunConfig base = {}) const;
+    /// The first descriptor flag given on the command line ("--bins", ...), or "" when none.
+    std::string FirstGiven() const;
 
 private:
     void ApplyHistogramFlags(core::DescriptorConfig& descriptor) const;

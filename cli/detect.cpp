@@ -12,6 +12,7 @@
 #include "dataset_options.hpp"
 #include "descriptor_options.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/io/database_file.hpp"
 #include "lidarloop/io/read_error.hpp"
 #include "lidarloop/io/similarity_file.hpp"
 #include "lidarloop/io/similarity_image.hpp"
@@ -26,6 +27,7 @@ struct DetectFlags {
     DescriptorOptions descriptor;
     DetectionOptions detection;
     std::string out;
+    std::string map;  // a database.lldb to localise against (query-only mode)
     bool skip_bad = false;
     bool quiet = false;
 };
@@ -59,7 +61,76 @@ void WriteCandidatesCsv(const std::filesystem::path& file,
     if (!out) throw io::WriteError(file, "writing failed");
 }
 
+std::size_t CountAccepted(const std::vector<pipeline::LoopQuery>& queries) {
+    std::size_t accepted = 0;
+    for (const auto& q : queries) accepted += q.accepted ? 1 : 0;
+    return accepted;
+}
+
+// The map fixes how scans are described; flags and --config may set thresholds and detection
+// keys only.
+io::RunConfig ResolveAgainstMap(const DetectFlags& flags, const pipeline::DescriptorDatabase& map) {
+    io::RunConfig base;
+    base.descriptor = map.config();
+    io::RunConfig config = flags.descriptor.Resolve(base);
+    flags.detection.ApplyTo(config);
+    if (!core::DescribesAlike(config.descriptor, map.config())) {
+        throw core::ConfigError(flags.descriptor.FirstGiven() +
+                                " changes how scans are described, but the map " + flags.map +
+                                " fixes that (its config.yaml beside it shows how)");
+    }
+    return config;
+}
+
+// Query-only mode: every scan of the dataset is searched in the map and not added to it.
+void RunLocalise(const DetectFlags& flags) {
+    Stopwatch total;
+    Stopwatch load_clock;
+    pipeline::DescriptorDatabase map = io::LoadDatabase(flags.map);
+    const io::RunConfig config = ResolveAgainstMap(flags, map);
+    const pipeline::LoopDetector detector(std::move(map), config.detection,
+                                          core::DefaultThreshold(config.descriptor));
+    const double load_map_s = load_clock.Seconds();
+    const io::Dataset dataset = flags.dataset.Open();
+    const std::filesystem::path out_dir = PrepareOutputFolder(flags.out);
+    io::WriteConfigYaml(out_dir / "config.yaml", config);
+
+    const pipeline::SequenceDescriptors described =
+        DescribeDataset(dataset, config.descriptor, {"describing", flags.skip_bad, flags.quiet});
+    Stopwatch query_clock;
+    const auto queries = pipeline::LocaliseSequence(detector, described.database);
+    const double query_s = query_clock.Seconds();
+
+    WriteLoopsCsv(out_dir / "loops.csv", queries);
+    WriteCandidatesCsv(out_dir / "candidates.csv", queries);
+    WriteSkipped(out_dir, described.skipped);
+    nlohmann::json timings = TimingsJson(described, 0, 0.0);
+    timings.erase("similarity_matrix_s");
+    timings.erase("pairs");
+    timings.erase("ns_per_comparison_wall");
+    timings["map"] = flags.map;
+    timings["map_scans"] = detector.database().size();
+    timings["load_map_s"] = load_map_s;
+    timings["query_ms_per_scan_wall"] =
+        queries.empty() ? 0.0 : 1e3 * query_s / static_cast<double>(queries.size());
+    timings["total_s"] = total.Seconds();
+    WriteJson(out_dir / "timings.json", timings);
+
+    std::cout << "lidarloop detect: " << dataset.size() << " scans (" << dataset.FormatName()
+              << ") localised against the map " << flags.map << " (" << detector.database().size()
+              << " scans), method " << core::ToString(config.descriptor.method) << ", threshold "
+              << detector.threshold() << ", " << CountAccepted(queries)
+              << " scans with an accepted match";
+    if (!described.skipped.empty()) std::cout << ", " << described.skipped.size() << " skipped";
+    std::cout << "\n  results in " << out_dir.string()
+              << "/ (loops.csv: query scan, map scan; candidates.csv, config.yaml, timings.json)\n";
+}
+
 void RunDetect(const DetectFlags& flags) {
+    if (!flags.map.empty()) {
+        RunLocalise(flags);
+        return;
+    }
     io::RunConfig config = flags.descriptor.Resolve();
     flags.detection.ApplyTo(config);
     const io::Dataset dataset = flags.dataset.Open();
@@ -88,21 +159,20 @@ void RunDetect(const DetectFlags& flags) {
                  io::ThresholdImage(matrix, config.descriptor.method, threshold));
     io::WritePng(out_dir / "similarity_distance.png", io::DistanceImage(matrix));
     WriteSkipped(out_dir, described.skipped);
+    io::SaveDatabase(out_dir / "database.lldb", described.database);
 
     nlohmann::json timings = TimingsJson(described, matrix.condensed().size(), matrix_s);
     timings["describe_total_s"] = describe_s;
     timings["total_s"] = total.Seconds();
     WriteJson(out_dir / "timings.json", timings);
 
-    std::size_t accepted = 0;
-    for (const auto& q : queries) accepted += q.accepted ? 1 : 0;
     std::cout << "lidarloop detect: " << dataset.size() << " scans (" << dataset.FormatName()
               << "), method " << core::ToString(config.descriptor.method) << ", threshold "
-              << threshold << ", " << accepted << " scans with an accepted loop";
+              << threshold << ", " << CountAccepted(queries) << " scans with an accepted loop";
     if (!described.skipped.empty()) std::cout << ", " << described.skipped.size() << " skipped";
     std::cout << "\n  results in " << out_dir.string()
               << "/ (loops.csv, candidates.csv, similarity.png, similarity_distance.png,"
-                 " similarity.bin, config.yaml, timings.json)\n";
+                 " similarity.bin, database.lldb, config.yaml, timings.json)\n";
 }
 
 }  // namespace
@@ -115,6 +185,11 @@ void AddDetectCommand(CLI::App& app) {
     flags->descriptor.AddTo(*command);
     flags->detection.AddTo(*command);
     command->add_option("--out", flags->out, "folder for the results (created)")->required();
+    command
+        ->add_option("--map", flags->map,
+                     "localise against this database.lldb (written by an earlier detect): "
+                     "every scan is a query, none is added, the map's descriptor config is used")
+        ->check(CLI::ExistingFile);
     command->add_flag("--skip-bad", flags->skip_bad,
                       "skip unreadable scans (listed in skipped.txt) instead of stopping");
     command->add_flag("--quiet", flags->quiet, "no progress bar");

@@ -100,7 +100,7 @@ cp "$samples/corner_b.ply" "$seq/scan6.ply"
 cp "$samples/courtyard.bin" "$seq/scan7.bin"
 expect_ok "detect" "8 scans (folder)" "$cli" detect "$seq" --min-gap 2 --quiet --out "$work/det"
 for file in loops.csv candidates.csv similarity.png similarity_distance.png similarity.bin \
-    config.yaml timings.json; do
+    database.lldb config.yaml timings.json; do
     if [ -s "$work/det/$file" ]; then pass; else fail "detect did not write $file"; fi
 done
 if head -1 "$work/det/loops.csv" | grep -qx "query,match,distance,second_ratio,accepted"; then
@@ -112,6 +112,25 @@ fi
 if grep -q "min_gap: 2" "$work/det/config.yaml"; then pass; else fail "config.yaml lacks the gap"; fi
 expect_ok "detect ndt" "method ndt" "$cli" detect "$seq" --method ndt --min-gap 2 --quiet \
     --out "$work/det_ndt"
+# Localisation against the saved map: every scan finds itself (or an identical copy) at distance 0.
+expect_ok "detect --map" "localised against the map" "$cli" detect "$seq" --map "$work/det/database.lldb" \
+    --threshold 0.001 --quiet --out "$work/loc"
+if [ "$(grep -c ',0,[^,]*,1$' "$work/loc/loops.csv")" -eq 8 ]; then pass; else
+    fail "localisation did not match every scan at distance 0: $(cat "$work/loc/loops.csv")"
+fi
+if grep -q "^6,6,0," "$work/loc/loops.csv" && grep -q "^7,7,0," "$work/loc/loops.csv"; then pass; else
+    fail "the unique scans 6 and 7 did not find themselves: $(cat "$work/loc/loops.csv")"
+fi
+if grep -q "threshold: 0.001" "$work/loc/config.yaml"; then pass; else
+    fail "the localisation config lacks the --threshold"
+fi
+expect_ok "detect --map ndt" "method ndt" "$cli" detect "$seq" --map "$work/det_ndt/database.lldb" \
+    --quiet --out "$work/loc_ndt"
+expect_error "detect --map with --bins" "--bins changes how scans are described" "$cli" detect \
+    "$seq" --map "$work/det/database.lldb" --bins 10 --quiet --out "$work/loc2"
+head -c 100 "$work/det/database.lldb" >"$work/truncated.lldb"
+expect_error "detect --map truncated" "truncated.lldb" "$cli" detect "$seq" \
+    --map "$work/truncated.lldb" --quiet --out "$work/loc3"
 printf 'garbage' >"$seq/scan3.bin"
 expect_error "detect bad scan" "scan 3: $seq/scan3.bin" "$cli" detect "$seq" --quiet --out "$work/det2"
 expect_ok "detect --skip-bad" "1 skipped" "$cli" detect "$seq" --skip-bad --quiet --min-gap 2 \

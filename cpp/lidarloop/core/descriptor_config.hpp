@@ -36,6 +36,11 @@ struct DescriptorConfig {
         histogram.Validate();
         ndt.Validate();
     }
+    bool operator==(const DescriptorConfig&) const = default;
 };
+
+/// True when `a` and `b` turn a scan into the same descriptor: they may differ in the decision
+/// thresholds only, so descriptors of one are comparable with those of the other.
+bool DescribesAlike(const DescriptorConfig& a, const DescriptorConfig& b);
 
 }  // namespace lidarloop::core

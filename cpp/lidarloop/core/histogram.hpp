@@ -45,6 +45,7 @@ struct HistogramConfig {
 
     /// Throws ConfigError naming the first invalid field.
     void Validate() const;
+    bool operator==(const HistogramConfig&) const = default;
 };
 
 /// A normalised histogram H_b (Röhling eq. 3–4) with the bookkeeping of how it was made.

@@ -37,6 +37,7 @@ struct NdtConfig {
     int RangeCount() const { return static_cast<int>(range_limits_m.size()) + 1; }
     /// Throws ConfigError naming the first invalid field.
     void Validate() const;
+    bool operator==(const NdtConfig&) const = default;
 };
 
 }  // namespace lidarloop::core

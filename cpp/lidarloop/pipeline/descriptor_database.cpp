@@ -71,6 +71,21 @@ PreparedQuery DescriptorDatabase::Prepare(const core::Descriptor& descriptor) co
     return query;
 }
 
+PreparedQuery DescriptorDatabase::PrepareStored(std::size_t i) const {
+    if (i >= size() || !IsValid(i)) {
+        throw core::ConfigError("scan " + std::to_string(i) + " of the database is " +
+                                (i >= size() ? "not stored" : "missing (it could not be read)"));
+    }
+    PreparedQuery query;
+    if (histograms_) {
+        const float* row = histograms_->Row(i);
+        query.cumulative_row.assign(row, row + histograms_->stride());
+    } else {
+        query.ndt = ndt_sets_[i];
+    }
+    return query;
+}
+
 double DescriptorDatabase::Distance(const PreparedQuery& query, std::size_t j) const {
     if (!IsValid(j)) return kInfinity;
     if (histograms_) return histograms_->DistanceToRow(query.cumulative_row.data(), j);

@@ -43,6 +43,8 @@ public:
     double Distance(std::size_t i, std::size_t j) const;
 
     PreparedQuery Prepare(const core::Descriptor& descriptor) const;
+    /// Stored scan i as a query (to search another database with it); it must be valid.
+    PreparedQuery PrepareStored(std::size_t i) const;
     /// Distance between a prepared query and stored scan j; +inf if j is missing.
     double Distance(const PreparedQuery& query, std::size_t j) const;
 

@@ -70,11 +70,11 @@ void HistogramIndex::Insert(std::size_t id) {
     sorted_.insert(std::upper_bound(sorted_.begin(), sorted_.end(), key, by_total), key);
 }
 
-void HistogramIndex::InsertAll() {
+void HistogramIndex::InsertAll(const std::function<bool(std::size_t)>& include) {
     indexed_.resize(store_.size(), 0);
     blocks_.resize(store_.size() * kBlocks, 0.0f);
     for (std::size_t id = 0; id < store_.size(); ++id) {
-        if (indexed_[id]) continue;
+        if (indexed_[id] || (include && !include(id))) continue;
         indexed_[id] = 1;
         Key key{0.0, id};
         ComputeBlocks(store_.Row(id), &blocks_[id * kBlocks], key.total);

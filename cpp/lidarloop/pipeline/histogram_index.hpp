@@ -39,8 +39,9 @@ public:
 
     /// Indexes row `id` of the store (rows may be indexed in any order, each once).
     void Insert(std::size_t id);
-    /// Indexes every row of the store not yet indexed, at once (O(n log n)).
-    void InsertAll();
+    /// Indexes every row of the store not yet indexed for which `include(id)` holds (all when
+    /// empty), at once (O(n log n)).
+    void InsertAll(const std::function<bool(std::size_t)>& include = {});
     std::size_t size() const { return sorted_.size(); }
 
     /// The k rows nearest to `query_row` (a row made by the store's MakeRow) among the indexed

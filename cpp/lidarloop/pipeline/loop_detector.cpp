@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <string>
 
+#include <tbb/parallel_for.h>
+
 #include "lidarloop/core/error.hpp"
 
 namespace lidarloop::pipeline {
@@ -70,9 +72,8 @@ LoopDetector::LoopDetector(DescriptorDatabase database, const DetectorConfig& de
     detector_.Validate();
     if (database_.histograms() != nullptr) {
         index_.emplace(*database_.histograms());
-        for (std::size_t i = 0; i < database_.size(); ++i) {
-            if (database_.IsValid(i)) index_->Insert(i);
-        }
+        // One sort instead of n sorted inserts: a loaded map may hold a million scans.
+        index_->InsertAll([this](std::size_t i) { return database_.IsValid(i); });
     }
 }
 
@@ -114,8 +115,30 @@ LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_
 }
 
 LoopQuery LoopDetector::Query(const core::Descriptor& descriptor) const {
-    const PreparedQuery query = database_.Prepare(descriptor);
-    return Search(query, database_.size(), [&](std::size_t j) { return database_.IsValid(j); });
+    return Query(database_.Prepare(descriptor), database_.size());
+}
+
+LoopQuery LoopDetector::Query(const PreparedQuery& query, std::size_t query_index) const {
+    return Search(query, query_index, [&](std::size_t j) { return database_.IsValid(j); });
+}
+
+std::vector<LoopQuery> LocaliseSequence(const LoopDetector& map, const DescriptorDatabase& queries,
+                                        Execution execution) {
+    if (!core::DescribesAlike(queries.config(), map.database().config())) {
+        throw core::ConfigError(
+            "the query scans were described with another configuration than the map's");
+    }
+    std::vector<LoopQuery> results(queries.size());
+    const auto localise = [&](std::size_t i) {
+        results[i].query = i;
+        if (queries.IsValid(i)) results[i] = map.Query(queries.PrepareStored(i), i);
+    };
+    if (execution == Execution::kSerial) {
+        for (std::size_t i = 0; i < queries.size(); ++i) localise(i);
+    } else {
+        tbb::parallel_for(std::size_t{0}, queries.size(), localise);
+    }
+    return results;
 }
 
 std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,

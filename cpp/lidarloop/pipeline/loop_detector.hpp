@@ -45,7 +45,8 @@ std::vector<Neighbor> NearestCandidates(std::size_t count, std::size_t k,
 
 /// Online loop detection: scans arrive one at a time; each is compared with the stored scans
 /// older than the minimum gap, then stored. Histogram methods use the exact HistogramIndex;
-/// NDT compares every eligible scan. Not thread-safe.
+/// NDT compares every eligible scan. Process is not thread-safe; Query may run concurrently.
+/// Neither copyable nor movable: the index refers to the detector's own database.
 class LoopDetector {
 public:
     /// `threshold` is tau or t_d (see core::DefaultThreshold). Validates the configs.
@@ -53,6 +54,8 @@ public:
                  double threshold);
     /// Continues from a loaded database (e.g. a map): every stored scan becomes searchable.
     LoopDetector(DescriptorDatabase database, const DetectorConfig& detector, double threshold);
+    LoopDetector(const LoopDetector&) = delete;
+    LoopDetector& operator=(const LoopDetector&) = delete;
 
     /// Describes `scan`, finds its candidates among the stored scans, then stores it.
     LoopQuery Process(const core::PointCloud& scan, double time_s);
@@ -60,6 +63,9 @@ public:
     /// Localisation against the stored scans: every stored scan is eligible and the query is not
     /// stored.
     LoopQuery Query(const core::Descriptor& descriptor) const;
+    /// The same for a prepared query (e.g. DescriptorDatabase::PrepareStored of another
+    /// database with the same configuration); `query_index` only labels the result.
+    LoopQuery Query(const PreparedQuery& query, std::size_t query_index) const;
 
     const DescriptorDatabase& database() const { return database_; }
     const DetectorConfig& detector_config() const { return detector_; }
@@ -74,6 +80,12 @@ private:
     double threshold_;
     std::optional<HistogramIndex> index_;
 };
+
+/// Localisation of a whole sequence against a map: LoopDetector::Query for every scan of
+/// `queries` (described with the map's configuration, which is checked), in parallel. Result i
+/// belongs to query scan i; a scan that could not be read has no candidates.
+std::vector<LoopQuery> LocaliseSequence(const LoopDetector& map, const DescriptorDatabase& queries,
+                                        Execution execution = Execution::kParallel);
 
 /// Offline detection from a full similarity matrix: for every scan i, the candidates among the
 /// scans j < i outside the gap, exactly as LoopDetector::Process would give them online.

@@ -105,6 +105,73 @@ TEST(LoopDetector, QueryOnlyDoesNotInsertAndSeesEveryScan) {
     EXPECT_EQ(q.candidates.front().distance, 0.0);
 }
 
+TEST(LoopDetector, ALoadedDatabaseNeverOffersAMissingScan) {
+    DescriptorDatabase database(HeightConfig(20));
+    const auto histograms = test::ClusteredHistograms(30, 20, 3, 4);
+    for (std::size_t i = 0; i < histograms.size(); ++i) {
+        if (i == 11) {
+            database.AddMissing(0.0);  // stored as a row of zeros
+        } else {
+            database.Add(test::HistogramDescriptor(histograms[i]), 0.0);
+        }
+    }
+    const LoopDetector detector(std::move(database), DetectorConfig{}, 1.0);
+    // All mass in the last bucket: its cumulative row is nearly the zero row of the missing scan.
+    std::vector<double> last_bucket(20, 0.0);
+    last_bucket.back() = 1.0;
+    const LoopQuery q = detector.Query(test::HistogramDescriptor(last_bucket));
+    ASSERT_EQ(q.candidates.size(), 5U);
+    for (const Neighbor& c : q.candidates) EXPECT_NE(c.index, 11U);
+}
+
+TEST(LocaliseSequence, EqualsBruteForceAgainstTheMap) {
+    const auto histograms = test::ClusteredHistograms(300, 30, 12, 21);
+    DescriptorDatabase map(HeightConfig(30));
+    DescriptorDatabase queries(HeightConfig(30));
+    for (std::size_t i = 0; i < histograms.size(); ++i) {
+        auto& target = i % 3 == 0 ? queries : map;
+        if (i % 37 == 5) {
+            target.AddMissing(0.0);
+        } else {
+            target.Add(test::HistogramDescriptor(histograms[i]), 0.0);
+        }
+    }
+    DetectorConfig config;
+    config.top_k = 4;
+    config.min_gap = {3.0, core::MinGap::Unit::kScans};
+    const LoopDetector detector(DescriptorDatabase(map), config, 0.01);
+    const auto parallel = LocaliseSequence(detector, queries);
+    const auto serial = LocaliseSequence(detector, queries, Execution::kSerial);
+    ASSERT_EQ(parallel.size(), queries.size());
+    std::size_t matched = 0;
+    for (std::size_t i = 0; i < queries.size(); ++i) {
+        ExpectSameQueries(parallel[i], serial[i]);
+        if (!queries.IsValid(i)) {
+            EXPECT_FALSE(parallel[i].has_match()) << i;
+            continue;
+        }
+        const PreparedQuery query = queries.PrepareStored(i);
+        const auto expected = NearestCandidates(
+            map.size(), 4, [&](std::size_t j) { return map.Distance(query, j); },
+            [&](std::size_t j) { return map.IsValid(j); });
+        ASSERT_EQ(parallel[i].candidates.size(), expected.size()) << i;
+        for (std::size_t r = 0; r < expected.size(); ++r) {
+            EXPECT_EQ(parallel[i].candidates[r].index, expected[r].index) << i;
+        }
+        matched += parallel[i].has_match();
+    }
+    EXPECT_GT(matched, 90U);
+}
+
+TEST(LocaliseSequence, RefusesQueriesDescribedDifferently) {
+    const LoopDetector detector(HeightConfig(30), DetectorConfig{}, 0.01);
+    EXPECT_THROW(LocaliseSequence(detector, DescriptorDatabase(HeightConfig(31))),
+                 core::ConfigError);
+    core::DescriptorConfig other_threshold = HeightConfig(30);
+    other_threshold.histogram.threshold = 0.2;  // thresholds do not change the descriptor
+    EXPECT_NO_THROW(LocaliseSequence(detector, DescriptorDatabase(other_threshold)));
+}
+
 TEST(LoopDetector, NdtUsesTheSameRules) {
     core::DescriptorConfig config;
     config.method = core::Method::kNdt;
