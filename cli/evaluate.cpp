@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -33,6 +34,8 @@ struct EvaluateFlags {
     double train_fraction = 0.5;
     std::string criterion = "mcc";
     std::vector<double> fixed_thresholds;
+    std::string train_on;
+    std::string train_poses;
     std::string out;
     bool skip_bad = false;
     bool quiet = false;
@@ -67,10 +70,37 @@ pipeline::SimilarityMatrix MatrixOfResults(const std::string& file, std::size_t 
     return matrix;
 }
 
+void RequirePoses(const io::Dataset& dataset, const std::string& role) {
+    if (!dataset.HasPoses()) {
+        throw core::ConfigError(dataset.root().string() + " has no poses; " + role +
+                                " needs ground truth (" +
+                                (role == "evaluation" ? "--poses" : "--train-poses") + " FILE)");
+    }
+}
+
+// Every scored pair of the training dataset under the evaluation's ground-truth rule.
+TrainingPairs TrainingPairsOf(const EvaluationRequest& request,
+                              const core::DescriptorConfig& descriptor,
+                              const io::Dataset& train_dataset) {
+    const auto described =
+        DescribeDataset(train_dataset, descriptor,
+                        {"training set (" + core::ToString(descriptor.method) + ")",
+                         request.skip_bad, request.quiet});
+    const pipeline::SimilarityMatrix matrix = pipeline::ComputeSimilarityMatrix(described.database);
+    const eval::GroundTruth truth =
+        eval::BuildGroundTruth(train_dataset.poses(), GroundTruthRule(request));
+    return {"all pairs of " + train_dataset.root().string(),
+            eval::CollectPairs(matrix.condensed(), truth)};
+}
+
 MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method method,
-                                const io::Dataset& dataset, const eval::GroundTruth& truth) {
+                                const io::Dataset& dataset, const eval::GroundTruth& truth,
+                                const io::Dataset* train_dataset) {
     io::RunConfig config = request.config;
     config.descriptor.method = method;
+    std::optional<TrainingPairs> training;
+    if (train_dataset != nullptr)
+        training = TrainingPairsOf(request, config.descriptor, *train_dataset);
     const auto described = DescribeDataset(
         dataset, config.descriptor,
         {"describing (" + core::ToString(method) + ")", request.skip_bad, request.quiet});
@@ -78,9 +108,9 @@ MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method m
     pipeline::SimilarityMatrix matrix = pipeline::ComputeSimilarityMatrix(described.database);
     const double matrix_s = matrix_clock.Seconds();
     const double pairs = static_cast<double>(matrix.condensed().size());
-    MethodEvaluation e =
-        EvaluateMatrix(core::ToString(method), std::move(matrix), truth, request.learning,
-                       core::DefaultThreshold(config.descriptor), request.fixed_thresholds);
+    MethodEvaluation e = EvaluateMatrix(core::ToString(method), std::move(matrix), truth,
+                                        request.learning, core::DefaultThreshold(config.descriptor),
+                                        request.fixed_thresholds, training ? &*training : nullptr);
     e.describe_ms_per_scan_median = 1e3 * Quantile(described.describe_seconds, 0.5);
     e.ns_per_comparison = pairs > 0 ? 1e9 * matrix_s / pairs : 0.0;
     return e;
@@ -106,7 +136,16 @@ void RunEvaluate(const EvaluateFlags& flags) {
     request.quiet = flags.quiet;
     request.out = flags.out;
     const io::Dataset dataset = flags.dataset.Open();
-    const EvaluationOutcome outcome = RunEvaluation(dataset, request);
+    std::optional<io::Dataset> train_dataset;
+    if (!flags.train_on.empty()) {
+        io::DatasetOptions options;
+        options.poses_file = flags.train_poses;
+        train_dataset = io::OpenDataset(flags.train_on, options);
+    } else if (!flags.train_poses.empty()) {
+        throw core::ConfigError("--train-poses needs --train-on DATASET");
+    }
+    const EvaluationOutcome outcome =
+        RunEvaluation(dataset, request, train_dataset ? &*train_dataset : nullptr);
     std::cout << "lidarloop evaluate: " << dataset.size() << " scans, " << outcome.truth.Describe()
               << "\n";
     for (const MethodEvaluation& e : outcome.methods) {
@@ -120,19 +159,18 @@ void RunEvaluate(const EvaluateFlags& flags) {
 
 }  // namespace
 
-EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequest& request) {
+EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequest& request,
+                                const io::Dataset* train_dataset) {
     request.learning.Validate();
-    if (!dataset.HasPoses()) {
-        throw core::ConfigError(dataset.root().string() +
-                                " has no poses; evaluation needs ground truth (--poses FILE)");
-    }
+    RequirePoses(dataset, "evaluation");
+    if (train_dataset != nullptr) RequirePoses(*train_dataset, "threshold learning");
     EvaluationOutcome outcome{
         eval::BuildGroundTruth(dataset.poses(), GroundTruthRule(request)), {}, {}};
     const eval::GroundTruth& truth = outcome.truth;
     const std::filesystem::path out_dir = PrepareOutputFolder(request.out.string());
     io::WriteConfigYaml(out_dir / "config.yaml", request.config);
     for (core::Method method : request.methods) {
-        outcome.methods.push_back(EvaluateMethod(request, method, dataset, truth));
+        outcome.methods.push_back(EvaluateMethod(request, method, dataset, truth, train_dataset));
     }
     for (const std::string& file : request.results_files) {
         outcome.methods.push_back(
@@ -182,6 +220,13 @@ void AddEvaluateCommand(CLI::App& app) {
                         "unit of --min-gap: scans | seconds");
     command->add_option("--train-fraction", flags->train_fraction,
                         "share of the sequence a threshold is learnt on (default 0.5)");
+    command
+        ->add_option("--train-on", flags->train_on,
+                     "learn each method's threshold on all pairs of this dataset (same rule) "
+                     "instead of the first part")
+        ->check(CLI::ExistingDirectory);
+    command->add_option("--train-poses", flags->train_poses, "poses file of --train-on")
+        ->check(CLI::ExistingFile);
     command->add_option("--criterion", flags->criterion,
                         "what the learnt threshold maximises: mcc | f1");
     command

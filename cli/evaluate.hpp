@@ -32,6 +32,10 @@ struct EvaluationOutcome {
 
 /// Evaluates every method and results file on one ground truth from the dataset's poses and
 /// writes metrics.json, roc.csv, pr.csv, the images and figures and report.md into request.out.
-EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequest& request);
+/// With `train_dataset` (which needs poses too), each method's threshold is learnt on all its
+/// pairs under the same ground-truth rule and tested on all pairs of `dataset`; results files
+/// keep learning on the first part.
+EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequest& request,
+                                const io::Dataset* train_dataset = nullptr);
 
 }  // namespace lidarloop::cli

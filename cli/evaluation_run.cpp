@@ -36,7 +36,8 @@ MethodEvaluation EvaluateMatrix(std::string name, pipeline::SimilarityMatrix mat
                                 const eval::GroundTruth& truth,
                                 const eval::ThresholdLearningConfig& learning,
                                 std::optional<double> default_threshold,
-                                const std::vector<double>& fixed_thresholds) {
+                                const std::vector<double>& fixed_thresholds,
+                                const TrainingPairs* training) {
     MethodEvaluation e;
     e.name = std::move(name);
     e.default_threshold = default_threshold;
@@ -44,9 +45,17 @@ MethodEvaluation EvaluateMatrix(std::string name, pipeline::SimilarityMatrix mat
     const std::vector<eval::ScoredPair> pairs = eval::CollectPairs(e.matrix.condensed(), truth);
     e.pairwise = eval::EvaluatePairs(pairs);
     try {
-        e.learnt = eval::LearnOnFirstPart(pairs, truth.size(), learning);
+        if (training != nullptr) {
+            e.learnt = eval::LearnAndTest(training->pairs, pairs, learning.criterion);
+            e.learnt_on = training->source;
+        } else {
+            e.learnt = eval::LearnOnFirstPart(pairs, truth.size(), learning);
+            e.learnt_on = "the queries of the first " +
+                          std::to_string(std::lround(100.0 * learning.train_fraction)) +
+                          " % of the scans";
+        }
     } catch (const core::EmptyInputError&) {
-        // Too short a sequence to split: the learnt row is left out of the report.
+        // Too short a sequence to split, or no pairs: the learnt row is left out of the report.
     }
     if (default_threshold) e.at_default = eval::ConfusionAt(pairs, *default_threshold);
     e.fixed_thresholds = fixed_thresholds;
@@ -82,7 +91,8 @@ nlohmann::json MetricsJson(const MethodEvaluation& e) {
         json["at_default_threshold"] = ConfusionJson(*e.at_default);
     }
     if (e.learnt) {
-        json["threshold_learning"] = {{"criterion", eval::ToString(e.learnt->criterion)},
+        json["threshold_learning"] = {{"trained_on", e.learnt_on},
+                                      {"criterion", eval::ToString(e.learnt->criterion)},
                                       {"tau", e.learnt->threshold},
                                       {"train_score", e.learnt->train_score},
                                       {"test_f1", e.learnt->test_f1},

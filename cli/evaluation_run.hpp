@@ -23,12 +23,13 @@ struct MethodEvaluation {
     std::optional<double> default_threshold;  ///< the config's tau / t_d, when a method
     pipeline::SimilarityMatrix matrix;
     eval::PairwiseEvaluation pairwise;              ///< Röhling IV-B/C
-    std::optional<eval::ThresholdTransfer> learnt;  ///< table I: learnt on the first part
-    std::optional<eval::Confusion> at_default;      ///< L_tau at the default threshold
-    std::vector<double> fixed_thresholds;           ///< Röhling table II columns
-    std::vector<eval::Confusion> at_fixed;          ///< L_tau at each of them
-    std::vector<eval::BestMatch> best_matches;      ///< per scan (Magnusson II-E)
-    eval::PerScanEvaluation per_scan;               ///< table I taxonomy, fig. 1
+    std::optional<eval::ThresholdTransfer> learnt;  ///< table I: learnt on training pairs
+    std::string learnt_on;  ///< where they came from: the first part or another dataset
+    std::optional<eval::Confusion> at_default;  ///< L_tau at the default threshold
+    std::vector<double> fixed_thresholds;       ///< Röhling table II columns
+    std::vector<eval::Confusion> at_fixed;      ///< L_tau at each of them
+    std::vector<eval::BestMatch> best_matches;  ///< per scan (Magnusson II-E)
+    eval::PerScanEvaluation per_scan;           ///< table I taxonomy, fig. 1
     std::vector<double> smallest_differences;
     eval::DifferenceThreshold em;  ///< fig. 2
     eval::DistinctivenessSummary distinctiveness;
@@ -36,12 +37,21 @@ struct MethodEvaluation {
     double ns_per_comparison = 0.0;
 };
 
-/// Evaluates a finished similarity matrix against `truth`.
+/// Scored pairs of another dataset to learn the threshold on (Röhling table I: learnt on one
+/// route, tested on another).
+struct TrainingPairs {
+    std::string source;  ///< e.g. the dataset's folder
+    std::vector<eval::ScoredPair> pairs;
+};
+
+/// Evaluates a finished similarity matrix against `truth`. The threshold is learnt on
+/// `training` when given, else on the first part of this sequence (learning.train_fraction).
 MethodEvaluation EvaluateMatrix(std::string name, pipeline::SimilarityMatrix matrix,
                                 const eval::GroundTruth& truth,
                                 const eval::ThresholdLearningConfig& learning,
                                 std::optional<double> default_threshold,
-                                const std::vector<double>& fixed_thresholds = {});
+                                const std::vector<double>& fixed_thresholds = {},
+                                const TrainingPairs* training = nullptr);
 
 /// metrics.json's entry for one method.
 nlohmann::json MetricsJson(const MethodEvaluation& evaluation);

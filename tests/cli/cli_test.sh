@@ -163,6 +163,21 @@ demo_seq="$work/demo/sequence"
 expect_ok "detect on demo" "320 scans (kitti)" "$cli" detect "$demo_seq" --quiet --out "$work/demo_det"
 expect_ok "evaluate results csv" "results:loops" "$cli" evaluate "$demo_seq" --method height \
     --results "$work/demo_det/loops.csv" --distance 5 --quiet --out "$work/demo_eval"
+# Trained on the test sequence itself, the learnt tau is exactly the best-MCC tau.
+expect_ok "evaluate --train-on" "report:" "$cli" evaluate "$demo_seq" --method height \
+    --train-on "$demo_seq" --quiet --out "$work/demo_train"
+json_number() { grep -o "\"$1\": [-0-9.e]*" "$work/demo_train/metrics.json" | head -1 | cut -d' ' -f2; }
+if [ -n "$(json_number tau)" ] && [ "$(json_number tau)" = "$(json_number tau_best_mcc)" ] &&
+    [ "$(json_number test_mcc)" = "$(json_number best_mcc)" ]; then pass; else
+    fail "threshold learnt on the same sequence: tau $(json_number tau) vs $(json_number tau_best_mcc)"
+fi
+if grep -q "\"trained_on\": \"all pairs of $demo_seq\"" "$work/demo_train/metrics.json"; then pass; else
+    fail "metrics.json does not say where the threshold was learnt"
+fi
+expect_error "evaluate --train-on without poses" "has no poses; threshold learning needs" "$cli" \
+    evaluate "$demo_seq" --method height --train-on "$seq" --quiet --out "$work/demo_train2"
+expect_error "evaluate --train-poses alone" "--train-poses needs --train-on" "$cli" evaluate \
+    "$demo_seq" --method height --train-poses "$demo_seq/poses.txt" --quiet --out "$work/demo_train3"
 expect_ok "evaluate fixed thresholds" "report:" "$cli" evaluate "$demo_seq" --method range \
     --fixed-thresholds 0.003,0.005,0.007 --quiet --out "$work/demo_fixed"
 if grep -q "L_0.003 | L_0.005 | L_0.007" "$work/demo_fixed/report.md"; then pass; else
