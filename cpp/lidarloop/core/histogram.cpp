@@ -1,8 +1,13 @@
 #include "lidarloop/core/histogram.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <string>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "lidarloop/core/error.hpp"
 
@@ -26,9 +31,63 @@ void RequireRange(double min_value, double max_value, const char* min_field,
     }
 }
 
-// Counts the values of `cloud` into buckets; `value_of` is the projection v(p).
-template <typename ValueOf>
-void CountValues(const PointCloud& cloud, ValueOf value_of, const HistogramConfig& config,
+// Points are counted in blocks, so that a projection can first compute a whole block's values
+// with SIMD (ranges: four square roots at once).
+constexpr std::size_t kBlockPoints = 256;
+
+// The projection of a block of points, point by point: v(p) = z + offset or u . p + offset.
+template <typename ValueOfPoint>
+struct PointwiseValues {
+    ValueOfPoint value_of;
+    static constexpr bool kInRangeImpliesFinite = false;  // z says nothing about x and y
+    void Prepare(const Eigen::Vector3f* /*points*/, std::size_t /*n*/) {}
+    double operator()(std::size_t /*j*/, const Eigen::Vector3f& p) const { return value_of(p); }
+};
+
+inline float RangeOf(float x, float y, float z) { return std::sqrt((x * x + y * y) + z * z); }
+
+// Ranges ||p|| of a block, four points per step where SSE2 is available. Both paths round the
+// same way, so a point's range does not depend on its position in the block.
+struct BlockRanges {
+    float ranges[kBlockPoints];
+    // A NaN or infinite coordinate makes the range NaN or infinite, never a value in range.
+    static constexpr bool kInRangeImpliesFinite = true;
+
+    void Prepare(const Eigen::Vector3f* points, std::size_t n) {
+        std::size_t j = 0;
+#if defined(__SSE2__)
+        // Eigen::Vector3f is three packed floats: four points are twelve consecutive floats.
+        static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float));
+        const float* f = points->data();
+        for (; j + 4 <= n; j += 4, f += 12) {
+            const __m128 a = _mm_loadu_ps(f);      // x0 y0 z0 x1
+            const __m128 b = _mm_loadu_ps(f + 4);  // y1 z1 x2 y2
+            const __m128 c = _mm_loadu_ps(f + 8);  // z2 x3 y3 z3
+            const __m128 x = _mm_shuffle_ps(_mm_shuffle_ps(a, a, _MM_SHUFFLE(0, 0, 3, 0)),
+                                            _mm_shuffle_ps(b, c, _MM_SHUFFLE(1, 1, 2, 2)),
+                                            _MM_SHUFFLE(2, 0, 1, 0));
+            const __m128 y = _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(0, 0, 1, 1)),
+                                            _mm_shuffle_ps(b, c, _MM_SHUFFLE(2, 2, 3, 3)),
+                                            _MM_SHUFFLE(2, 0, 2, 0));
+            const __m128 z = _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(1, 1, 2, 2)),
+                                            _mm_shuffle_ps(c, c, _MM_SHUFFLE(3, 3, 0, 0)),
+                                            _MM_SHUFFLE(2, 0, 2, 0));
+            const __m128 squared =
+                _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, x), _mm_mul_ps(y, y)), _mm_mul_ps(z, z));
+            _mm_storeu_ps(ranges + j, _mm_sqrt_ps(squared));
+        }
+#endif
+        for (; j < n; ++j) ranges[j] = RangeOf(points[j].x(), points[j].y(), points[j].z());
+    }
+    double operator()(std::size_t j, const Eigen::Vector3f& /*p*/) const {
+        return double{ranges[j]};
+    }
+};
+
+// Counts the values of `cloud` into buckets; `values` gives the projection v(p) of point j of
+// the block it prepared last.
+template <typename BlockValues>
+void CountValues(const PointCloud& cloud, BlockValues values, const HistogramConfig& config,
                  std::vector<std::size_t>& counts, Histogram& histogram) {
     const double min_value = histogram.min_value;
     const double max_value = histogram.max_value;
@@ -41,24 +100,30 @@ void CountValues(const PointCloud& cloud, ValueOf value_of, const HistogramConfi
     std::vector<std::uint32_t> partial(kWays * counts.size(), 0);
     std::size_t skipped = 0;
     std::size_t out_of_range = 0;
-    for (std::size_t i = 0; i < cloud.size(); ++i) {
-        const Eigen::Vector3f& p = cloud[i];
-        if (!p.allFinite()) {
-            ++skipped;
-            continue;
+    for (std::size_t start = 0; start < cloud.size(); start += kBlockPoints) {
+        const std::size_t n = std::min(kBlockPoints, cloud.size() - start);
+        values.Prepare(cloud.data() + start, n);
+        for (std::size_t j = 0; j < n; ++j) {
+            const Eigen::Vector3f& p = cloud[start + j];
+            const double v = values(j, p);  // garbage for a non-finite point, not used then
+            const bool in_range = v >= min_value && v <= max_value;
+            if (!(BlockValues::kInRangeImpliesFinite && in_range) && !p.allFinite()) {
+                ++skipped;
+                continue;
+            }
+            long k = 0;
+            if (in_range) {
+                // Truncation is floor here (the argument is >= 0) and, unlike std::floor without
+                // SSE4.1, no library call; v == v_max lands in the last bucket (eq. 2's closed
+                // end).
+                k = std::min(static_cast<long>((v - min_value) * buckets_per_unit), bins - 1);
+            } else {
+                ++out_of_range;
+                if (!clamp) continue;
+                k = v < min_value ? 0 : bins - 1;
+            }
+            ++partial[(j % kWays) * counts.size() + static_cast<std::size_t>(k)];
         }
-        const double v = value_of(p);
-        long k = 0;
-        if (v >= min_value && v <= max_value) {
-            // Truncation is floor here (the argument is >= 0) and, unlike std::floor without
-            // SSE4.1, no library call; v == v_max lands in the last bucket (eq. 2's closed end).
-            k = std::min(static_cast<long>((v - min_value) * buckets_per_unit), bins - 1);
-        } else {
-            ++out_of_range;
-            if (!clamp) continue;
-            k = v < min_value ? 0 : bins - 1;
-        }
-        ++partial[(i % kWays) * counts.size() + static_cast<std::size_t>(k)];
     }
     for (std::size_t way = 0; way < kWays; ++way) {
         for (std::size_t b = 0; b < counts.size(); ++b)
@@ -67,6 +132,11 @@ void CountValues(const PointCloud& cloud, ValueOf value_of, const HistogramConfi
     histogram.points_skipped += skipped;
     histogram.points_out_of_range += out_of_range;
     histogram.points_used += cloud.size() - skipped - (clamp ? 0 : out_of_range);
+}
+
+template <typename ValueOfPoint>
+PointwiseValues<ValueOfPoint> Pointwise(ValueOfPoint value_of) {
+    return {value_of};
 }
 
 }  // namespace
@@ -112,22 +182,21 @@ Histogram ComputeHistogram(const PointCloud& cloud, Projection projection,
         const Eigen::Vector3d up = histogram.up;
         const double offset_m = config.sensor_height_m;
         if (up == Eigen::Vector3d::UnitZ()) {  // the fixed up vector: the height is z
-            CountValues(
-                cloud, [&](const Eigen::Vector3f& p) { return double{p.z()} + offset_m; }, config,
-                counts, histogram);
+            CountValues(cloud, Pointwise([&](const Eigen::Vector3f& p) {
+                            return double{p.z()} + offset_m;
+                        }),
+                        config, counts, histogram);
         } else {
-            CountValues(
-                cloud,
-                [&](const Eigen::Vector3f& p) { return p.cast<double>().dot(up) + offset_m; },
-                config, counts, histogram);
+            CountValues(cloud, Pointwise([&](const Eigen::Vector3f& p) {
+                            return p.cast<double>().dot(up) + offset_m;
+                        }),
+                        config, counts, histogram);
         }
     } else {
         histogram.min_value = config.range_min_m;
         histogram.max_value = config.range_max_m;
         // Single-precision sqrt: the points are float already, and sqrt is the loop's cost.
-        CountValues(
-            cloud, [](const Eigen::Vector3f& p) { return double{p.norm()}; }, config, counts,
-            histogram);
+        CountValues(cloud, BlockRanges{}, config, counts, histogram);
     }
     if (histogram.points_used == 0) {
         throw EmptyInputError("no point of the scan is usable (" +

@@ -84,6 +84,46 @@ TEST(Histogram, SkipsAndCountsNonFinitePoints) {
     EXPECT_DOUBLE_EQ(h.mass[2], 1.0);
 }
 
+// Ranges are computed four points at a time and the rest one by one: a cloud longer than a block
+// and not a multiple of four, with non-finite and overflowing points among the others, must give
+// every point the bucket it was built for.
+TEST(Histogram, RangesOfEveryPointLandInTheirBucketsWithNonFiniteOnesSkipped) {
+    constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
+    constexpr float kInf = std::numeric_limits<float>::infinity();
+    const HistogramConfig config = SmallConfig();  // 10 buckets of 1 m over [0, 10] m
+    std::mt19937 rng(31);
+    std::normal_distribution<float> direction(0.0f, 1.0f);
+    std::uniform_int_distribution<int> bucket_of(0, 9);
+    std::uniform_real_distribution<float> offset_in_bucket(0.2f, 0.8f);  // far from the borders
+    PointCloud cloud;
+    std::vector<double> expected(10, 0.0);
+    std::size_t non_finite = 0;
+    std::size_t overflowing = 0;
+    for (int i = 0; i < 1031; ++i) {
+        if (i % 97 == 3) {
+            cloud.push_back({i % 2 ? kNan : 1.0f, i % 2 ? 1.0f : kInf, 2.0f});
+            ++non_finite;
+        } else if (i % 211 == 5) {
+            cloud.push_back({1e30f, 0.0f, 0.0f});  // finite, but its squared range is +inf
+            ++overflowing;
+            expected[9] += 1.0;
+        } else {
+            const int bucket = bucket_of(rng);
+            const Eigen::Vector3f unit =
+                Eigen::Vector3f(direction(rng), direction(rng), direction(rng)).normalized();
+            cloud.push_back(unit * (static_cast<float>(bucket) + offset_in_bucket(rng)));
+            expected[static_cast<std::size_t>(bucket)] += 1.0;
+        }
+    }
+    const Histogram h = ComputeHistogram(cloud, Projection::kRange, config);
+    EXPECT_EQ(h.points_skipped, non_finite);
+    EXPECT_EQ(h.points_out_of_range, overflowing);
+    ASSERT_EQ(h.points_used, 1031U - non_finite);
+    for (std::size_t k = 0; k < 10; ++k) {
+        EXPECT_DOUBLE_EQ(h.mass[k] * static_cast<double>(h.points_used), expected[k]) << k;
+    }
+}
+
 TEST(Histogram, EmptyOrUnusableScanIsAnError) {
     constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
     EXPECT_THROW(ComputeHistogram({}, Projection::kHeight, SmallConfig()), EmptyInputError);
