@@ -121,6 +121,26 @@ private:
     std::size_t last_id_ = 0;
 };
 
+// Sorts (key, id) pairs by key, which are unique and below 2^bits: least significant digit
+// first, 11 bits per pass (a scan's keys have about 30 bits: three passes). std::sort spent
+// about 40 ns per voxel here, mostly on mispredicted comparisons.
+void RadixSortByKey(std::vector<std::pair<std::uint64_t, std::uint32_t>>& items, int bits,
+                    std::vector<std::pair<std::uint64_t, std::uint32_t>>& scratch) {
+    constexpr int kDigitBits = 11;
+    constexpr std::size_t kBuckets = std::size_t{1} << kDigitBits;
+    scratch.resize(items.size());
+    std::vector<std::size_t> start(kBuckets);
+    for (int shift = 0; shift < bits; shift += kDigitBits) {
+        const auto digit = [shift](std::uint64_t key) { return (key >> shift) & (kBuckets - 1); };
+        std::fill(start.begin(), start.end(), 0);
+        for (const auto& item : items) ++start[digit(item.first)];
+        std::size_t offset = 0;
+        for (std::size_t& s : start) offset += std::exchange(s, offset);
+        for (const auto& item : items) scratch[start[digit(item.first)]++] = item;
+        items.swap(scratch);
+    }
+}
+
 // Scratch memory reused by later calls on the same thread: a scan's grid needs a few MB, and
 // fresh allocations of that size cost more in page faults than the arithmetic on them.
 struct Workspace {
@@ -128,6 +148,7 @@ struct Workspace {
     std::vector<std::uint64_t> keys;
     std::vector<Moments> moments;
     std::vector<std::pair<std::uint64_t, std::uint32_t>> order;
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> order_scratch;
     std::vector<KeyedMoments> blocks;
     std::vector<KeyedMoments> scratch;
 };
@@ -180,7 +201,7 @@ void BinIntoVoxels(const PointCloud& cloud, double voxel_size_m, NdtCellStats& s
     for (std::size_t id = 0; id < moments.size(); ++id) {
         ws.order[id] = {table.keys()[id], static_cast<std::uint32_t>(id)};
     }
-    std::sort(ws.order.begin(), ws.order.end());
+    RadixSortByKey(ws.order, layout.total_bits, ws.order_scratch);
     ws.blocks.resize(moments.size());
     for (std::size_t i = 0; i < ws.order.size(); ++i) {
         ws.blocks[i] = {ws.order[i].first, moments[ws.order[i].second]};
