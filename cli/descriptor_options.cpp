@@ -33,18 +33,14 @@ io::RunConfig DescriptorOptions::Resolve(io::RunConfig base) const {
 std::string DescriptorOptions::FirstGiven() const {
     if (!config_file_.empty()) return "--config";
     if (!method_.empty()) return "--method";
-    const CLI::Option* flags[] = {bins_option_, min_option_,           max_option_,
-                                  up_option_,   sensor_height_option_, out_of_range_option_};
-    for (const CLI::Option* flag : flags) {
+    for (const CLI::Option* flag : HistogramFlags()) {
         if (*flag) return flag->get_name();
     }
     return "";
 }
 
 void DescriptorOptions::ApplyHistogramFlags(core::DescriptorConfig& descriptor) const {
-    const CLI::Option* flags[] = {bins_option_, min_option_,           max_option_,
-                                  up_option_,   sensor_height_option_, out_of_range_option_};
-    for (const CLI::Option* flag : flags) {
+    for (const CLI::Option* flag : HistogramFlags()) {
         if (*flag && !core::IsHistogramMethod(descriptor.method)) {
             throw core::ConfigError(flag->get_name() +
                                     " applies to the height and range methods; set NDT "

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <filesystem>
 #include <string>
 
@@ -26,6 +27,11 @@ public:
 
 private:
     void ApplyHistogramFlags(core::DescriptorConfig& descriptor) const;
+    /// --bins, --min, --max, --up, --sensor-height, --out-of-range.
+    std::array<const CLI::Option*, 6> HistogramFlags() const {
+        return {bins_option_, min_option_,           max_option_,
+                up_option_,   sensor_height_option_, out_of_range_option_};
+    }
 
     std::string config_file_;
     std::string method_;

@@ -104,10 +104,7 @@ void RunLocalise(const DetectFlags& flags) {
     WriteLoopsCsv(out_dir / "loops.csv", queries);
     WriteCandidatesCsv(out_dir / "candidates.csv", queries);
     WriteSkipped(out_dir, described.skipped);
-    nlohmann::json timings = TimingsJson(described, 0, 0.0);
-    timings.erase("similarity_matrix_s");
-    timings.erase("pairs");
-    timings.erase("ns_per_comparison_wall");
+    nlohmann::json timings = DescribeTimingsJson(described);
     timings["map"] = flags.map;
     timings["map_scans"] = detector.database().size();
     timings["load_map_s"] = load_map_s;

@@ -70,11 +70,12 @@ pipeline::SimilarityMatrix MatrixOfResults(const std::string& file, std::size_t 
     return matrix;
 }
 
-void RequirePoses(const io::Dataset& dataset, const std::string& role) {
+// `poses_flag` names the option that gives a dataset its poses.
+void RequirePoses(const io::Dataset& dataset, const std::string& role,
+                  const std::string& poses_flag) {
     if (!dataset.HasPoses()) {
         throw core::ConfigError(dataset.root().string() + " has no poses; " + role +
-                                " needs ground truth (" +
-                                (role == "evaluation" ? "--poses" : "--train-poses") + " FILE)");
+                                " needs ground truth (" + poses_flag + " FILE)");
     }
 }
 
@@ -162,8 +163,9 @@ void RunEvaluate(const EvaluateFlags& flags) {
 EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequest& request,
                                 const io::Dataset* train_dataset) {
     request.learning.Validate();
-    RequirePoses(dataset, "evaluation");
-    if (train_dataset != nullptr) RequirePoses(*train_dataset, "threshold learning");
+    RequirePoses(dataset, "evaluation", "--poses");
+    if (train_dataset != nullptr)
+        RequirePoses(*train_dataset, "threshold learning", "--train-poses");
     EvaluationOutcome outcome{
         eval::BuildGroundTruth(dataset.poses(), GroundTruthRule(request)), {}, {}};
     const eval::GroundTruth& truth = outcome.truth;

@@ -71,8 +71,7 @@ pipeline::SequenceDescriptors DescribeDataset(const io::Dataset& dataset,
     return pipeline::DescribeSequence(SourceOf(dataset), config, options);
 }
 
-nlohmann::json TimingsJson(const pipeline::SequenceDescriptors& described, std::size_t pairs,
-                           double matrix_s) {
+nlohmann::json DescribeTimingsJson(const pipeline::SequenceDescriptors& described) {
     const auto ms = [](std::vector<double> seconds, double q) {
         return 1e3 * Quantile(seconds, q);
     };
@@ -83,6 +82,12 @@ nlohmann::json TimingsJson(const pipeline::SequenceDescriptors& described, std::
                                     {"p95", ms(described.describe_seconds, 0.95)}};
     json["load_ms_per_scan"] = {{"median", ms(described.load_seconds, 0.5)},
                                 {"p95", ms(described.load_seconds, 0.95)}};
+    return json;
+}
+
+nlohmann::json TimingsJson(const pipeline::SequenceDescriptors& described, std::size_t pairs,
+                           double matrix_s) {
+    nlohmann::json json = DescribeTimingsJson(described);
     json["similarity_matrix_s"] = matrix_s;
     json["pairs"] = pairs;
     json["ns_per_comparison_wall"] = pairs > 0 ? 1e9 * matrix_s / static_cast<double>(pairs) : 0.0;

@@ -65,7 +65,9 @@ pipeline::SequenceDescriptors DescribeDataset(const io::Dataset& dataset,
                                               const core::DescriptorConfig& config,
                                               const DescribeRun& run);
 
-/// Per-scan and per-comparison timings of a run, in milliseconds and nanoseconds.
+/// Per-scan timings of describing a dataset (reading and describing, median and p95), in ms.
+nlohmann::json DescribeTimingsJson(const pipeline::SequenceDescriptors& described);
+/// DescribeTimingsJson plus the similarity matrix: per comparison in nanoseconds.
 nlohmann::json TimingsJson(const pipeline::SequenceDescriptors& described, std::size_t pairs,
                            double matrix_s);
 

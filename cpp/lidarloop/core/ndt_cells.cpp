@@ -154,7 +154,6 @@ void BinIntoVoxels(const PointCloud& cloud, double voxel_size_m, NdtCellStats& s
         keyed.emplace_back(layout.Key(index_of(p)), static_cast<std::uint32_t>(i));
     }
     RadixSortByKey(keyed, layout.total_bits, ws.sort_scratch);
-    ws.blocks.clear();
     for (std::size_t i = 0; i < keyed.size();) {
         KeyedMoments block{keyed[i].first, {}};
         for (; i < keyed.size() && keyed[i].first == block.key; ++i) {
