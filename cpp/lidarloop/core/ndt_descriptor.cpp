@@ -15,16 +15,6 @@
 namespace lidarloop::core {
 namespace {
 
-// A classified cell, independent of any rotation: its shape, orientation axis and the row and
-// column parts of its feature index that rotation cannot change.
-struct ClassifiedCell {
-    CellShape shape;
-    Eigen::Vector3d axis;
-    Eigen::Vector3d mean_m;
-    int row;               // range interval
-    int spherical_column;  // for spherical cells
-};
-
 // A line has two unit vectors, and the rotation that aligns one of them differs from the one
 // aligning the other by a half turn, which moves cells to other orientation classes (the
 // partition is not symmetric under it). Each line is therefore given the sign that points
@@ -38,10 +28,46 @@ struct Partitions {
     std::optional<HalfSpherePartition> linear;
 };
 
-int RangeRow(const Eigen::Vector3d& mean_m, const std::vector<double>& limits_m) {
-    const double range_m = mean_m.norm();
-    return static_cast<int>(std::upper_bound(limits_m.begin(), limits_m.end(), range_m) -
-                            limits_m.begin());
+// The classified cells of one shape whose column depends on their orientation (planar or
+// linear): unit axes as float columns, so that the nearest-line search of every rotation
+// candidate runs over contiguous arrays, and the range row of each cell.
+struct OrientedCells {
+    std::vector<float> x, y, z;
+    std::vector<int> row;
+
+    std::size_t size() const { return row.size(); }
+    void Add(const Eigen::Vector3d& axis, int range_row) {
+        x.push_back(static_cast<float>(axis.x()));
+        y.push_back(static_cast<float>(axis.y()));
+        z.push_back(static_cast<float>(axis.z()));
+        row.push_back(range_row);
+    }
+    Eigen::Vector3d Axis(std::size_t i) const { return {x[i], y[i], z[i]}; }
+};
+
+// Every classified cell of a scan, split into what rotation cannot change (range rows, spherical
+// columns and any class of a one-line partition, counted once into `fixed_counts`) and the
+// planar and linear axes that each rotation candidate classifies anew.
+struct ClassifiedCells {
+    std::vector<float> fixed_counts;  // rows x cols, like NdtDescriptor::counts
+    OrientedCells planar;
+    OrientedCells linear;
+    Eigen::Vector3d mean_sum_m = Eigen::Vector3d::Zero();  // of all classified cells' means
+    std::size_t degenerate = 0;
+};
+
+// The squared borders of the range intervals, so that rows are found without a square root.
+std::vector<double> SquaredLimits(const std::vector<double>& limits_m) {
+    std::vector<double> squared;
+    for (double limit : limits_m) squared.push_back(limit * limit);
+    return squared;
+}
+
+int RangeRow(const Eigen::Vector3d& mean_m, const std::vector<double>& squared_limits_m2) {
+    const double range2 = mean_m.squaredNorm();
+    int row = 0;
+    for (double limit2 : squared_limits_m2) row += range2 >= limit2 ? 1 : 0;
+    return row;
 }
 
 int SphericalColumn(double l2_over_l1, const NdtConfig& config) {
@@ -52,89 +78,111 @@ int SphericalColumn(double l2_over_l1, const NdtConfig& config) {
     return std::clamp(static_cast<int>(t * s), 0, s - 1);
 }
 
-std::vector<ClassifiedCell> ClassifyCells(const std::vector<NdtCell>& cells,
-                                          const NdtConfig& config, std::size_t& degenerate) {
-    std::vector<ClassifiedCell> classified;
-    classified.reserve(cells.size());
+// Puts one classified cell where it belongs: a fixed count, or the oriented list of its shape.
+void AddCell(const CellShapeInfo& info, int row, const NdtConfig& config,
+             const Partitions& partitions, ClassifiedCells& out) {
+    const int cols = config.FeatureCount();
+    const auto count_fixed = [&](int column) {
+        out.fixed_counts[static_cast<std::size_t>(row * cols + column)] += 1.0f;
+    };
+    switch (info.shape) {
+        case CellShape::kSpherical:
+            if (config.spherical_classes > 0) count_fixed(SphericalColumn(info.l2_over_l1, config));
+            break;
+        case CellShape::kPlanar:
+            out.planar.Add(info.axis, row);  // its axes steer the rotation even when p = 1
+            if (partitions.planar && partitions.planar->size() == 1) {
+                count_fixed(config.spherical_classes);
+            }
+            break;
+        case CellShape::kLinear:
+            out.linear.Add(info.axis, row);
+            if (partitions.linear && partitions.linear->size() == 1) {
+                count_fixed(config.spherical_classes + config.planar_classes);
+            }
+            break;
+        case CellShape::kDegenerate:
+            break;
+    }
+}
+
+ClassifiedCells ClassifyCells(const std::vector<NdtCell>& cells, const NdtConfig& config,
+                              const Partitions& partitions) {
+    ClassifiedCells out;
+    out.fixed_counts.assign(static_cast<std::size_t>(config.RangeCount() * config.FeatureCount()),
+                            0.0f);
+    const std::vector<double> squared_limits_m2 = SquaredLimits(config.range_limits_m);
     for (const NdtCell& cell : cells) {
         const CellShapeInfo info =
             ClassifyCovariance(cell.covariance_m2, config.eigen_ratio_threshold);
         if (info.shape == CellShape::kDegenerate) {
-            ++degenerate;
+            ++out.degenerate;
             continue;
         }
-        const int spherical_column =
-            config.spherical_classes > 0 ? SphericalColumn(info.l2_over_l1, config) : 0;
-        classified.push_back({info.shape, info.axis, cell.mean_m,
-                              RangeRow(cell.mean_m, config.range_limits_m), spherical_column});
+        out.mean_sum_m += cell.mean_m;
+        AddCell(info, RangeRow(cell.mean_m, squared_limits_m2), config, partitions, out);
     }
-    return classified;
+    return out;
 }
 
-// Nearest-line classification (eq. 2) of many axes seen after rotating the scan by R. Because
-// (R a) . c_j = a . (R^T c_j), the few centres are rotated once instead of every cell's axis.
-class RotatedLines {
-public:
-    RotatedLines(const std::optional<HalfSpherePartition>& partition, const Eigen::Matrix3d& R) {
-        if (!partition) return;
-        for (const Eigen::Vector3d& centre : partition->centres()) {
-            const Eigen::Vector3d c = R.transpose() * centre;
-            x_.push_back(c.x());
-            y_.push_back(c.y());
-            z_.push_back(c.z());
+// Eq. (2) for every cell of `cells` seen after rotating the scan by R: the index of the nearest
+// line, argmax_j |(R a) . c_j| = argmax_j |a . (R^T c_j)|, so the few centres are rotated instead
+// of the many axes. One pass per line over the float columns, which the compiler vectorises;
+// ties keep the lowest index, as HalfSpherePartition::NearestLine does.
+void NearestLines(const OrientedCells& cells, const HalfSpherePartition& partition,
+                  const Eigen::Matrix3d& R, std::vector<float>& best_dot,
+                  std::vector<int>& nearest) {
+    const std::size_t n = cells.size();
+    best_dot.assign(n, -1.0f);
+    nearest.assign(n, 0);
+    const float* __restrict x = cells.x.data();
+    const float* __restrict y = cells.y.data();
+    const float* __restrict z = cells.z.data();
+    float* __restrict best = best_dot.data();
+    int* __restrict index = nearest.data();
+    for (int j = 0; j < partition.size(); ++j) {
+        const Eigen::Vector3f c = (R.transpose() * partition.centres()[j]).cast<float>();
+        for (std::size_t i = 0; i < n; ++i) {
+            // Written as a mask blend: GCC 12 does not vectorise the equivalent `if`.
+            const float dot = std::abs(x[i] * c.x() + y[i] * c.y() + z[i] * c.z());
+            const float previous = best[i];
+            const int nearer_mask = -static_cast<int>(dot > previous);
+            best[i] = dot > previous ? dot : previous;
+            index[i] = (index[i] & ~nearer_mask) | (j & nearer_mask);
         }
     }
-    bool empty() const { return x_.empty(); }
-    int Classify(const Eigen::Vector3d& axis) const {
-        int best = 0;
-        double best_dot = -1.0;
-        for (std::size_t j = 0; j < x_.size(); ++j) {
-            const double dot = std::abs(axis.x() * x_[j] + axis.y() * y_[j] + axis.z() * z_[j]);
-            if (dot > best_dot) {  // strict: ties keep the lowest index, as NearestLine does
-                best_dot = dot;
-                best = static_cast<int>(j);
-            }
-        }
-        return best;
-    }
+}
 
-private:
-    std::vector<double> x_, y_, z_;
+// Scratch of the nearest-line search, reused across the rotation candidates of one scan.
+struct LineScratch {
+    std::vector<float> best_dot;
+    std::vector<int> nearest;
 };
 
-// Feature column of a cell (eq. 1 and 2); -1 when its class is not counted (s, p or l is 0).
-int FeatureColumn(const ClassifiedCell& cell, const NdtConfig& config, const RotatedLines& planes,
-                  const RotatedLines& lines) {
-    switch (cell.shape) {
-        case CellShape::kSpherical:
-            return config.spherical_classes > 0 ? cell.spherical_column : -1;
-        case CellShape::kPlanar:
-            if (planes.empty()) return -1;
-            return config.spherical_classes + planes.Classify(cell.axis);
-        case CellShape::kLinear:
-            if (lines.empty()) return -1;
-            return config.spherical_classes + config.planar_classes + lines.Classify(cell.axis);
-        case CellShape::kDegenerate:
-            break;
+void CountOriented(const OrientedCells& cells, const std::optional<HalfSpherePartition>& partition,
+                   const Eigen::Matrix3d& R, int first_column, int cols, std::vector<float>& counts,
+                   LineScratch& scratch) {
+    if (!partition || partition->size() == 1) return;  // counted among the fixed counts
+    NearestLines(cells, *partition, R, scratch.best_dot, scratch.nearest);
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+        counts[static_cast<std::size_t>(cells.row[i] * cols + first_column + scratch.nearest[i])] +=
+            1.0f;
     }
-    return -1;
 }
 
-NdtDescriptor CountFeatures(const std::vector<ClassifiedCell>& cells, const Eigen::Matrix3d& R,
-                            const NdtConfig& config, const Partitions& partitions) {
+NdtDescriptor CountFeatures(const ClassifiedCells& cells, const Eigen::Matrix3d& R,
+                            const NdtConfig& config, const Partitions& partitions,
+                            LineScratch& scratch) {
     NdtDescriptor f;
     f.rows = config.RangeCount();
     f.cols = config.FeatureCount();
-    f.counts.assign(static_cast<std::size_t>(f.rows * f.cols), 0.0f);
+    f.counts = cells.fixed_counts;
     f.R_aligned_sensor = R;
-    const RotatedLines planes(partitions.planar, R);
-    const RotatedLines lines(partitions.linear, R);
-    for (const ClassifiedCell& cell : cells) {
-        const int column = FeatureColumn(cell, config, planes, lines);
-        if (column < 0) continue;
-        f.counts[static_cast<std::size_t>(cell.row * f.cols + column)] += 1.0f;
-        f.total += 1.0;
-    }
+    CountOriented(cells.planar, partitions.planar, R, config.spherical_classes, f.cols, f.counts,
+                  scratch);
+    CountOriented(cells.linear, partitions.linear, R,
+                  config.spherical_classes + config.planar_classes, f.cols, f.counts, scratch);
+    for (float count : f.counts) f.total += count;
     f.normalised.resize(f.counts.size());
     const double inverse_total = f.total > 0.0 ? 1.0 / f.total : 0.0;
     for (std::size_t i = 0; i < f.counts.size(); ++i) {
@@ -186,16 +234,17 @@ struct LineClasses {
     std::vector<Eigen::Vector3d> directions;
 };
 
-LineClasses SummariseLines(const std::vector<ClassifiedCell>& cells, CellShape shape,
-                           const HalfSpherePartition& partition, bool mean_direction) {
+LineClasses SummariseLines(const OrientedCells& cells, const HalfSpherePartition& partition,
+                           bool mean_direction, LineScratch& scratch) {
     const auto n = static_cast<std::size_t>(partition.size());
     LineClasses classes{std::vector<double>(n, 0.0), partition.centres()};
     std::vector<Eigen::Matrix3d> scatter(n, Eigen::Matrix3d::Zero());
-    for (const ClassifiedCell& cell : cells) {
-        if (cell.shape != shape) continue;
-        const auto j = static_cast<std::size_t>(partition.NearestLine(cell.axis));
+    NearestLines(cells, partition, Eigen::Matrix3d::Identity(), scratch.best_dot, scratch.nearest);
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+        const auto j = static_cast<std::size_t>(scratch.nearest[i]);
+        const Eigen::Vector3d axis = cells.Axis(i);
         classes.counts[j] += 1.0;
-        scatter[j].noalias() += cell.axis * cell.axis.transpose();
+        scatter[j].noalias() += axis * axis.transpose();
     }
     if (!mean_direction) return classes;
     for (std::size_t j = 0; j < n; ++j) {
@@ -205,13 +254,6 @@ LineClasses SummariseLines(const std::vector<ClassifiedCell>& cells, CellShape s
         classes.directions[j] = solver.eigenvectors().col(2).normalized();
     }
     return classes;
-}
-
-Eigen::Vector3d CentroidDirection(const std::vector<ClassifiedCell>& cells) {
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (const ClassifiedCell& cell : cells) sum += cell.mean_m;
-    const double norm = sum.norm();
-    return norm > 0.0 ? Eigen::Vector3d(sum / norm) : Eigen::Vector3d::Zero();
 }
 
 // The signed unit vectors of `line` to align: the one pointing against `centroid`, or both.
@@ -224,12 +266,13 @@ std::vector<Eigen::Vector3d> SignedVariants(const Eigen::Vector3d& line,
 
 // The rotations R_y R_z of section II-C, one per combination of an entry of Z with another
 // entry of Z or Y; R_z alone when no second direction exists; identity without planar cells.
-std::vector<Eigen::Matrix3d> CandidateRotations(const std::vector<ClassifiedCell>& cells,
+std::vector<Eigen::Matrix3d> CandidateRotations(const ClassifiedCells& cells,
                                                 const NdtConfig& config,
-                                                const Partitions& partitions) {
+                                                const Partitions& partitions,
+                                                LineScratch& scratch) {
     if (!config.normalise_rotation || !partitions.planar) return {Eigen::Matrix3d::Identity()};
     const bool mean = config.align_to_mean_direction;
-    const LineClasses planes = SummariseLines(cells, CellShape::kPlanar, *partitions.planar, mean);
+    const LineClasses planes = SummariseLines(cells.planar, *partitions.planar, mean, scratch);
     std::vector<int> z;
     std::vector<int> y;
     AmbiguousPeaks(planes.counts, config.ambiguity_ratio, z, y);
@@ -238,14 +281,16 @@ std::vector<Eigen::Matrix3d> CandidateRotations(const std::vector<ClassifiedCell
     std::vector<Eigen::Vector3d> seconds;
     for (int j : y) seconds.push_back(planes.directions[j]);
     if (z.size() + y.size() < 2 && partitions.linear && partitions.linear->size() > 1) {
-        const LineClasses lines =
-            SummariseLines(cells, CellShape::kLinear, *partitions.linear, mean);
+        const LineClasses lines = SummariseLines(cells.linear, *partitions.linear, mean, scratch);
         std::vector<int> lz;
         std::vector<int> ly;
         AmbiguousPeaks(lines.counts, config.ambiguity_ratio, lz, ly);
         for (int j : lz) seconds.push_back(lines.directions[j]);
     }
-    const Eigen::Vector3d centroid = CentroidDirection(cells);
+    const double centroid_norm = cells.mean_sum_m.norm();
+    const Eigen::Vector3d centroid = centroid_norm > 0.0
+                                         ? Eigen::Vector3d(cells.mean_sum_m / centroid_norm)
+                                         : Eigen::Vector3d::Zero();
     std::vector<Eigen::Matrix3d> rotations;
     for (int i : z) {
         for (const Eigen::Vector3d& first : SignedVariants(planes.directions[i], centroid)) {
@@ -311,20 +356,22 @@ NdtDescriptorSet ComputeNdtDescriptorSet(const PointCloud& cloud, const NdtConfi
     config.Validate();
     NdtDescriptorSet set;
     const Partitions partitions = MakePartitions(config);
-    const auto cells_of = [&](const PointCloud& points) {
-        return ClassifyCells(ComputeNdtCells(points, config.cell_size_m, config.min_points_per_cell,
-                                             &set.cell_stats),
-                             config, set.degenerate_cells);
-    };
-    const std::vector<ClassifiedCell> cells = cells_of(cloud);
-    for (const Eigen::Matrix3d& R : CandidateRotations(cells, config, partitions)) {
+    LineScratch scratch;
+    const ClassifiedCells cells = ClassifyCells(
+        ComputeNdtCells(cloud, config.cell_size_m, config.min_points_per_cell, &set.cell_stats),
+        config, partitions);
+    set.degenerate_cells = cells.degenerate;
+    for (const Eigen::Matrix3d& R : CandidateRotations(cells, config, partitions, scratch)) {
         if (config.regrid_rotations && !R.isIdentity()) {
-            NdtDescriptor f = CountFeatures(cells_of(Rotated(cloud, R)),
-                                            Eigen::Matrix3d::Identity(), config, partitions);
+            const ClassifiedCells regridded = ClassifyCells(
+                ComputeNdtCells(Rotated(cloud, R), config.cell_size_m, config.min_points_per_cell),
+                config, partitions);
+            NdtDescriptor f =
+                CountFeatures(regridded, Eigen::Matrix3d::Identity(), config, partitions, scratch);
             f.R_aligned_sensor = R;
             set.descriptors.push_back(std::move(f));
         } else {
-            set.descriptors.push_back(CountFeatures(cells, R, config, partitions));
+            set.descriptors.push_back(CountFeatures(cells, R, config, partitions, scratch));
         }
     }
     if (set.descriptors.front().total <= 0.0) {
