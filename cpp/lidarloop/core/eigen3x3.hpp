@@ -1,8 +1,6 @@
 #pragma once
 
-#include <algorithm>
 #include <cmath>
-#include <functional>
 #include <numbers>
 
 #include <Eigen/Core>
@@ -41,46 +39,65 @@ inline void CosSinSmall(double t, double& c, double& s) {
                                                                             t2 / 6227020800.0))))));
 }
 
-}  // namespace detail
+struct Eigenvalues3 {
+    double l1, l2, l3;  // descending
+};
 
-/// Eigenvalues of a symmetric 3x3 matrix in descending order (l1 >= l2 >= l3), by the closed
-/// trigonometric form of the characteristic cubic (Smith 1961) with polynomial acos, cos and sin:
-/// no library call, the hot loop of the NDT descriptor. Absolute error below
-/// 1e-8 * |l1| (tested against Eigen's iterative solver): ratios compared with t_e ~ 0.1 come out
-/// the same as exact ones unless they lie within ~1e-7 of the threshold. Only the upper triangle
-/// is read.
-inline Eigen::Vector3d SymmetricEigenvaluesDescending(const Eigen::Matrix3d& a) {
-    const double a01 = a(0, 1);
-    const double a02 = a(0, 2);
-    const double a12 = a(1, 2);
+// The eigenvalues of the symmetric matrix with upper triangle (a00 a01 a02; a11 a12; a22).
+// Written with selects on values only (no std::min, no branch), so that a loop over many
+// matrices vectorises; see SymmetricEigenvaluesDescending.
+inline Eigenvalues3 SymmetricEigenvalues(double a00, double a01, double a02, double a11, double a12,
+                                         double a22) {
     const double off_diagonal = a01 * a01 + a02 * a02 + a12 * a12;
-    if (off_diagonal == 0.0) {  // exact for diagonal input, which the formula would round
-        Eigen::Vector3d d = a.diagonal();
-        std::sort(d.data(), d.data() + 3, std::greater<>());
-        return d;
-    }
     // Shift by the mean eigenvalue q and scale by p so that B = (A - qI)/p has eigenvalues
     // 2 cos(phi + 2 pi k / 3), with cos(3 phi) = det(B) / 2 and phi in [0, pi/3].
-    const double q = (a(0, 0) + a(1, 1) + a(2, 2)) / 3.0;
-    const double d0 = a(0, 0) - q;
-    const double d1 = a(1, 1) - q;
-    const double d2 = a(2, 2) - q;
+    const double q = (a00 + a11 + a22) / 3.0;
+    const double d0 = a00 - q;
+    const double d1 = a11 - q;
+    const double d2 = a22 - q;
     const double p2 = (d0 * d0 + d1 * d1 + d2 * d2 + 2.0 * off_diagonal) / 6.0;
     const double p = std::sqrt(p2);
     const double det_shifted =
         d0 * (d1 * d2 - a12 * a12) - a01 * (a01 * d2 - a12 * a02) + a02 * (a01 * a12 - d1 * a02);
-    const double half_det = std::clamp(det_shifted / (2.0 * p2 * p), -1.0, 1.0);
+    const double denominator = 2.0 * p2 * p;  // 0 only for A = qI, where det_shifted is 0 too
+    double half_det = det_shifted / (denominator > 1e-300 ? denominator : 1e-300);
+    half_det = half_det > 1.0 ? 1.0 : half_det;
+    half_det = half_det < -1.0 ? -1.0 : half_det;
     // With t = phi - pi/6 in [-pi/6, pi/6]: cos(phi) and sin(phi) from cos(t) and sin(t).
-    const double t = detail::AcosApprox(half_det) / 3.0 - std::numbers::pi / 6.0;
+    const double t = AcosApprox(half_det) / 3.0 - std::numbers::pi / 6.0;
     double cos_t = 0.0;
     double sin_t = 0.0;
-    detail::CosSinSmall(t, cos_t, sin_t);
+    CosSinSmall(t, cos_t, sin_t);
     constexpr double kHalfSqrt3 = 0.8660254037844386;
     const double cos_phi = kHalfSqrt3 * cos_t - 0.5 * sin_t;
     const double sin_phi = 0.5 * cos_t + kHalfSqrt3 * sin_t;
     const double l1 = q + 2.0 * p * cos_phi;
     const double l3 = q - p * (cos_phi + std::numbers::sqrt3 * sin_phi);  // 2p cos(phi + 2pi/3)
-    return {l1, 3.0 * q - l1 - l3, l3};
+    const double l2 = 3.0 * q - l1 - l3;
+    // A diagonal matrix gets its sorted diagonal exactly, which the formula would round.
+    const double high01 = a00 > a11 ? a00 : a11;
+    const double low01 = a00 > a11 ? a11 : a00;
+    const double max_diagonal = high01 > a22 ? high01 : a22;
+    const double min_diagonal = low01 < a22 ? low01 : a22;
+    const double high01_or_a22 = high01 < a22 ? high01 : a22;
+    const double mid_diagonal = low01 > high01_or_a22 ? low01 : high01_or_a22;
+    const bool diagonal = off_diagonal == 0.0;
+    return {diagonal ? max_diagonal : l1, diagonal ? mid_diagonal : l2,
+            diagonal ? min_diagonal : l3};
+}
+
+}  // namespace detail
+
+/// Eigenvalues of a symmetric 3x3 matrix in descending order (l1 >= l2 >= l3), by the closed
+/// trigonometric form of the characteristic cubic (Smith 1961) with polynomial acos, cos and sin:
+/// no library call and no branch, the hot loop of the NDT descriptor. Absolute error below
+/// 1e-8 * |l1| (tested against Eigen's iterative solver): ratios compared with t_e ~ 0.1 come out
+/// the same as exact ones unless they lie within ~1e-7 of the threshold. Exact for diagonal
+/// input. Only the upper triangle is read.
+inline Eigen::Vector3d SymmetricEigenvaluesDescending(const Eigen::Matrix3d& a) {
+    const detail::Eigenvalues3 e =
+        detail::SymmetricEigenvalues(a(0, 0), a(0, 1), a(0, 2), a(1, 1), a(1, 2), a(2, 2));
+    return {e.l1, e.l2, e.l3};
 }
 
 /// A unit eigenvector of the symmetric matrix `a` for its eigenvalue `lambda`, from the largest

@@ -5,6 +5,7 @@
 #include <climits>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -81,31 +82,73 @@ int FloorToInt(double value) {
     return truncated - (value < static_cast<double>(truncated) ? 1 : 0);
 }
 
-// Sorts (key, index) pairs by key (below 2^bits), stably, so the points of a voxel keep the
-// scan's order: least significant digit first, 11 bits per pass (a scan's keys have about 30
-// bits: three passes). Unlike std::sort it makes no unpredictable comparisons.
-void RadixSortByKey(std::vector<std::pair<std::uint64_t, std::uint32_t>>& items, int bits,
-                    std::vector<std::pair<std::uint64_t, std::uint32_t>>& scratch) {
-    constexpr int kDigitBits = 11;
-    constexpr std::size_t kBuckets = std::size_t{1} << kDigitBits;
+// Sorts `items` stably by key_of(item) < 2^key_bits: least significant digit first, all digit
+// histograms counted in one pass, digits of at most 11 bits (a scan's keys have about 30 bits:
+// three passes), and a pass skipped when every item has the same digit. Stable, so the points of
+// a voxel keep the scanner's order and their sums do not depend on the sort.
+template <typename Item, typename KeyOf>
+void RadixSort(std::vector<Item>& items, int key_bits, std::vector<Item>& scratch,
+               std::vector<std::uint32_t>& counts, KeyOf key_of) {
+    constexpr int kMaxDigitBits = 11;
+    if (items.size() < 2 || key_bits <= 0) return;
+    const int passes = (key_bits + kMaxDigitBits - 1) / kMaxDigitBits;
+    const int digit_bits = (key_bits + passes - 1) / passes;
+    const std::size_t buckets = std::size_t{1} << digit_bits;
+    const std::uint64_t digit_mask = buckets - 1;
+    counts.assign(static_cast<std::size_t>(passes) * buckets, 0);
+    for (const Item& item : items) {
+        const std::uint64_t key = key_of(item);
+        for (int pass = 0; pass < passes; ++pass) {
+            ++counts[pass * buckets + ((key >> (pass * digit_bits)) & digit_mask)];
+        }
+    }
     scratch.resize(items.size());
-    std::vector<std::size_t> start(kBuckets);
-    for (int shift = 0; shift < bits; shift += kDigitBits) {
-        const auto digit = [shift](std::uint64_t key) { return (key >> shift) & (kBuckets - 1); };
-        std::fill(start.begin(), start.end(), 0);
-        for (const auto& item : items) ++start[digit(item.first)];
-        std::size_t offset = 0;
-        for (std::size_t& s : start) offset += std::exchange(s, offset);
-        for (const auto& item : items) scratch[start[digit(item.first)]++] = item;
+    for (int pass = 0; pass < passes; ++pass) {
+        const int shift = pass * digit_bits;
+        std::uint32_t* start = counts.data() + pass * buckets;
+        if (start[(key_of(items.front()) >> shift) & digit_mask] == items.size()) continue;
+        std::uint32_t offset = 0;
+        for (std::size_t b = 0; b < buckets; ++b) offset += std::exchange(start[b], offset);
+        for (const Item& item : items)
+            scratch[start[(key_of(item) >> shift) & digit_mask]++] = item;
         items.swap(scratch);
     }
+}
+
+// How a (voxel key, point index) pair is stored for the sort: one 64-bit word with the key above
+// the index when both fit (every real scan; half the memory traffic), else a pair.
+struct PackedItems {
+    int index_bits;
+    std::uint64_t Make(std::uint64_t key, std::uint32_t index) const {
+        return (key << index_bits) | index;
+    }
+    std::uint64_t Key(std::uint64_t item) const { return item >> index_bits; }
+    std::uint32_t Index(std::uint64_t item) const {
+        return static_cast<std::uint32_t>(item & ((std::uint64_t{1} << index_bits) - 1));
+    }
+};
+
+struct PairItems {
+    using Item = std::pair<std::uint64_t, std::uint32_t>;
+    Item Make(std::uint64_t key, std::uint32_t index) const { return {key, index}; }
+    std::uint64_t Key(const Item& item) const { return item.first; }
+    std::uint32_t Index(const Item& item) const { return item.second; }
+};
+
+int BitsFor(std::size_t count) {
+    int bits = 1;
+    while (bits < 64 && (std::uint64_t{1} << bits) < count) ++bits;
+    return bits;
 }
 
 // Scratch memory reused by later calls on the same thread: a scan's grid needs a few MB, and
 // fresh allocations of that size cost more in page faults than the arithmetic on them.
 struct Workspace {
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed_points;  // (voxel key, point)
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> sort_scratch;
+    std::vector<std::uint64_t> packed;
+    std::vector<std::uint64_t> packed_scratch;
+    std::vector<PairItems::Item> pairs;
+    std::vector<PairItems::Item> pairs_scratch;
+    std::vector<std::uint32_t> digit_counts;
     std::vector<KeyedMoments> blocks;
     std::vector<KeyedMoments> scratch;
 };
@@ -115,89 +158,123 @@ Workspace& ThreadWorkspace() {
     return workspace;
 }
 
+// The voxel index bounds of the usable points, which fix the key layout. Bounds of the
+// coordinates suffice: floor(x / h) is monotonic in x.
+bool VoxelBounds(const PointCloud& cloud, double inverse_voxel_size, float max_coordinate_m,
+                 NdtCellStats& stats, Eigen::Array3i& lo, Eigen::Array3i& hi) {
+    Eigen::Array3f min_m = Eigen::Array3f::Constant(std::numeric_limits<float>::infinity());
+    Eigen::Array3f max_m = -min_m;
+    for (const Eigen::Vector3f& p : cloud) {
+        if (!IsUsable(p, max_coordinate_m)) {
+            ++stats.points_skipped;
+            continue;
+        }
+        min_m = min_m.min(p.array());
+        max_m = max_m.max(p.array());
+    }
+    stats.points_used = cloud.size() - stats.points_skipped;
+    if (stats.points_used == 0) return false;
+    for (int axis = 0; axis < 3; ++axis) {
+        lo[axis] = FloorToInt(min_m[axis] * inverse_voxel_size);
+        hi[axis] = FloorToInt(max_m[axis] * inverse_voxel_size);
+    }
+    return true;
+}
+
+// Sorts the usable points by voxel key and sums the moments of each run of equal keys into
+// ws.blocks. Sorting does not depend on the order in which the scanner wrote its points (ring by
+// ring or column by column), unlike a hash table whose lookups miss when consecutive points
+// change voxel.
+template <typename Codec, typename Item>
+void SortAndSumVoxels(const PointCloud& cloud, double inverse_voxel_size, float max_coordinate_m,
+                      const KeyLayout& layout, const Codec& codec, std::vector<Item>& items,
+                      std::vector<Item>& scratch, Workspace& ws) {
+    items.clear();
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const Eigen::Vector3f& p = cloud[i];
+        if (!IsUsable(p, max_coordinate_m)) continue;
+        const Eigen::Array3i index(FloorToInt(p.x() * inverse_voxel_size),
+                                   FloorToInt(p.y() * inverse_voxel_size),
+                                   FloorToInt(p.z() * inverse_voxel_size));
+        items.push_back(codec.Make(layout.Key(index), static_cast<std::uint32_t>(i)));
+    }
+    RadixSort(items, layout.total_bits, scratch, ws.digit_counts,
+              [&codec](const Item& item) { return codec.Key(item); });
+    ws.blocks.clear();
+    for (std::size_t i = 0; i < items.size();) {
+        KeyedMoments block{codec.Key(items[i]), {}};
+        for (; i < items.size() && codec.Key(items[i]) == block.key; ++i) {
+            const Eigen::Vector3f& p = cloud[codec.Index(items[i])];
+            block.moments.Add(p.cast<double>());
+        }
+        ws.blocks.push_back(block);
+    }
+}
+
 // Fills ws.blocks with the moments of every occupied voxel, sorted by key.
 void BinIntoVoxels(const PointCloud& cloud, double voxel_size_m, NdtCellStats& stats,
                    KeyLayout& layout, Workspace& ws) {
     const double inverse_voxel_size = 1.0 / voxel_size_m;
     const auto max_coordinate_m =
         static_cast<float>(std::min(kMaxCoordinate_m, kMaxVoxelIndex * voxel_size_m));
-    const auto index_of = [inverse_voxel_size](const Eigen::Vector3f& p) {
-        return Eigen::Array3i(FloorToInt(p.x() * inverse_voxel_size),
-                              FloorToInt(p.y() * inverse_voxel_size),
-                              FloorToInt(p.z() * inverse_voxel_size));
-    };
-    // Pass 1: the bounds of the voxel indices, which fix the key layout. Recomputing the indices
-    // in pass 2 is cheaper than storing them.
-    Eigen::Array3i lo = Eigen::Array3i::Constant(INT32_MAX);
-    Eigen::Array3i hi = Eigen::Array3i::Constant(INT32_MIN);
-    for (const Eigen::Vector3f& p : cloud) {
-        if (!IsUsable(p, max_coordinate_m)) {
-            ++stats.points_skipped;
-            continue;
-        }
-        const Eigen::Array3i index = index_of(p);
-        lo = lo.min(index);
-        hi = hi.max(index);
-    }
-    stats.points_used = cloud.size() - stats.points_skipped;
+    Eigen::Array3i lo;
+    Eigen::Array3i hi;
     ws.blocks.clear();
-    if (stats.points_used == 0) return;
+    if (!VoxelBounds(cloud, inverse_voxel_size, max_coordinate_m, stats, lo, hi)) return;
     layout = KeyLayout(lo, hi);
-    // Pass 2: sort the points by voxel key and sum the moments of each run of equal keys. This
-    // does not depend on the order in which the scanner wrote its points (ring by ring or column
-    // by column), unlike a hash table whose lookups miss when consecutive points change voxel.
-    auto& keyed = ws.keyed_points;
-    keyed.clear();
-    for (std::size_t i = 0; i < cloud.size(); ++i) {
-        const Eigen::Vector3f& p = cloud[i];
-        if (!IsUsable(p, max_coordinate_m)) continue;
-        keyed.emplace_back(layout.Key(index_of(p)), static_cast<std::uint32_t>(i));
-    }
-    RadixSortByKey(keyed, layout.total_bits, ws.sort_scratch);
-    for (std::size_t i = 0; i < keyed.size();) {
-        KeyedMoments block{keyed[i].first, {}};
-        for (; i < keyed.size() && keyed[i].first == block.key; ++i) {
-            block.moments.Add(cloud[keyed[i].second].cast<double>());
-        }
-        ws.blocks.push_back(block);
+    const int index_bits = BitsFor(cloud.size());
+    if (layout.total_bits + index_bits <= 64) {
+        SortAndSumVoxels(cloud, inverse_voxel_size, max_coordinate_m, layout,
+                         PackedItems{index_bits}, ws.packed, ws.packed_scratch, ws);
+    } else {
+        SortAndSumVoxels(cloud, inverse_voxel_size, max_coordinate_m, layout, PairItems{}, ws.pairs,
+                         ws.pairs_scratch, ws);
     }
 }
 
-// Box sum of width 2 along one axis: out[k] = in[k] + in[k + step], for every k where either is
-// present. Both `in` and `in` shifted by -step are sorted, so one merge pass suffices.
-void PairSumAlongAxis(const std::vector<KeyedMoments>& in, std::uint64_t step,
-                      std::vector<KeyedMoments>& out) {
-    out.clear();
+// Box sum of width 2 along one axis: emit(k, in[k] + in[k + step]) for every k where either is
+// present, in key order. Both `in` and `in` shifted by -step are sorted, so one merge pass
+// suffices.
+template <typename Emit>
+void PairSumAlongAxis(const std::vector<KeyedMoments>& in, std::uint64_t step, Emit emit) {
     std::size_t a = 0;  // walks keys k = in[a].key   (the cell's own voxel)
     std::size_t b = 0;  // walks keys k = in[b].key - step (the cell's upper neighbour)
     while (a < in.size() || b < in.size()) {
         const std::uint64_t key_a = a < in.size() ? in[a].key : UINT64_MAX;
         const std::uint64_t key_b = b < in.size() ? in[b].key - step : UINT64_MAX;
         const std::uint64_t key = std::min(key_a, key_b);
-        KeyedMoments cell{key, {}};
-        if (key_a == key) cell.moments += in[a++].moments;
-        if (key_b == key) cell.moments += in[b++].moments;
-        out.push_back(cell);
+        Moments sum;
+        if (key_a == key) sum += in[a++].moments;
+        if (key_b == key) sum += in[b++].moments;
+        emit(key, sum);
     }
 }
 
-NdtCell CellFromMoments(const Moments& moments) {
-    const auto& m = moments.m;
-    const double n = m[0];
-    NdtCell cell;
-    cell.point_count = static_cast<int>(n);
-    cell.mean_m = Eigen::Vector3d(m[1], m[2], m[3]) / n;
-    Eigen::Matrix3d sum_outer;
-    sum_outer << m[4], m[5], m[6], m[5], m[7], m[8], m[6], m[8], m[9];
-    // Unbiased covariance from raw moments: (sum x x^T - n mean mean^T) / (n - 1).
-    cell.covariance_m2 = (sum_outer - n * cell.mean_m * cell.mean_m.transpose()) / (n - 1.0);
-    return cell;
-}
+// Unbiased covariance from raw moments: (sum x x^T - n mean mean^T) / (n - 1).
+struct MeanAndCovariance {
+    double n;
+    Eigen::Vector3d mean_m;
+    double xx, xy, xz, yy, yz, zz;
 
-}  // namespace
+    explicit MeanAndCovariance(const Moments& moments) {
+        const auto& m = moments.m;
+        n = m[0];
+        mean_m = Eigen::Vector3d(m[1], m[2], m[3]) / n;
+        const double inverse_dof = 1.0 / (n - 1.0);
+        xx = (m[4] - m[1] * mean_m.x()) * inverse_dof;
+        xy = (m[5] - m[1] * mean_m.y()) * inverse_dof;
+        xz = (m[6] - m[1] * mean_m.z()) * inverse_dof;
+        yy = (m[7] - m[2] * mean_m.y()) * inverse_dof;
+        yz = (m[8] - m[2] * mean_m.z()) * inverse_dof;
+        zz = (m[9] - m[3] * mean_m.z()) * inverse_dof;
+    }
+};
 
-std::vector<NdtCell> ComputeNdtCells(const PointCloud& cloud, double cell_size_m, int min_points,
-                                     NdtCellStats* stats) {
+// The grid of ComputeNdtCells; `sink(moments)` receives every cell with at least `min_points`
+// points, in key order.
+template <typename Sink>
+void ForEachCell(const PointCloud& cloud, double cell_size_m, int min_points, NdtCellStats* stats,
+                 Sink sink) {
     if (!(cell_size_m >= 0.01 && cell_size_m <= 100.0)) {
         throw ConfigError("ndt.cell_size_m must be in [0.01, 100] m, got " +
                           std::to_string(cell_size_m));
@@ -216,20 +293,72 @@ std::vector<NdtCell> ComputeNdtCells(const PointCloud& cloud, double cell_size_m
     KeyLayout layout(Eigen::Array3i::Zero(), Eigen::Array3i::Zero());
     Workspace& ws = ThreadWorkspace();
     BinIntoVoxels(cloud, cell_size_m / 2.0, s, layout, ws);
-    for (const std::uint64_t step : layout.step) {
-        PairSumAlongAxis(ws.blocks, step, ws.scratch);
+    for (int axis = 0; axis < 2; ++axis) {
+        ws.scratch.clear();
+        PairSumAlongAxis(ws.blocks, layout.step[axis], [&ws](std::uint64_t key, const Moments& m) {
+            ws.scratch.push_back({key, m});
+        });
         ws.blocks.swap(ws.scratch);
     }
-    std::vector<NdtCell> cells;
-    cells.reserve(ws.blocks.size());
-    for (const KeyedMoments& block : ws.blocks) {
-        if (block.moments.m[0] < static_cast<double>(min_points)) {
+    // The last pass hands the cells straight to the sink instead of storing them all.
+    const auto enough = static_cast<double>(min_points);
+    PairSumAlongAxis(ws.blocks, layout.step[2], [&](std::uint64_t, const Moments& m) {
+        if (m.m[0] < enough) {
             ++s.sparse_cells;
-            continue;
+        } else {
+            sink(m);
         }
-        cells.push_back(CellFromMoments(block.moments));
+    });
+}
+
+}  // namespace
+
+void NdtCellColumns::clear() {
+    for (auto* column : {&mean_x_m, &mean_y_m, &mean_z_m, &cov_xx_m2, &cov_xy_m2, &cov_xz_m2,
+                         &cov_yy_m2, &cov_yz_m2, &cov_zz_m2}) {
+        column->clear();
     }
+    point_count.clear();
+}
+
+NdtCell NdtCellColumns::Cell(std::size_t i) const {
+    NdtCell cell;
+    cell.point_count = point_count[i];
+    cell.mean_m = {mean_x_m[i], mean_y_m[i], mean_z_m[i]};
+    cell.covariance_m2 << cov_xx_m2[i], cov_xy_m2[i], cov_xz_m2[i], cov_xy_m2[i], cov_yy_m2[i],
+        cov_yz_m2[i], cov_xz_m2[i], cov_yz_m2[i], cov_zz_m2[i];
+    return cell;
+}
+
+std::vector<NdtCell> ComputeNdtCells(const PointCloud& cloud, double cell_size_m, int min_points,
+                                     NdtCellStats* stats) {
+    std::vector<NdtCell> cells;
+    ForEachCell(cloud, cell_size_m, min_points, stats, [&cells](const Moments& moments) {
+        const MeanAndCovariance c(moments);
+        NdtCell& cell = cells.emplace_back();
+        cell.point_count = static_cast<int>(c.n);
+        cell.mean_m = c.mean_m;
+        cell.covariance_m2 << c.xx, c.xy, c.xz, c.xy, c.yy, c.yz, c.xz, c.yz, c.zz;
+    });
     return cells;
+}
+
+void ComputeNdtCellColumns(const PointCloud& cloud, double cell_size_m, int min_points,
+                           NdtCellColumns& cells, NdtCellStats* stats) {
+    cells.clear();
+    ForEachCell(cloud, cell_size_m, min_points, stats, [&cells](const Moments& moments) {
+        const MeanAndCovariance c(moments);
+        cells.point_count.push_back(static_cast<int>(c.n));
+        cells.mean_x_m.push_back(c.mean_m.x());
+        cells.mean_y_m.push_back(c.mean_m.y());
+        cells.mean_z_m.push_back(c.mean_m.z());
+        cells.cov_xx_m2.push_back(c.xx);
+        cells.cov_xy_m2.push_back(c.xy);
+        cells.cov_xz_m2.push_back(c.xz);
+        cells.cov_yy_m2.push_back(c.yy);
+        cells.cov_yz_m2.push_back(c.yz);
+        cells.cov_zz_m2.push_back(c.zz);
+    });
 }
 
 }  // namespace lidarloop::core

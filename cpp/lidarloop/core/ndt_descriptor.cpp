@@ -8,7 +8,6 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
-#include "lidarloop/core/eigen3x3.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/core/sphere_partition.hpp"
 
@@ -79,24 +78,24 @@ int SphericalColumn(double l2_over_l1, const NdtConfig& config) {
 }
 
 // Puts one classified cell where it belongs: a fixed count, or the oriented list of its shape.
-void AddCell(const CellShapeInfo& info, int row, const NdtConfig& config,
-             const Partitions& partitions, ClassifiedCells& out) {
+void AddCell(CellShape shape, double l2_over_l1, const Eigen::Vector3d& axis, int row,
+             const NdtConfig& config, const Partitions& partitions, ClassifiedCells& out) {
     const int cols = config.FeatureCount();
     const auto count_fixed = [&](int column) {
         out.fixed_counts[static_cast<std::size_t>(row * cols + column)] += 1.0f;
     };
-    switch (info.shape) {
+    switch (shape) {
         case CellShape::kSpherical:
-            if (config.spherical_classes > 0) count_fixed(SphericalColumn(info.l2_over_l1, config));
+            if (config.spherical_classes > 0) count_fixed(SphericalColumn(l2_over_l1, config));
             break;
         case CellShape::kPlanar:
-            out.planar.Add(info.axis, row);  // its axes steer the rotation even when p = 1
+            out.planar.Add(axis, row);  // its axes steer the rotation even when p = 1
             if (partitions.planar && partitions.planar->size() == 1) {
                 count_fixed(config.spherical_classes);
             }
             break;
         case CellShape::kLinear:
-            out.linear.Add(info.axis, row);
+            out.linear.Add(axis, row);
             if (partitions.linear && partitions.linear->size() == 1) {
                 count_fixed(config.spherical_classes + config.planar_classes);
             }
@@ -106,21 +105,40 @@ void AddCell(const CellShapeInfo& info, int row, const NdtConfig& config,
     }
 }
 
-ClassifiedCells ClassifyCells(const std::vector<NdtCell>& cells, const NdtConfig& config,
-                              const Partitions& partitions) {
+// Scratch memory reused by later scans on the same thread (see ComputeNdtCells: fresh buffers
+// of this size cost more in page faults than the arithmetic on them).
+struct CellWorkspace {
+    NdtCellColumns cells;
+    CellShapeColumns shapes;
+};
+
+CellWorkspace& ThreadCellWorkspace() {
+    thread_local CellWorkspace workspace;
+    return workspace;
+}
+
+// The NDT cells of `cloud`, classified (section II-B) and sorted into ClassifiedCells.
+ClassifiedCells DescribeCells(const PointCloud& cloud, const NdtConfig& config,
+                              const Partitions& partitions, NdtCellStats* stats) {
+    CellWorkspace& ws = ThreadCellWorkspace();
+    ComputeNdtCellColumns(cloud, config.cell_size_m, config.min_points_per_cell, ws.cells, stats);
+    ClassifyCells(ws.cells, config.eigen_ratio_threshold, ws.shapes);
     ClassifiedCells out;
     out.fixed_counts.assign(static_cast<std::size_t>(config.RangeCount() * config.FeatureCount()),
                             0.0f);
     const std::vector<double> squared_limits_m2 = SquaredLimits(config.range_limits_m);
-    for (const NdtCell& cell : cells) {
-        const CellShapeInfo info =
-            ClassifyCovariance(cell.covariance_m2, config.eigen_ratio_threshold);
-        if (info.shape == CellShape::kDegenerate) {
+    const NdtCellColumns& cells = ws.cells;
+    const CellShapeColumns& shapes = ws.shapes;
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+        if (shapes.shape[i] == CellShape::kDegenerate) {
             ++out.degenerate;
             continue;
         }
-        out.mean_sum_m += cell.mean_m;
-        AddCell(info, RangeRow(cell.mean_m, squared_limits_m2), config, partitions, out);
+        const Eigen::Vector3d mean_m(cells.mean_x_m[i], cells.mean_y_m[i], cells.mean_z_m[i]);
+        out.mean_sum_m += mean_m;
+        AddCell(shapes.shape[i], shapes.l2_over_l1[i],
+                {shapes.axis_x[i], shapes.axis_y[i], shapes.axis_z[i]},
+                RangeRow(mean_m, squared_limits_m2), config, partitions, out);
     }
     return out;
 }
@@ -330,42 +348,17 @@ PointCloud Rotated(const PointCloud& cloud, const Eigen::Matrix3d& R) {
 
 }  // namespace
 
-CellShapeInfo ClassifyCovariance(const Eigen::Matrix3d& covariance_m2, double t_e) {
-    CellShapeInfo info;
-    if (!covariance_m2.allFinite()) return info;
-    // Eigenvalues first; only the one eigenvector the shape needs is computed (the hot loop).
-    const Eigen::Vector3d lambda = SymmetricEigenvaluesDescending(covariance_m2).cwiseMax(0.0);
-    const double l1 = lambda[0];
-    const double l2 = lambda[1];
-    const double l3 = lambda[2];
-    if (!(l1 > 1e-12 * std::max(1.0, covariance_m2.trace()))) return info;  // no spread
-    info.l2_over_l1 = l2 / l1;
-    if (l2 / l1 < t_e) {
-        info.shape = CellShape::kLinear;
-        info.axis = SymmetricEigenvector(covariance_m2, lambda[0]);
-    } else if (l3 / l2 < t_e) {
-        info.shape = CellShape::kPlanar;
-        info.axis = SymmetricEigenvector(covariance_m2, lambda[2]);
-    } else {
-        info.shape = CellShape::kSpherical;
-    }
-    return info;
-}
-
 NdtDescriptorSet ComputeNdtDescriptorSet(const PointCloud& cloud, const NdtConfig& config) {
     config.Validate();
     NdtDescriptorSet set;
     const Partitions partitions = MakePartitions(config);
     LineScratch scratch;
-    const ClassifiedCells cells = ClassifyCells(
-        ComputeNdtCells(cloud, config.cell_size_m, config.min_points_per_cell, &set.cell_stats),
-        config, partitions);
+    const ClassifiedCells cells = DescribeCells(cloud, config, partitions, &set.cell_stats);
     set.degenerate_cells = cells.degenerate;
     for (const Eigen::Matrix3d& R : CandidateRotations(cells, config, partitions, scratch)) {
         if (config.regrid_rotations && !R.isIdentity()) {
-            const ClassifiedCells regridded = ClassifyCells(
-                ComputeNdtCells(Rotated(cloud, R), config.cell_size_m, config.min_points_per_cell),
-                config, partitions);
+            const ClassifiedCells regridded =
+                DescribeCells(Rotated(cloud, R), config, partitions, nullptr);
             NdtDescriptor f =
                 CountFeatures(regridded, Eigen::Matrix3d::Identity(), config, partitions, scratch);
             f.R_aligned_sensor = R;

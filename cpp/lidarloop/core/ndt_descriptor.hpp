@@ -7,24 +7,10 @@
 
 #include "lidarloop/core/ndt_cells.hpp"
 #include "lidarloop/core/ndt_config.hpp"
+#include "lidarloop/core/ndt_shape.hpp"
 #include "lidarloop/core/point_cloud.hpp"
 
 namespace lidarloop::core {
-
-/// Shape classes of an NDT cell (Magnusson II-B).
-enum class CellShape { kSpherical, kPlanar, kLinear, kDegenerate };
-
-/// The shape of one covariance and the axis that carries its orientation.
-struct CellShapeInfo {
-    CellShape shape = CellShape::kDegenerate;
-    Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  ///< planar: normal e3; linear: e1
-    double l2_over_l1 = 0.0;                          ///< for spherical sub-classes
-};
-
-/// Classifies a covariance by its sorted eigenvalues l1 >= l2 >= l3: linear if l2/l1 < t_e,
-/// planar if not linear and l3/l2 < t_e, spherical otherwise. A covariance with l1 ~ 0 (all
-/// points equal) or a non-finite entry is kDegenerate. Uses Eigen's closed-form 3x3 solver.
-CellShapeInfo ClassifyCovariance(const Eigen::Matrix3d& covariance_m2, double t_e);
 
 /// One appearance descriptor F (eq. 3): rows = range intervals, columns = the feature vector f
 /// of eq. (1) (s spherical, p planar, l linear classes), entries = cell counts.
