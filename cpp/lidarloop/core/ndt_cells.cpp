@@ -20,7 +20,9 @@ constexpr double kMaxCoordinate_m = 100'000.0;
 constexpr double kMaxVoxelIndex = static_cast<double>((1 << 20) - 4);
 
 // Count, first and (upper-triangle) second raw moments of the points of a voxel or cell, in
-// absolute coordinates: double keeps the covariance exact to ~1e-12 m^2 even 100 km away.
+// sensor coordinates. The covariance then loses digits to cancellation with distance from the
+// sensor (measured: errors of 5e-9 m^2 at 1 km, 3e-7 m^2 at 10 km): negligible within a
+// LiDAR's range, where a 1 cm thick plane has variances of 1e-4 m^2.
 struct Moments {
     std::array<double, 10> m{};  // n, sx, sy, sz, sxx, sxy, sxz, syy, syz, szz
 
@@ -187,19 +189,26 @@ bool VoxelBounds(const PointCloud& cloud, double inverse_voxel_size, float max_c
 // change voxel.
 template <typename Codec, typename Item>
 void SortAndSumVoxels(const PointCloud& cloud, double inverse_voxel_size, float max_coordinate_m,
-                      const KeyLayout& layout, const Codec& codec, std::vector<Item>& items,
-                      std::vector<Item>& scratch, Workspace& ws) {
-    items.clear();
+                      const KeyLayout& layout, std::size_t points_used, const Codec& codec,
+                      std::vector<Item>& items, std::vector<Item>& scratch, Workspace& ws) {
+    // Every point gets an item, without a branch: unusable points (NaN, too far) get the largest
+    // key, which no voxel has (each field of a voxel key is at most 2^bits - 2), so they sort to
+    // the end and are cut off there.
+    const std::uint64_t unusable_key = (std::uint64_t{1} << layout.total_bits) - 1;
+    items.resize(cloud.size());
     for (std::size_t i = 0; i < cloud.size(); ++i) {
         const Eigen::Vector3f& p = cloud[i];
-        if (!IsUsable(p, max_coordinate_m)) continue;
-        const Eigen::Array3i index(FloorToInt(p.x() * inverse_voxel_size),
-                                   FloorToInt(p.y() * inverse_voxel_size),
-                                   FloorToInt(p.z() * inverse_voxel_size));
-        items.push_back(codec.Make(layout.Key(index), static_cast<std::uint32_t>(i)));
+        const bool usable = IsUsable(p, max_coordinate_m);
+        const Eigen::Vector3f q = usable ? p : Eigen::Vector3f::Zero();  // no NaN to convert
+        const Eigen::Array3i index(FloorToInt(q.x() * inverse_voxel_size),
+                                   FloorToInt(q.y() * inverse_voxel_size),
+                                   FloorToInt(q.z() * inverse_voxel_size));
+        items[i] =
+            codec.Make(usable ? layout.Key(index) : unusable_key, static_cast<std::uint32_t>(i));
     }
     RadixSort(items, layout.total_bits, scratch, ws.digit_counts,
               [&codec](const Item& item) { return codec.Key(item); });
+    items.resize(points_used);
     ws.blocks.clear();
     for (std::size_t i = 0; i < items.size();) {
         KeyedMoments block{codec.Key(items[i]), {}};
@@ -224,11 +233,11 @@ void BinIntoVoxels(const PointCloud& cloud, double voxel_size_m, NdtCellStats& s
     layout = KeyLayout(lo, hi);
     const int index_bits = BitsFor(cloud.size());
     if (layout.total_bits + index_bits <= 64) {
-        SortAndSumVoxels(cloud, inverse_voxel_size, max_coordinate_m, layout,
+        SortAndSumVoxels(cloud, inverse_voxel_size, max_coordinate_m, layout, stats.points_used,
                          PackedItems{index_bits}, ws.packed, ws.packed_scratch, ws);
     } else {
-        SortAndSumVoxels(cloud, inverse_voxel_size, max_coordinate_m, layout, PairItems{}, ws.pairs,
-                         ws.pairs_scratch, ws);
+        SortAndSumVoxels(cloud, inverse_voxel_size, max_coordinate_m, layout, stats.points_used,
+                         PairItems{}, ws.pairs, ws.pairs_scratch, ws);
     }
 }
 
