@@ -18,12 +18,19 @@ struct NdtConfig {
     /// Borders of the range intervals R, metres from the sensor to the cell mean; the paper's
     /// {[0,3), [3,6), [6,9), [9,15), [15,inf)}.
     std::vector<double> range_limits_m = {3.0, 6.0, 9.0, 15.0};
-    bool normalise_rotation = true;  ///< section II-C; false gives one unrotated descriptor
-    double ambiguity_ratio = 0.60;   ///< t_a, peaks >= t_a * the highest are ambiguous
+    /// Section II-C: align the scan by the peaks of its planar orientation classes (and, for a
+    /// second direction, of its linear classes when l > 1); a second direction within 20 degrees
+    /// of the first sets no yaw. The planar classes steer it, so with p = 0 there is nothing to
+    /// align by and the descriptor is unrotated, whatever l is. false gives one unrotated
+    /// descriptor.
+    bool normalise_rotation = true;
+    double ambiguity_ratio = 0.60;  ///< t_a, peaks >= t_a * the highest are ambiguous
     /// true: align a peak class by the mean line of its cells' normals (principal axis of their
-    /// scatter), which makes the normalisation rotation invariant up to the grid. false: align
-    /// by the class's partition line P_i as the paper writes; the alignment is then quantised to
-    /// the partition (~40 degrees for p = 9) and a rotated scan can get a different descriptor.
+    /// scatter), which makes the normalisation rotation invariant up to the grid; peaks of Z (or
+    /// of Y) whose mean lines are within 20 degrees are one surface split by a class border and
+    /// are merged. false: align by the class's partition line P_i as the paper writes; the
+    /// alignment is then quantised to the partition (~40 degrees for p = 9) and a rotated scan
+    /// can get a different descriptor.
     bool align_to_mean_direction = true;
     /// false: rotate each cell's axes (the grid turns with the scan; exact rotation invariance,
     /// one grid per scan). true: rotate the points and build a new axis-aligned grid per rotation,

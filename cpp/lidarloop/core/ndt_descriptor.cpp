@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <numbers>
 #include <optional>
 #include <string>
 
@@ -20,6 +22,18 @@ namespace {
 // against the centroid of the cell means, a choice that turns with the scan; when the line is
 // too close to perpendicular to the centroid for the sign to be stable, both signs are kept.
 constexpr double kSignAmbiguity = 0.1;  // |cos| of the angle between line and centroid
+// The centroid of a scan that surrounds the sensor evenly (a room seen from its middle) is a
+// small leftover of sampling and grid noise, and so is its direction: below this fraction of the
+// cells' mean range it is ignored, and every line keeps both signs.
+constexpr double kShortCentroid = 0.1;
+
+// The smallest angle between the first direction and a second one. After R_z, a second direction
+// nearly parallel to the first is nearly the z axis, and its azimuth, which sets the yaw R_y, is
+// then noise or the mark of where a partition border cut a plane, not the scan's structure. Peaks
+// of one set closer than this are one surface split by a border, and are merged. 20 degrees is
+// far above the spread between the mean normals of such halves (a degree or two) and about half
+// the smallest angle between two lines of the paper's partition (38 degrees for p = 9).
+constexpr double kMinLineAngleRad = 20.0 * std::numbers::pi / 180.0;
 
 // The orientation partitions of the planar and linear classes (absent when a count is 0).
 struct Partitions {
@@ -52,7 +66,11 @@ struct ClassifiedCells {
     OrientedCells planar;
     OrientedCells linear;
     Eigen::Vector3d mean_sum_m = Eigen::Vector3d::Zero();  // of all classified cells' means
+    double range_sum_m = 0.0;                              // of their distances to the sensor
+    std::size_t spherical = 0;
     std::size_t degenerate = 0;
+
+    std::size_t classified() const { return spherical + planar.size() + linear.size(); }
 };
 
 // The squared borders of the range intervals, so that rows are found without a square root.
@@ -86,6 +104,7 @@ void AddCell(CellShape shape, double l2_over_l1, const Eigen::Vector3d& axis, in
     };
     switch (shape) {
         case CellShape::kSpherical:
+            ++out.spherical;
             if (config.spherical_classes > 0) count_fixed(SphericalColumn(l2_over_l1, config));
             break;
         case CellShape::kPlanar:
@@ -136,6 +155,7 @@ ClassifiedCells DescribeCells(const PointCloud& cloud, const NdtConfig& config,
         }
         const Eigen::Vector3d mean_m(cells.mean_x_m[i], cells.mean_y_m[i], cells.mean_z_m[i]);
         out.mean_sum_m += mean_m;
+        out.range_sum_m += mean_m.norm();
         AddCell(shapes.shape[i], shapes.l2_over_l1[i],
                 {shapes.axis_x[i], shapes.axis_y[i], shapes.axis_z[i]},
                 RangeRow(mean_m, squared_limits_m2), config, partitions, out);
@@ -209,8 +229,9 @@ NdtDescriptor CountFeatures(const ClassifiedCells& cells, const Eigen::Matrix3d&
     return f;
 }
 
-// Z and Y of eq. (4)-(7) over a histogram of line directions. Y needs a non-zero second peak:
-// with only zeros left, "p_i >= t_a * 0" would make every empty class ambiguous.
+// Z and Y of eq. (4)-(7) over a histogram of line directions. Both need classes with cells: for
+// t_a = 0 (Z) or a zero second peak (Y), "p_i >= t_a * peak" would hold for every empty class,
+// which has no direction to align.
 void AmbiguousPeaks(const std::vector<double>& histogram, double t_a, std::vector<int>& z,
                     std::vector<int>& y) {
     z.clear();
@@ -218,7 +239,7 @@ void AmbiguousPeaks(const std::vector<double>& histogram, double t_a, std::vecto
     const double first = *std::max_element(histogram.begin(), histogram.end());
     if (first <= 0.0) return;
     for (int i = 0; i < static_cast<int>(histogram.size()); ++i) {
-        if (histogram[i] >= t_a * first) z.push_back(i);
+        if (histogram[i] > 0.0 && histogram[i] >= t_a * first) z.push_back(i);
     }
     double second = 0.0;
     for (int i = 0; i < static_cast<int>(histogram.size()); ++i) {
@@ -226,7 +247,8 @@ void AmbiguousPeaks(const std::vector<double>& histogram, double t_a, std::vecto
     }
     if (second <= 0.0) return;
     for (int i = 0; i < static_cast<int>(histogram.size()); ++i) {
-        if (std::find(z.begin(), z.end(), i) == z.end() && histogram[i] >= t_a * second) {
+        const bool in_z = std::find(z.begin(), z.end(), i) != z.end();
+        if (!in_z && histogram[i] > 0.0 && histogram[i] >= t_a * second) {
             y.push_back(i);
         }
     }
@@ -238,40 +260,98 @@ Eigen::Matrix3d AlignToZ(const Eigen::Vector3d& line) {
 }
 
 // R_y of section II-C: a rotation about z that brings `v` (already rotated by R_z) into the
-// yz plane, on the +y side. nullopt when v is (nearly) the z axis and sets no direction.
-std::optional<Eigen::Matrix3d> AlignToYz(const Eigen::Vector3d& v) {
-    if (std::hypot(v.x(), v.y()) < 1e-9) return std::nullopt;
+// yz plane, on the +y side. `v` must be far from the z axis (see SetsAYaw).
+Eigen::Matrix3d AlignToYz(const Eigen::Vector3d& v) {
     return Eigen::AngleAxisd(std::atan2(v.x(), v.y()), Eigen::Vector3d::UnitZ()).toRotationMatrix();
 }
 
-// The orientation classes of the planar (or linear) cells: how many cells each holds, and the
-// direction a peak in it stands for: the principal axis of its cells' axes (their mean line) or,
-// as the paper writes, the class's partition line P_i.
+// Whether the line `second` is far enough from the line `first` for R_y to follow it.
+bool SetsAYaw(const Eigen::Vector3d& first, const Eigen::Vector3d& second) {
+    return std::abs(first.dot(second)) < std::cos(kMinLineAngleRad);
+}
+
+// The orientation classes of the planar (or linear) cells: how many cells each holds, the sum of
+// a a^T over their axes a, and the direction a peak in it stands for: the principal axis of that
+// scatter (the mean line of its cells' axes) or, as the paper writes, the class's line P_i.
 struct LineClasses {
     std::vector<double> counts;
+    std::vector<Eigen::Matrix3d> scatter;
     std::vector<Eigen::Vector3d> directions;
 };
+
+Eigen::Vector3d PrincipalAxis(const Eigen::Matrix3d& scatter) {
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+    solver.computeDirect(scatter);
+    return solver.eigenvectors().col(2).normalized();
+}
 
 LineClasses SummariseLines(const OrientedCells& cells, const HalfSpherePartition& partition,
                            bool mean_direction, LineScratch& scratch) {
     const auto n = static_cast<std::size_t>(partition.size());
-    LineClasses classes{std::vector<double>(n, 0.0), partition.centres()};
-    std::vector<Eigen::Matrix3d> scatter(n, Eigen::Matrix3d::Zero());
+    LineClasses classes{std::vector<double>(n, 0.0),
+                        std::vector<Eigen::Matrix3d>(n, Eigen::Matrix3d::Zero()),
+                        partition.centres()};
     NearestLines(cells, partition, Eigen::Matrix3d::Identity(), scratch.best_dot, scratch.nearest);
     for (std::size_t i = 0; i < cells.size(); ++i) {
         const auto j = static_cast<std::size_t>(scratch.nearest[i]);
         const Eigen::Vector3d axis = cells.Axis(i);
         classes.counts[j] += 1.0;
-        scatter[j].noalias() += axis * axis.transpose();
+        classes.scatter[j].noalias() += axis * axis.transpose();
     }
     if (!mean_direction) return classes;
     for (std::size_t j = 0; j < n; ++j) {
-        if (classes.counts[j] <= 0.0) continue;
-        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-        solver.computeDirect(scatter[j]);
-        classes.directions[j] = solver.eigenvectors().col(2).normalized();
+        if (classes.counts[j] > 0.0) classes.directions[j] = PrincipalAxis(classes.scatter[j]);
     }
     return classes;
+}
+
+// The directions of the peaks `indices` of one set (Z or Y). With mean directions, a peak within
+// kMinLineAngleRad of a stronger one of the set is merged into it (their scatters added): it is
+// the same surface, split between two classes by a partition border. Partition lines are
+// distinct by design and are kept as they are.
+std::vector<Eigen::Vector3d> PeakDirections(const LineClasses& classes, std::vector<int> indices,
+                                            bool mean_direction) {
+    std::vector<Eigen::Vector3d> lines;
+    if (!mean_direction) {
+        for (int j : indices) lines.push_back(classes.directions[static_cast<std::size_t>(j)]);
+        return lines;
+    }
+    std::stable_sort(indices.begin(), indices.end(), [&](int a, int b) {
+        return classes.counts[static_cast<std::size_t>(a)] >
+               classes.counts[static_cast<std::size_t>(b)];
+    });
+    std::vector<Eigen::Matrix3d> scatters;
+    for (int j : indices) {
+        const auto k = static_cast<std::size_t>(j);
+        const auto same = std::find_if(lines.begin(), lines.end(), [&](const Eigen::Vector3d& l) {
+            return !SetsAYaw(l, classes.directions[k]);
+        });
+        if (same == lines.end()) {
+            lines.push_back(classes.directions[k]);
+            scatters.push_back(classes.scatter[k]);
+            continue;
+        }
+        Eigen::Matrix3d& merged = scatters[static_cast<std::size_t>(same - lines.begin())];
+        merged += classes.scatter[k];
+        *same = PrincipalAxis(merged);
+    }
+    return lines;
+}
+
+// The lines of Z and Y (eq. 4-7) of the planar or linear cells.
+struct PeakLines {
+    std::vector<Eigen::Vector3d> z;
+    std::vector<Eigen::Vector3d> y;
+};
+
+PeakLines FindPeakLines(const OrientedCells& cells, const HalfSpherePartition& partition,
+                        const NdtConfig& config, LineScratch& scratch) {
+    const bool mean = config.align_to_mean_direction;
+    const LineClasses classes = SummariseLines(cells, partition, mean, scratch);
+    std::vector<int> z;
+    std::vector<int> y;
+    AmbiguousPeaks(classes.counts, config.ambiguity_ratio, z, y);
+    return {PeakDirections(classes, z, mean), PeakDirections(classes, y, mean)};
 }
 
 // The signed unit vectors of `line` to align: the one pointing against `centroid`, or both.
@@ -282,51 +362,67 @@ std::vector<Eigen::Vector3d> SignedVariants(const Eigen::Vector3d& line,
     return {cosine > 0.0 ? Eigen::Vector3d(-line) : line};
 }
 
+// The direction SignedVariants orients lines against: the centroid of the cell means, or zero
+// (both signs kept) when it is too short to have a meaningful direction (see kShortCentroid).
+Eigen::Vector3d SignReference(const ClassifiedCells& cells) {
+    const double norm = cells.mean_sum_m.norm();
+    if (norm <= 0.0 || norm < kShortCentroid * cells.range_sum_m) return Eigen::Vector3d::Zero();
+    return cells.mean_sum_m / norm;
+}
+
+// Appends R_y R_z for every signed variant of every line of `seconds` that sets a yaw with
+// `first`; returns how many it appended.
+std::size_t AddYawRotations(const Eigen::Matrix3d& R_z, const Eigen::Vector3d& first,
+                            const std::vector<Eigen::Vector3d>& seconds,
+                            const Eigen::Vector3d& centroid,
+                            std::vector<Eigen::Matrix3d>& rotations) {
+    std::size_t added = 0;
+    for (const Eigen::Vector3d& line : seconds) {
+        if (!SetsAYaw(first, line)) continue;
+        for (const Eigen::Vector3d& second : SignedVariants(line, centroid)) {
+            rotations.push_back(AlignToYz(R_z * second) * R_z);
+            ++added;
+        }
+    }
+    return added;
+}
+
+// The lines of the linear peaks Z, the paper's fallback for a second direction; none when there
+// is no linear partition or it has one line, which carries no direction.
+std::vector<Eigen::Vector3d> LinearPeakLines(const ClassifiedCells& cells, const NdtConfig& config,
+                                             const Partitions& partitions, LineScratch& scratch) {
+    if (!partitions.linear || partitions.linear->size() == 1) return {};
+    return FindPeakLines(cells.linear, *partitions.linear, config, scratch).z;
+}
+
 // The rotations R_y R_z of section II-C, one per combination of an entry of Z with another
-// entry of Z or Y; R_z alone when no second direction exists; identity without planar cells.
+// entry of Z or Y that sets a yaw; failing those, as the paper allows, with a linear peak; R_z
+// alone when no second direction exists; identity without planar cells.
 std::vector<Eigen::Matrix3d> CandidateRotations(const ClassifiedCells& cells,
                                                 const NdtConfig& config,
                                                 const Partitions& partitions,
                                                 LineScratch& scratch) {
     if (!config.normalise_rotation || !partitions.planar) return {Eigen::Matrix3d::Identity()};
-    const bool mean = config.align_to_mean_direction;
-    const LineClasses planes = SummariseLines(cells.planar, *partitions.planar, mean, scratch);
-    std::vector<int> z;
-    std::vector<int> y;
-    AmbiguousPeaks(planes.counts, config.ambiguity_ratio, z, y);
-    if (z.empty()) return {Eigen::Matrix3d::Identity()};
-    // Second directions: the other planar peaks; else, as the paper allows, linear peaks.
-    std::vector<Eigen::Vector3d> seconds;
-    for (int j : y) seconds.push_back(planes.directions[j]);
-    if (z.size() + y.size() < 2 && partitions.linear && partitions.linear->size() > 1) {
-        const LineClasses lines = SummariseLines(cells.linear, *partitions.linear, mean, scratch);
-        std::vector<int> lz;
-        std::vector<int> ly;
-        AmbiguousPeaks(lines.counts, config.ambiguity_ratio, lz, ly);
-        for (int j : lz) seconds.push_back(lines.directions[j]);
-    }
-    const double centroid_norm = cells.mean_sum_m.norm();
-    const Eigen::Vector3d centroid = centroid_norm > 0.0
-                                         ? Eigen::Vector3d(cells.mean_sum_m / centroid_norm)
-                                         : Eigen::Vector3d::Zero();
+    const PeakLines planes = FindPeakLines(cells.planar, *partitions.planar, config, scratch);
+    if (planes.z.empty()) return {Eigen::Matrix3d::Identity()};
+    std::optional<std::vector<Eigen::Vector3d>> lines;  // found only when needed
+    const auto linear_peaks = [&]() -> const std::vector<Eigen::Vector3d>& {
+        if (!lines) lines = LinearPeakLines(cells, config, partitions, scratch);
+        return *lines;
+    };
+    const Eigen::Vector3d centroid = SignReference(cells);
     std::vector<Eigen::Matrix3d> rotations;
-    for (int i : z) {
-        for (const Eigen::Vector3d& first : SignedVariants(planes.directions[i], centroid)) {
+    for (std::size_t i = 0; i < planes.z.size(); ++i) {
+        std::vector<Eigen::Vector3d> seconds;
+        for (std::size_t j = 0; j < planes.z.size(); ++j) {
+            if (j != i) seconds.push_back(planes.z[j]);
+        }
+        seconds.insert(seconds.end(), planes.y.begin(), planes.y.end());
+        for (const Eigen::Vector3d& first : SignedVariants(planes.z[i], centroid)) {
             const Eigen::Matrix3d R_z = AlignToZ(first);
-            std::size_t added = 0;
-            const auto add_second = [&](const Eigen::Vector3d& line) {
-                for (const Eigen::Vector3d& second : SignedVariants(line, centroid)) {
-                    if (const auto R_y = AlignToYz(R_z * second)) {
-                        rotations.push_back(*R_y * R_z);
-                        ++added;
-                    }
-                }
-            };
-            for (int j : z) {
-                if (j != i) add_second(planes.directions[j]);
-            }
-            for (const Eigen::Vector3d& second : seconds) add_second(second);
-            if (added == 0) rotations.push_back(R_z);
+            if (AddYawRotations(R_z, first, seconds, centroid, rotations) > 0) continue;
+            if (AddYawRotations(R_z, first, linear_peaks(), centroid, rotations) > 0) continue;
+            rotations.push_back(R_z);
         }
     }
     return rotations;
@@ -344,6 +440,31 @@ PointCloud Rotated(const PointCloud& cloud, const Eigen::Matrix3d& R) {
     PointCloud rotated(cloud.size());
     for (std::size_t i = 0; i < cloud.size(); ++i) rotated[i] = Rf * cloud[i];
     return rotated;
+}
+
+// Why a descriptor counted no cell: none had enough points, all were degenerate, or their
+// classes are switched off. The first two keep the words "could be classified" that callers
+// (and the CLI's tests) know.
+std::string NothingCountedMessage(const ClassifiedCells& cells, const NdtCellStats& stats,
+                                  const NdtConfig& config) {
+    const auto text = [](auto number) { return std::to_string(number); };
+    const std::string minimum = text(config.min_points_per_cell);
+    if (cells.classified() + cells.degenerate == 0) {
+        return "no NDT cell could be classified: none had at least " + minimum + " points (" +
+               text(stats.points_used) + " usable points, " + text(stats.sparse_cells) +
+               " cells with fewer than " + minimum + " points)";
+    }
+    if (cells.classified() == 0) {
+        return "no NDT cell could be classified: all " + text(cells.degenerate) +
+               " cells were degenerate (all their points coincide, or their covariance is not "
+               "finite)";
+    }
+    return "no NDT cell was counted: " + text(cells.classified()) + " cells were classified (" +
+           text(cells.spherical) + " spherical, " + text(cells.planar.size()) + " planar, " +
+           text(cells.linear.size()) +
+           " linear), but the classes of those shapes are all disabled (s = " +
+           text(config.spherical_classes) + ", p = " + text(config.planar_classes) +
+           ", l = " + text(config.linear_classes) + ")";
 }
 
 }  // namespace
@@ -368,10 +489,7 @@ NdtDescriptorSet ComputeNdtDescriptorSet(const PointCloud& cloud, const NdtConfi
         }
     }
     if (set.descriptors.front().total <= 0.0) {
-        throw EmptyInputError(
-            "no NDT cell could be classified (" + std::to_string(set.cell_stats.points_used) +
-            " usable points, " + std::to_string(set.cell_stats.sparse_cells) +
-            " cells with fewer than " + std::to_string(config.min_points_per_cell) + " points)");
+        throw EmptyInputError(NothingCountedMessage(cells, set.cell_stats, config));
     }
     return set;
 }
@@ -392,6 +510,7 @@ double NdtDifference(const NdtDescriptor& f, const NdtDescriptor& g) {
     }
     const double larger = std::max(f.total, g.total);
     const double smaller = std::min(f.total, g.total);
+    if (larger <= 0.0) return 0.0;  // two empty descriptors are equal
     return smaller > 0.0 ? sum * larger / smaller : std::numeric_limits<double>::infinity();
 }
 

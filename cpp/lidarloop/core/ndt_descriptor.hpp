@@ -30,13 +30,16 @@ struct NdtDescriptorSet {
     std::size_t degenerate_cells = 0;
 };
 
-/// Builds the descriptor set of `cloud`. Throws EmptyInputError when no cell can be classified
-/// (too few points), ConfigError for an invalid config. Thread-safe.
+/// Builds the descriptor set of `cloud`. Throws EmptyInputError when no cell is counted, with a
+/// message saying why: no cell had enough points, all cells were degenerate, or the classes of
+/// the classified cells are disabled (s, p or l = 0). ConfigError for an invalid config.
+/// Thread-safe.
 NdtDescriptorSet ComputeNdtDescriptorSet(const PointCloud& cloud, const NdtConfig& config);
 
 /// sigma of eq. (8): sum over range intervals of the Euclidean distance between the rows of the
-/// 1-norm-normalised descriptors, times max(|F|,|G|)/min(|F|,|G|). Symmetric, 0 for equal input.
-/// The descriptors must have the same shape (ConfigError otherwise).
+/// 1-norm-normalised descriptors, times max(|F|,|G|)/min(|F|,|G|). Symmetric, 0 for equal input
+/// (two empty descriptors included), infinity when exactly one is empty. The descriptors must
+/// have the same shape (ConfigError otherwise).
 double NdtDifference(const NdtDescriptor& f, const NdtDescriptor& g);
 
 /// sigma' of eq. (9): the smallest sigma over all pairs of the two sets.
