@@ -41,6 +41,21 @@ constexpr double Code(CellShape shape) { return static_cast<double>(static_cast<
 
 constexpr double Select(bool condition, double a, double b) { return condition ? a : b; }
 
+// The cross product of two rows of (A - lambda I) with the largest norm seen so far: rows 0 x 1,
+// then 0 x 2, then 1 x 2; a later one replaces it only when strictly larger.
+struct CrossProduct {
+    double x, y, z;
+    double norm2 = x * x + y * y + z * z;
+
+    LIDARLOOP_ALWAYS_INLINE void KeepLarger(const CrossProduct& other) {
+        const bool larger = other.norm2 > norm2;
+        x = Select(larger, other.x, x);
+        y = Select(larger, other.y, y);
+        z = Select(larger, other.z, z);
+        norm2 = Select(larger, other.norm2, norm2);
+    }
+};
+
 // Every branch is a select on one comparison of doubles (GCC 12 does not vectorise selects on
 // combined bools), so the caller's loop vectorises; it must be inlined there (into each target
 // clone) for that. Ratios of a rejected test are set to 2, above any t_e in (0, 1).
@@ -83,26 +98,13 @@ LIDARLOOP_ALWAYS_INLINE ShapeResult ClassifyUpperTriangle(double a00, double a01
     const double r00 = a00 - lambda;
     const double r11 = a11 - lambda;
     const double r22 = a22 - lambda;
-    double ax = a01 * a12 - a02 * r11;  // row0 x row1
-    double ay = a02 * a01 - r00 * a12;
-    double az = r00 * r11 - a01 * a01;
-    double best_norm2 = ax * ax + ay * ay + az * az;
-    const double c02x = a01 * r22 - a02 * a12;  // row0 x row2
-    const double c02y = a02 * a02 - r00 * r22;
-    const double c02z = r00 * a12 - a01 * a02;
-    const double n02 = c02x * c02x + c02y * c02y + c02z * c02z;
-    ax = Select(n02 > best_norm2, c02x, ax);
-    ay = Select(n02 > best_norm2, c02y, ay);
-    az = Select(n02 > best_norm2, c02z, az);
-    best_norm2 = Select(n02 > best_norm2, n02, best_norm2);
-    const double c12x = r11 * r22 - a12 * a12;  // row1 x row2
-    const double c12y = a12 * a02 - a01 * r22;
-    const double c12z = a01 * a12 - r11 * a02;
-    const double n12 = c12x * c12x + c12y * c12y + c12z * c12z;
-    ax = Select(n12 > best_norm2, c12x, ax);
-    ay = Select(n12 > best_norm2, c12y, ay);
-    az = Select(n12 > best_norm2, c12z, az);
-    best_norm2 = Select(n12 > best_norm2, n12, best_norm2);
+    CrossProduct best{a01 * a12 - a02 * r11, a02 * a01 - r00 * a12, r00 * r11 - a01 * a01};
+    best.KeepLarger({a01 * r22 - a02 * a12, a02 * a02 - r00 * r22, r00 * a12 - a01 * a02});
+    best.KeepLarger({r11 * r22 - a12 * a12, a12 * a02 - a01 * r22, a01 * a12 - r11 * a02});
+    const double ax = best.x;
+    const double ay = best.y;
+    const double az = best.z;
+    const double best_norm2 = best.norm2;
     const double scale = std::abs(r00) + std::abs(r11) + std::abs(r22) + std::abs(a01) +
                          std::abs(a02) + std::abs(a12);
     const double scale2 = scale * scale;
