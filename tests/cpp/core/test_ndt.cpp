@@ -4,7 +4,6 @@
 #include <map>
 #include <random>
 #include <string>
-#include <tuple>
 
 #include <gtest/gtest.h>
 #include <Eigen/Eigenvalues>
@@ -15,12 +14,11 @@
 #include "lidarloop/core/ndt_descriptor.hpp"
 #include "lidarloop/core/ndt_shape.hpp"
 #include "lidarloop/core/sphere_partition.hpp"
+#include "ndt_reference.hpp"
 #include "test_utils.hpp"
 
 namespace lidarloop::core {
 namespace {
-
-using CellIndex = std::tuple<long, long, long>;
 
 // A uniformly random rotation from the test's own generator (Eigen's UnitRandom draws from the
 // global std::rand, which makes one test's draws depend on which tests ran before it).
@@ -31,37 +29,8 @@ Eigen::Matrix3d RandomRotation(std::mt19937& rng) {
         .toRotationMatrix();
 }
 
-// Reference: every point into each of the 8 cells [i h, i h + q) that contain it, by definition.
-std::map<CellIndex, std::vector<Eigen::Vector3d>> BruteForceCells(const PointCloud& cloud,
-                                                                  double q) {
-    std::map<CellIndex, std::vector<Eigen::Vector3d>> cells;
-    const double h = q / 2.0;
-    for (const auto& pf : cloud) {
-        const Eigen::Vector3d p = pf.cast<double>();
-        const long x = static_cast<long>(std::floor(p.x() * (1.0 / h)));
-        const long y = static_cast<long>(std::floor(p.y() * (1.0 / h)));
-        const long z = static_cast<long>(std::floor(p.z() * (1.0 / h)));
-        for (long dx = 0; dx < 2; ++dx)
-            for (long dy = 0; dy < 2; ++dy)
-                for (long dz = 0; dz < 2; ++dz) cells[{x - dx, y - dy, z - dz}].push_back(p);
-    }
-    return cells;
-}
-
 void ExpectCellsMatchBruteForce(const PointCloud& cloud, double q, int min_points) {
-    const auto reference = BruteForceCells(cloud, q);
-    std::vector<NdtCell> expected;
-    for (const auto& [index, points] : reference) {
-        if (static_cast<int>(points.size()) < min_points) continue;
-        NdtCell cell;
-        cell.point_count = static_cast<int>(points.size());
-        for (const auto& p : points) cell.mean_m += p / static_cast<double>(points.size());
-        for (const auto& p : points) {
-            cell.covariance_m2 += (p - cell.mean_m) * (p - cell.mean_m).transpose() /
-                                  static_cast<double>(points.size() - 1);
-        }
-        expected.push_back(cell);
-    }
+    std::vector<NdtCell> expected = test_reference::BruteForceCells(cloud, q, min_points);
     const auto cells = ComputeNdtCells(cloud, q, min_points);
     ASSERT_EQ(cells.size(), expected.size());
     // Both lists are sorted by (z, y, x) cell index: the map's order is (x, y, z), so match
