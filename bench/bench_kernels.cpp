@@ -1,4 +1,7 @@
 // Google Benchmark kernels of the descriptors. Run: ./build/bench/bench_kernels
+#include <cstdint>
+#include <iterator>
+#include <map>
 #include <random>
 
 #include <benchmark/benchmark.h>
@@ -82,39 +85,50 @@ void BM_NdtDescriptorSet(benchmark::State& state) {
 }
 BENCHMARK(BM_NdtDescriptorSet)->Arg(0)->Arg(1)->ArgName("regrid")->Unit(benchmark::kMillisecond);
 
-// A scan of the simulated town (HDL-64E, urban, ~116k points: buildings, trees, poles, cars):
-// about 1.5x the classified cells of the plane-and-walls scan, the case the 10 ms is for.
-const core::PointCloud& TownScan() {
-    static const core::PointCloud scan = [] {
-        sim::SimulationConfig config;
-        config.scene = sim::SceneType::kUrban;
-        config.route.type = sim::RouteType::kUTurn;
-        config.sensor.model = sim::SensorModel::kHdl64;
-        config.scans = 300;
-        config.seed = 3;
-        return sim::Simulator(config).Scan(100);
-    }();
-    return scan;
+// Scan 100 of a simulated HDL-64E sequence (~116k points) of each scene: the town (urban:
+// buildings, trees, poles, cars; about 1.5x the classified cells of the plane-and-walls scan, the
+// case the 10 ms is for), rural roads, a self-similar mine and an office floor, whose
+// walls and ceilings give other numbers of rotation candidates.
+constexpr sim::SceneType kScenes[] = {sim::SceneType::kUrban, sim::SceneType::kRural,
+                                      sim::SceneType::kMine, sim::SceneType::kIndoor};
+
+const core::PointCloud& SimulatedScan(sim::SceneType scene) {
+    static std::map<sim::SceneType, core::PointCloud> scans;
+    auto found = scans.find(scene);
+    if (found != scans.end()) return found->second;
+    sim::SimulationConfig config;
+    config.scene = scene;
+    config.route.type = sim::RouteType::kUTurn;
+    config.sensor.model = sim::SensorModel::kHdl64;
+    config.scans = 300;
+    config.seed = 3;
+    return scans.emplace(scene, sim::Simulator(config).Scan(100)).first->second;
 }
 
-void BM_NdtDescriptorSetTown(benchmark::State& state) {
+void BM_NdtDescriptorSetScene(benchmark::State& state) {
+    const sim::SceneType scene = kScenes[static_cast<std::size_t>(state.range(0))];
+    const core::PointCloud& scan = SimulatedScan(scene);
     const core::NdtConfig config;
     std::size_t descriptors = 0;
     std::size_t cells = 0;
     for (auto _ : state) {
-        const auto set = core::ComputeNdtDescriptorSet(TownScan(), config);
+        const auto set = core::ComputeNdtDescriptorSet(scan, config);
         descriptors = set.descriptors.size();
         cells = static_cast<std::size_t>(set.descriptors.front().total);
         benchmark::DoNotOptimize(set);
     }
+    state.SetLabel(sim::ToString(scene));
     state.counters["descriptors"] = static_cast<double>(descriptors);
     state.counters["classified_cells"] = static_cast<double>(cells);
-    state.counters["points"] = static_cast<double>(TownScan().size());
+    state.counters["points"] = static_cast<double>(scan.size());
     state.counters["per_point"] = benchmark::Counter(
-        static_cast<double>(TownScan().size()),
+        static_cast<double>(scan.size()),
         benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
-BENCHMARK(BM_NdtDescriptorSetTown)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_NdtDescriptorSetScene)
+    ->DenseRange(0, static_cast<std::int64_t>(std::size(kScenes)) - 1)
+    ->ArgName("scene")
+    ->Unit(benchmark::kMillisecond);
 
 void BM_NdtDifference(benchmark::State& state) {
     const core::NdtConfig config;

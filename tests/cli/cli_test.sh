@@ -146,6 +146,18 @@ expect_error "detect missing dataset" "no such dataset folder" "$cli" detect "$w
     --quiet --out "$work/det6"
 expect_ok "bench" '"ns_per_comparison_one_core"' "$cli" bench "$seq" --queries 3 --quiet
 expect_ok "bench scaled" '"scaled_queries"' "$cli" bench "$seq" --queries 3 --scale-to 500 --quiet
+# bench --method ndt reports the rotation candidates of each scan: copies of one scan have as many
+# as describe prints descriptors for it.
+ndt_seq="$work/ndt_seq"
+mkdir -p "$ndt_seq"
+for i in 0 1 2; do cp "$samples/corner_a.bin" "$ndt_seq/scan$i.bin"; done
+described="$("$cli" describe --method ndt "$samples/corner_a.bin" | grep -o '"R_aligned_sensor"' | wc -l)"
+benched="$("$cli" bench "$ndt_seq" --method ndt --queries 3 --quiet | tr -d ' \n' |
+    grep -o '"rotation_candidates_per_scan":{"max":[0-9.]*,"median":[0-9.]*' |
+    grep -o '"median":[0-9]*' | cut -d: -f2)"
+if [ "$described" -ge 1 ] && [ "$benched" = "$described" ]; then pass; else
+    fail "bench ndt: median rotation candidates '$benched', describe printed $described descriptors"
+fi
 
 # --- demo and evaluate --------------------------------------------------------------------------
 expect_ok "demo" "figures and tables:" "$cli" demo --out "$work/demo" --quiet
