@@ -7,10 +7,10 @@
 #include <optional>
 #include <string>
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/core/ndt_orientation_modes.hpp"
 #include "lidarloop/core/sphere_partition.hpp"
 
 namespace lidarloop::core {
@@ -29,10 +29,10 @@ constexpr double kShortCentroid = 0.1;
 
 // The smallest angle between the first direction and a second one. After R_z, a second direction
 // nearly parallel to the first is nearly the z axis, and its azimuth, which sets the yaw R_y, is
-// then noise or the mark of where a partition border cut a plane, not the scan's structure. Peaks
-// of one set closer than this are one surface split by a border, and are merged. 20 degrees is
-// far above the spread between the mean normals of such halves (a degree or two) and about half
-// the smallest angle between two lines of the paper's partition (38 degrees for p = 9).
+// then noise or the mark of where a partition border cut a plane, not the scan's structure. It is
+// also the half-width of the window in which orientation modes gather their cells: well above the
+// spread of one surface's normals (a few degrees), and about half the smallest angle between two
+// lines of the paper's partition (38 degrees for p = 9).
 constexpr double kMinLineAngleRad = 20.0 * std::numbers::pi / 180.0;
 
 // The orientation partitions of the planar and linear classes (absent when a count is 0).
@@ -236,6 +236,7 @@ void AmbiguousPeaks(const std::vector<double>& histogram, double t_a, std::vecto
                     std::vector<int>& y) {
     z.clear();
     y.clear();
+    if (histogram.empty()) return;  // no orientation mode: no planar cells, or only noise
     const double first = *std::max_element(histogram.begin(), histogram.end());
     if (first <= 0.0) return;
     for (int i = 0; i < static_cast<int>(histogram.size()); ++i) {
@@ -270,71 +271,37 @@ bool SetsAYaw(const Eigen::Vector3d& first, const Eigen::Vector3d& second) {
     return std::abs(first.dot(second)) < std::cos(kMinLineAngleRad);
 }
 
-// The orientation classes of the planar (or linear) cells: how many cells each holds, the sum of
-// a a^T over their axes a, and the direction a peak in it stands for: the principal axis of that
-// scatter (the mean line of its cells' axes) or, as the paper writes, the class's line P_i.
-struct LineClasses {
+// Peaks of the orientations of the planar (or linear) cells and how many cells each stands for.
+struct OrientationPeaks {
     std::vector<double> counts;
-    std::vector<Eigen::Matrix3d> scatter;
-    std::vector<Eigen::Vector3d> directions;
+    std::vector<Eigen::Vector3d> lines;
 };
 
-Eigen::Vector3d PrincipalAxis(const Eigen::Matrix3d& scatter) {
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-    solver.computeDirect(scatter);
-    return solver.eigenvectors().col(2).normalized();
-}
-
-LineClasses SummariseLines(const OrientedCells& cells, const HalfSpherePartition& partition,
-                           bool mean_direction, LineScratch& scratch) {
-    const auto n = static_cast<std::size_t>(partition.size());
-    LineClasses classes{std::vector<double>(n, 0.0),
-                        std::vector<Eigen::Matrix3d>(n, Eigen::Matrix3d::Zero()),
-                        partition.centres()};
+// As the paper writes: the classes of eq. (2), each standing for its line P_i.
+OrientationPeaks PartitionClasses(const OrientedCells& cells, const HalfSpherePartition& partition,
+                                  LineScratch& scratch) {
+    OrientationPeaks peaks{std::vector<double>(static_cast<std::size_t>(partition.size()), 0.0),
+                           partition.centres()};
     NearestLines(cells, partition, Eigen::Matrix3d::Identity(), scratch.best_dot, scratch.nearest);
-    for (std::size_t i = 0; i < cells.size(); ++i) {
-        const auto j = static_cast<std::size_t>(scratch.nearest[i]);
-        const Eigen::Vector3d axis = cells.Axis(i);
-        classes.counts[j] += 1.0;
-        classes.scatter[j].noalias() += axis * axis.transpose();
-    }
-    if (!mean_direction) return classes;
-    for (std::size_t j = 0; j < n; ++j) {
-        if (classes.counts[j] > 0.0) classes.directions[j] = PrincipalAxis(classes.scatter[j]);
-    }
-    return classes;
+    for (int j : scratch.nearest) peaks.counts[static_cast<std::size_t>(j)] += 1.0;
+    return peaks;
 }
 
-// The directions of the peaks `indices` of one set (Z or Y). With mean directions, a peak within
-// kMinLineAngleRad of a stronger one of the set is merged into it (their scatters added): it is
-// the same surface, split between two classes by a partition border. Partition lines are
-// distinct by design and are kept as they are.
-std::vector<Eigen::Vector3d> PeakDirections(const LineClasses& classes, std::vector<int> indices,
-                                            bool mean_direction) {
+// The modes of the cells' lines (FindOrientationModes), which turn with the scan; modes are at
+// least kMinLineAngleRad apart, so none is half of a surface that a class border split.
+OrientationPeaks OrientationModes(const OrientedCells& cells) {
+    OrientationPeaks peaks;
+    for (const OrientationMode& mode :
+         FindOrientationModes(cells.x, cells.y, cells.z, kMinLineAngleRad)) {
+        peaks.counts.push_back(static_cast<double>(mode.count));
+        peaks.lines.push_back(mode.line);
+    }
+    return peaks;
+}
+
+std::vector<Eigen::Vector3d> LinesOf(const OrientationPeaks& peaks, const std::vector<int>& which) {
     std::vector<Eigen::Vector3d> lines;
-    if (!mean_direction) {
-        for (int j : indices) lines.push_back(classes.directions[static_cast<std::size_t>(j)]);
-        return lines;
-    }
-    std::stable_sort(indices.begin(), indices.end(), [&](int a, int b) {
-        return classes.counts[static_cast<std::size_t>(a)] >
-               classes.counts[static_cast<std::size_t>(b)];
-    });
-    std::vector<Eigen::Matrix3d> scatters;
-    for (int j : indices) {
-        const auto k = static_cast<std::size_t>(j);
-        const auto same = std::find_if(lines.begin(), lines.end(), [&](const Eigen::Vector3d& l) {
-            return !SetsAYaw(l, classes.directions[k]);
-        });
-        if (same == lines.end()) {
-            lines.push_back(classes.directions[k]);
-            scatters.push_back(classes.scatter[k]);
-            continue;
-        }
-        Eigen::Matrix3d& merged = scatters[static_cast<std::size_t>(same - lines.begin())];
-        merged += classes.scatter[k];
-        *same = PrincipalAxis(merged);
-    }
+    for (int i : which) lines.push_back(peaks.lines[static_cast<std::size_t>(i)]);
     return lines;
 }
 
@@ -346,12 +313,13 @@ struct PeakLines {
 
 PeakLines FindPeakLines(const OrientedCells& cells, const HalfSpherePartition& partition,
                         const NdtConfig& config, LineScratch& scratch) {
-    const bool mean = config.align_to_mean_direction;
-    const LineClasses classes = SummariseLines(cells, partition, mean, scratch);
+    const OrientationPeaks peaks = config.align_to_mean_direction
+                                       ? OrientationModes(cells)
+                                       : PartitionClasses(cells, partition, scratch);
     std::vector<int> z;
     std::vector<int> y;
-    AmbiguousPeaks(classes.counts, config.ambiguity_ratio, z, y);
-    return {PeakDirections(classes, z, mean), PeakDirections(classes, y, mean)};
+    AmbiguousPeaks(peaks.counts, config.ambiguity_ratio, z, y);
+    return {LinesOf(peaks, z), LinesOf(peaks, y)};
 }
 
 // The signed unit vectors of `line` to align: the one pointing against `centroid`, or both.
