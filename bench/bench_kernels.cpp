@@ -3,6 +3,7 @@
 #include <iterator>
 #include <map>
 #include <random>
+#include <utility>
 
 #include <benchmark/benchmark.h>
 
@@ -92,9 +93,10 @@ BENCHMARK(BM_NdtDescriptorSet)->Arg(0)->Arg(1)->ArgName("regrid")->Unit(benchmar
 constexpr sim::SceneType kScenes[] = {sim::SceneType::kUrban, sim::SceneType::kRural,
                                       sim::SceneType::kMine, sim::SceneType::kIndoor};
 
-const core::PointCloud& SimulatedScan(sim::SceneType scene) {
-    static std::map<sim::SceneType, core::PointCloud> scans;
-    auto found = scans.find(scene);
+const core::PointCloud& SimulatedScan(sim::SceneType scene, int index = 100) {
+    static std::map<std::pair<sim::SceneType, int>, core::PointCloud> scans;
+    const auto key = std::make_pair(scene, index);
+    auto found = scans.find(key);
     if (found != scans.end()) return found->second;
     sim::SimulationConfig config;
     config.scene = scene;
@@ -102,7 +104,7 @@ const core::PointCloud& SimulatedScan(sim::SceneType scene) {
     config.sensor.model = sim::SensorModel::kHdl64;
     config.scans = 300;
     config.seed = 3;
-    return scans.emplace(scene, sim::Simulator(config).Scan(100)).first->second;
+    return scans.emplace(key, sim::Simulator(config).Scan(index)).first->second;
 }
 
 void BM_NdtDescriptorSetScene(benchmark::State& state) {
@@ -148,6 +150,18 @@ void BM_NdtSetDifference(benchmark::State& state) {
     state.counters["pairs"] = static_cast<double>(a.descriptors.size() * b.descriptors.size());
 }
 BENCHMARK(BM_NdtSetDifference)->Unit(benchmark::kNanosecond);
+
+// sigma' of two town scans (urban scans 100 and 200), whose sets hold several rotation
+// candidates each, as grid-like streets give (ground and two wall directions are ambiguous peaks).
+void BM_NdtSetDifferenceTown(benchmark::State& state) {
+    const core::NdtConfig config;
+    const auto a = core::ComputeNdtDescriptorSet(SimulatedScan(sim::SceneType::kUrban), config);
+    const auto b =
+        core::ComputeNdtDescriptorSet(SimulatedScan(sim::SceneType::kUrban, 200), config);
+    for (auto _ : state) benchmark::DoNotOptimize(core::NdtSetDifference(a, b));
+    state.counters["pairs"] = static_cast<double>(a.descriptors.size() * b.descriptors.size());
+}
+BENCHMARK(BM_NdtSetDifferenceTown)->Unit(benchmark::kNanosecond);
 
 }  // namespace
 }  // namespace lidarloop::bench

@@ -211,21 +211,15 @@ void CountOriented(const OrientedCells& cells, const std::optional<HalfSpherePar
 NdtDescriptor CountFeatures(const ClassifiedCells& cells, const Eigen::Matrix3d& R,
                             const NdtConfig& config, const Partitions& partitions,
                             LineScratch& scratch) {
-    NdtDescriptor f;
-    f.rows = config.RangeCount();
-    f.cols = config.FeatureCount();
-    f.counts = cells.fixed_counts;
-    f.R_aligned_sensor = R;
-    CountOriented(cells.planar, partitions.planar, R, config.spherical_classes, f.cols, f.counts,
+    const int cols = config.FeatureCount();
+    std::vector<float> counts = cells.fixed_counts;
+    CountOriented(cells.planar, partitions.planar, R, config.spherical_classes, cols, counts,
                   scratch);
     CountOriented(cells.linear, partitions.linear, R,
-                  config.spherical_classes + config.planar_classes, f.cols, f.counts, scratch);
-    for (float count : f.counts) f.total += count;
-    f.normalised.resize(f.counts.size());
-    const double inverse_total = f.total > 0.0 ? 1.0 / f.total : 0.0;
-    for (std::size_t i = 0; i < f.counts.size(); ++i) {
-        f.normalised[i] = static_cast<float>(f.counts[i] * inverse_total);
-    }
+                  config.spherical_classes + config.planar_classes, cols, counts, scratch);
+    NdtDescriptor f;
+    SetNdtCounts(f, config.RangeCount(), cols, std::move(counts));
+    f.R_aligned_sensor = R;
     return f;
 }
 
@@ -462,24 +456,80 @@ NdtDescriptorSet ComputeNdtDescriptorSet(const PointCloud& cloud, const NdtConfi
     return set;
 }
 
-double NdtDifference(const NdtDescriptor& f, const NdtDescriptor& g) {
-    if (f.rows != g.rows || f.cols != g.cols || f.normalised.size() != g.normalised.size()) {
+namespace {
+
+void RequireSameShape(const NdtDescriptor& f, const NdtDescriptor& g) {
+    if (f.rows != g.rows || f.cols != g.cols ||
+        f.normalised.size() != static_cast<std::size_t>(f.cols * f.PaddedRows()) ||
+        g.normalised.size() != f.normalised.size()) {
         throw ConfigError("NDT descriptors of different shapes cannot be compared");
     }
+}
+
+// Eq. (8) without its factor: the sum over range intervals of the Euclidean distances between
+// the rows of the normalised descriptors. kNdtRowBlock rows at a time, column by column, which
+// GCC turns into vector arithmetic and vector square roots (padding rows are zero on both sides
+// and add 0). Keep the block a plain local array: splitting it into two sums, or passing it by
+// pointer, made GCC 12 fall back to scalar code (measured 15 -> 35 ns per sigma).
+double RowDistanceSum(const NdtDescriptor& f, const NdtDescriptor& g) {
+    const auto padded = static_cast<std::size_t>(f.PaddedRows());
+    const auto cols = static_cast<std::size_t>(f.cols);
     double sum = 0.0;
-    for (int row = 0; row < f.rows; ++row) {
-        float squared = 0.0f;
-        const std::size_t begin = static_cast<std::size_t>(row * f.cols);
-        for (std::size_t k = begin; k < begin + static_cast<std::size_t>(f.cols); ++k) {
-            const float d = f.normalised[k] - g.normalised[k];
-            squared += d * d;
+    for (std::size_t block = 0; block < padded; block += kNdtRowBlock) {
+        float squared[kNdtRowBlock] = {};
+        for (std::size_t k = 0; k < cols; ++k) {
+            const float* a = f.normalised.data() + k * padded + block;
+            const float* b = g.normalised.data() + k * padded + block;
+            for (int row = 0; row < kNdtRowBlock; ++row) {
+                const float d = a[row] - b[row];
+                squared[row] += d * d;
+            }
         }
-        sum += std::sqrt(static_cast<double>(squared));
+        float distance = 0.0f;
+        for (int row = 0; row < kNdtRowBlock; ++row) distance += std::sqrt(squared[row]);
+        sum += distance;
     }
-    const double larger = std::max(f.total, g.total);
-    const double smaller = std::min(f.total, g.total);
-    if (larger <= 0.0) return 0.0;  // two empty descriptors are equal
-    return smaller > 0.0 ? sum * larger / smaller : std::numeric_limits<double>::infinity();
+    return sum;
+}
+
+// The factor of eq. (8), max(|F|, |G|) / min(|F|, |G|); both totals must be positive.
+double CellCountRatio(const NdtDescriptor& f, const NdtDescriptor& g) {
+    return std::max(f.total, g.total) / std::min(f.total, g.total);
+}
+
+}  // namespace
+
+void SetNdtCounts(NdtDescriptor& f, int rows, int cols, std::vector<float> counts) {
+    if (rows < 1 || cols < 1 || counts.size() != static_cast<std::size_t>(rows) * cols) {
+        throw ConfigError("an NDT descriptor needs rows x cols counts (rows, cols >= 1)");
+    }
+    double total = 0.0;
+    for (float count : counts) {
+        if (!(count >= 0.0f && std::isfinite(count))) {
+            throw ConfigError("NDT cell counts must be finite and non-negative");
+        }
+        total += count;
+    }
+    f.rows = rows;
+    f.cols = cols;
+    f.total = total;
+    f.counts = std::move(counts);
+    const auto padded = static_cast<std::size_t>(f.PaddedRows());
+    f.normalised.assign(padded * static_cast<std::size_t>(cols), 0.0f);
+    const double inverse_total = total > 0.0 ? 1.0 / total : 0.0;
+    for (std::size_t row = 0; row < static_cast<std::size_t>(rows); ++row) {
+        for (std::size_t k = 0; k < static_cast<std::size_t>(cols); ++k) {
+            f.normalised[k * padded + row] = static_cast<float>(
+                f.counts[row * static_cast<std::size_t>(cols) + k] * inverse_total);
+        }
+    }
+}
+
+double NdtDifference(const NdtDescriptor& f, const NdtDescriptor& g) {
+    RequireSameShape(f, g);
+    if (std::max(f.total, g.total) <= 0.0) return 0.0;  // two empty descriptors are equal
+    if (std::min(f.total, g.total) <= 0.0) return std::numeric_limits<double>::infinity();
+    return RowDistanceSum(f, g) * CellCountRatio(f, g);
 }
 
 double NdtSetDifference(const NdtDescriptorSet& f, const NdtDescriptorSet& g) {

@@ -1,5 +1,8 @@
 #include "lidarloop/io/database_file.hpp"
 
+#include <cmath>
+
+#include "lidarloop/core/error.hpp"
 #include "lidarloop/io/config_yaml.hpp"
 #include "lidarloop/io/detail/byte_stream.hpp"
 
@@ -25,20 +28,24 @@ core::NdtDescriptorSet GetNdtSet(detail::ByteReader& in) {
     const auto count = in.Get<std::uint32_t>("NDT descriptor count");
     in.RequireItems(count, 16, "NDT descriptors");
     for (std::uint32_t d = 0; d < count; ++d) {
-        core::NdtDescriptor f;
-        f.rows = static_cast<int>(in.Get<std::uint32_t>("NDT rows"));
-        f.cols = static_cast<int>(in.Get<std::uint32_t>("NDT columns"));
-        const std::uint64_t entries =
-            std::uint64_t{static_cast<std::uint32_t>(f.rows)} * static_cast<std::uint32_t>(f.cols);
+        const auto rows = in.Get<std::uint32_t>("NDT rows");
+        const auto cols = in.Get<std::uint32_t>("NDT columns");
+        const std::uint64_t entries = std::uint64_t{rows} * cols;
         if (entries > kMaxMatrixEntries) in.Fail("absurd NDT descriptor size");
-        f.total = in.Get<double>("NDT cell total");
-        f.counts.resize(entries);
-        in.GetArray(f.counts.data(), f.counts.size(), "NDT counts");
+        const auto stored_total = in.Get<double>("NDT cell total");
+        std::vector<float> counts(entries);
+        in.GetArray(counts.data(), counts.size(), "NDT counts");
+        core::NdtDescriptor f;
         in.GetArray(f.R_aligned_sensor.data(), 9, "NDT rotation");
-        f.normalised.resize(entries);
-        for (std::size_t i = 0; i < entries; ++i) {
-            f.normalised[i] = f.total > 0.0 ? static_cast<float>(f.counts[i] / f.total) : 0.0f;
+        try {
+            core::SetNdtCounts(f, static_cast<int>(rows), static_cast<int>(cols),
+                               std::move(counts));
+        } catch (const core::ConfigError& error) {
+            in.Fail(error.what());
         }
+        // Counts are whole numbers, so their sum is exact: any difference is a damaged file.
+        if (!(std::abs(f.total - stored_total) < 0.5))
+            in.Fail("NDT cell total differs from its counts");
         set.descriptors.push_back(std::move(f));
     }
     return set;

@@ -375,35 +375,53 @@ TEST(NdtDescriptor, SigmaIsSymmetricAndZeroOnIdenticalInput) {
 
 TEST(NdtDescriptor, SigmaMatchesEquationEightByHand) {
     NdtDescriptor f;
-    f.rows = 2;
-    f.cols = 2;
-    f.counts = {1, 1, 2, 0};
-    f.total = 4;
-    f.normalised = {0.25f, 0.25f, 0.5f, 0.0f};
-    NdtDescriptor g = f;
-    g.counts = {0, 2, 0, 0};
-    g.total = 2;
-    g.normalised = {0.0f, 1.0f, 0.0f, 0.0f};
+    SetNdtCounts(f, 2, 2, {1, 1, 2, 0});
+    EXPECT_EQ(f.total, 4.0);
+    NdtDescriptor g;
+    SetNdtCounts(g, 2, 2, {0, 2, 0, 0});
     // Row 0: |(0.25, -0.75)| = 0.7906; row 1: |(0.5, 0)| = 0.5; times 4/2.
     EXPECT_NEAR(NdtDifference(f, g), (std::sqrt(0.625) + 0.5) * 2.0, 1e-6);
-    NdtDescriptor other_shape = g;
-    other_shape.cols = 4;
-    other_shape.rows = 1;
+    NdtDescriptor other_shape;
+    SetNdtCounts(other_shape, 1, 4, {0, 2, 0, 0});
     EXPECT_THROW(NdtDifference(f, other_shape), ConfigError);
 }
 
-// A descriptor with no cells equals another one (sigma of F with itself is 0) and differs
-// infinitely from one with cells, as the factor max/min of eq. (8) says in the limit.
+// More range rows than one block of kNdtRowBlock compares, in more than one column: each row
+// adds its own distance, none is lost at a block border.
+TEST(NdtDescriptor, SigmaSumsEveryRowAcrossRowBlocks) {
+    const int rows = kNdtRowBlock + 3;
+    const int cols = 3;
+    std::vector<float> a_counts(static_cast<std::size_t>(rows * cols), 0.0f);
+    std::vector<float> b_counts = a_counts;
+    double expected = 0.0;
+    for (int row = 0; row < rows; ++row) {
+        a_counts[static_cast<std::size_t>(row * cols)] = 1.0f;            // (1, 0, 0) in every row
+        b_counts[static_cast<std::size_t>(row * cols + row % 3)] = 1.0f;  // (1,0,0), (0,1,0), ...
+        expected += row % 3 == 0 ? 0.0 : std::sqrt(2.0) / rows;
+    }
+    NdtDescriptor a;
+    NdtDescriptor b;
+    SetNdtCounts(a, rows, cols, a_counts);
+    SetNdtCounts(b, rows, cols, b_counts);
+    EXPECT_EQ(a.PaddedRows(), 2 * kNdtRowBlock);
+    EXPECT_NEAR(NdtDifference(a, b), expected, 1e-6);
+    EXPECT_EQ(NdtDifference(a, a), 0.0);
+}
+
+TEST(NdtDescriptor, SetCountsRejectsBadCounts) {
+    NdtDescriptor f;
+    EXPECT_THROW(SetNdtCounts(f, 2, 2, {1, 2, 3}), ConfigError);
+    EXPECT_THROW(SetNdtCounts(f, 0, 2, {}), ConfigError);
+    EXPECT_THROW(SetNdtCounts(f, 1, 2, {1, -1}), ConfigError);
+    EXPECT_THROW(SetNdtCounts(f, 1, 2, {1, std::numeric_limits<float>::quiet_NaN()}), ConfigError);
+    EXPECT_THROW(SetNdtCounts(f, 1, 2, {1, std::numeric_limits<float>::infinity()}), ConfigError);
+}
+
 TEST(NdtDescriptor, SigmaOfEmptyDescriptors) {
     NdtDescriptor empty;
-    empty.rows = 1;
-    empty.cols = 2;
-    empty.counts = {0, 0};
-    empty.normalised = {0.0f, 0.0f};
-    NdtDescriptor full = empty;
-    full.counts = {1, 0};
-    full.normalised = {1.0f, 0.0f};
-    full.total = 1;
+    SetNdtCounts(empty, 1, 2, {0, 0});
+    NdtDescriptor full;
+    SetNdtCounts(full, 1, 2, {1, 0});
     EXPECT_EQ(NdtDifference(empty, empty), 0.0);
     EXPECT_EQ(NdtDifference(empty, full), std::numeric_limits<double>::infinity());
     EXPECT_EQ(NdtDifference(full, empty), std::numeric_limits<double>::infinity());
