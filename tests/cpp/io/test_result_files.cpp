@@ -1,3 +1,5 @@
+#include <cstdint>
+#include <cstring>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -106,6 +108,44 @@ TEST(DatabaseFile, BadFilesAreClearErrors) {
     test::ExpectReadError(LoadDatabase, dir / "config.bin", "key 'histogram.binz': unknown key");
     test::WriteFile(dir / "long.bin", good + "\x01");
     test::ExpectReadError(LoadDatabase, dir / "long.bin", "trailing bytes");
+}
+
+// The bytes of the first NDT descriptor's header in a saved database: rows, cols and total, as
+// SaveDatabase writes them (little-endian, like the machines lidarloop runs on).
+std::string DescriptorHeaderBytes(const core::NdtDescriptor& f) {
+    std::string bytes(16, '\0');
+    const auto rows = static_cast<std::uint32_t>(f.rows);
+    const auto cols = static_cast<std::uint32_t>(f.cols);
+    std::memcpy(bytes.data(), &rows, 4);
+    std::memcpy(bytes.data() + 4, &cols, 4);
+    std::memcpy(bytes.data() + 8, &f.total, 8);
+    return bytes;
+}
+
+// An NDT descriptor whose stored total disagrees with its counts, or with a negative count, is a
+// damaged file, not a descriptor to compare (sigma would be silently wrong).
+TEST(DatabaseFile, DamagedNdtCountsAreClearErrors) {
+    test::TempDir dir;
+    const auto database = SmallDatabase(core::Method::kNdt);
+    SaveDatabase(dir / "db.bin", database);
+    const std::string good = test::ReadFile(dir / "db.bin");
+    const core::NdtDescriptor& first = database.ndt_sets()[0].descriptors[0];
+    const std::string header = DescriptorHeaderBytes(first);
+    const auto at = good.find(header);
+    ASSERT_NE(at, std::string::npos);
+
+    std::string total = good;
+    const double wrong_total = first.total + 3.0;
+    total.replace(at + 8, 8, std::string(reinterpret_cast<const char*>(&wrong_total), 8));
+    test::WriteFile(dir / "total.bin", total);
+    test::ExpectReadError(LoadDatabase, dir / "total.bin",
+                          "NDT cell total differs from its counts");
+
+    std::string negative = good;
+    const float minus_one = -1.0f;
+    negative.replace(at + 16, 4, std::string(reinterpret_cast<const char*>(&minus_one), 4));
+    test::WriteFile(dir / "negative.bin", negative);
+    test::ExpectReadError(LoadDatabase, dir / "negative.bin", "finite and non-negative");
 }
 
 TEST(Png, WritesAValidFileWithTheRightSize) {
