@@ -18,23 +18,26 @@ struct NdtConfig {
     /// Borders of the range intervals R, metres from the sensor to the cell mean; the paper's
     /// {[0,3), [3,6), [6,9), [9,15), [15,inf)}.
     std::vector<double> range_limits_m = {3.0, 6.0, 9.0, 15.0};
-    /// Section II-C: align the scan by the peaks of its planar orientation classes (and, for a
-    /// second direction, of its linear classes when l > 1); a second direction within 20 degrees
+    /// Section II-C: align the scan by the peaks of its planar cells' orientations (and, for a
+    /// second direction, of its linear cells' when l > 1); a second direction within 20 degrees
     /// of the first sets no yaw. The planar classes steer it, so with p = 0 there is nothing to
     /// align by and the descriptor is unrotated, whatever l is. false gives one unrotated
     /// descriptor.
     bool normalise_rotation = true;
     double ambiguity_ratio = 0.60;  ///< t_a, peaks >= t_a * the highest are ambiguous
-    /// true: align a peak class by the mean line of its cells' normals (principal axis of their
-    /// scatter), which makes the normalisation rotation invariant up to the grid; peaks of Z (or
-    /// of Y) whose mean lines are within 20 degrees are one surface split by a class border and
-    /// are merged. false: align by the class's partition line P_i as the paper writes; the
-    /// alignment is then quantised to the partition (~40 degrees for p = 9) and a rotated scan
-    /// can get a different descriptor.
+    /// true: the peaks of eqs. (4)-(7) are the modes of the cells' normals (mean shift with a
+    /// 20-degree window, core/ndt_orientation_modes.hpp), counted by the cells within 20 degrees
+    /// of each; they turn with the scan, so a rotated scan gets the same peaks, and a surface is
+    /// never split in two by a class border. false: the peaks are the classes of the partition,
+    /// each aligned by its line P_i, as the paper writes; which surfaces share a class (~40
+    /// degrees wide for p = 9) then depends on how the scan is turned, and a rotated scan can
+    /// get other peaks and a different descriptor.
     bool align_to_mean_direction = true;
-    /// false: rotate each cell's axes (the grid turns with the scan; exact rotation invariance,
-    /// one grid per scan). true: rotate the points and build a new axis-aligned grid per rotation,
-    /// as the paper does; slower, and results differ only by the grid's discretisation.
+    /// false: count each rotation candidate by rotating the cells' axes (one grid per scan).
+    /// true: rotate the points and build a new axis-aligned grid per candidate, as the paper
+    /// does; slower. Either way a rotated or moved scan falls differently into its grid, so
+    /// sigma' between a scan and its rotated copy is as small as that discretisation allows
+    /// (about that of a translation by a fraction of a cell), not zero.
     bool regrid_rotations = false;
     /// t_d: scans are similar when sigma' < t_d. 0.0737 is the paper's Hannover2 value (table II);
     /// it depends on the data, so estimate it (EM) or learn it for yours.

@@ -43,7 +43,7 @@ void VisitFields(core::NdtConfig& c, Visitor& v) {
     v.Field("normalise_rotation", c.normalise_rotation, "align dominant planes (section II-C)");
     v.Field("ambiguity_ratio", c.ambiguity_ratio, "t_a, peaks this close are ambiguous");
     v.Field("align_to_mean_direction", c.align_to_mean_direction,
-            "align peaks by their cells' mean normal (true) or partition line (false)");
+            "peaks are modes of the cells' normals (true) or partition classes, lines P_i (false)");
     v.Field("regrid_rotations", c.regrid_rotations,
             "new grid per rotation (paper) vs rotated cells");
     v.Field("threshold", c.threshold, "t_d: similar when sigma' < t_d (Magnusson II-E)");

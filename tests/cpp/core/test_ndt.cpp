@@ -450,6 +450,35 @@ TEST(NdtDescriptor, FeatureLayoutFollowsEquationOne) {
     EXPECT_GT(f.total, 100.0);
 }
 
+// Coinciding points far from the sensor: their raw moments cancel to rounding noise (~1e-11 m^2
+// at 100 m), which must not pass for a shape with a made-up axis. Found by review: 1000 copies of
+// one point gave linear cells, and half the cells were wrong at 500 copies.
+TEST(NdtCells, CoincidingPointsAreDegenerateAtAnyDistance) {
+    std::mt19937 rng(31);
+    std::uniform_real_distribution<float> coordinate(-120.0f, 120.0f);
+    int cells = 0;
+    for (int copies : {5, 100, 1000, 3000}) {
+        for (int trial = 0; trial < 40; ++trial) {
+            const Eigen::Vector3f p(coordinate(rng), coordinate(rng), coordinate(rng) / 10.0f);
+            for (const NdtCell& cell : ComputeNdtCells(PointCloud(copies, p), 0.5, 5)) {
+                ++cells;
+                EXPECT_EQ(ClassifyCovariance(cell.covariance_m2, 0.1).shape, CellShape::kDegenerate)
+                    << copies << " copies of " << p.transpose();
+                EXPECT_LT((cell.mean_m - p.cast<double>()).norm(), 1e-9);
+            }
+        }
+    }
+    EXPECT_EQ(cells, 4 * 40 * 8);  // every point lies in 8 cells
+    // A real spread as small as float coordinates 120 m away resolve is still a shape.
+    PointCloud thin;
+    for (int i = 0; i < 200; ++i) {
+        thin.push_back({100.0f + 0.001f * static_cast<float>(i % 20), 80.0f, 10.0f});
+    }
+    for (const NdtCell& cell : ComputeNdtCells(thin, 0.5, 5)) {
+        EXPECT_EQ(ClassifyCovariance(cell.covariance_m2, 0.1).shape, CellShape::kLinear);
+    }
+}
+
 TEST(NdtDescriptor, DegenerateScansGiveDefinedResults) {
     NdtConfig config;
     const PointCloud same(100, Eigen::Vector3f(1, 2, 3));
