@@ -211,7 +211,9 @@ TEST(NdtClassify, BatchOverColumnsEqualsOneByOne) {
          {CellShape::kSpherical, CellShape::kPlanar, CellShape::kLinear, CellShape::kDegenerate}) {
         EXPECT_GT(seen[shape], 0) << "the input lacks a shape: the test would prove less";
     }
-    // The repeated-eigenvalue plane (2, 2, 0) still gets its normal, through the solver.
+    // The plane (2, 2, 0), whose in-plane eigenvalues are equal, still gets its normal from the
+    // cross products (the normal's own eigenvalue is apart from both, so two rows of A - l3 I
+    // stay independent; the solver fallback is only a guard against rounding).
     EXPECT_NEAR(std::abs(shapes.axis_z[covariances.size() - 3]), 1.0, 1e-12);
 }
 
