@@ -266,6 +266,15 @@ PointCloud Transformed(const PointCloud& cloud, const Eigen::Matrix3f& R,
     return out;
 }
 
+// The floor any revisit sees: the same scan moved by a fraction of a cell falls differently
+// into the grid. A rotated scan cannot do better than that.
+double TranslationFloor(const PointCloud& cloud, const NdtDescriptorSet& reference,
+                        const NdtConfig& config) {
+    const PointCloud moved =
+        Transformed(cloud, Eigen::Matrix3f::Identity(), Eigen::Vector3f(0.11f, 0.07f, 0.13f));
+    return NdtSetDifference(reference, ComputeNdtDescriptorSet(moved, config));
+}
+
 TEST(NdtDescriptor, RotatedScanHasSmallSigmaWhileUnnormalisedDiffers) {
     const PointCloud cloud = StructuredScan(8);
     std::mt19937 rng(9);
@@ -274,12 +283,7 @@ TEST(NdtDescriptor, RotatedScanHasSmallSigmaWhileUnnormalisedDiffers) {
     unnormalised.normalise_rotation = false;
     const auto reference = ComputeNdtDescriptorSet(cloud, config);
     const auto reference_raw = ComputeNdtDescriptorSet(cloud, unnormalised);
-    // The floor any revisit sees: the same scan moved by a fraction of a cell falls differently
-    // into the grid. A rotated scan cannot do better than that.
-    const double grid_floor = NdtSetDifference(
-        reference, ComputeNdtDescriptorSet(Transformed(cloud, Eigen::Matrix3f::Identity(),
-                                                       Eigen::Vector3f(0.11f, 0.07f, 0.13f)),
-                                           config));
+    const double grid_floor = TranslationFloor(cloud, reference, config);
     EXPECT_GT(grid_floor, 0.0);
     // Every rotated copy stays near the floor. The unnormalised descriptor proves the rotations
     // mattered: it differs by ~1 for tilts, less (0.15-0.3) for turns mostly about the floor's
@@ -319,10 +323,7 @@ TEST(NdtDescriptor, RotatedStreetScansStayAtTheTranslationFloor) {
         const PointCloud cloud = test_reference::StreetScan(seed).Build();
         const auto reference = ComputeNdtDescriptorSet(cloud, config);
         const auto reference_raw = ComputeNdtDescriptorSet(cloud, unnormalised);
-        const double grid_floor = NdtSetDifference(
-            reference, ComputeNdtDescriptorSet(Transformed(cloud, Eigen::Matrix3f::Identity(),
-                                                           Eigen::Vector3f(0.11f, 0.07f, 0.13f)),
-                                               config));
+        const double grid_floor = TranslationFloor(cloud, reference, config);
         std::mt19937 rng(seed + 20);
         double raw_sum = 0.0;
         double sigma_sum = 0.0;
