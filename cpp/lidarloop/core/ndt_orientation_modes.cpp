@@ -29,6 +29,15 @@ constexpr double kConverged = 1e-12;  // 1 - |cos| between two steps
 // Seeds are taken in decreasing order of the lines they hold, so the cap only drops the weakest:
 // scattered noise far from every surface.
 constexpr std::size_t kMaxSeeds = 64;
+// A direction held by fewer lines than this share of all is a few stray cells, whose orientation
+// differs between two scans of one place; as a peak it would only multiply the rotation
+// candidates (eq. 7 measures Y against its own strongest member, however weak). A wall seen from
+// afar holds more.
+constexpr double kMinPeakShare = 0.01;
+// A peak gathers its lines near its centre: an even spread puts a quarter of a window's lines
+// within half its angle, a surface's normals nearly all. A mode with less than half there is a
+// shoulder: scattered lines whose window reaches into the flank of a surface beside it.
+constexpr double kMinCoreShare = 0.5;
 
 // The lines of one bin: lines[first, last) of the sorted lines, their scatter sum of v v^T, their
 // mean direction, and the largest angle between it and any of them.
@@ -189,17 +198,24 @@ Eigen::Vector3d PrincipalAxis(const Eigen::Matrix3d& scatter) {
     return solver.eigenvectors().col(2).normalized();
 }
 
-// Mean shift from `line` to the mode whose basin holds it.
-Eigen::Vector3d Shift(const BinnedLines& binned, const WindowBounds& bounds, Eigen::Vector3d line) {
+// Mean shift from `line` to the mode whose basin holds it, in place. Returns false, and stops,
+// if the walk comes within `cos_known` of one of the `known` modes, onto which it is climbing (or
+// next to which it would be dropped as the same cluster).
+bool Climb(const BinnedLines& binned, const WindowBounds& bounds, Eigen::Vector3d& line,
+           const std::vector<Eigen::Vector3d>& known = {}, double cos_known = 1.0) {
     for (int step = 0; step < kMaxIterations; ++step) {
         const Window window = Gather(binned, bounds, line);
         if (window.count <= 0.0) break;
         const Eigen::Vector3d next = PrincipalAxis(window.scatter);
         const bool converged = 1.0 - std::abs(next.dot(line)) < kConverged;
         line = next;
+        const bool reached_known = std::any_of(known.begin(), known.end(), [&](const auto& k) {
+            return std::abs(k.dot(line)) >= cos_known;
+        });
+        if (reached_known) return false;
         if (converged) break;
     }
-    return line;
+    return true;
 }
 
 // The two windows of the search: the full one, and half of it for the last steps.
@@ -208,16 +224,24 @@ struct Windows {
     WindowBounds half;
 };
 
-// The mode reached from `seed`. A window's mean line is pulled towards any other surface inside
-// it (two planes 16 degrees apart are one mode whose mean lies between them); shifting on with
-// half the window from there settles on the stronger surface's own normal. The count is over the
-// whole window, the support the peak has.
-OrientationMode FindMode(const BinnedLines& binned, const Windows& windows,
-                         const Eigen::Vector3d& seed) {
-    Eigen::Vector3d line = Shift(binned, windows.full, seed);
-    line = Shift(binned, windows.half, line);
+// The mode reached from `seed`, and the lines within half its window. A window's mean line is
+// pulled towards any other surface inside it (two planes 16 degrees apart are one mode whose mean
+// lies between them); shifting on with half the window from there settles on the stronger
+// surface's own normal. The count is over the whole window, the support the peak has.
+struct ModeAndCore {
+    OrientationMode mode;
+    double core_count = 0.0;
+};
+
+std::optional<ModeAndCore> FindMode(const BinnedLines& binned, const Windows& windows,
+                                    const Eigen::Vector3d& seed,
+                                    const std::vector<Eigen::Vector3d>& known) {
+    Eigen::Vector3d line = seed;
+    if (!Climb(binned, windows.full, line, known, windows.half.cos_window)) return std::nullopt;
+    Climb(binned, windows.half, line);
     if (line.z() < 0.0) line = -line;
-    return {line, static_cast<std::size_t>(Gather(binned, windows.full, line).count)};
+    const auto count = static_cast<std::size_t>(Gather(binned, windows.full, line).count);
+    return ModeAndCore{{line, count}, Gather(binned, windows.half, line).count};
 }
 
 // The uncovered bin with the most lines, or none.
@@ -254,31 +278,61 @@ std::vector<OrientationMode> FindOrientationModes(std::span<const float> x,
     if (x.size() != y.size() || x.size() != z.size()) {
         throw Error("FindOrientationModes: the x, y and z columns differ in length");
     }
-    if (!(window_rad > 0.0 && window_rad <= std::numbers::pi / 2)) {
-        throw ConfigError("FindOrientationModes: the window must be in (0, pi/2] radians");
+    if (!(window_rad > 0.0 && window_rad <= std::numbers::pi / 4)) {
+        throw ConfigError("FindOrientationModes: the window must be in (0, pi/4] radians");
     }
     const BinnedLines binned = BinLines(x, y, z);
     const std::vector<Bin>& bins = binned.bins;
     const Windows windows{Bounds(bins, window_rad), Bounds(bins, 0.5 * window_rad)};
     const double cos_window = windows.full.cos_window;
-    // Lines spread evenly over the half sphere (area 2 pi) would put a fraction (1 - cos w) into
-    // a window and 4 / (pi kGrid^2) into a bin (a square of the disc of area 2 pi). A window
-    // holding no more is no peak of their density, and once no uncovered bin is denser than
-    // that, what is left is scattered noise with no peak to seed.
     const auto lines = static_cast<double>(binned.lines.size());
-    const double uniform_share = (1.0 - cos_window) * lines;
-    const double uniform_bin = 4.0 / (std::numbers::pi * kGrid * kGrid) * lines;
+    // The lines no accepted mode explains (outside their windows). Spread evenly over the half
+    // sphere (area 2 pi) they would put a fraction (1 - cos w) into a window and 4 / (pi kGrid^2)
+    // into a bin (a square of the disc of area 2 pi): a window holding no more is no peak of
+    // their density, and once no uncovered bin is denser than that, nothing is left to seed.
+    // Measured against the unexplained lines, not all: a wall is a peak beside a ground that
+    // holds 95% of the normals.
+    double unexplained = lines;
+    const double window_share = 1.0 - cos_window;
+    const double bin_share = 4.0 / (std::numbers::pi * kGrid * kGrid);
+    // A peak holds kMinPeakShare of all lines, kMinCoreShare of those in its core (half the
+    // window), so the densest bin of its core at least their share per bin there: a weaker seed
+    // leads to no peak, only to another mean shift through noise.
+    const double core_share = 1.0 - std::cos(0.5 * window_rad);
+    const double weakest_seed = kMinPeakShare * kMinCoreShare * lines * bin_share / core_share;
     std::vector<char> covered(bins.size(), 0);
+    std::vector<char> explained(bins.size(), 0);
     std::vector<OrientationMode> modes;
+    std::vector<Eigen::Vector3d> known;  // every mode reached, peak or not
     for (std::size_t seeds = 0; seeds < kMaxSeeds; ++seeds) {
         const std::optional<std::size_t> seed = StrongestUncovered(bins, covered);
-        if (!seed || bins[*seed].count() <= uniform_bin) break;
-        const OrientationMode mode = FindMode(binned, windows, bins[*seed].direction);
-        covered[*seed] = 1;  // even if the mode it led to lies elsewhere
-        for (std::size_t b = 0; b < bins.size(); ++b) {
-            if (std::abs(bins[b].direction.dot(mode.line)) >= cos_window) covered[b] = 1;
+        if (!seed || bins[*seed].count() <= std::max(bin_share * unexplained, weakest_seed)) {
+            break;
         }
-        if (static_cast<double>(mode.count) > uniform_share) modes.push_back(mode);
+        // The seed's neighbours (within half a window) climb the same way: no walk of their own.
+        for (std::size_t b = 0; b < bins.size(); ++b) {
+            if (std::abs(bins[b].direction.dot(bins[*seed].direction)) >= windows.half.cos_window) {
+                covered[b] = 1;
+            }
+        }
+        covered[*seed] = 1;
+        const std::optional<ModeAndCore> found =
+            FindMode(binned, windows, bins[*seed].direction, known);
+        if (!found) continue;
+        const auto& [mode, core_count] = *found;
+        known.push_back(mode.line);
+        const auto count = static_cast<double>(mode.count);
+        const bool peak = count > window_share * unexplained && count >= kMinPeakShare * lines &&
+                          core_count >= kMinCoreShare * count;
+        for (std::size_t b = 0; b < bins.size(); ++b) {
+            if (std::abs(bins[b].direction.dot(mode.line)) < cos_window) continue;
+            covered[b] = 1;
+            if (peak && !explained[b]) {
+                explained[b] = 1;
+                unexplained -= bins[b].count();
+            }
+        }
+        if (peak) modes.push_back(mode);
     }
     return SuppressWeakerNeighbours(std::move(modes), cos_window);
 }

@@ -21,10 +21,13 @@ struct OrientationMode {
 /// moving, then on with half the window, so that a second surface inside the window does not pull
 /// the mode off the stronger one's normal. Seeds are taken where most lines lie that no mode found
 /// so far covers, so every cluster of lines gets its own mode; a mode within `window_rad` of a
-/// stronger one is the same cluster and is dropped, and so is a mode whose window holds no more
-/// lines than an even spread of all of them over the half sphere would put there (a fraction 1 -
-/// cos(window_rad)): that is scattered noise, not a peak. Sorted by decreasing count (ties: found
-/// first). Non-finite and zero vectors are ignored.
+/// stronger one is the same cluster and is dropped. A mode is kept only if its window holds more
+/// lines than an even spread of the lines no stronger mode explains would put there (a fraction
+/// 1 - cos(window_rad) of them), so that scattered noise is no peak while a wall beside a
+/// dominant ground is; at least 1% of all lines (fewer are stray cells); and with at least half
+/// of them within half the window (a surface's normals gather at its centre; a window of noise
+/// reaching into the flank of a surface beside it does not). Sorted by decreasing count (ties:
+/// found first). Non-finite and zero vectors are ignored.
 ///
 /// Magnusson et al. 2009 (section II-C) take the peaks of the planar orientation histogram, whose
 /// classes are fixed in the sensor frame: one class (~40 degrees wide for p = 9) can hold two
@@ -32,7 +35,7 @@ struct OrientationMode {
 /// a mode is a function of the lines alone (rotating every line rotates it), and only which
 /// modes are found depends on the frame: seeds come from a fixed binning, so a weak cluster close
 /// to a strong one may be reached from one orientation and not from another. `window_rad` in
-/// (0, pi/2]; O(n) in the lines. Thread-safe.
+/// (0, pi/4] (ConfigError otherwise); O(n) in the lines. Thread-safe.
 std::vector<OrientationMode> FindOrientationModes(std::span<const float> x,
                                                   std::span<const float> y,
                                                   std::span<const float> z, double window_rad);
