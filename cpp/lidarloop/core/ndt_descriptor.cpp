@@ -35,10 +35,18 @@ constexpr double kShortCentroid = 0.1;
 // lines of the paper's partition (38 degrees for p = 9).
 constexpr double kMinLineAngleRad = 20.0 * std::numbers::pi / 180.0;
 
-// The orientation partitions of the planar and linear classes (absent when a count is 0).
+// For each line of a partition, the line a half turn about z takes it to, when that maps the
+// partition's lines onto its lines (the paper's p = 9, a cap and 8 equal sectors, and any
+// partition whose collars have even sector counts); nothing otherwise.
+using HalfTurnImage = std::optional<std::vector<int>>;
+
+// The orientation partitions of the planar and linear classes (absent when a count is 0), and
+// their half-turn images.
 struct Partitions {
     std::optional<HalfSpherePartition> planar;
     std::optional<HalfSpherePartition> linear;
+    HalfTurnImage planar_half_turn;
+    HalfTurnImage linear_half_turn;
 };
 
 // The classified cells of one shape whose column depends on their orientation (planar or
@@ -390,11 +398,78 @@ std::vector<Eigen::Matrix3d> CandidateRotations(const ClassifiedCells& cells,
     return rotations;
 }
 
+HalfTurnImage HalfTurnOf(const HalfSpherePartition& partition) {
+    const std::vector<Eigen::Vector3d>& centres = partition.centres();
+    std::vector<int> image;
+    for (const Eigen::Vector3d& c : centres) {
+        const Eigen::Vector3d turned(-c.x(), -c.y(), c.z());
+        const auto match = std::find_if(centres.begin(), centres.end(), [&](const auto& other) {
+            return std::abs(turned.dot(other)) > 1.0 - 1e-12;
+        });
+        if (match == centres.end()) return std::nullopt;
+        image.push_back(static_cast<int>(match - centres.begin()));
+    }
+    return image;
+}
+
 Partitions MakePartitions(const NdtConfig& config) {
     Partitions partitions;
-    if (config.planar_classes > 0) partitions.planar.emplace(config.planar_classes);
-    if (config.linear_classes > 0) partitions.linear.emplace(config.linear_classes);
+    if (config.planar_classes > 0) {
+        partitions.planar.emplace(config.planar_classes);
+        partitions.planar_half_turn = HalfTurnOf(*partitions.planar);
+    }
+    if (config.linear_classes > 0) {
+        partitions.linear.emplace(config.linear_classes);
+        partitions.linear_half_turn = HalfTurnOf(*partitions.linear);
+    }
     return partitions;
+}
+
+// Whether a half turn about z maps both partitions onto themselves (an absent one trivially).
+bool HalfTurnSymmetric(const Partitions& partitions) {
+    return (!partitions.planar || partitions.planar_half_turn) &&
+           (!partitions.linear || partitions.linear_half_turn);
+}
+
+// The descriptor of the scan turned by R_z(pi) R, from `f`, the one turned by R, when the half
+// turn maps the partitions onto themselves: eq. (2) then sends a cell's axis to the image of its
+// class, so each oriented column moves to its image's; rows and spherical columns stay. Exact
+// but for cells tied between two lines, which either count may put on either side.
+NdtDescriptor HalfTurned(const NdtDescriptor& f, const Eigen::Matrix3d& R, const NdtConfig& config,
+                         const Partitions& partitions) {
+    const int s = config.spherical_classes;
+    const int p = config.planar_classes;
+    std::vector<int> column(static_cast<std::size_t>(f.cols));
+    for (int k = 0; k < f.cols; ++k) column[static_cast<std::size_t>(k)] = k;
+    const auto map = [&](const HalfTurnImage& image, int first) {
+        if (!image) return;
+        for (std::size_t j = 0; j < image->size(); ++j) {
+            column[static_cast<std::size_t>(first) + j] = first + (*image)[j];
+        }
+    };
+    map(partitions.planar_half_turn, s);
+    map(partitions.linear_half_turn, s + p);
+    std::vector<float> counts(f.counts.size(), 0.0f);
+    for (int row = 0; row < f.rows; ++row) {
+        for (int k = 0; k < f.cols; ++k) {
+            counts[static_cast<std::size_t>(row * f.cols + column[static_cast<std::size_t>(k)])] =
+                f.counts[static_cast<std::size_t>(row * f.cols + k)];
+        }
+    }
+    NdtDescriptor turned;
+    SetNdtCounts(turned, f.rows, f.cols, std::move(counts));
+    turned.R_aligned_sensor = R;
+    return turned;
+}
+
+// The descriptor among `counted` whose rotation, turned half about z, is R; or none.
+const NdtDescriptor* HalfTurnPartner(const std::vector<NdtDescriptor>& counted,
+                                     const Eigen::Matrix3d& R) {
+    const Eigen::Matrix3d half_turn = Eigen::Vector3d(-1.0, -1.0, 1.0).asDiagonal();
+    for (const NdtDescriptor& f : counted) {
+        if ((half_turn * f.R_aligned_sensor - R).cwiseAbs().maxCoeff() < 1e-9) return &f;
+    }
+    return nullptr;
 }
 
 PointCloud Rotated(const PointCloud& cloud, const Eigen::Matrix3d& R) {
@@ -446,6 +521,11 @@ NdtDescriptorSet ComputeNdtDescriptorSet(const PointCloud& cloud, const NdtConfi
                 CountFeatures(regridded, Eigen::Matrix3d::Identity(), config, partitions, scratch);
             f.R_aligned_sensor = R;
             set.descriptors.push_back(std::move(f));
+        } else if (const NdtDescriptor* partner = HalfTurnSymmetric(partitions)
+                                                      ? HalfTurnPartner(set.descriptors, R)
+                                                      : nullptr) {
+            // Both signs of a second direction: the two candidates differ by a half turn.
+            set.descriptors.push_back(HalfTurned(*partner, R, config, partitions));
         } else {
             set.descriptors.push_back(CountFeatures(cells, R, config, partitions, scratch));
         }

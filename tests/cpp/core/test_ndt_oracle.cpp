@@ -147,6 +147,27 @@ TEST(NdtOracle, PaperDefaultsWithRotationCandidatesMatchTheDefinitions) {
     ExpectSetMatchesReference(StreetScan(1).Build(), config);
 }
 
+// A street scan and its mirror through the sensor: the centroid of the cells is too short to
+// choose the sign of a line, so both are kept, and candidates come in pairs that differ by a
+// half turn about z, the second of which is derived from the first by moving columns (the paper's
+// p = 9 partition maps onto itself under that turn). Each must match the definitions as well.
+TEST(NdtOracle, HalfTurnedCandidatesMatchTheDefinitions) {
+    PointCloud scan = StreetScan(5).Build();
+    const std::size_t n = scan.size();
+    for (std::size_t i = 0; i < n; ++i) scan.push_back(-scan[i]);
+    const NdtConfig config;
+    const NdtDescriptorSet set = ComputeNdtDescriptorSet(scan, config);
+    const Eigen::Matrix3d half_turn = Eigen::Vector3d(-1.0, -1.0, 1.0).asDiagonal();
+    int pairs = 0;
+    for (const NdtDescriptor& a : set.descriptors) {
+        for (const NdtDescriptor& b : set.descriptors) {
+            pairs += (half_turn * a.R_aligned_sensor).isApprox(b.R_aligned_sensor, 1e-9);
+        }
+    }
+    EXPECT_GE(pairs, 2) << "no half-turn pair: the test would prove nothing";
+    ExpectSetMatchesReference(scan, config);
+}
+
 TEST(NdtOracle, SubClassesOfEveryShapeMatchTheDefinitions) {
     NdtConfig config;
     config.spherical_classes = 3;
