@@ -472,12 +472,15 @@ TEST(NdtCells, CoincidingPointsAreDegenerateAtAnyDistance) {
         }
     }
     EXPECT_EQ(cells, 4 * 40 * 8);  // every point lies in 8 cells
-    // A real spread as small as float coordinates 120 m away resolve is still a shape.
+    // A real spread a few times the cutoff is still a shape: points 0.025 mm apart along x,
+    // 0.5 mm in all (variance 2e-8 m^2 against a cutoff of 4e-9 m^2 here, 130 m out).
     PointCloud thin;
     for (int i = 0; i < 200; ++i) {
-        thin.push_back({100.0f + 0.001f * static_cast<float>(i % 20), 80.0f, 10.0f});
+        thin.push_back({100.0f + 2.5e-5f * static_cast<float>(i % 20), 80.0f, 10.0f});
     }
-    for (const NdtCell& cell : ComputeNdtCells(thin, 0.5, 5)) {
+    const std::vector<NdtCell> thin_cells = ComputeNdtCells(thin, 0.5, 5);
+    ASSERT_FALSE(thin_cells.empty());
+    for (const NdtCell& cell : thin_cells) {
         EXPECT_EQ(ClassifyCovariance(cell.covariance_m2, 0.1).shape, CellShape::kLinear);
     }
 }
