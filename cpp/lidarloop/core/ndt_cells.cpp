@@ -264,7 +264,8 @@ void PairSumAlongAxis(const std::vector<KeyedMoments>& in, std::uint64_t step, E
 // A covariance from raw moments carries a rounding error of a few epsilon times sum x^2 / (n - 1)
 // (measured: up to ~5 epsilon |mean|^2 for identical points). A spread below this many times
 // that, 3e-9 m^2 at 120 m, cannot be told from none: the points coincide. Real surfaces spread
-// 1e-6 m^2 and more (1 mm of noise), and float coordinates 120 m away resolve no finer.
+// 1e-6 m^2 and more (1 mm of noise); no LiDAR measures finer than the cutoff, although float
+// coordinates 120 m away could hold spreads down to ~1e-11 m^2.
 constexpr double kCancellationMargin = 1000.0 * std::numeric_limits<double>::epsilon();
 
 // Unbiased covariance from raw moments: (sum x x^T - n mean mean^T) / (n - 1); exactly zero when

@@ -63,7 +63,6 @@ struct OrientedCells {
         z.push_back(static_cast<float>(axis.z()));
         row.push_back(range_row);
     }
-    Eigen::Vector3d Axis(std::size_t i) const { return {x[i], y[i], z[i]}; }
 };
 
 // Every classified cell of a scan, split into what rotation cannot change (range rows, spherical
