@@ -1,20 +1,14 @@
-#include <sys/resource.h>
-
-#include <cstdio>
 #include <iostream>
 #include <memory>
-#include <random>
 
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
 #include "commands.hpp"
 #include "dataset_options.hpp"
 #include "descriptor_options.hpp"
-#include "lidarloop/core/error.hpp"
-#include "lidarloop/pipeline/histogram_index.hpp"
-#include "lidarloop/pipeline/loop_detector.hpp"
-#include "run_output.hpp"
+#include "lidarloop/app/bench.hpp"
+#include "lidarloop/app/results_folder.hpp"
+#include "progress.hpp"
 
 namespace lidarloop::cli {
 namespace {
@@ -22,114 +16,18 @@ namespace {
 struct BenchFlags {
     DatasetOptions dataset;
     DescriptorOptions descriptor;
-    std::size_t scale_to = 0;
-    std::size_t queries = 200;
+    app::BenchRequest request;
     std::string json;
     bool quiet = false;
 };
 
-double PeakMemoryMiB() {
-    rusage usage{};
-    getrusage(RUSAGE_SELF, &usage);
-    return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
-}
-
-// Times `queries` top-1 searches of stored scans (as queries) against the whole database,
-// through the index when there is one, and by comparing every scan.
-nlohmann::json TimeQueries(const pipeline::DescriptorDatabase& database, std::size_t queries) {
-    nlohmann::json json;
-    std::vector<double> index_us;
-    std::vector<double> brute_us;
-    const pipeline::CumulativeHistograms* rows = database.histograms();
-    std::optional<pipeline::HistogramIndex> index;
-    if (rows != nullptr) {
-        index.emplace(*rows);
-        index->InsertAll();
-    }
-    std::mt19937 rng(1);
-    for (std::size_t q = 0; q < queries && database.size() > 0; ++q) {
-        const std::size_t id = rng() % database.size();
-        if (!database.IsValid(id)) continue;
-        Stopwatch brute;
-        std::size_t best = 0;
-        double best_distance = std::numeric_limits<double>::infinity();
-        for (std::size_t j = 0; j < database.size(); ++j) {
-            const double d = database.Distance(id, j);
-            if (d < best_distance) best_distance = d, best = j;
-        }
-        brute_us.push_back(1e6 * brute.Seconds());
-        if (index) {
-            Stopwatch indexed;
-            const auto found = index->Search(rows->Row(id), 1);
-            index_us.push_back(1e6 * indexed.Seconds());
-            if (found.empty() || found.front().distance > best_distance) {
-                throw core::Error("bench: index and brute force disagree (a bug; please report)");
-            }
-        }
-        (void)best;
-    }
-    json["brute_force_us"] = {{"median", Quantile(brute_us, 0.5)},
-                              {"p95", Quantile(brute_us, 0.95)}};
-    if (index)
-        json["index_us"] = {{"median", Quantile(index_us, 0.5)}, {"p95", Quantile(index_us, 0.95)}};
-    return json;
-}
-
-// A database of `size` histograms made from the dataset's by small random perturbations, to
-// measure how queries scale beyond the dataset's length (synthetic; said so in the output).
-pipeline::DescriptorDatabase Scaled(const pipeline::DescriptorDatabase& source, std::size_t size) {
-    pipeline::DescriptorDatabase scaled(source.config());
-    const pipeline::CumulativeHistograms& rows = *source.histograms();
-    std::mt19937 rng(2);
-    std::normal_distribution<float> noise(0.0f, 0.002f);
-    std::vector<float> row(static_cast<std::size_t>(rows.stride()));
-    for (std::size_t i = 0; i < size; ++i) {
-        const float* base = rows.Row(i % rows.size());
-        float previous = 0.0f;
-        for (int k = 0; k < rows.bins(); ++k) {  // stays a valid cumulative histogram
-            previous = std::clamp(std::max(previous, base[k] + noise(rng)), 0.0f, 1.0f);
-            row[static_cast<std::size_t>(k)] = k + 1 == rows.bins() ? 1.0f : previous;
-        }
-        scaled.AddCumulativeRow(row, static_cast<double>(i), true);
-    }
-    return scaled;
-}
-
-void RunBench(const BenchFlags& flags) {
-    const io::RunConfig config = flags.descriptor.Resolve();
-    const io::Dataset dataset = flags.dataset.Open();
-    // One core, so that the per-scan times are what one scan costs.
-    const auto described = DescribeDataset(
-        dataset, config.descriptor,
-        {"describing", /*skip_bad=*/false, flags.quiet, pipeline::Execution::kSerial});
-    const auto& database = described.database;
-
-    Stopwatch serial_clock;
-    const auto matrix = pipeline::ComputeSimilarityMatrix(database, pipeline::Execution::kSerial);
-    const double serial_s = serial_clock.Seconds();
-    Stopwatch parallel_clock;
-    pipeline::ComputeSimilarityMatrix(database, pipeline::Execution::kParallel);
-    const double parallel_s = parallel_clock.Seconds();
-    const double pairs = static_cast<double>(matrix.condensed().size());
-
-    nlohmann::json json = TimingsJson(described, matrix.condensed().size(), parallel_s);
-    json["method"] = core::ToString(config.descriptor.method);
-    json["ns_per_comparison_one_core"] = pairs > 0 ? 1e9 * serial_s / pairs : 0.0;
-    json["similarity_matrix_one_core_s"] = serial_s;
-    json["queries"] = TimeQueries(database, flags.queries);
-    if (flags.scale_to > 0 && database.histograms() != nullptr) {
-        const auto scaled = Scaled(database, flags.scale_to);
-        json["scaled_queries"] = TimeQueries(scaled, flags.queries);
-        json["scaled_queries"]["stored_histograms"] = flags.scale_to;
-        json["scaled_queries"]["note"] = "synthetic: the dataset's histograms perturbed";
-    }
-    if (const auto* rows = database.histograms()) {
-        json["bytes_per_stored_histogram"] =
-            4 * rows->stride() + 4 * pipeline::HistogramIndex::kBlocks + 16 + 9;
-    }
-    json["peak_memory_mib"] = PeakMemoryMiB();
-    std::cout << json.dump(2) << "\n";
-    if (!flags.json.empty()) WriteJson(flags.json, json);
+void RunBench(BenchFlags& flags) {
+    ProgressPrinter progress(flags.quiet);
+    flags.request.config = flags.descriptor.Resolve();
+    flags.request.progress = progress.Callback();
+    const nlohmann::json figures = app::RunBench(flags.dataset.Open(), flags.request);
+    std::cout << figures.dump(2) << "\n";
+    if (!flags.json.empty()) app::WriteJson(flags.json, figures);
 }
 
 }  // namespace
@@ -140,8 +38,8 @@ void AddBenchCommand(CLI::App& app) {
     auto flags = std::make_shared<BenchFlags>();
     flags->dataset.AddTo(*command);
     flags->descriptor.AddTo(*command);
-    command->add_option("--queries", flags->queries, "query scans to time (default 200)");
-    command->add_option("--scale-to", flags->scale_to,
+    command->add_option("--queries", flags->request.queries, "query scans to time (default 200)");
+    command->add_option("--scale-to", flags->request.scale_to,
                         "also time queries against this many stored histograms (synthetic)");
     command->add_option("--json", flags->json, "also write the figures to this file");
     command->add_flag("--quiet", flags->quiet, "no progress bar");

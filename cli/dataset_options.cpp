@@ -25,14 +25,4 @@ io::Dataset DatasetOptions::Open() const {
     return io::OpenDataset(path_, options);
 }
 
-pipeline::ScanSource SourceOf(const io::Dataset& dataset) {
-    pipeline::ScanSource source;
-    source.count = dataset.size();
-    source.load = [&dataset](std::size_t i) { return dataset.LoadScan(i); };
-    source.time_s = [&dataset](std::size_t i) {
-        return dataset.HasPoses() ? dataset.poses()[i].time_s : static_cast<double>(i);
-    };
-    return source;
-}
-
 }  // namespace lidarloop::cli

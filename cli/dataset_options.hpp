@@ -5,7 +5,6 @@
 #include <CLI/CLI.hpp>
 
 #include "lidarloop/io/dataset.hpp"
-#include "lidarloop/pipeline/sequence.hpp"
 
 namespace lidarloop::cli {
 
@@ -23,8 +22,5 @@ private:
     std::string poses_;
     std::string calib_;
 };
-
-/// The scans of `dataset` as a pipeline source; times from its poses, else the scan index.
-pipeline::ScanSource SourceOf(const io::Dataset& dataset);
 
 }  // namespace lidarloop::cli

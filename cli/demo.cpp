@@ -6,10 +6,11 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
-#include "evaluate.hpp"
+#include "lidarloop/app/evaluation.hpp"
+#include "lidarloop/app/simulation.hpp"
 #include "lidarloop/eval/per_scan.hpp"
 #include "lidarloop/io/dataset.hpp"
-#include "simulate.hpp"
+#include "progress.hpp"
 
 namespace lidarloop::cli {
 namespace {
@@ -25,21 +26,15 @@ std::string Fixed(double value, int decimals) {
     return text;
 }
 
-// The demo sequence: generated once (a fraction of a second), reused on later runs.
-std::filesystem::path DemoSequence(const std::filesystem::path& out, bool quiet) {
-    const std::filesystem::path sequence = out / "sequence";
-    if (std::filesystem::exists(sequence / "simulation.yaml")) return sequence;
-    const sim::Simulator simulator(sim::DemoConfig());
-    const SimulationSummary summary =
-        WriteSimulation(simulator, sequence, /*overwrite=*/true, /*threads=*/0, quiet);
-    std::cout << "demo sequence: " << simulator.size() << " synthetic VLP-16 scans of a town "
+void PrintSequence(const app::DemoSequence& demo, std::size_t scans) {
+    if (!demo.generated) return;
+    std::cout << "demo sequence: " << scans << " synthetic VLP-16 scans of a town "
               << "(grid route with same-lane, opposite-direction and lane-offset revisits), "
-              << summary.revisited_scans << " of them revisit a place, generated in "
-              << Fixed(summary.seconds, 2) << " s -> " << sequence.string() << "\n";
-    return sequence;
+              << demo.generated->revisited_scans << " of them revisit a place, generated in "
+              << Fixed(demo.generated->seconds, 2) << " s -> " << demo.folder.string() << "\n";
 }
 
-void PrintMethod(const MethodEvaluation& e, const eval::GroundTruth& truth) {
+void PrintMethod(const app::MethodEvaluation& e, const eval::GroundTruth& truth) {
     const double threshold = *e.default_threshold;
     const eval::TaxonomyCounts at_default =
         eval::CountLabels(eval::LabelScans(e.best_matches, truth, threshold));
@@ -60,16 +55,18 @@ void PrintMethod(const MethodEvaluation& e, const eval::GroundTruth& truth) {
 
 void RunDemo(const DemoFlags& flags) {
     const std::filesystem::path out(flags.out);
-    const io::Dataset dataset = io::OpenDataset(DemoSequence(out, flags.quiet));
-    EvaluationRequest request;
+    ProgressPrinter progress(flags.quiet);
+    const app::DemoSequence demo = app::PrepareDemoSequence(out / "sequence", progress.Callback());
+    const io::Dataset dataset = io::OpenDataset(demo.folder);
+    PrintSequence(demo, dataset.size());
+    app::EvaluationRequest request;
     request.methods = {core::Method::kHeight, core::Method::kRange, core::Method::kNdt};
     request.distance_m = 10.0;  // Röhling's d
-    request.quiet = flags.quiet;
+    request.progress = progress.Callback();
     request.out = out / "evaluation";
-    request.config.Validate();
-    const EvaluationOutcome outcome = RunEvaluation(dataset, request);
+    const app::EvaluationOutcome outcome = app::RunEvaluation(dataset, request);
     std::cout << "ground truth: " << outcome.truth.Describe() << "\n";
-    for (const MethodEvaluation& e : outcome.methods) PrintMethod(e, outcome.truth);
+    for (const app::MethodEvaluation& e : outcome.methods) PrintMethod(e, outcome.truth);
     for (const std::string& note : outcome.notes) std::cout << "  note: " << note << "\n";
     std::cout << "figures and tables: " << (request.out / "report.md").string()
               << " (similarity matrices, ROC, precision-recall, EM fit, counts against t_d)\n";

@@ -2,60 +2,13 @@
 #include <memory>
 
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
 #include "commands.hpp"
 #include "descriptor_options.hpp"
+#include "lidarloop/app/describe_run.hpp"
+#include "lidarloop/app/descriptor_json.hpp"
 
 namespace lidarloop::cli {
-namespace {
-
-nlohmann::json HistogramJson(const core::Histogram& histogram) {
-    nlohmann::json json;
-    json["method"] = core::ToString(histogram.projection);
-    json["min"] = histogram.min_value;
-    json["max"] = histogram.max_value;
-    if (histogram.projection == core::Projection::kHeight) {
-        json["up"] = {histogram.up.x(), histogram.up.y(), histogram.up.z()};
-    }
-    json["bins"] = histogram.mass;
-    json["points_used"] = histogram.points_used;
-    json["points_skipped"] = histogram.points_skipped;
-    json["points_out_of_range"] = histogram.points_out_of_range;
-    return json;
-}
-
-nlohmann::json NdtJson(const core::NdtDescriptorSet& set) {
-    nlohmann::json json;
-    json["method"] = "ndt";
-    json["descriptors"] = nlohmann::json::array();
-    for (const core::NdtDescriptor& f : set.descriptors) {
-        nlohmann::json rows = nlohmann::json::array();
-        for (int row = 0; row < f.rows; ++row) {
-            const auto begin = f.counts.begin() + row * f.cols;
-            rows.push_back(std::vector<float>(begin, begin + f.cols));
-        }
-        nlohmann::json rotation = nlohmann::json::array();
-        for (int i = 0; i < 3; ++i) {
-            rotation.push_back(
-                {f.R_aligned_sensor(i, 0), f.R_aligned_sensor(i, 1), f.R_aligned_sensor(i, 2)});
-        }
-        json["descriptors"].push_back(
-            {{"R_aligned_sensor", rotation}, {"cells", f.total}, {"F", rows}});
-    }
-    json["points_used"] = set.cell_stats.points_used;
-    json["points_skipped"] = set.cell_stats.points_skipped;
-    json["sparse_cells"] = set.cell_stats.sparse_cells;
-    json["degenerate_cells"] = set.degenerate_cells;
-    return json;
-}
-
-nlohmann::json DescriptorJson(const core::Descriptor& descriptor) {
-    if (descriptor.method == core::Method::kNdt) return NdtJson(descriptor.ndt());
-    return HistogramJson(descriptor.histogram());
-}
-
-}  // namespace
 
 void AddDescribeCommand(CLI::App& app) {
     auto* command = app.add_subcommand("describe", "Print the descriptor of one scan as JSON");
@@ -65,7 +18,8 @@ void AddDescribeCommand(CLI::App& app) {
     options->AddTo(*command);
     command->callback([scan, options] {
         const io::RunConfig config = options->Resolve();
-        std::cout << DescriptorJson(DescriptorOfFile(*scan, config)).dump() << "\n";
+        const core::Descriptor descriptor = app::DescribeScanFile(*scan, config.descriptor);
+        std::cout << app::DescriptorJson(descriptor).dump() << "\n";
     });
 }
 

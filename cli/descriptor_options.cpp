@@ -2,8 +2,6 @@
 
 #include "lidarloop/core/descriptor_config.hpp"
 #include "lidarloop/core/error.hpp"
-#include "lidarloop/io/read_error.hpp"
-#include "lidarloop/io/scan_reader.hpp"
 
 namespace lidarloop::cli {
 
@@ -56,15 +54,6 @@ void DescriptorOptions::ApplyHistogramFlags(core::DescriptorConfig& descriptor) 
     const bool height = descriptor.method == core::Method::kHeight;
     if (*min_option_) (height ? histogram.height_min_m : histogram.range_min_m) = min_m_;
     if (*max_option_) (height ? histogram.height_max_m : histogram.range_max_m) = max_m_;
-}
-
-core::Descriptor DescriptorOfFile(const std::filesystem::path& file, const io::RunConfig& config) {
-    const core::PointCloud cloud = io::ReadScan(file);
-    try {
-        return core::ComputeDescriptor(cloud, config.descriptor);
-    } catch (const core::EmptyInputError& e) {
-        throw io::ReadError(file, e.what());
-    }
 }
 
 }  // namespace lidarloop::cli

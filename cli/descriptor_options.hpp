@@ -1,12 +1,10 @@
 #pragma once
 
 #include <array>
-#include <filesystem>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
-#include "lidarloop/core/descriptor.hpp"
 #include "lidarloop/io/config_yaml.hpp"
 
 namespace lidarloop::cli {
@@ -48,8 +46,5 @@ private:
     CLI::Option* up_option_ = nullptr;
     CLI::Option* out_of_range_option_ = nullptr;
 };
-
-/// Reads `file` and computes its descriptor under `config`; errors name the file.
-core::Descriptor DescriptorOfFile(const std::filesystem::path& file, const io::RunConfig& config);
 
 }  // namespace lidarloop::cli

@@ -5,6 +5,7 @@
 
 #include "commands.hpp"
 #include "descriptor_options.hpp"
+#include "lidarloop/app/describe_run.hpp"
 
 namespace lidarloop::cli {
 
@@ -18,8 +19,8 @@ void AddDistanceCommand(CLI::App& app) {
     options->AddTo(*command);
     command->callback([scans, options] {
         const io::RunConfig config = options->Resolve();
-        const core::Descriptor a = DescriptorOfFile((*scans)[0], config);
-        const core::Descriptor b = DescriptorOfFile((*scans)[1], config);
+        const core::Descriptor a = app::DescribeScanFile((*scans)[0], config.descriptor);
+        const core::Descriptor b = app::DescribeScanFile((*scans)[1], config.descriptor);
         // %.9g keeps enough digits to compare against thresholds near 1e-3.
         std::printf("%.9g\n", core::DescriptorDistance(a, b));
     });

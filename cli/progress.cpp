@@ -38,4 +38,26 @@ void ProgressBar::Finish() {
     drawn_ = false;
 }
 
+app::Progress ProgressPrinter::Callback() {
+    if (quiet_) return {};
+    return [this](const std::string& stage, std::size_t done, std::size_t total) {
+        Update(stage, done, total);
+    };
+}
+
+void ProgressPrinter::Update(const std::string& stage, std::size_t done, std::size_t total) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (stage == finished_) return;  // a worker reporting late on a finished stage
+    if (!bar_ || stage != stage_) {
+        bar_.reset();  // clears the previous stage's line first
+        stage_ = stage;
+        bar_ = std::make_unique<ProgressBar>(stage, quiet_);
+    }
+    bar_->Update(done, total);
+    if (done >= total) {
+        bar_.reset();
+        finished_ = stage;
+    }
+}
+
 }  // namespace lidarloop::cli

@@ -2,8 +2,11 @@
 
 #include <chrono>
 #include <cstddef>
+#include <memory>
 #include <mutex>
 #include <string>
+
+#include "lidarloop/app/progress.hpp"
 
 namespace lidarloop::cli {
 
@@ -28,6 +31,23 @@ private:
     std::mutex mutex_;
     std::chrono::steady_clock::time_point start_;
     std::chrono::steady_clock::time_point last_draw_;
+};
+
+/// Shows a run layer's progress as one bar per stage. Must outlive the runs it is given to.
+class ProgressPrinter {
+public:
+    explicit ProgressPrinter(bool quiet) : quiet_(quiet) {}
+    /// The callback to put into a run's request.
+    app::Progress Callback();
+
+private:
+    void Update(const std::string& stage, std::size_t done, std::size_t total);
+
+    bool quiet_;
+    std::mutex mutex_;
+    std::string stage_;
+    std::string finished_;
+    std::unique_ptr<ProgressBar> bar_;
 };
 
 }  // namespace lidarloop::cli

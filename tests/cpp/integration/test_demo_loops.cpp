@@ -1,63 +1,50 @@
-// End to end on the demo sequence: simulate, describe, compare, evaluate. The threshold is
-// chosen on one seed's world and applied to another's, so nothing is tuned to the test data.
+// End to end on the demo sequence through the run layer, as `lidarloop evaluate --train-on` runs
+// it: simulate two worlds, learn each method's threshold on all pairs of one and test it on the
+// other, so nothing is tuned to the test data.
 #include <gtest/gtest.h>
 
-#include "lidarloop/core/descriptor.hpp"
-#include "lidarloop/eval/ground_truth.hpp"
+#include "lidarloop/app/evaluation.hpp"
+#include "lidarloop/app/simulation.hpp"
 #include "lidarloop/eval/metrics.hpp"
-#include "lidarloop/eval/pairwise.hpp"
-#include "lidarloop/pipeline/sequence.hpp"
-#include "lidarloop/pipeline/similarity_matrix.hpp"
-#include "lidarloop/sim/simulator.hpp"
+#include "test_utils.hpp"
 
 namespace lidarloop {
 namespace {
 
-struct ScoredSequence {
-    std::vector<eval::ScoredPair> pairs;
-};
-
-ScoredSequence ScoreDemo(std::uint64_t seed, core::Method method) {
+io::Dataset SimulateDemo(std::uint64_t seed, const std::filesystem::path& folder) {
     sim::SimulationConfig config = sim::DemoConfig();
     config.seed = seed;
-    const sim::Simulator simulator(config);
-    pipeline::ScanSource source;
-    source.count = simulator.size();
-    source.load = [&](std::size_t i) { return simulator.Scan(i); };
-    source.time_s = [&](std::size_t i) { return simulator.GroundTruthPose(i).time_s; };
-    core::DescriptorConfig descriptor;
-    descriptor.method = method;
-    const auto described = pipeline::DescribeSequence(source, descriptor);
-    const auto matrix = pipeline::ComputeSimilarityMatrix(described.database);
-    std::vector<core::StampedPose> poses;
-    for (std::size_t i = 0; i < simulator.size(); ++i)
-        poses.push_back(simulator.GroundTruthPose(i));
-    eval::GroundTruthConfig rule;  // Röhling: same place within 10 m
-    rule.min_gap = {30.0, core::MinGap::Unit::kScans};
-    const eval::GroundTruth truth = eval::BuildGroundTruth(poses, rule);
-    return {eval::CollectPairs(matrix.condensed(), truth)};
+    app::WriteSimulation(sim::Simulator(config), folder, /*overwrite=*/false, /*threads=*/0);
+    return io::OpenDataset(folder);
 }
 
-void ExpectLoopsFoundWellAboveChance(core::Method method) {
-    const ScoredSequence train = ScoreDemo(2, method);
-    const double tau = eval::EvaluatePairs(train.pairs).best_mcc.threshold;
-    const ScoredSequence test = ScoreDemo(1, method);
-    const eval::Confusion c = eval::ConfusionAt(test.pairs, tau);
+void ExpectLoopsFoundWellAboveChance(const app::MethodEvaluation& e) {
+    ASSERT_TRUE(e.learnt.has_value()) << e.name;
+    const eval::Confusion& c = e.learnt->test;
     const double recall = eval::Recall(c);
     const double fpr = eval::FalsePositiveRate(c);
     // A detector that guesses finds loops at the rate it raises false alarms (TPR = FPR).
-    EXPECT_GT(recall, 5.0 * fpr) << core::ToString(method) << ": recall " << recall << ", FPR "
-                                 << fpr << " at tau " << tau;
-    EXPECT_GT(c.tp, 20U) << core::ToString(method);
-    EXPECT_GT(eval::Mcc(c), 0.05) << core::ToString(method);
+    EXPECT_GT(recall, 5.0 * fpr) << e.name << ": recall " << recall << ", FPR " << fpr << " at tau "
+                                 << e.learnt->threshold;
+    EXPECT_GT(c.tp, 20U) << e.name;
+    EXPECT_GT(eval::Mcc(c), 0.05) << e.name;
 }
 
-TEST(DemoSequence, HistogramsFindLoopsAtAThresholdChosenOnAnotherSeed) {
-    ExpectLoopsFoundWellAboveChance(core::Method::kHeight);
-}
-
-TEST(DemoSequence, NdtFindsLoopsAtAThresholdChosenOnAnotherSeed) {
-    ExpectLoopsFoundWellAboveChance(core::Method::kNdt);
+TEST(DemoSequence, LoopsFoundAtAThresholdLearntOnAnotherSeed) {
+    const test::TempDir dir;
+    const io::Dataset train = SimulateDemo(2, dir / "seed2");
+    const io::Dataset test = SimulateDemo(1, dir / "seed1");
+    app::EvaluationRequest request;
+    request.methods = {core::Method::kHeight, core::Method::kNdt};
+    request.out = dir / "evaluation";  // Röhling's rule: same place within 10 m, gap 30 scans
+    const app::EvaluationOutcome outcome = app::RunEvaluation(test, request, &train);
+    ASSERT_EQ(outcome.methods.size(), 2U);
+    for (const app::MethodEvaluation& e : outcome.methods) {
+        ExpectLoopsFoundWellAboveChance(e);
+        EXPECT_EQ(e.learnt_on, "all pairs of " + (dir / "seed2").string());
+    }
+    EXPECT_TRUE(std::filesystem::exists(dir / "evaluation" / "metrics.json"));
+    EXPECT_TRUE(std::filesystem::exists(dir / "evaluation" / "report.md"));
 }
 
 }  // namespace

@@ -4,9 +4,9 @@
 #include <string>
 #include <vector>
 
-#include "evaluation_run.hpp"
+#include "lidarloop/app/evaluation.hpp"
 
-namespace lidarloop::cli {
+namespace lidarloop::app {
 
 /// What the report says about the run besides the methods.
 struct ReportContext {
@@ -31,4 +31,4 @@ void WriteReport(const std::filesystem::path& folder, const ReportContext& conte
                  const std::vector<MethodEvaluation>& evaluations,
                  const std::vector<std::string>& notes);
 
-}  // namespace lidarloop::cli
+}  // namespace lidarloop::app

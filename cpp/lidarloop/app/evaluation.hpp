@@ -1,26 +1,28 @@
 #pragma once
 
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
+#include "lidarloop/app/progress.hpp"
 #include "lidarloop/eval/em.hpp"
 #include "lidarloop/eval/ground_truth.hpp"
 #include "lidarloop/eval/pairwise.hpp"
 #include "lidarloop/eval/per_scan.hpp"
 #include "lidarloop/eval/summary.hpp"
 #include "lidarloop/eval/threshold_learning.hpp"
+#include "lidarloop/io/config_yaml.hpp"
+#include "lidarloop/io/dataset.hpp"
 #include "lidarloop/pipeline/similarity_matrix.hpp"
 
-namespace lidarloop::cli {
+namespace lidarloop::app {
 
 /// Everything the evaluation computed for one method (or one external results file) on one
 /// ground truth: both papers' protocols side by side.
 struct MethodEvaluation {
     std::string name;                         ///< height, range, ndt, or results:<file>
-    std::optional<double> default_threshold;  ///< the config's tau / t_d, when a method
+    std::optional<double> default_threshold;  ///< the method's default tau / t_d, when a method
     pipeline::SimilarityMatrix matrix;
     eval::PairwiseEvaluation pairwise;              ///< Röhling IV-B/C
     std::optional<eval::ThresholdTransfer> learnt;  ///< table I: learnt on training pairs
@@ -53,7 +55,40 @@ MethodEvaluation EvaluateMatrix(std::string name, pipeline::SimilarityMatrix mat
                                 const std::vector<double>& fixed_thresholds = {},
                                 const TrainingPairs* training = nullptr);
 
-/// metrics.json's entry for one method.
-nlohmann::json MetricsJson(const MethodEvaluation& evaluation);
+/// The similarity matrix of an external detector's `query,match,distance` CSV: listed pairs get
+/// their distance (the smallest when listed twice), every other pair +inf (never detected).
+/// io::ReadError when a pair names a scan beyond `scans`.
+pipeline::SimilarityMatrix MatrixOfResults(const std::filesystem::path& file, std::size_t scans);
 
-}  // namespace lidarloop::cli
+/// What `lidarloop evaluate` (and `lidarloop demo`) asks for.
+struct EvaluationRequest {
+    io::RunConfig config;  ///< descriptors, and detection.min_gap as the evaluation's gap S
+    std::vector<core::Method> methods;
+    std::vector<std::string> results_files;  ///< other detectors' query,match,distance CSVs
+    double distance_m = 10.0;                ///< same place when closer (Röhling d, Magnusson t_r)
+    double max_heading_deg = 0.0;            ///< and headings closer than this; 0: any
+    eval::ThresholdLearningConfig learning;
+    std::vector<double> fixed_thresholds;  ///< MCC at each, as Röhling's table II
+    bool skip_bad = false;
+    Progress progress;
+    std::filesystem::path out;  ///< the results folder (created)
+};
+
+struct EvaluationOutcome {
+    eval::GroundTruth truth;
+    std::vector<MethodEvaluation> methods;
+    std::vector<std::string> notes;  ///< figures that could not be drawn
+};
+
+/// The ground-truth rule of `request`: its distance, heading and the config's minimum gap.
+eval::GroundTruthConfig GroundTruthRule(const EvaluationRequest& request);
+
+/// Evaluates every method and results file on one ground truth from the dataset's poses and
+/// writes config.yaml, metrics.json, roc.csv, pr.csv, the images and figures and report.md into
+/// request.out. With `train_dataset` (which needs poses too), each method's threshold is learnt
+/// on all its pairs under the same ground-truth rule and tested on all pairs of `dataset`;
+/// results files keep learning on the first part. ConfigError when a dataset has no poses.
+EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequest& request,
+                                const io::Dataset* train_dataset = nullptr);
+
+}  // namespace lidarloop::app

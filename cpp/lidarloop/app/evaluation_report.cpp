@@ -1,4 +1,4 @@
-#include "evaluation_report.hpp"
+#include "lidarloop/app/evaluation_report.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -8,7 +8,7 @@
 #include "lidarloop/io/png.hpp"
 #include "lidarloop/io/read_error.hpp"
 
-namespace lidarloop::cli {
+namespace lidarloop::app {
 namespace {
 
 constexpr std::uint8_t kBlack = 0;
@@ -153,6 +153,86 @@ std::string LearningCriterion(const std::vector<MethodEvaluation>& evaluations) 
     return "–";
 }
 
+void WritePairwiseTable(std::ostream& out, const std::vector<MethodEvaluation>& evaluations) {
+    out << "## All scan pairs (Röhling et al. 2015, tables I and II, fig. 4)\n\n"
+        << "| method | pairs (loops) | best MCC (τ) | best F1 (τ) | ROC AUC | learnt τ → test F1 "
+           "/ MCC | MCC at the default τ |\n|---|---|---|---|---|---|---|\n";
+    for (const MethodEvaluation& e : evaluations) {
+        const auto& p = e.pairwise;
+        out << "| " << e.name << " | " << p.pairs << " (" << p.positives << ") | "
+            << Number(p.best_mcc.score, 3) << " (" << Number(p.best_mcc.threshold) << ") | "
+            << Number(p.best_f1.score, 3) << " (" << Number(p.best_f1.threshold) << ") | "
+            << (p.roc_auc ? Number(*p.roc_auc, 3) : "–") << " | ";
+        if (e.learnt) {
+            out << Number(e.learnt->threshold) << " → " << Number(e.learnt->test_f1, 3) << " / "
+                << Number(e.learnt->test_mcc, 3);
+        } else {
+            out << "–";
+        }
+        out << " | "
+            << (e.at_default ? Number(eval::Mcc(*e.at_default), 3) +
+                                   " (τ = " + Number(*e.default_threshold) + ")"
+                             : "–")
+            << " |\n";
+    }
+    out << "\nLearnt τ (criterion: best " << LearningCriterion(evaluations) << ") trained on: ";
+    for (const MethodEvaluation& e : evaluations) {
+        if (e.learnt) out << e.name << " — " << e.learnt_on << "; ";
+    }
+    out << "tested on all pairs of this sequence not used for training.\n";
+}
+
+void WriteFixedThresholdTable(std::ostream& out, const std::vector<MethodEvaluation>& evaluations) {
+    if (evaluations.empty() || evaluations.front().fixed_thresholds.empty()) return;
+    out << "\nMCC at fixed thresholds (table II):\n\n| method |";
+    for (double tau : evaluations.front().fixed_thresholds) out << " L_" << Number(tau) << " |";
+    out << "\n|---|";
+    for (std::size_t t = 0; t < evaluations.front().fixed_thresholds.size(); ++t) out << "---|";
+    out << "\n";
+    for (const MethodEvaluation& e : evaluations) {
+        out << "| " << e.name << " |";
+        for (const eval::Confusion& c : e.at_fixed) out << " " << Number(eval::Mcc(c), 3) << " |";
+        out << "\n";
+    }
+}
+
+void WritePerScanTable(std::ostream& out, const std::vector<MethodEvaluation>& evaluations) {
+    out << "\n## Every scan and its most similar scan (Magnusson et al. 2009, tables I and II, "
+           "figs. 1 and 2)\n\n| method | overlapping / other scans | recall at zero errors "
+           "(t_d) | EM t_d | median best/second ratio |\n|---|---|---|---|---|\n";
+    for (const MethodEvaluation& e : evaluations) {
+        const auto& z = e.per_scan.zero_error;
+        out << "| " << e.name << " | " << e.per_scan.overlapping << " / "
+            << e.per_scan.non_overlapping << " | " << Number(100.0 * z.recall, 3) << " % ("
+            << Number(z.t_d) << ") | " << (e.em.t_d ? Number(*e.em.t_d) : "–") << " | "
+            << (e.distinctiveness.ratio ? Number(e.distinctiveness.ratio->median, 3) : "–")
+            << " |\n";
+    }
+    out << "\nZero errors: no false positive and no mismatch (table I). Timings on this "
+           "machine: ";
+    for (const MethodEvaluation& e : evaluations) {
+        out << e.name << " " << Number(e.describe_ms_per_scan_median, 3) << " ms per scan, "
+            << Number(e.ns_per_comparison, 3) << " ns per comparison; ";
+    }
+}
+
+void WriteFigureGallery(std::ostream& out, const std::vector<MethodEvaluation>& evaluations) {
+    out << "\n\n## Similarity matrices (black: pairs under the best-MCC threshold; grey: inside "
+           "the minimum gap, not evaluated)\n\n| ground truth |";
+    for (const MethodEvaluation& e : evaluations) out << " " << e.name << " |";
+    out << "\n|---|";
+    for (std::size_t i = 0; i < evaluations.size(); ++i) out << "---|";
+    out << "\n| ![](ground_truth.png) |";
+    for (const MethodEvaluation& e : evaluations) {
+        out << " ![](similarity_" << FileSafe(e.name) << ".png) |";
+    }
+    out << "\n\n## Curves\n\n![ROC](roc.png) ![precision-recall](pr.png)\n\n";
+    for (const MethodEvaluation& e : evaluations) {
+        out << "![EM " << e.name << "](em_" << FileSafe(e.name) << ".png) ![counts " << e.name
+            << "](counts_" << FileSafe(e.name) << ".png)\n\n";
+    }
+}
+
 }  // namespace
 
 void WriteCurveCsvs(const std::filesystem::path& folder,
@@ -208,78 +288,12 @@ void WriteReport(const std::filesystem::path& folder, const ReportContext& conte
     std::ofstream out(folder / "report.md");
     out << "# Loop detection on " << context.dataset << "\n\n"
         << context.scans << " scans. Ground truth: " << context.ground_truth_rule << "\n\n";
-    out << "## All scan pairs (Röhling et al. 2015, tables I and II, fig. 4)\n\n"
-        << "| method | pairs (loops) | best MCC (τ) | best F1 (τ) | ROC AUC | learnt τ → test F1 "
-           "/ MCC | MCC at the default τ |\n|---|---|---|---|---|---|---|\n";
-    for (const MethodEvaluation& e : evaluations) {
-        const auto& p = e.pairwise;
-        out << "| " << e.name << " | " << p.pairs << " (" << p.positives << ") | "
-            << Number(p.best_mcc.score, 3) << " (" << Number(p.best_mcc.threshold) << ") | "
-            << Number(p.best_f1.score, 3) << " (" << Number(p.best_f1.threshold) << ") | "
-            << (p.roc_auc ? Number(*p.roc_auc, 3) : "–") << " | ";
-        if (e.learnt) {
-            out << Number(e.learnt->threshold) << " → " << Number(e.learnt->test_f1, 3) << " / "
-                << Number(e.learnt->test_mcc, 3);
-        } else {
-            out << "–";
-        }
-        out << " | "
-            << (e.at_default ? Number(eval::Mcc(*e.at_default), 3) +
-                                   " (τ = " + Number(*e.default_threshold) + ")"
-                             : "–")
-            << " |\n";
-    }
-    out << "\nLearnt τ (criterion: best " << LearningCriterion(evaluations) << ") trained on: ";
-    for (const MethodEvaluation& e : evaluations) {
-        if (e.learnt) out << e.name << " — " << e.learnt_on << "; ";
-    }
-    out << "tested on all pairs of this sequence not used for training.\n";
-    if (!evaluations.empty() && !evaluations.front().fixed_thresholds.empty()) {
-        out << "\nMCC at fixed thresholds (table II):\n\n| method |";
-        for (double tau : evaluations.front().fixed_thresholds) out << " L_" << Number(tau) << " |";
-        out << "\n|---|";
-        for (std::size_t t = 0; t < evaluations.front().fixed_thresholds.size(); ++t) out << "---|";
-        out << "\n";
-        for (const MethodEvaluation& e : evaluations) {
-            out << "| " << e.name << " |";
-            for (const eval::Confusion& c : e.at_fixed)
-                out << " " << Number(eval::Mcc(c), 3) << " |";
-            out << "\n";
-        }
-    }
-    out << "\n## Every scan and its most similar scan (Magnusson et al. 2009, tables I and II, "
-           "figs. 1 and 2)\n\n| method | overlapping / other scans | recall at zero errors "
-           "(t_d) | EM t_d | median best/second ratio |\n|---|---|---|---|---|\n";
-    for (const MethodEvaluation& e : evaluations) {
-        const auto& z = e.per_scan.zero_error;
-        out << "| " << e.name << " | " << e.per_scan.overlapping << " / "
-            << e.per_scan.non_overlapping << " | " << Number(100.0 * z.recall, 3) << " % ("
-            << Number(z.t_d) << ") | " << (e.em.t_d ? Number(*e.em.t_d) : "–") << " | "
-            << (e.distinctiveness.ratio ? Number(e.distinctiveness.ratio->median, 3) : "–")
-            << " |\n";
-    }
-    out << "\nZero errors: no false positive and no mismatch (table I). Timings on this "
-           "machine: ";
-    for (const MethodEvaluation& e : evaluations) {
-        out << e.name << " " << Number(e.describe_ms_per_scan_median, 3) << " ms per scan, "
-            << Number(e.ns_per_comparison, 3) << " ns per comparison; ";
-    }
-    out << "\n\n## Similarity matrices (black: pairs under the best-MCC threshold; grey: inside "
-           "the minimum gap, not evaluated)\n\n| ground truth |";
-    for (const MethodEvaluation& e : evaluations) out << " " << e.name << " |";
-    out << "\n|---|";
-    for (std::size_t i = 0; i < evaluations.size(); ++i) out << "---|";
-    out << "\n| ![](ground_truth.png) |";
-    for (const MethodEvaluation& e : evaluations) {
-        out << " ![](similarity_" << FileSafe(e.name) << ".png) |";
-    }
-    out << "\n\n## Curves\n\n![ROC](roc.png) ![precision-recall](pr.png)\n\n";
-    for (const MethodEvaluation& e : evaluations) {
-        out << "![EM " << e.name << "](em_" << FileSafe(e.name) << ".png) ![counts " << e.name
-            << "](counts_" << FileSafe(e.name) << ".png)\n\n";
-    }
+    WritePairwiseTable(out, evaluations);
+    WriteFixedThresholdTable(out, evaluations);
+    WritePerScanTable(out, evaluations);
+    WriteFigureGallery(out, evaluations);
     for (const std::string& note : notes) out << "Note: " << note << "\n\n";
     if (!out) throw io::WriteError(folder / "report.md", "writing failed");
 }
 
-}  // namespace lidarloop::cli
+}  // namespace lidarloop::app

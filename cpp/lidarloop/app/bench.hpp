@@ -1,0 +1,27 @@
+#pragma once
+
+#include <cstddef>
+
+#include <nlohmann/json.hpp>
+
+#include "lidarloop/app/progress.hpp"
+#include "lidarloop/io/config_yaml.hpp"
+#include "lidarloop/io/dataset.hpp"
+
+namespace lidarloop::app {
+
+/// What `lidarloop bench` asks for.
+struct BenchRequest {
+    io::RunConfig config;
+    std::size_t queries = 200;  ///< query scans to time
+    std::size_t scale_to = 0;   ///< also time queries against this many histograms (synthetic)
+    Progress progress;
+};
+
+/// Times describing (one core), the similarity matrix (one core and all cores), and top-1
+/// queries through the index and by brute force on `dataset`; with scale_to, also queries
+/// against a synthetic database of that many perturbed histograms. The figures as JSON (keys in
+/// docs/cli.md), with the peak memory of the process.
+nlohmann::json RunBench(const io::Dataset& dataset, const BenchRequest& request);
+
+}  // namespace lidarloop::app

@@ -1,0 +1,91 @@
+#include "lidarloop/app/describe_run.hpp"
+
+#include <thread>
+
+#include "lidarloop/app/results_folder.hpp"
+#include "lidarloop/core/error.hpp"
+#include "lidarloop/io/read_error.hpp"
+#include "lidarloop/io/scan_reader.hpp"
+
+namespace lidarloop::app {
+
+pipeline::ScanSource SourceOf(const io::Dataset& dataset) {
+    pipeline::ScanSource source;
+    source.count = dataset.size();
+    source.load = [&dataset](std::size_t i) { return dataset.LoadScan(i); };
+    source.time_s = [&dataset](std::size_t i) {
+        return dataset.HasPoses() ? dataset.poses()[i].time_s : static_cast<double>(i);
+    };
+    return source;
+}
+
+core::Descriptor DescribeScanFile(const std::filesystem::path& file,
+                                  const core::DescriptorConfig& config) {
+    const core::PointCloud cloud = io::ReadScan(file);
+    try {
+        return core::ComputeDescriptor(cloud, config);
+    } catch (const core::EmptyInputError& e) {
+        throw io::ReadError(file, e.what());
+    }
+}
+
+pipeline::SequenceDescriptors DescribeDataset(const io::Dataset& dataset,
+                                              const core::DescriptorConfig& config,
+                                              const DescribeRun& run) {
+    pipeline::DescribeOptions options;
+    options.skip_bad = run.skip_bad;
+    options.execution = run.execution;
+    if (run.progress) {
+        options.progress = [&run](std::size_t done, std::size_t n) {
+            run.progress(run.stage, done, n);
+        };
+    }
+    return pipeline::DescribeSequence(SourceOf(dataset), config, options);
+}
+
+namespace {
+
+// How much work the NDT descriptors of a sequence were: rotation candidates (section II-C, one
+// descriptor each) and classified cells per valid scan, so that a time per scan can be read
+// against what it covered.
+nlohmann::json NdtSetSizesJson(const pipeline::DescriptorDatabase& database) {
+    std::vector<double> candidates;
+    std::vector<double> cells;
+    for (std::size_t i = 0; i < database.size(); ++i) {
+        if (!database.IsValid(i)) continue;
+        const core::NdtDescriptorSet& set = database.ndt_sets()[i];
+        candidates.push_back(static_cast<double>(set.descriptors.size()));
+        cells.push_back(set.descriptors.empty() ? 0.0 : set.descriptors.front().total);
+    }
+    return {{"rotation_candidates_per_scan", SummaryJson(candidates)},
+            {"classified_cells_per_scan", SummaryJson(cells)}};
+}
+
+}  // namespace
+
+nlohmann::json DescribeTimingsJson(const pipeline::SequenceDescriptors& described) {
+    const auto ms = [](std::vector<double> seconds, double q) {
+        return 1e3 * Quantile(std::move(seconds), q);
+    };
+    nlohmann::json json;
+    json["scans"] = described.database.size();
+    json["threads"] = std::thread::hardware_concurrency();
+    json["describe_ms_per_scan"] = {{"median", ms(described.describe_seconds, 0.5)},
+                                    {"p95", ms(described.describe_seconds, 0.95)}};
+    json["describe_ms_per_scan"]["max"] = ms(described.describe_seconds, 1.0);
+    json["load_ms_per_scan"] = {{"median", ms(described.load_seconds, 0.5)},
+                                {"p95", ms(described.load_seconds, 0.95)}};
+    if (!described.database.ndt_sets().empty()) json["ndt"] = NdtSetSizesJson(described.database);
+    return json;
+}
+
+nlohmann::json TimingsJson(const pipeline::SequenceDescriptors& described, std::size_t pairs,
+                           double matrix_s) {
+    nlohmann::json json = DescribeTimingsJson(described);
+    json["similarity_matrix_s"] = matrix_s;
+    json["pairs"] = pairs;
+    json["ns_per_comparison_wall"] = pairs > 0 ? 1e9 * matrix_s / static_cast<double>(pairs) : 0.0;
+    return json;
+}
+
+}  // namespace lidarloop::app

@@ -1,0 +1,118 @@
+#include "lidarloop/app/detection.hpp"
+
+#include "lidarloop/app/describe_run.hpp"
+#include "lidarloop/app/results_folder.hpp"
+#include "lidarloop/core/descriptor.hpp"
+#include "lidarloop/core/error.hpp"
+#include "lidarloop/io/database_file.hpp"
+#include "lidarloop/io/png.hpp"
+#include "lidarloop/io/similarity_file.hpp"
+#include "lidarloop/io/similarity_image.hpp"
+
+namespace lidarloop::app {
+namespace {
+
+void RequireTimesForSeconds(const io::RunConfig& config, const io::Dataset& dataset) {
+    if (config.detection.min_gap.unit == core::MinGap::Unit::kSeconds && !dataset.HasPoses()) {
+        throw core::ConfigError("a minimum gap in seconds needs scan times, and " +
+                                dataset.root().string() +
+                                " has no poses; give --poses or a gap in scans");
+    }
+}
+
+void WriteDetectResults(const std::filesystem::path& out_dir, const io::RunConfig& config,
+                        const pipeline::SequenceDescriptors& described,
+                        const pipeline::SimilarityMatrix& matrix, const DetectOutcome& outcome) {
+    const core::Method method = config.descriptor.method;
+    WriteLoopsCsv(out_dir / "loops.csv", outcome.queries);
+    WriteCandidatesCsv(out_dir / "candidates.csv", outcome.queries);
+    io::WriteSimilarityMatrix(out_dir / "similarity.bin", matrix, method);
+    io::WritePng(out_dir / "similarity.png", io::ThresholdImage(matrix, method, outcome.threshold));
+    io::WritePng(out_dir / "similarity_distance.png", io::DistanceImage(matrix));
+    WriteSkipped(out_dir, described.skipped);
+    io::SaveDatabase(out_dir / "database.lldb", described.database);
+}
+
+}  // namespace
+
+DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request) {
+    const io::RunConfig& config = request.config;
+    config.Validate();
+    RequireTimesForSeconds(config, dataset);
+    const std::filesystem::path out_dir = PrepareOutputFolder(request.out);
+    io::WriteConfigYaml(out_dir / "config.yaml", config);
+
+    Stopwatch total;
+    Stopwatch describe_clock;
+    const pipeline::SequenceDescriptors described = DescribeDataset(
+        dataset, config.descriptor,
+        {"describing", request.skip_bad, pipeline::Execution::kParallel, request.progress});
+    const double describe_s = describe_clock.Seconds();
+
+    Stopwatch matrix_clock;
+    const pipeline::SimilarityMatrix matrix = pipeline::ComputeSimilarityMatrix(described.database);
+    const double matrix_s = matrix_clock.Seconds();
+    DetectOutcome outcome;
+    outcome.threshold = core::DefaultThreshold(config.descriptor);
+    outcome.queries =
+        pipeline::DetectFromMatrix(matrix, described.database.times_s(), config.detection,
+                                   config.descriptor.method, outcome.threshold);
+    outcome.accepted = CountAccepted(outcome.queries);
+    outcome.skipped = described.skipped;
+    WriteDetectResults(out_dir, config, described, matrix, outcome);
+
+    nlohmann::json timings = TimingsJson(described, matrix.condensed().size(), matrix_s);
+    timings["describe_total_s"] = describe_s;
+    outcome.total_s = total.Seconds();
+    timings["total_s"] = outcome.total_s;
+    WriteJson(out_dir / "timings.json", timings);
+    return outcome;
+}
+
+LoadedMap LoadMap(const std::filesystem::path& file) {
+    Stopwatch clock;
+    pipeline::DescriptorDatabase database = io::LoadDatabase(file);
+    return {file, std::move(database), clock.Seconds()};
+}
+
+DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const DetectRequest& request) {
+    Stopwatch total;
+    const io::RunConfig& config = request.config;
+    config.Validate();
+    if (!core::DescribesAlike(config.descriptor, map.database.config())) {
+        throw core::ConfigError("the configuration changes how scans are described, but the map " +
+                                map.file.string() + " fixes that");
+    }
+    const pipeline::LoopDetector detector(std::move(map.database), config.detection,
+                                          core::DefaultThreshold(config.descriptor));
+    const std::filesystem::path out_dir = PrepareOutputFolder(request.out);
+    io::WriteConfigYaml(out_dir / "config.yaml", config);
+
+    const pipeline::SequenceDescriptors described = DescribeDataset(
+        dataset, config.descriptor,
+        {"describing", request.skip_bad, pipeline::Execution::kParallel, request.progress});
+    Stopwatch query_clock;
+    DetectOutcome outcome;
+    outcome.queries = pipeline::LocaliseSequence(detector, described.database);
+    const double query_s = query_clock.Seconds();
+    outcome.threshold = detector.threshold();
+    outcome.map_scans = detector.database().size();
+    outcome.accepted = CountAccepted(outcome.queries);
+    outcome.skipped = described.skipped;
+
+    WriteLoopsCsv(out_dir / "loops.csv", outcome.queries);
+    WriteCandidatesCsv(out_dir / "candidates.csv", outcome.queries);
+    WriteSkipped(out_dir, described.skipped);
+    nlohmann::json timings = DescribeTimingsJson(described);
+    timings["map"] = map.file.string();
+    timings["map_scans"] = detector.database().size();
+    timings["load_map_s"] = map.load_s;
+    timings["query_ms_per_scan_wall"] =
+        outcome.queries.empty() ? 0.0 : 1e3 * query_s / static_cast<double>(outcome.queries.size());
+    outcome.total_s = total.Seconds() + map.load_s;
+    timings["total_s"] = outcome.total_s;
+    WriteJson(out_dir / "timings.json", timings);
+    return outcome;
+}
+
+}  // namespace lidarloop::app

@@ -1,0 +1,53 @@
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "lidarloop/app/progress.hpp"
+#include "lidarloop/io/config_yaml.hpp"
+#include "lidarloop/io/dataset.hpp"
+#include "lidarloop/pipeline/loop_detector.hpp"
+
+namespace lidarloop::app {
+
+/// What `lidarloop detect` asks for.
+struct DetectRequest {
+    io::RunConfig config;   ///< how scans are described and how loops are decided
+    bool skip_bad = false;  ///< unreadable scans are listed in skipped.txt instead of stopping
+    Progress progress;
+    std::filesystem::path out;  ///< the results folder (created)
+};
+
+struct DetectOutcome {
+    std::vector<pipeline::LoopQuery> queries;  ///< one per scan, in scan order
+    double threshold = 0.0;                    ///< the decision threshold applied
+    std::size_t accepted = 0;                  ///< scans whose best match was accepted
+    std::vector<std::string> skipped;          ///< "scan 17: <reason>" per skipped scan
+    std::size_t map_scans = 0;                 ///< scans of the map (localisation only)
+    double total_s = 0.0;
+};
+
+/// Offline detection over a whole sequence: describes every scan, computes the similarity
+/// matrix, finds each scan's candidates among the earlier scans outside the minimum gap, and
+/// writes loops.csv, candidates.csv, similarity.bin, similarity.png, similarity_distance.png,
+/// database.lldb, config.yaml, timings.json (and skipped.txt) into request.out.
+DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request);
+
+/// A saved descriptor database to localise against.
+struct LoadedMap {
+    std::filesystem::path file;
+    pipeline::DescriptorDatabase database;
+    double load_s = 0.0;
+};
+
+/// Loads a database.lldb written by RunDetect (io::ReadError naming what is wrong).
+LoadedMap LoadMap(const std::filesystem::path& file);
+
+/// Localisation: every scan of `dataset` is searched in `map` and not added to it.
+/// request.config must describe scans as the map does (core::DescribesAlike; ConfigError
+/// otherwise); its detection keys apply. Writes loops.csv (query scan, map scan),
+/// candidates.csv, config.yaml, timings.json (and skipped.txt) into request.out.
+DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const DetectRequest& request);
+
+}  // namespace lidarloop::app

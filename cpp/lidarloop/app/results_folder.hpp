@@ -1,0 +1,49 @@
+#pragma once
+
+#include <chrono>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "lidarloop/pipeline/loop_detector.hpp"
+
+namespace lidarloop::app {
+
+/// Creates `folder` (and parents); io::WriteError when that is impossible.
+std::filesystem::path PrepareOutputFolder(const std::filesystem::path& folder);
+
+/// Wall-clock seconds since construction.
+class Stopwatch {
+public:
+    double Seconds() const {
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    }
+
+private:
+    std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+/// The q-quantile (0..1) of `values` (eval::Quantile after sorting); 0 for an empty list.
+double Quantile(std::vector<double> values, double q);
+
+/// {median, p95, max} of `values` times `scale`.
+nlohmann::json SummaryJson(const std::vector<double>& values, double scale = 1.0);
+
+void WriteJson(const std::filesystem::path& file, const nlohmann::json& json);
+/// Writes skipped.txt (one line per skipped scan) when any scan was skipped.
+void WriteSkipped(const std::filesystem::path& folder, const std::vector<std::string>& skipped);
+
+/// loops.csv: one row per query scan with a candidate, its best match
+/// (query,match,distance,second_ratio,accepted).
+void WriteLoopsCsv(const std::filesystem::path& file,
+                   const std::vector<pipeline::LoopQuery>& queries);
+/// candidates.csv: every candidate of every query (query,rank,match,distance).
+void WriteCandidatesCsv(const std::filesystem::path& file,
+                        const std::vector<pipeline::LoopQuery>& queries);
+
+/// Query scans whose best match was accepted.
+std::size_t CountAccepted(const std::vector<pipeline::LoopQuery>& queries);
+
+}  // namespace lidarloop::app

@@ -1,0 +1,140 @@
+#include "lidarloop/app/simulation.hpp"
+
+#include <atomic>
+#include <charconv>
+#include <chrono>
+#include <fstream>
+#include <limits>
+#include <string>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "lidarloop/io/kitti_sequence.hpp"
+#include "lidarloop/io/read_error.hpp"
+
+namespace lidarloop::app {
+namespace {
+
+constexpr std::size_t kPoseChunk = 4096;
+
+std::string Number(double value) {
+    char buffer[64];
+    const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+    return std::string(buffer, result.ptr);
+}
+
+// The effective parameters, so that a sequence can be made again and its origin is known.
+void WriteSimulationYaml(const std::filesystem::path& file, const sim::Simulator& simulator) {
+    const sim::SimulationConfig& c = simulator.config();
+    const sim::SensorSpec& s = simulator.sensor();
+    std::ofstream out(file);
+    out << "# lidarloop " << LIDARLOOP_VERSION << " simulate: the parameters of this sequence\n"
+        << "scene: " << sim::ToString(c.scene) << "\n"
+        << "scans: " << c.scans << "\n"
+        << "seed: " << c.seed << "\n"
+        << "route:\n"
+        << "  type: " << sim::ToString(c.route.type) << "\n"
+        << "  spacing_min_m: " << Number(c.route.spacing_min_m) << "\n"
+        << "  spacing_max_m: " << Number(c.route.spacing_max_m) << "\n"
+        << "  uturn_blocks: " << c.route.uturn_blocks << "\n"
+        << "  lap_length_m: " << Number(simulator.route().lap_length_m()) << "\n"
+        << "sensor:\n"
+        << "  model: " << sim::ToString(s.model) << "\n"
+        << "  beams: " << s.beams << "\n"
+        << "  horizontal_steps: " << s.horizontal_steps << "\n"
+        << "  min_range_m: " << Number(s.min_range_m) << "\n"
+        << "  max_range_m: " << Number(s.max_range_m) << "\n"
+        << "  mount_height_m: " << Number(s.mount_height_m) << "\n"
+        << "  scan_period_s: " << Number(s.scan_period_s) << "\n"
+        << "  noise_m: " << Number(s.noise_m) << "\n"
+        << "  dropout: " << Number(s.dropout) << "\n"
+        << "odometry:\n"
+        << "  yaw_noise_deg: " << Number(c.odometry.yaw_noise_deg) << "\n"
+        << "  translation_noise: " << Number(c.odometry.translation_noise) << "\n"
+        << "files:\n"
+        << "  scans: velodyne/NNNNNN.bin  # KITTI float32 x y z intensity(0), sensor frame\n"
+        << "  poses: poses.txt  # ground truth T_world_sensor, 3x4 row-major, LiDAR frame\n"
+        << "  odometry: poses_odometry.txt  # the same with accumulated drift\n"
+        << "  times: times.txt  # seconds\n";
+    out.close();
+    if (!out) throw io::WriteError(file, "writing failed");
+}
+
+struct ScanStats {
+    std::atomic<std::size_t> points{0};
+    std::atomic<std::size_t> min_points{std::numeric_limits<std::size_t>::max()};
+    std::atomic<std::size_t> max_points{0};
+    std::atomic<std::size_t> done{0};
+
+    void Add(std::size_t count) {
+        points += count;
+        std::size_t seen = min_points.load();
+        while (count < seen && !min_points.compare_exchange_weak(seen, count)) {
+        }
+        seen = max_points.load();
+        while (count > seen && !max_points.compare_exchange_weak(seen, count)) {
+        }
+        ++done;
+    }
+};
+
+void WriteScans(const sim::Simulator& simulator, const io::KittiSequenceWriter& writer, int threads,
+                const Progress& progress, ScanStats& stats) {
+    tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
+    arena.execute([&] {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, simulator.size(), 1),
+                          [&](const tbb::blocked_range<std::size_t>& range) {
+                              for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                                  const core::PointCloud cloud = simulator.Scan(i);
+                                  writer.WriteScan(i, cloud);
+                                  stats.Add(cloud.size());
+                                  if (progress) progress("simulate", stats.done, simulator.size());
+                              }
+                          });
+    });
+}
+
+void WritePoses(const sim::Simulator& simulator, io::KittiSequenceWriter& writer) {
+    for (std::size_t first = 0; first < simulator.size(); first += kPoseChunk) {
+        const std::size_t count = std::min(kPoseChunk, simulator.size() - first);
+        const std::vector<core::StampedPose> odometry = simulator.OdometryPoses(first, count);
+        for (std::size_t k = 0; k < count; ++k) {
+            writer.AppendPose(simulator.GroundTruthPose(first + k));
+            writer.AppendOdometryPose(odometry[k]);
+        }
+    }
+    writer.Finish();
+}
+
+}  // namespace
+
+SimulationSummary WriteSimulation(const sim::Simulator& simulator, const std::filesystem::path& out,
+                                  bool overwrite, int threads, const Progress& progress) {
+    const auto start = std::chrono::steady_clock::now();
+    io::KittiSequenceWriter writer(out, overwrite);
+    ScanStats stats;
+    WriteScans(simulator, writer, threads, progress, stats);
+    WritePoses(simulator, writer);
+    WriteSimulationYaml(writer.dir() / "simulation.yaml", simulator);
+    SimulationSummary summary;
+    summary.mean_points = stats.points / simulator.size();
+    summary.min_points = stats.min_points;
+    summary.max_points = stats.max_points;
+    summary.revisited_scans = sim::CountRevisitedScans(simulator, kRevisitGap, kRevisitDistance_m);
+    summary.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return summary;
+}
+
+DemoSequence PrepareDemoSequence(const std::filesystem::path& folder, const Progress& progress) {
+    DemoSequence demo{folder, std::nullopt};
+    if (std::filesystem::exists(folder / "simulation.yaml")) return demo;
+    const sim::Simulator simulator(sim::DemoConfig());
+    demo.generated =
+        WriteSimulation(simulator, folder, /*overwrite=*/true, /*threads=*/0, progress);
+    return demo;
+}
+
+}  // namespace lidarloop::app

@@ -1,0 +1,124 @@
+// The detect and localise runs: what they return equals what the pipeline gives for the same
+// descriptors, and the results folder holds what the outcome says.
+#include <fstream>
+#include <mutex>
+#include <set>
+
+#include <gtest/gtest.h>
+
+#include "app_test_utils.hpp"
+#include "lidarloop/app/describe_run.hpp"
+#include "lidarloop/app/detection.hpp"
+#include "lidarloop/core/error.hpp"
+#include "lidarloop/io/results_csv.hpp"
+#include "test_utils.hpp"
+
+namespace lidarloop {
+namespace {
+
+std::size_t CsvRows(const std::filesystem::path& file) {
+    std::ifstream in(file);
+    std::size_t lines = 0;
+    for (std::string line; std::getline(in, line);) ++lines;
+    return lines - 1;  // header
+}
+
+class DetectionRun : public ::testing::Test {
+protected:
+    void SetUp() override { dataset_.emplace(test::SmallSequence(dir_ / "sequence")); }
+    app::DetectRequest Request(const std::string& out, core::Method method) const {
+        app::DetectRequest request;
+        request.config.descriptor.method = method;
+        request.config.detection.min_gap.value = 10;
+        request.out = dir_ / out;
+        return request;
+    }
+
+    test::TempDir dir_;
+    std::optional<io::Dataset> dataset_;
+};
+
+TEST_F(DetectionRun, EqualsThePipelineOnTheSameDescriptors) {
+    for (core::Method method : {core::Method::kRange, core::Method::kNdt}) {
+        const app::DetectRequest request = Request("detect_" + core::ToString(method), method);
+        const app::DetectOutcome outcome = app::RunDetect(*dataset_, request);
+        const auto described =
+            pipeline::DescribeSequence(app::SourceOf(*dataset_), request.config.descriptor);
+        const double threshold = core::DefaultThreshold(request.config.descriptor);
+        const auto expected = pipeline::DetectFromMatrix(
+            pipeline::ComputeSimilarityMatrix(described.database), described.database.times_s(),
+            request.config.detection, method, threshold);
+        ASSERT_EQ(outcome.queries.size(), expected.size());
+        std::size_t with_match = 0;
+        for (std::size_t i = 0; i < expected.size(); ++i) {
+            ASSERT_EQ(outcome.queries[i].candidates.size(), expected[i].candidates.size());
+            for (std::size_t r = 0; r < expected[i].candidates.size(); ++r) {
+                EXPECT_EQ(outcome.queries[i].candidates[r].index, expected[i].candidates[r].index);
+            }
+            EXPECT_EQ(outcome.queries[i].accepted, expected[i].accepted);
+            with_match += expected[i].has_match() ? 1 : 0;
+        }
+        EXPECT_EQ(outcome.threshold, threshold);
+        EXPECT_GT(outcome.accepted, 0U);
+        EXPECT_EQ(CsvRows(request.out / "loops.csv"), with_match);
+        for (const char* file : {"candidates.csv", "similarity.bin", "similarity.png",
+                                 "database.lldb", "config.yaml", "timings.json"}) {
+            EXPECT_TRUE(std::filesystem::exists(request.out / file)) << file;
+        }
+        EXPECT_FALSE(std::filesystem::exists(request.out / "skipped.txt"));
+    }
+}
+
+TEST_F(DetectionRun, LocalisingTheSequenceAgainstItsOwnMapFindsEveryScanItself) {
+    const app::DetectRequest detect = Request("detect", core::Method::kRange);
+    app::RunDetect(*dataset_, detect);
+    app::DetectRequest localise = Request("localise", core::Method::kRange);
+    const app::DetectOutcome outcome =
+        app::RunLocalise(*dataset_, app::LoadMap(detect.out / "database.lldb"), localise);
+    EXPECT_EQ(outcome.map_scans, dataset_->size());
+    ASSERT_EQ(outcome.queries.size(), dataset_->size());
+    for (const pipeline::LoopQuery& q : outcome.queries) {
+        ASSERT_TRUE(q.has_match());
+        EXPECT_EQ(q.candidates.front().distance, 0.0) << "scan " << q.query;
+    }
+    EXPECT_EQ(outcome.accepted, dataset_->size());
+}
+
+TEST_F(DetectionRun, AMapDescribedOtherwiseIsAClearError) {
+    const app::DetectRequest detect = Request("detect", core::Method::kRange);
+    app::RunDetect(*dataset_, detect);
+    app::DetectRequest localise = Request("localise", core::Method::kRange);
+    localise.config.descriptor.histogram.bins = 50;
+    EXPECT_THROW(app::RunLocalise(*dataset_, app::LoadMap(detect.out / "database.lldb"), localise),
+                 core::ConfigError);
+    EXPECT_FALSE(std::filesystem::exists(localise.out));
+}
+
+TEST_F(DetectionRun, ReportsProgressOfEveryScanAndEndsTheStage) {
+    app::DetectRequest request = Request("detect", core::Method::kHeight);
+    std::mutex mutex;
+    std::set<std::size_t> seen;
+    std::set<std::string> stages;
+    request.progress = [&](const std::string& stage, std::size_t done, std::size_t total) {
+        const std::lock_guard<std::mutex> lock(mutex);
+        EXPECT_EQ(total, dataset_->size());
+        stages.insert(stage);
+        seen.insert(done);
+    };
+    app::RunDetect(*dataset_, request);
+    EXPECT_EQ(stages, std::set<std::string>{"describing"});
+    EXPECT_EQ(seen.size(), dataset_->size());
+    EXPECT_EQ(*seen.rbegin(), dataset_->size());
+}
+
+TEST_F(DetectionRun, AGapInSecondsWithoutTimesIsAClearError) {
+    std::filesystem::create_directories(dir_ / "bare" / "velodyne");
+    std::filesystem::copy(dir_ / "sequence" / "velodyne", dir_ / "bare" / "velodyne");
+    const io::Dataset bare = io::OpenDataset(dir_ / "bare");
+    app::DetectRequest request = Request("detect", core::Method::kHeight);
+    request.config.detection.min_gap = {5.0, core::MinGap::Unit::kSeconds};
+    EXPECT_THROW(app::RunDetect(bare, request), core::ConfigError);
+}
+
+}  // namespace
+}  // namespace lidarloop
