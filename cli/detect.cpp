@@ -32,7 +32,7 @@ io::RunConfig ResolveAgainstMap(const DetectFlags& flags, const pipeline::Descri
     base.descriptor = map.config();
     io::RunConfig config = flags.descriptor.Resolve(base);
     flags.detection.ApplyTo(config);
-    if (!core::DescribesAlike(config.descriptor, map.config())) {
+    if (config.descriptor != map.config()) {
         throw core::ConfigError(flags.descriptor.FirstGiven() +
                                 " changes how scans are described, but the map " + flags.map +
                                 " fixes that (its config.yaml beside it shows how)");

@@ -15,11 +15,7 @@ void DetectionOptions::AddTo(CLI::App& command, bool decides_loops,
 }
 
 void DetectionOptions::ApplyTo(io::RunConfig& config) const {
-    if (threshold_option_ != nullptr && *threshold_option_) {
-        (config.descriptor.method == core::Method::kNdt ? config.descriptor.ndt.threshold
-                                                        : config.descriptor.histogram.threshold) =
-            threshold_;
-    }
+    if (threshold_option_ != nullptr && *threshold_option_) config.detection.threshold = threshold_;
     if (*min_gap_option_) config.detection.min_gap.value = min_gap_;
     if (!min_gap_unit_.empty())
         config.detection.min_gap.unit = core::ParseMinGapUnit(min_gap_unit_);

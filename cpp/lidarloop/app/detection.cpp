@@ -20,6 +20,12 @@ void RequireTimesForSeconds(const io::RunConfig& config, const io::Dataset& data
     }
 }
 
+// The config as the run applies it: the decision threshold resolved to the number used.
+io::RunConfig Effective(io::RunConfig config) {
+    config.detection.threshold = config.detection.ThresholdFor(config.descriptor.method);
+    return config;
+}
+
 void WriteDetectResults(const std::filesystem::path& out_dir, const io::RunConfig& config,
                         const pipeline::SequenceDescriptors& described,
                         const pipeline::SimilarityMatrix& matrix, const DetectOutcome& outcome) {
@@ -40,7 +46,7 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     config.Validate();
     RequireTimesForSeconds(config, dataset);
     const std::filesystem::path out_dir = PrepareOutputFolder(request.out);
-    io::WriteConfigYaml(out_dir / "config.yaml", config);
+    io::WriteConfigYaml(out_dir / "config.yaml", Effective(config));
 
     Stopwatch total;
     Stopwatch describe_clock;
@@ -53,10 +59,9 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     const pipeline::SimilarityMatrix matrix = pipeline::ComputeSimilarityMatrix(described.database);
     const double matrix_s = matrix_clock.Seconds();
     DetectOutcome outcome;
-    outcome.threshold = core::DefaultThreshold(config.descriptor);
-    outcome.queries =
-        pipeline::DetectFromMatrix(matrix, described.database.times_s(), config.detection,
-                                   config.descriptor.method, outcome.threshold);
+    outcome.threshold = config.detection.ThresholdFor(config.descriptor.method);
+    outcome.queries = pipeline::DetectFromMatrix(matrix, described.database.times_s(),
+                                                 config.detection, config.descriptor.method);
     outcome.accepted = CountAccepted(outcome.queries);
     outcome.skipped = described.skipped;
     WriteDetectResults(out_dir, config, described, matrix, outcome);
@@ -79,14 +84,13 @@ DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const Detec
     Stopwatch total;
     const io::RunConfig& config = request.config;
     config.Validate();
-    if (!core::DescribesAlike(config.descriptor, map.database.config())) {
+    if (config.descriptor != map.database.config()) {
         throw core::ConfigError("the configuration changes how scans are described, but the map " +
                                 map.file.string() + " fixes that");
     }
-    const pipeline::LoopDetector detector(std::move(map.database), config.detection,
-                                          core::DefaultThreshold(config.descriptor));
+    const pipeline::LoopDetector detector(std::move(map.database), config.detection);
     const std::filesystem::path out_dir = PrepareOutputFolder(request.out);
-    io::WriteConfigYaml(out_dir / "config.yaml", config);
+    io::WriteConfigYaml(out_dir / "config.yaml", Effective(config));
 
     const pipeline::SequenceDescriptors described = DescribeDataset(
         dataset, config.descriptor,

@@ -31,7 +31,8 @@ struct DetectOutcome {
 /// Offline detection over a whole sequence: describes every scan, computes the similarity
 /// matrix, finds each scan's candidates among the earlier scans outside the minimum gap, and
 /// writes loops.csv, candidates.csv, similarity.bin, similarity.png, similarity_distance.png,
-/// database.lldb, config.yaml, timings.json (and skipped.txt) into request.out.
+/// database.lldb, config.yaml (with the threshold applied), timings.json (and skipped.txt) into
+/// request.out.
 DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request);
 
 /// A saved descriptor database to localise against.
@@ -45,8 +46,8 @@ struct LoadedMap {
 LoadedMap LoadMap(const std::filesystem::path& file);
 
 /// Localisation: every scan of `dataset` is searched in `map` and not added to it.
-/// request.config must describe scans as the map does (core::DescribesAlike; ConfigError
-/// otherwise); its detection keys apply. Writes loops.csv (query scan, map scan),
+/// request.config.descriptor must equal the map's (ConfigError otherwise): scans are described
+/// as the map's were; its detection keys apply. Writes loops.csv (query scan, map scan),
 /// candidates.csv, config.yaml, timings.json (and skipped.txt) into request.out.
 DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const DetectRequest& request);
 

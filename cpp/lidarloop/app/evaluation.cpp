@@ -82,7 +82,7 @@ MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method m
     const double matrix_s = matrix_clock.Seconds();
     const double pairs = static_cast<double>(matrix.condensed().size());
     MethodEvaluation e = EvaluateMatrix(core::ToString(method), std::move(matrix), truth,
-                                        request.learning, core::DefaultThreshold(config.descriptor),
+                                        request.learning, config.detection.ThresholdFor(method),
                                         request.fixed_thresholds, training ? &*training : nullptr);
     e.describe_ms_per_scan_median = 1e3 * Quantile(described.describe_seconds, 0.5);
     e.ns_per_comparison = pairs > 0 ? 1e9 * matrix_s / pairs : 0.0;

@@ -21,9 +21,7 @@ double DescriptorDistance(const Descriptor& a, const Descriptor& b) {
     return WassersteinDistance(a.histogram().mass, b.histogram().mass);
 }
 
-double DefaultThreshold(const DescriptorConfig& config) {
-    return config.method == Method::kNdt ? config.ndt.threshold : config.histogram.threshold;
-}
+double DefaultThreshold(Method method) { return method == Method::kNdt ? 0.0737 : 0.005; }
 
 bool IsMatch(Method method, double distance, double threshold) {
     return method == Method::kNdt ? distance < threshold : IsLoop(distance, threshold);

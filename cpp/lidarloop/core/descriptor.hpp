@@ -27,8 +27,11 @@ Descriptor ComputeDescriptor(const PointCloud& cloud, const DescriptorConfig& co
 /// Magnusson's sigma' (eq. 9) for NDT. Smaller is more similar. ConfigError on mixed methods.
 double DescriptorDistance(const Descriptor& a, const Descriptor& b);
 
-/// The method's default decision threshold: tau (histograms) or t_d (NDT).
-double DefaultThreshold(const DescriptorConfig& config);
+/// The method's default decision threshold, the one place it is written: tau = 0.005 for the
+/// histograms (Röhling table II: MCC is best near 0.005 on every route; their b and value range
+/// are not published, so treat it as a starting point) and t_d = 0.0737 for NDT (Magnusson table
+/// II, Hannover2). Both depend on the data: learn yours with `lidarloop evaluate`.
+double DefaultThreshold(Method method);
 
 /// Whether `distance` says "same place" under `threshold`, with each paper's own comparison:
 /// W <= tau (Röhling eq. 7), sigma' < t_d (Magnusson II-E, table I).

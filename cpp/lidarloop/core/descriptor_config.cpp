@@ -31,11 +31,4 @@ Projection ProjectionOf(Method method) {
     throw ConfigError("method '" + ToString(method) + "' is not a histogram projection");
 }
 
-bool DescribesAlike(const DescriptorConfig& a, const DescriptorConfig& b) {
-    DescriptorConfig b_with_thresholds_of_a = b;
-    b_with_thresholds_of_a.histogram.threshold = a.histogram.threshold;
-    b_with_thresholds_of_a.ndt.threshold = a.ndt.threshold;
-    return a == b_with_thresholds_of_a;
-}
-
 }  // namespace lidarloop::core

@@ -25,7 +25,8 @@ bool IsHistogramMethod(Method method);
 /// The projection a histogram method uses; throws ConfigError for kNdt.
 Projection ProjectionOf(Method method);
 
-/// Everything that decides how a scan becomes a descriptor. The single home of the defaults.
+/// Everything that decides how a scan becomes a descriptor, and nothing else: two equal configs
+/// give comparable descriptors. The single home of the descriptor defaults.
 struct DescriptorConfig {
     Method method = Method::kHeight;
     HistogramConfig histogram;
@@ -38,9 +39,5 @@ struct DescriptorConfig {
     }
     bool operator==(const DescriptorConfig&) const = default;
 };
-
-/// True when `a` and `b` turn a scan into the same descriptor: they may differ in the decision
-/// thresholds only, so descriptors of one are comparable with those of the other.
-bool DescribesAlike(const DescriptorConfig& a, const DescriptorConfig& b);
 
 }  // namespace lidarloop::core

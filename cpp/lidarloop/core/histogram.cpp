@@ -161,11 +161,6 @@ void HistogramConfig::Validate() const {
     RequireRange(height_min_m, height_max_m, "height_min_m", "height_max_m");
     RequireRange(range_min_m, range_max_m, "range_min_m", "range_max_m");
     if (range_min_m < 0.0) throw ConfigError("histogram.range_min_m must be >= 0 (a range)");
-    RequireFinite(threshold, "threshold");
-    if (threshold < 0.0 || threshold > 1.0) {
-        throw ConfigError("histogram.threshold must be in [0, 1] (the range of W), got " +
-                          std::to_string(threshold));
-    }
 }
 
 Histogram ComputeHistogram(const PointCloud& cloud, Projection projection,

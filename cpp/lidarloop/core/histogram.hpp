@@ -26,8 +26,9 @@ OutOfRangePolicy ParseOutOfRangePolicy(std::string_view name);
 
 /// Parameters of the LiDAR histograms (Röhling et al. 2015, section III). The paper states no
 /// bucket count or value range; the defaults below are lidarloop's choices for a car-mounted
-/// 360° LiDAR (10 cm height buckets, 0.8 m range buckets). The threshold tau depends on b and on
-/// the value range, so learn it on your data (`lidarloop evaluate`) when you change them.
+/// 360° LiDAR (10 cm height buckets, 0.8 m range buckets). The decision threshold tau is not a
+/// descriptor parameter (detection.threshold); it depends on b and on the value range, so learn it
+/// on your data (`lidarloop evaluate`) when you change them.
 struct HistogramConfig {
     int bins = 100;                                 ///< b, number of buckets, 1..1'000'000
     UpVectorMode up_vector = UpVectorMode::kFixed;  ///< up vector of the height projection
@@ -39,9 +40,6 @@ struct HistogramConfig {
     double range_min_m = 0.0;    ///< v_min of the range projection
     double range_max_m = 80.0;   ///< v_max of the range projection
     OutOfRangePolicy out_of_range = OutOfRangePolicy::kClamp;
-    /// tau of eq. (7). Röhling table II: MCC is best near 0.005 on every route (their b and range
-    /// are not published, so treat this as a starting point).
-    double threshold = 0.005;
 
     /// Throws ConfigError naming the first invalid field.
     void Validate() const;

@@ -37,7 +37,6 @@ void NdtConfig::Validate() const {
     }
     Require(ambiguity_ratio >= 0.0 && ambiguity_ratio <= 1.0,
             "ndt.ambiguity_ratio (t_a) must be in [0, 1]");
-    Require(std::isfinite(threshold) && threshold >= 0.0, "ndt.threshold (t_d) must be >= 0");
 }
 
 }  // namespace lidarloop::core

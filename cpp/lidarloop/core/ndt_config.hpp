@@ -5,7 +5,8 @@
 namespace lidarloop::core {
 
 /// Parameters of the NDT appearance descriptor (Magnusson et al. 2009, section II-E). Defaults
-/// are the paper's, except where a comment says otherwise.
+/// are the paper's, except where a comment says otherwise. The decision threshold t_d is not a
+/// descriptor parameter (detection.threshold).
 struct NdtConfig {
     double cell_size_m = 0.5;  ///< q, side of an NDT cell; cell corners are q/2 apart
     /// Cells with fewer points are not classified. The paper does not state its minimum; 5 is
@@ -39,9 +40,6 @@ struct NdtConfig {
     /// sigma' between a scan and its rotated copy is as small as that discretisation allows
     /// (about that of a translation by a fraction of a cell), not zero.
     bool regrid_rotations = false;
-    /// t_d: scans are similar when sigma' < t_d. 0.0737 is the paper's Hannover2 value (table II);
-    /// it depends on the data, so estimate it (EM) or learn it for yours.
-    double threshold = 0.0737;
 
     int FeatureCount() const { return spherical_classes + planar_classes + linear_classes; }
     int RangeCount() const { return static_cast<int>(range_limits_m.size()) + 1; }

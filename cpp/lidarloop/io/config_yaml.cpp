@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <iterator>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <type_traits>
@@ -16,8 +17,25 @@
 namespace lidarloop::io {
 namespace {
 
+// lidarloop 0.1 kept the decision thresholds in the descriptor sections and wrote these defaults
+// into every config.yaml and database; they are read only to say where the key moved.
+constexpr double kLegacyHistogramThreshold = 0.005;
+constexpr double kLegacyNdtThreshold = 0.0737;
+// What an optional number that is not set reads and writes as.
+constexpr char kUnsetValue[] = "default";
+
+std::string ThresholdHelp() {
+    using detail::ShortNumber;
+    return "tau (height, range: a loop when W <= tau) or t_d (ndt: sigma' < t_d); default: the "
+           "method's (height " +
+           ShortNumber(core::DefaultThreshold(core::Method::kHeight)) + ", range " +
+           ShortNumber(core::DefaultThreshold(core::Method::kRange)) + ", ndt " +
+           ShortNumber(core::DefaultThreshold(core::Method::kNdt)) + ")";
+}
+
 // The one list of keys. Both the writer and the reader walk it, so a key cannot exist in one and
-// be missing in the other. `visitor.Field(key, value, help)`, `visitor.Section(key, struct)`.
+// be missing in the other. `visitor.Field(key, value, help)`, `visitor.Section(key, struct)`,
+// `visitor.Moved(key, new_key, legacy_default)` for a key that moved elsewhere.
 template <typename Visitor>
 void VisitFields(core::HistogramConfig& c, Visitor& v) {
     v.Field("bins", c.bins, "b, number of buckets");
@@ -28,7 +46,7 @@ void VisitFields(core::HistogramConfig& c, Visitor& v) {
     v.Field("range_min_m", c.range_min_m, "v_min of the range histogram");
     v.Field("range_max_m", c.range_max_m, "v_max of the range histogram");
     v.Field("out_of_range", c.out_of_range, "values outside [v_min, v_max]: clamp | drop");
-    v.Field("threshold", c.threshold, "tau: a pair is a loop when W <= tau (Roehling eq. 7)");
+    v.Moved("threshold", "detection.threshold", kLegacyHistogramThreshold);
 }
 
 template <typename Visitor>
@@ -46,7 +64,7 @@ void VisitFields(core::NdtConfig& c, Visitor& v) {
             "peaks are modes of the cells' normals (true) or partition classes, lines P_i (false)");
     v.Field("regrid_rotations", c.regrid_rotations,
             "new grid per rotation (paper) vs rotated cells");
-    v.Field("threshold", c.threshold, "t_d: similar when sigma' < t_d (Magnusson II-E)");
+    v.Moved("threshold", "detection.threshold", kLegacyNdtThreshold);
 }
 
 template <typename Visitor>
@@ -54,6 +72,7 @@ void VisitFields(pipeline::DetectorConfig& c, Visitor& v) {
     v.Field("min_gap", c.min_gap.value, "S: candidates are at least this far back (Magnusson)");
     v.Field("min_gap_unit", c.min_gap.unit, "unit of min_gap: scans | seconds");
     v.Field("top_k", c.top_k, "candidates reported per query scan");
+    v.Field("threshold", c.threshold, ThresholdHelp());
 }
 
 template <typename Visitor>
@@ -78,9 +97,15 @@ void ParseEnum(const std::string& s, core::OutOfRangePolicy& m) {
 class YamlWriter {
 public:
     template <typename T>
-    void Field(const char* key, const T& value, const char* help) {
+    void Field(const char* key, const T& value, const std::string& help) {
         out_ << indent_ << key << ": ";
-        if constexpr (std::is_enum_v<T>) {
+        if constexpr (std::is_same_v<T, std::optional<double>>) {
+            if (value) {
+                WriteNumber(*value);
+            } else {
+                out_ << kUnsetValue;
+            }
+        } else if constexpr (std::is_enum_v<T>) {
             out_ << EnumName(value);
         } else if constexpr (std::is_same_v<T, bool>) {
             out_ << (value ? "true" : "false");
@@ -103,6 +128,7 @@ public:
         const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
         out_.write(buffer, result.ptr - buffer);
     }
+    void Moved(const char*, const char*, double) {}  // written under its new key only
     template <typename Struct>
     void Section(const char* key, Struct& section) {
         out_ << indent_ << key << ":\n";
@@ -120,6 +146,7 @@ private:
 
 template <typename T>
 const char* ExpectedKind() {
+    if constexpr (std::is_same_v<T, std::optional<double>>) return "a number or 'default'";
     if constexpr (std::is_same_v<T, bool>) return "true or false";
     if constexpr (std::is_same_v<T, std::vector<double>>) return "a list of numbers";
     if constexpr (std::is_integral_v<T>) return "an integer";
@@ -128,20 +155,28 @@ const char* ExpectedKind() {
 
 class YamlReader {
 public:
-    YamlReader(const YAML::Node& node, std::string source, std::string prefix)
-        : node_(node), source_(std::move(source)), prefix_(std::move(prefix)) {}
+    YamlReader(const YAML::Node& node, std::string source, std::string prefix, LegacyKeys legacy)
+        : node_(node), source_(std::move(source)), prefix_(std::move(prefix)), legacy_(legacy) {}
 
     template <typename T>
-    void Field(const char* key, T& value, const char*) {
+    void Field(const char* key, T& value, const std::string&) {
         known_.insert(key);
         const YAML::Node child = node_[key];
         if (!child) return;
+        if constexpr (std::is_same_v<T, std::optional<double>>) {
+            if (child.IsNull() || (child.IsScalar() && child.Scalar() == kUnsetValue)) {
+                value.reset();
+                return;
+            }
+        }
         constexpr bool kIsList = std::is_same_v<T, std::vector<double>>;
         if (kIsList && !child.IsSequence()) Fail(key, "expected a list of numbers like [3, 6]");
         if (!kIsList && !child.IsScalar()) Fail(key, "expected a single value");
         try {
             if constexpr (kIsList) {
                 value = child.as<std::vector<double>>();
+            } else if constexpr (std::is_same_v<T, std::optional<double>>) {
+                value = child.as<double>();
             } else if constexpr (std::is_enum_v<T>) {
                 ParseEnum(child.as<std::string>(), value);
             } else {
@@ -154,13 +189,24 @@ public:
             Fail(key, e.what());
         }
     }
+    // lidarloop 0.1's key: its default (which every 0.1 config.yaml and database holds) is
+    // ignored, as it is the method's default now; another value says where it moved.
+    void Moved(const char* key, const char* new_key, double legacy_default) {
+        known_.insert(key);
+        const YAML::Node child = node_[key];
+        if (!child || legacy_ == LegacyKeys::kIgnore) return;
+        if (child.IsScalar() && detail::ParseDouble(child.Scalar()) == legacy_default) return;
+        Fail(key, std::string("moved to '") + new_key +
+                      "' (the decision threshold is no longer a descriptor parameter); write " +
+                      new_key + ": " + YAML::Dump(child) + " instead");
+    }
     template <typename Struct>
     void Section(const char* key, Struct& section) {
         known_.insert(key);
         const YAML::Node child = node_[key];
         if (!child || child.IsNull()) return;
         if (!child.IsMap()) Fail(key, "expected a section of keys");
-        YamlReader reader(child, source_, prefix_ + key + ".");
+        YamlReader reader(child, source_, prefix_ + key + ".", legacy_);
         VisitFields(section, reader);
         reader.RejectUnknownKeys();
     }
@@ -182,6 +228,7 @@ private:
     YAML::Node node_;
     std::string source_;
     std::string prefix_;
+    LegacyKeys legacy_;
     std::set<std::string> known_;
 };
 
@@ -195,7 +242,8 @@ std::string DumpConfigYaml(const RunConfig& config) {
            writer.str();
 }
 
-void ApplyConfigYaml(const std::string& yaml_text, const std::string& source, RunConfig& config) {
+void ApplyConfigYaml(const std::string& yaml_text, const std::string& source, RunConfig& config,
+                     LegacyKeys legacy) {
     YAML::Node root;
     try {
         root = YAML::Load(yaml_text);
@@ -205,7 +253,7 @@ void ApplyConfigYaml(const std::string& yaml_text, const std::string& source, Ru
     if (!root || root.IsNull()) return;  // an empty file overrides nothing
     if (!root.IsMap()) throw ReadError(source, "expected a map of keys at the top level");
     RunConfig updated = config;
-    YamlReader reader(root, source, "");
+    YamlReader reader(root, source, "", legacy);
     VisitFields(updated, reader);
     reader.RejectUnknownKeys();
     try {

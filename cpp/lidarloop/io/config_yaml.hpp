@@ -23,10 +23,21 @@ struct RunConfig {
 /// The whole configuration as YAML, every key present, with a comment line per key.
 std::string DumpConfigYaml(const RunConfig& config);
 
+/// Keys of lidarloop 0.1 that moved: `histogram.threshold` and `ndt.threshold` are now
+/// `detection.threshold`.
+enum class LegacyKeys {
+    /// A moved key with 0.1's default value (as every 0.1 config.yaml holds) is ignored; another
+    /// value is a ReadError saying where it moved.
+    kExplain,
+    /// Ignored whatever their value (a saved database: thresholds never changed a descriptor).
+    kIgnore,
+};
+
 /// Overrides the keys that `yaml_text` names in `config` and validates the result. `source`
 /// (a file name) prefixes error messages. Throws ReadError for YAML syntax errors, unknown keys
 /// (naming the key path and the valid keys), values of the wrong type, and invalid values.
-void ApplyConfigYaml(const std::string& yaml_text, const std::string& source, RunConfig& config);
+void ApplyConfigYaml(const std::string& yaml_text, const std::string& source, RunConfig& config,
+                     LegacyKeys legacy = LegacyKeys::kExplain);
 
 /// Reads `file` and applies it on top of `base` (default: the built-in defaults).
 RunConfig LoadConfigYaml(const std::filesystem::path& file, RunConfig base = {});

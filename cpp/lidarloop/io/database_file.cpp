@@ -78,7 +78,8 @@ pipeline::DescriptorDatabase LoadDatabase(const std::filesystem::path& file) {
     in.ExpectMagic(kMagic, "lidarloop database");
     RunConfig config;
     try {
-        ApplyConfigYaml(in.GetString("configuration"), "embedded config", config);
+        ApplyConfigYaml(in.GetString("configuration"), "embedded config", config,
+                        LegacyKeys::kIgnore);
     } catch (const ReadError& e) {
         in.Fail(e.what());
     }

@@ -1,6 +1,7 @@
 #include "lidarloop/pipeline/loop_detector.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include <tbb/parallel_for.h>
@@ -35,6 +36,10 @@ void Finish(LoopQuery& result, const core::MinGap& gap, const std::vector<double
 
 void DetectorConfig::Validate() const {
     min_gap.Validate("detection.min_gap");
+    if (threshold && !(std::isfinite(*threshold) && *threshold >= 0.0)) {
+        throw core::ConfigError("detection.threshold must be a finite number >= 0, got " +
+                                std::to_string(*threshold));
+    }
     if (top_k < 1 || top_k > 1000) {
         throw core::ConfigError("detection.top_k must be in [1, 1000], got " +
                                 std::to_string(top_k));
@@ -62,13 +67,13 @@ std::vector<Neighbor> NearestCandidates(std::size_t count, std::size_t k,
     return all;
 }
 
-LoopDetector::LoopDetector(const core::DescriptorConfig& descriptor, const DetectorConfig& detector,
-                           double threshold)
-    : LoopDetector(DescriptorDatabase(descriptor), detector, threshold) {}
+LoopDetector::LoopDetector(const core::DescriptorConfig& descriptor, const DetectorConfig& detector)
+    : LoopDetector(DescriptorDatabase(descriptor), detector) {}
 
-LoopDetector::LoopDetector(DescriptorDatabase database, const DetectorConfig& detector,
-                           double threshold)
-    : database_(std::move(database)), detector_(detector), threshold_(threshold) {
+LoopDetector::LoopDetector(DescriptorDatabase database, const DetectorConfig& detector)
+    : database_(std::move(database)),
+      detector_(detector),
+      threshold_(detector.ThresholdFor(database_.method())) {
     detector_.Validate();
     if (database_.histograms() != nullptr) {
         index_.emplace(*database_.histograms());
@@ -124,7 +129,7 @@ LoopQuery LoopDetector::Query(const PreparedQuery& query, std::size_t query_inde
 
 std::vector<LoopQuery> LocaliseSequence(const LoopDetector& map, const DescriptorDatabase& queries,
                                         Execution execution) {
-    if (!core::DescribesAlike(queries.config(), map.database().config())) {
+    if (queries.config() != map.database().config()) {
         throw core::ConfigError(
             "the query scans were described with another configuration than the map's");
     }
@@ -143,9 +148,9 @@ std::vector<LoopQuery> LocaliseSequence(const LoopDetector& map, const Descripto
 
 std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,
                                         const std::vector<double>& times_s,
-                                        const DetectorConfig& detector, core::Method method,
-                                        double threshold) {
+                                        const DetectorConfig& detector, core::Method method) {
     detector.Validate();
+    const double threshold = detector.ThresholdFor(method);
     if (times_s.size() != matrix.size()) {
         throw core::ConfigError("DetectFromMatrix: " + std::to_string(times_s.size()) +
                                 " times for " + std::to_string(matrix.size()) + " scans");

@@ -14,14 +14,22 @@
 
 namespace lidarloop::pipeline {
 
-/// How loop candidates are chosen.
+/// How loop candidates are chosen and decided.
 struct DetectorConfig {
     /// S: a scan's candidates are the scans at least this far back (Magnusson II-E).
     core::MinGap min_gap;
     int top_k = 5;  ///< candidates reported per query, nearest first; 1..1000
+    /// The decision threshold, tau (W <= tau, Röhling eq. 7) or t_d (sigma' < t_d, Magnusson
+    /// II-E); empty: the method's default (core::DefaultThreshold).
+    std::optional<double> threshold;
 
+    /// `threshold` when set, else the default of `method`.
+    double ThresholdFor(core::Method method) const {
+        return threshold ? *threshold : core::DefaultThreshold(method);
+    }
     /// Throws ConfigError naming the first invalid field.
     void Validate() const;
+    bool operator==(const DetectorConfig&) const = default;
 };
 
 /// What the detector says about one query scan.
@@ -49,11 +57,10 @@ std::vector<Neighbor> NearestCandidates(std::size_t count, std::size_t k,
 /// Neither copyable nor movable: the index refers to the detector's own database.
 class LoopDetector {
 public:
-    /// `threshold` is tau or t_d (see core::DefaultThreshold). Validates the configs.
-    LoopDetector(const core::DescriptorConfig& descriptor, const DetectorConfig& detector,
-                 double threshold);
+    /// Validates the configs.
+    LoopDetector(const core::DescriptorConfig& descriptor, const DetectorConfig& detector);
     /// Continues from a loaded database (e.g. a map): every stored scan becomes searchable.
-    LoopDetector(DescriptorDatabase database, const DetectorConfig& detector, double threshold);
+    LoopDetector(DescriptorDatabase database, const DetectorConfig& detector);
     LoopDetector(const LoopDetector&) = delete;
     LoopDetector& operator=(const LoopDetector&) = delete;
 
@@ -69,6 +76,7 @@ public:
 
     const DescriptorDatabase& database() const { return database_; }
     const DetectorConfig& detector_config() const { return detector_; }
+    /// The decision threshold applied (detector_config().ThresholdFor the database's method).
     double threshold() const { return threshold_; }
 
 private:
@@ -91,7 +99,6 @@ std::vector<LoopQuery> LocaliseSequence(const LoopDetector& map, const Descripto
 /// scans j < i outside the gap, exactly as LoopDetector::Process would give them online.
 std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,
                                         const std::vector<double>& times_s,
-                                        const DetectorConfig& detector, core::Method method,
-                                        double threshold);
+                                        const DetectorConfig& detector, core::Method method);
 
 }  // namespace lidarloop::pipeline

@@ -44,10 +44,10 @@ TEST_F(DetectionRun, EqualsThePipelineOnTheSameDescriptors) {
         const app::DetectOutcome outcome = app::RunDetect(*dataset_, request);
         const auto described =
             pipeline::DescribeSequence(app::SourceOf(*dataset_), request.config.descriptor);
-        const double threshold = core::DefaultThreshold(request.config.descriptor);
+        const double threshold = core::DefaultThreshold(method);
         const auto expected = pipeline::DetectFromMatrix(
             pipeline::ComputeSimilarityMatrix(described.database), described.database.times_s(),
-            request.config.detection, method, threshold);
+            request.config.detection, method);
         ASSERT_EQ(outcome.queries.size(), expected.size());
         std::size_t with_match = 0;
         for (std::size_t i = 0; i < expected.size(); ++i) {

@@ -241,8 +241,6 @@ TEST(HistogramConfig, RejectsAbsurdValues) {
     expect_invalid([](HistogramConfig& c) { c.range_min_m = -1; }, "range_min_m");
     expect_invalid([](HistogramConfig& c) { c.height_max_m = NAN; }, "height_max_m");
     expect_invalid([](HistogramConfig& c) { c.sensor_height_m = INFINITY; }, "sensor_height_m");
-    expect_invalid([](HistogramConfig& c) { c.threshold = 2.0; }, "threshold");
-    expect_invalid([](HistogramConfig& c) { c.threshold = -0.1; }, "threshold");
 }
 
 TEST(HistogramConfig, InvalidConfigIsRejectedByCompute) {

@@ -27,39 +27,26 @@ TEST(ConfigYaml, DumpThenLoadGivesTheSameConfig) {
     changed.descriptor.histogram.sensor_height_m = 1.73;
     changed.descriptor.histogram.range_max_m = 120.5;
     changed.descriptor.histogram.out_of_range = core::OutOfRangePolicy::kDrop;
-    changed.descriptor.histogram.threshold = 0.0033;
+    changed.detection.threshold = 0.0033;
     RunConfig loaded;
     ApplyConfigYaml(DumpConfigYaml(changed), "dump", loaded);
     EXPECT_EQ(DumpConfigYaml(loaded), DumpConfigYaml(changed));
     EXPECT_EQ(loaded.descriptor.method, core::Method::kRange);
     EXPECT_EQ(loaded.descriptor.histogram.bins, 250);
     EXPECT_EQ(loaded.descriptor.histogram.sensor_height_m, 1.73);
-    EXPECT_EQ(loaded.descriptor.histogram.threshold, 0.0033);
+    EXPECT_EQ(loaded.detection.threshold, 0.0033);
     EXPECT_EQ(loaded.descriptor.histogram.out_of_range, core::OutOfRangePolicy::kDrop);
 }
 
 TEST(ConfigYaml, DumpNamesEveryKeyWithItsDefault) {
     const std::string dump = DumpConfigYaml({});
-    for (const char* key : {"method: height",
-                            "bins: 100",
-                            "up_vector: fixed",
-                            "sensor_height_m: 0",
-                            "height_min_m: -3",
-                            "height_max_m: 7",
-                            "range_min_m: 0",
-                            "range_max_m: 80",
-                            "out_of_range: clamp",
-                            "threshold: 0.005",
-                            "cell_size_m: 0.5",
-                            "planar_classes: 9",
-                            "eigen_ratio_threshold: 0.1",
-                            "ambiguity_ratio: 0.6",
-                            "range_limits_m: [3, 6, 9, 15]",
-                            "threshold: 0.0737",
-                            "normalise_rotation: true",
-                            "min_gap: 30",
-                            "min_gap_unit: scans",
-                            "top_k: 5"}) {
+    for (const char* key :
+         {"method: height", "bins: 100", "up_vector: fixed", "sensor_height_m: 0",
+          "height_min_m: -3", "height_max_m: 7", "range_min_m: 0", "range_max_m: 80",
+          "out_of_range: clamp", "cell_size_m: 0.5", "planar_classes: 9",
+          "eigen_ratio_threshold: 0.1", "ambiguity_ratio: 0.6", "range_limits_m: [3, 6, 9, 15]",
+          "normalise_rotation: true", "min_gap: 30", "min_gap_unit: scans", "top_k: 5",
+          "threshold: default"}) {
         EXPECT_NE(dump.find(key), std::string::npos) << key << " missing in\n" << dump;
     }
 }
@@ -89,7 +76,9 @@ TEST(ConfigYaml, BadInputNamesFileKeyAndProblem) {
     expect_error("colour: red\n", "key 'colour': unknown key");
     expect_error("histogram:\n  bins: many\n", "expected an integer, got 'many'");
     expect_error("histogram:\n  bins: 2.5\n", "expected an integer");
-    expect_error("histogram:\n  threshold: [1, 2]\n", "expected a single value");
+    expect_error("detection:\n  threshold: [1, 2]\n", "expected a single value");
+    expect_error("detection:\n  threshold: many\n", "expected a number or 'default', got 'many'");
+    expect_error("detection:\n  threshold: -0.1\n", "detection.threshold must be a finite");
     expect_error("histogram: 5\n", "expected a section");
     expect_error("method: sift\n", "unknown method 'sift'");
     expect_error("histogram:\n  bins: 0\n", "histogram.bins must be between");
@@ -128,6 +117,40 @@ TEST(ConfigYaml, FailedApplyLeavesConfigUnchanged) {
     RunConfig config;
     EXPECT_THROW(ApplyConfigYaml("histogram:\n  bins: 7\n  oops: 1\n", "f", config), ReadError);
     EXPECT_EQ(config.descriptor.histogram.bins, 100);
+}
+
+TEST(ConfigYaml, TheThresholdIsUnsetByDefaultOrNull) {
+    RunConfig config;
+    config.detection.threshold = 0.2;
+    ApplyConfigYaml("detection:\n  threshold: default\n", "a", config);
+    EXPECT_FALSE(config.detection.threshold.has_value());
+    config.detection.threshold = 0.2;
+    ApplyConfigYaml("detection:\n  threshold: ~\n", "b", config);
+    EXPECT_FALSE(config.detection.threshold.has_value());
+    ApplyConfigYaml("detection:\n  threshold: 0.01\n", "c", config);
+    EXPECT_EQ(config.detection.threshold, 0.01);
+}
+
+// lidarloop 0.1 kept tau and t_d in the descriptor sections; its files still load, or say where
+// the key went.
+TEST(ConfigYaml, AConfigOfVersion01LoadsWithItsDefaultThresholds) {
+    const std::filesystem::path legacy = std::filesystem::path(LIDARLOOP_TEST_DATA_DIR) / "legacy";
+    EXPECT_EQ(DumpConfigYaml(LoadConfigYaml(legacy / "config_v0.1.yaml")), DumpConfigYaml({}));
+    try {
+        LoadConfigYaml(legacy / "config_v0.1_threshold.yaml");
+        FAIL() << "a threshold of 0.004 under histogram was accepted";
+    } catch (const ReadError& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find("key 'histogram.threshold': moved to 'detection.threshold'"),
+                  std::string::npos)
+            << message;
+        EXPECT_NE(message.find("detection.threshold: 0.004"), std::string::npos) << message;
+    }
+    EXPECT_NE(ErrorOf("ndt:\n  threshold: 0.05\n").find("key 'ndt.threshold': moved"),
+              std::string::npos);
+    RunConfig ignored;
+    ApplyConfigYaml("ndt:\n  threshold: 0.05\n", "db", ignored, LegacyKeys::kIgnore);
+    EXPECT_EQ(DumpConfigYaml(ignored), DumpConfigYaml({}));
 }
 
 TEST(ConfigYaml, FileRoundTripAndMissingFile) {

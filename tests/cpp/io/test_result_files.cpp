@@ -83,7 +83,9 @@ TEST(DatabaseFile, RoundTripsHistogramAndNdtDatabases) {
         ExpectSameDatabase(database, loaded);
         EXPECT_EQ(loaded.config().histogram.bins, 24);
         // A detector continued from the loaded map finds the stored scans again.
-        pipeline::LoopDetector detector(loaded, pipeline::DetectorConfig{}, 1.0);
+        pipeline::DetectorConfig accept_all;
+        accept_all.threshold = 1.0;
+        pipeline::LoopDetector detector(loaded, accept_all);
         const auto query = detector.Query(
             core::ComputeDescriptor(test::RandomCloud(3000, 2, 5.0f), loaded.config()));
         ASSERT_TRUE(query.has_match());
@@ -124,6 +126,18 @@ std::string DescriptorHeaderBytes(const core::NdtDescriptor& f) {
 
 // An NDT descriptor whose stored total disagrees with its counts, or with a negative count, is a
 // damaged file, not a descriptor to compare (sigma would be silently wrong).
+// A 0.1 database embeds its decision threshold (0.004 here) in the descriptor section; it never
+// changed a descriptor, so the map loads.
+TEST(DatabaseFile, ADatabaseOfVersion01Loads) {
+    const auto database = LoadDatabase(std::filesystem::path(LIDARLOOP_TEST_DATA_DIR) / "legacy" /
+                                       "database_v0.1.lldb");
+    EXPECT_EQ(database.method(), core::Method::kRange);
+    EXPECT_EQ(database.config().histogram.bins, 20);
+    ASSERT_EQ(database.size(), 2U);
+    EXPECT_TRUE(database.IsValid(0));
+    EXPECT_EQ(database.Distance(0, 1), 0.0);  // two copies of one scan
+}
+
 TEST(DatabaseFile, DamagedNdtCountsAreClearErrors) {
     test::TempDir dir;
     const auto database = SmallDatabase(core::Method::kNdt);

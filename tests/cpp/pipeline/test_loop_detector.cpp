@@ -18,6 +18,12 @@ core::DescriptorConfig HeightConfig(int bins) {
     return config;
 }
 
+// `detector` deciding with `threshold` instead of the method's default.
+DetectorConfig Deciding(DetectorConfig detector, double threshold) {
+    detector.threshold = threshold;
+    return detector;
+}
+
 void ExpectSameQueries(const LoopQuery& online, const LoopQuery& offline) {
     EXPECT_EQ(online.query, offline.query);
     ASSERT_EQ(online.candidates.size(), offline.candidates.size()) << "query " << online.query;
@@ -38,7 +44,7 @@ void ExpectSameQueries(const LoopQuery& online, const LoopQuery& offline) {
 void CheckOnlineEqualsOffline(const DetectorConfig& detector, unsigned seed) {
     const auto histograms = test::ClusteredHistograms(400, 40, 25, seed);
     const core::DescriptorConfig config = HeightConfig(40);
-    LoopDetector online(config, detector, 0.01);
+    LoopDetector online(config, Deciding(detector, 0.01));
     std::vector<LoopQuery> online_results;
     std::vector<double> times;
     for (std::size_t i = 0; i < histograms.size(); ++i) {
@@ -47,8 +53,8 @@ void CheckOnlineEqualsOffline(const DetectorConfig& detector, unsigned seed) {
             online.Process(test::HistogramDescriptor(histograms[i]), times[i]));
     }
     const SimilarityMatrix matrix = ComputeSimilarityMatrix(online.database());
-    const auto offline =
-        DetectFromMatrix(matrix, times, detector, core::Method::kHeight, online.threshold());
+    const auto offline = DetectFromMatrix(matrix, times, Deciding(detector, online.threshold()),
+                                          core::Method::kHeight);
     ASSERT_EQ(offline.size(), online_results.size());
     std::size_t with_match = 0;
     for (std::size_t i = 0; i < offline.size(); ++i) {
@@ -76,7 +82,7 @@ TEST(LoopDetector, CandidatesRespectTheGapAndThreshold) {
     const auto histograms = test::ClusteredHistograms(100, 20, 3, 7);
     DetectorConfig detector;
     detector.min_gap = {10.0, core::MinGap::Unit::kScans};
-    LoopDetector online(HeightConfig(20), detector, 1.0);  // tau = 1 accepts everything
+    LoopDetector online(HeightConfig(20), Deciding(detector, 1.0));  // tau = 1 accepts everything
     for (std::size_t i = 0; i < histograms.size(); ++i) {
         const LoopQuery q = online.Process(test::HistogramDescriptor(histograms[i]), 0.0);
         EXPECT_EQ(q.has_match(), i > 10) << i;
@@ -85,7 +91,8 @@ TEST(LoopDetector, CandidatesRespectTheGapAndThreshold) {
             EXPECT_TRUE(q.accepted);
         }
     }
-    LoopDetector strict(HeightConfig(20), detector, 0.0);  // tau = 0 accepts only equal scans
+    LoopDetector strict(HeightConfig(20),
+                        Deciding(detector, 0.0));  // tau = 0 accepts only equal scans
     for (std::size_t i = 0; i < 30; ++i) {
         const LoopQuery q = strict.Process(test::HistogramDescriptor(histograms[i]), 0.0);
         if (q.has_match()) {
@@ -96,7 +103,7 @@ TEST(LoopDetector, CandidatesRespectTheGapAndThreshold) {
 
 TEST(LoopDetector, QueryOnlyDoesNotInsertAndSeesEveryScan) {
     const auto histograms = test::ClusteredHistograms(50, 20, 5, 8);
-    LoopDetector detector(HeightConfig(20), DetectorConfig{}, 0.01);
+    LoopDetector detector(HeightConfig(20), Deciding(DetectorConfig{}, 0.01));
     for (const auto& h : histograms) detector.Process(test::HistogramDescriptor(h), 0.0);
     const LoopQuery q = detector.Query(test::HistogramDescriptor(histograms[49]));
     EXPECT_EQ(detector.database().size(), 50U);
@@ -115,7 +122,7 @@ TEST(LoopDetector, ALoadedDatabaseNeverOffersAMissingScan) {
             database.Add(test::HistogramDescriptor(histograms[i]), 0.0);
         }
     }
-    const LoopDetector detector(std::move(database), DetectorConfig{}, 1.0);
+    const LoopDetector detector(std::move(database), Deciding(DetectorConfig{}, 1.0));
     // All mass in the last bucket: its cumulative row is nearly the zero row of the missing scan.
     std::vector<double> last_bucket(20, 0.0);
     last_bucket.back() = 1.0;
@@ -139,7 +146,7 @@ TEST(LocaliseSequence, EqualsBruteForceAgainstTheMap) {
     DetectorConfig config;
     config.top_k = 4;
     config.min_gap = {3.0, core::MinGap::Unit::kScans};
-    const LoopDetector detector(DescriptorDatabase(map), config, 0.01);
+    const LoopDetector detector(DescriptorDatabase(map), Deciding(config, 0.01));
     const auto parallel = LocaliseSequence(detector, queries);
     const auto serial = LocaliseSequence(detector, queries, Execution::kSerial);
     ASSERT_EQ(parallel.size(), queries.size());
@@ -164,12 +171,10 @@ TEST(LocaliseSequence, EqualsBruteForceAgainstTheMap) {
 }
 
 TEST(LocaliseSequence, RefusesQueriesDescribedDifferently) {
-    const LoopDetector detector(HeightConfig(30), DetectorConfig{}, 0.01);
+    const LoopDetector detector(HeightConfig(30), Deciding(DetectorConfig{}, 0.01));
     EXPECT_THROW(LocaliseSequence(detector, DescriptorDatabase(HeightConfig(31))),
                  core::ConfigError);
-    core::DescriptorConfig other_threshold = HeightConfig(30);
-    other_threshold.histogram.threshold = 0.2;  // thresholds do not change the descriptor
-    EXPECT_NO_THROW(LocaliseSequence(detector, DescriptorDatabase(other_threshold)));
+    EXPECT_NO_THROW(LocaliseSequence(detector, DescriptorDatabase(HeightConfig(30))));
 }
 
 TEST(LoopDetector, NdtUsesTheSameRules) {
@@ -177,7 +182,7 @@ TEST(LoopDetector, NdtUsesTheSameRules) {
     config.method = core::Method::kNdt;
     DetectorConfig detector;
     detector.min_gap = {2.0, core::MinGap::Unit::kScans};
-    LoopDetector online(config, detector, config.ndt.threshold);
+    LoopDetector online(config, detector);
     std::vector<double> times;
     std::vector<LoopQuery> results;
     for (unsigned i = 0; i < 10; ++i) {
@@ -185,7 +190,8 @@ TEST(LoopDetector, NdtUsesTheSameRules) {
         results.push_back(online.Process(test::RandomCloud(2000, i % 4, 3.0f), times.back()));
     }
     const auto offline = DetectFromMatrix(ComputeSimilarityMatrix(online.database()), times,
-                                          detector, core::Method::kNdt, online.threshold());
+                                          detector, core::Method::kNdt);
+    EXPECT_EQ(online.threshold(), core::DefaultThreshold(core::Method::kNdt));
     for (std::size_t i = 0; i < results.size(); ++i) ExpectSameQueries(results[i], offline[i]);
     // Scan 4 repeats scan 0 (same seed): found with distance 0.
     ASSERT_TRUE(results[4].has_match());
@@ -196,11 +202,16 @@ TEST(LoopDetector, NdtUsesTheSameRules) {
 TEST(LoopDetector, RejectsBadConfigAndMixedMethods) {
     DetectorConfig detector;
     detector.top_k = 0;
-    EXPECT_THROW(LoopDetector(HeightConfig(10), detector, 0.01), core::ConfigError);
+    EXPECT_THROW(LoopDetector(HeightConfig(10), Deciding(detector, 0.01)), core::ConfigError);
     detector.top_k = 1;
     detector.min_gap.value = -1;
-    EXPECT_THROW(LoopDetector(HeightConfig(10), detector, 0.01), core::ConfigError);
-    LoopDetector ok(HeightConfig(10), DetectorConfig{}, 0.01);
+    EXPECT_THROW(LoopDetector(HeightConfig(10), Deciding(detector, 0.01)), core::ConfigError);
+    for (double bad : {-0.1, std::nan(""), HUGE_VAL}) {
+        EXPECT_THROW(LoopDetector(HeightConfig(10), Deciding(DetectorConfig{}, bad)),
+                     core::ConfigError)
+            << bad;
+    }
+    LoopDetector ok(HeightConfig(10), Deciding(DetectorConfig{}, 0.01));
     core::Descriptor range = test::HistogramDescriptor(std::vector<double>(10, 0.1));
     range.method = core::Method::kRange;
     EXPECT_THROW(ok.Process(range, 0.0), core::ConfigError);
@@ -248,7 +259,7 @@ TEST(DescribeSequence, SkipsABadScanWhenAskedAndItNeverMatches) {
     EXPECT_FALSE(result.database.IsValid(7));
     EXPECT_DOUBLE_EQ(result.database.TimeS(19), 1.9);
     EXPECT_EQ(result.database.Distance(7, 3), std::numeric_limits<double>::infinity());
-    LoopDetector detector(result.database, DetectorConfig{}, 1.0);
+    LoopDetector detector(result.database, Deciding(DetectorConfig{}, 1.0));
     const LoopQuery q =
         detector.Query(core::ComputeDescriptor(test::RandomCloud(500, 7), HeightConfig(50)));
     ASSERT_TRUE(q.has_match());
