@@ -34,10 +34,10 @@ std::vector<double> PlaceHistogram(std::mt19937& rng) {
 }
 
 // `count` scans: every 100 consecutive scans revisit one of count/100 places, perturbed.
-pipeline::CumulativeHistograms SyntheticStore(std::size_t count, unsigned seed) {
+std::vector<std::vector<double>> SyntheticHistograms(std::size_t count, unsigned seed) {
     std::mt19937 rng(seed);
     std::normal_distribution<double> noise(0.0, 0.03);
-    pipeline::CumulativeHistograms store(kBins);
+    std::vector<std::vector<double>> histograms;
     std::vector<double> place;
     for (std::size_t i = 0; i < count; ++i) {
         if (i % 100 == 0) place = PlaceHistogram(rng);
@@ -45,8 +45,14 @@ pipeline::CumulativeHistograms SyntheticStore(std::size_t count, unsigned seed) 
         double total = 0.0;
         for (double& v : h) total += (v *= std::max(0.0, 1.0 + noise(rng)));
         for (double& v : h) v /= total;
-        store.Add(h);
+        histograms.push_back(std::move(h));
     }
+    return histograms;
+}
+
+pipeline::CumulativeHistograms SyntheticStore(std::size_t count, unsigned seed) {
+    pipeline::CumulativeHistograms store(kBins);
+    for (const std::vector<double>& h : SyntheticHistograms(count, seed)) store.Add(h);
     return store;
 }
 
@@ -59,11 +65,12 @@ BENCHMARK(BM_WassersteinOnCumulativeRows)->Unit(benchmark::kNanosecond);
 void BM_SimilarityMatrix(benchmark::State& state) {
     const auto n = static_cast<std::size_t>(state.range(0));
     core::DescriptorConfig config;
+    config.histogram.bins = kBins;
     pipeline::DescriptorDatabase database(config);
-    const auto store = SyntheticStore(n, 2);
-    for (std::size_t i = 0; i < n; ++i) {
-        database.AddCumulativeRow({store.Row(i), static_cast<std::size_t>(store.stride())}, 0.0,
-                                  true);
+    for (std::vector<double>& mass : SyntheticHistograms(n, 2)) {
+        core::Histogram histogram;
+        histogram.mass = std::move(mass);
+        database.Add({core::Method::kHeight, std::move(histogram)}, 0.0);
     }
     const auto execution =
         state.range(1) != 0 ? pipeline::Execution::kParallel : pipeline::Execution::kSerial;

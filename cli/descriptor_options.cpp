@@ -2,13 +2,19 @@
 
 #include "lidarloop/core/descriptor_config.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/pipeline/descriptor_method.hpp"
 
 namespace lidarloop::cli {
 
 void DescriptorOptions::AddTo(CLI::App& command, bool with_method) {
     command.add_option("--config", config_file_, "YAML file overriding the defaults it names")
         ->check(CLI::ExistingFile);
-    if (with_method) command.add_option("--method", method_, "descriptor: height | range | ndt");
+    if (with_method) {
+        std::string names;
+        for (const std::string& name : pipeline::MethodNames())
+            names += (names.empty() ? "" : " | ") + name;
+        command.add_option("--method", method_, "descriptor: " + names);
+    }
     bins_option_ = command.add_option("--bins", bins_, "number of histogram buckets b");
     min_option_ = command.add_option("--min", min_m_, "v_min of the chosen projection, metres");
     max_option_ = command.add_option("--max", max_m_, "v_max of the chosen projection, metres");
@@ -22,7 +28,7 @@ void DescriptorOptions::AddTo(CLI::App& command, bool with_method) {
 io::RunConfig DescriptorOptions::Resolve(io::RunConfig base) const {
     io::RunConfig config = std::move(base);
     if (!config_file_.empty()) config = io::LoadConfigYaml(config_file_, config);
-    if (!method_.empty()) config.descriptor.method = core::ParseMethod(method_);
+    if (!method_.empty()) config.descriptor.method = pipeline::ParseMethod(method_);
     ApplyHistogramFlags(config.descriptor);
     config.Validate();
     return config;

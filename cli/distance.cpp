@@ -22,7 +22,7 @@ void AddDistanceCommand(CLI::App& app) {
         const core::Descriptor a = app::DescribeScanFile((*scans)[0], config.descriptor);
         const core::Descriptor b = app::DescribeScanFile((*scans)[1], config.descriptor);
         // %.9g keeps enough digits to compare against thresholds near 1e-3.
-        std::printf("%.9g\n", core::DescriptorDistance(a, b));
+        std::printf("%.9g\n", pipeline::DescriptorDistance(a, b));
     });
 }
 

@@ -10,6 +10,7 @@
 #include "detection_options.hpp"
 #include "lidarloop/app/evaluation.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/pipeline/descriptor_method.hpp"
 #include "progress.hpp"
 
 namespace lidarloop::cli {
@@ -19,7 +20,7 @@ struct EvaluateFlags {
     DatasetOptions dataset;
     DescriptorOptions descriptor;
     DetectionOptions detection;
-    std::vector<std::string> methods = {"height", "range", "ndt"};
+    std::vector<std::string> methods = pipeline::MethodNames();
     std::vector<std::string> results;
     double distance_m = 10.0;
     double max_heading_deg = 0.0;
@@ -33,12 +34,26 @@ struct EvaluateFlags {
     bool quiet = false;
 };
 
+// CLI11 names the flag in the message of a failed check.
+CLI::Validator RegisteredMethod() {
+    return CLI::Validator(
+        [](const std::string& name) {
+            try {
+                pipeline::ParseMethod(name);
+                return std::string();
+            } catch (const core::ConfigError& e) {
+                return std::string(e.what());
+            }
+        },
+        "METHOD");
+}
+
 app::EvaluationRequest RequestOf(const EvaluateFlags& flags) {
     app::EvaluationRequest request;
     request.config = flags.descriptor.Resolve();
     flags.detection.ApplyTo(request.config);
     for (const std::string& name : flags.methods)
-        request.methods.push_back(core::ParseMethod(name));
+        request.methods.push_back(pipeline::ParseMethod(name));
     request.results_files = flags.results;
     request.distance_m = flags.distance_m;
     request.max_heading_deg = flags.max_heading_deg;
@@ -123,7 +138,7 @@ void AddEvaluateCommand(CLI::App& app) {
     command
         ->add_option("--method", flags->methods,
                      "methods to evaluate on the same ground truth (repeatable; default all)")
-        ->check(CLI::IsMember({"height", "range", "ndt"}));
+        ->check(RegisteredMethod());
     command
         ->add_option("--results", flags->results,
                      "also score another detector's CSV (query,match,distance); repeatable")

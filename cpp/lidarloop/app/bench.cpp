@@ -11,6 +11,7 @@
 #include "lidarloop/app/results_folder.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/pipeline/histogram_index.hpp"
+#include "lidarloop/pipeline/histogram_method.hpp"
 #include "lidarloop/pipeline/similarity_matrix.hpp"
 
 namespace lidarloop::app {
@@ -28,12 +29,8 @@ nlohmann::json TimeQueries(const pipeline::DescriptorDatabase& database, std::si
     nlohmann::json json;
     std::vector<double> index_us;
     std::vector<double> brute_us;
-    const pipeline::CumulativeHistograms* rows = database.histograms();
-    std::optional<pipeline::HistogramIndex> index;
-    if (rows != nullptr) {
-        index.emplace(*rows);
-        index->InsertAll();
-    }
+    const std::unique_ptr<pipeline::NeighborIndex> index = database.store().MakeIndex();
+    if (index) index->InsertAll([&](std::size_t i) { return database.IsValid(i); });
     std::mt19937 rng(1);
     for (std::size_t q = 0; q < queries && database.size() > 0; ++q) {
         const std::size_t id = rng() % database.size();
@@ -48,7 +45,7 @@ nlohmann::json TimeQueries(const pipeline::DescriptorDatabase& database, std::si
         brute_us.push_back(1e6 * brute.Seconds());
         if (index) {
             Stopwatch indexed;
-            const auto found = index->Search(rows->Row(id), 1);
+            const auto found = index->Search(*database.PrepareStored(id), 1, {});
             index_us.push_back(1e6 * indexed.Seconds());
             if (found.empty() || found.front().distance > best_distance) {
                 throw core::Error("bench: index and brute force disagree (a bug; please report)");
@@ -67,18 +64,23 @@ nlohmann::json TimeQueries(const pipeline::DescriptorDatabase& database, std::si
 // measure how queries scale beyond the dataset's length (synthetic; said so in the output).
 pipeline::DescriptorDatabase Scaled(const pipeline::DescriptorDatabase& source, std::size_t size) {
     pipeline::DescriptorDatabase scaled(source.config());
-    const pipeline::CumulativeHistograms& rows = *source.histograms();
+    const pipeline::CumulativeHistograms& rows = *pipeline::HistogramRows(source);
     std::mt19937 rng(2);
     std::normal_distribution<float> noise(0.0f, 0.002f);
-    std::vector<float> row(static_cast<std::size_t>(rows.stride()));
+    core::Histogram histogram;
+    histogram.mass.resize(static_cast<std::size_t>(rows.bins()));
     for (std::size_t i = 0; i < size; ++i) {
         const float* base = rows.Row(i % rows.size());
         float previous = 0.0f;
         for (int k = 0; k < rows.bins(); ++k) {  // stays a valid cumulative histogram
-            previous = std::clamp(std::max(previous, base[k] + noise(rng)), 0.0f, 1.0f);
-            row[static_cast<std::size_t>(k)] = k + 1 == rows.bins() ? 1.0f : previous;
+            const float next =
+                k + 1 == rows.bins()
+                    ? 1.0f
+                    : std::clamp(std::max(previous, base[k] + noise(rng)), 0.0f, 1.0f);
+            histogram.mass[static_cast<std::size_t>(k)] = double{next} - double{previous};
+            previous = next;
         }
-        scaled.AddCumulativeRow(row, static_cast<double>(i), true);
+        scaled.Add({source.method(), histogram}, static_cast<double>(i));
     }
     return scaled;
 }
@@ -107,13 +109,13 @@ nlohmann::json RunBench(const io::Dataset& dataset, const BenchRequest& request)
     json["ns_per_comparison_one_core"] = pairs > 0 ? 1e9 * serial_s / pairs : 0.0;
     json["similarity_matrix_one_core_s"] = serial_s;
     json["queries"] = TimeQueries(database, request.queries);
-    if (request.scale_to > 0 && database.histograms() != nullptr) {
+    if (request.scale_to > 0 && pipeline::HistogramRows(database) != nullptr) {
         const auto scaled = Scaled(database, request.scale_to);
         json["scaled_queries"] = TimeQueries(scaled, request.queries);
         json["scaled_queries"]["stored_histograms"] = request.scale_to;
         json["scaled_queries"]["note"] = "synthetic: the dataset's histograms perturbed";
     }
-    if (const auto* rows = database.histograms()) {
+    if (const auto* rows = pipeline::HistogramRows(database)) {
         json["bytes_per_stored_histogram"] =
             4 * rows->stride() + 4 * pipeline::HistogramIndex::kBlocks + 16 + 9;
     }

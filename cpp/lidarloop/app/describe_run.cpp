@@ -23,7 +23,7 @@ core::Descriptor DescribeScanFile(const std::filesystem::path& file,
                                   const core::DescriptorConfig& config) {
     const core::PointCloud cloud = io::ReadScan(file);
     try {
-        return core::ComputeDescriptor(cloud, config);
+        return pipeline::ComputeDescriptor(cloud, config);
     } catch (const core::EmptyInputError& e) {
         throw io::ReadError(file, e.what());
     }
@@ -45,20 +45,13 @@ pipeline::SequenceDescriptors DescribeDataset(const io::Dataset& dataset,
 
 namespace {
 
-// How much work the NDT descriptors of a sequence were: rotation candidates (section II-C, one
-// descriptor each) and classified cells per valid scan, so that a time per scan can be read
-// against what it covered.
-nlohmann::json NdtSetSizesJson(const pipeline::DescriptorDatabase& database) {
-    std::vector<double> candidates;
-    std::vector<double> cells;
-    for (std::size_t i = 0; i < database.size(); ++i) {
-        if (!database.IsValid(i)) continue;
-        const core::NdtDescriptorSet& set = database.ndt_sets()[i];
-        candidates.push_back(static_cast<double>(set.descriptors.size()));
-        cells.push_back(set.descriptors.empty() ? 0.0 : set.descriptors.front().total);
-    }
-    return {{"rotation_candidates_per_scan", SummaryJson(candidates)},
-            {"classified_cells_per_scan", SummaryJson(cells)}};
+// How much work each scan's descriptor was (e.g. NDT rotation candidates and classified cells),
+// under the method's name, so that a time per scan can be read against what it covered.
+nlohmann::json WorkJson(const pipeline::DescriptorDatabase& database) {
+    nlohmann::json json;
+    for (const pipeline::WorkFigure& figure : database.Work())
+        json[figure.name] = SummaryJson(figure.values);
+    return json;
 }
 
 }  // namespace
@@ -75,7 +68,8 @@ nlohmann::json DescribeTimingsJson(const pipeline::SequenceDescriptors& describe
     json["describe_ms_per_scan"]["max"] = ms(described.describe_seconds, 1.0);
     json["load_ms_per_scan"] = {{"median", ms(described.load_seconds, 0.5)},
                                 {"p95", ms(described.load_seconds, 0.95)}};
-    if (!described.database.ndt_sets().empty()) json["ndt"] = NdtSetSizesJson(described.database);
+    const nlohmann::json work = WorkJson(described.database);
+    if (!work.empty()) json[core::ToString(described.database.method())] = work;
     return json;
 }
 

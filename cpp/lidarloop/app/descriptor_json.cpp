@@ -46,8 +46,18 @@ nlohmann::json NdtJson(const core::NdtDescriptorSet& set) {
 }  // namespace
 
 nlohmann::json DescriptorJson(const core::Descriptor& descriptor) {
-    if (descriptor.method == core::Method::kNdt) return NdtJson(descriptor.ndt());
-    return HistogramJson(descriptor.histogram());
+    // By the type the method keeps, so that a registered method built on either shows too.
+    if (const auto* set = std::any_cast<core::NdtDescriptorSet>(&descriptor.value)) {
+        nlohmann::json json = NdtJson(*set);
+        json["method"] = core::ToString(descriptor.method);
+        return json;
+    }
+    if (const auto* histogram = std::any_cast<core::Histogram>(&descriptor.value)) {
+        nlohmann::json json = HistogramJson(*histogram);
+        json["method"] = core::ToString(descriptor.method);
+        return json;
+    }
+    return {{"method", core::ToString(descriptor.method)}};
 }
 
 }  // namespace lidarloop::app

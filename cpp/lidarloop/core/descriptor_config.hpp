@@ -1,29 +1,57 @@
 #pragma once
 
+#include <algorithm>
+#include <array>
+#include <cstddef>
 #include <string>
 #include <string_view>
 
+#include "lidarloop/core/error.hpp"
 #include "lidarloop/core/histogram.hpp"
 #include "lidarloop/core/ndt_config.hpp"
 
 namespace lidarloop::core {
 
-/// Place descriptors lidarloop can compute.
-enum class Method {
-    kHeight,  ///< Röhling 2015 histogram of heights above the ground plane
-    kRange,   ///< Röhling 2015 histogram of ranges
-    kNdt,     ///< Magnusson 2009 NDT appearance descriptor
+/// A place descriptor method, named as it is registered (pipeline/descriptor_method.hpp says
+/// how a method describes and compares scans; pipeline::ParseMethod checks a name). A value
+/// type: the name (at most kMaxName characters) is stored inline, so the built-in constants are
+/// constant-initialised.
+class Method {
+public:
+    static constexpr std::size_t kMaxName = 31;
+    static const Method kHeight;  ///< Röhling 2015 histogram of heights above the ground plane
+    static const Method kRange;   ///< Röhling 2015 histogram of ranges
+    static const Method kNdt;     ///< Magnusson 2009 NDT appearance descriptor
+
+    constexpr Method() = default;
+    /// ConfigError when `name` is empty or longer than kMaxName.
+    constexpr explicit Method(std::string_view name) {
+        if (name.empty() || name.size() > kMaxName) {
+            throw ConfigError("a method name has 1 to 31 characters, got '" + std::string(name) +
+                              "'");
+        }
+        std::copy(name.begin(), name.end(), name_.begin());
+        size_ = name.size();
+    }
+    std::string_view name() const { return {name_.data(), size_}; }
+    bool operator==(const Method& other) const { return name() == other.name(); }
+
+private:
+    std::array<char, kMaxName> name_{};
+    std::size_t size_ = 0;
 };
 
-std::string ToString(Method method);
-/// Parses "height" / "range" / "ndt"; throws ConfigError listing the valid names.
-Method ParseMethod(std::string_view name);
+inline constexpr Method Method::kHeight{"height"};
+inline constexpr Method Method::kRange{"range"};
+inline constexpr Method Method::kNdt{"ndt"};
+
+inline std::string ToString(const Method& method) { return std::string(method.name()); }
 
 /// True for the methods built on Röhling's histograms (height, range).
-bool IsHistogramMethod(Method method);
+bool IsHistogramMethod(const Method& method);
 
-/// The projection a histogram method uses; throws ConfigError for kNdt.
-Projection ProjectionOf(Method method);
+/// The projection a histogram method uses; throws ConfigError for any other method.
+Projection ProjectionOf(const Method& method);
 
 /// Everything that decides how a scan becomes a descriptor, and nothing else: two equal configs
 /// give comparable descriptors. The single home of the descriptor defaults.

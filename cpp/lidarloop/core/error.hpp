@@ -17,6 +17,12 @@ public:
     using Error::Error;
 };
 
+/// Encoded data (a saved database, a similarity matrix) is damaged or not what it claims.
+class FormatError : public Error {
+public:
+    using Error::Error;
+};
+
 /// The input holds no usable data (empty scan, every point non-finite or out of range).
 class EmptyInputError : public Error {
 public:

@@ -28,9 +28,16 @@ std::string ThresholdHelp() {
     using detail::ShortNumber;
     return "tau (height, range: a loop when W <= tau) or t_d (ndt: sigma' < t_d); default: the "
            "method's (height " +
-           ShortNumber(core::DefaultThreshold(core::Method::kHeight)) + ", range " +
-           ShortNumber(core::DefaultThreshold(core::Method::kRange)) + ", ndt " +
-           ShortNumber(core::DefaultThreshold(core::Method::kNdt)) + ")";
+           ShortNumber(pipeline::DefaultThreshold(core::Method::kHeight)) + ", range " +
+           ShortNumber(pipeline::DefaultThreshold(core::Method::kRange)) + ", ndt " +
+           ShortNumber(pipeline::DefaultThreshold(core::Method::kNdt)) + ")";
+}
+
+std::string MethodHelp() {
+    std::string names;
+    for (const std::string& name : pipeline::MethodNames())
+        names += (names.empty() ? "" : " | ") + name;
+    return "descriptor: " + names;
 }
 
 // The one list of keys. Both the writer and the reader walk it, so a key cannot exist in one and
@@ -77,22 +84,26 @@ void VisitFields(pipeline::DetectorConfig& c, Visitor& v) {
 
 template <typename Visitor>
 void VisitFields(RunConfig& c, Visitor& v) {
-    v.Field("method", c.descriptor.method, "descriptor: height | range | ndt");
+    v.Field("method", c.descriptor.method, MethodHelp());
     v.Section("histogram", c.descriptor.histogram);
     v.Section("ndt", c.descriptor.ndt);
     v.Section("detection", c.detection);
 }
 
-std::string EnumName(core::Method m) { return core::ToString(m); }
+std::string EnumName(const core::Method& m) { return core::ToString(m); }
 std::string EnumName(core::UpVectorMode m) { return core::ToString(m); }
 std::string EnumName(core::OutOfRangePolicy m) { return core::ToString(m); }
 std::string EnumName(core::MinGap::Unit u) { return core::ToString(u); }
-void ParseEnum(const std::string& s, core::Method& m) { m = core::ParseMethod(s); }
+void ParseEnum(const std::string& s, core::Method& m) { m = pipeline::ParseMethod(s); }
 void ParseEnum(const std::string& s, core::UpVectorMode& m) { m = core::ParseUpVectorMode(s); }
 void ParseEnum(const std::string& s, core::MinGap::Unit& u) { u = core::ParseMinGapUnit(s); }
 void ParseEnum(const std::string& s, core::OutOfRangePolicy& m) {
     m = core::ParseOutOfRangePolicy(s);
 }
+
+// Values written and read by their names: enums and the method.
+template <typename T>
+constexpr bool kIsNamed = std::is_enum_v<T> || std::is_same_v<T, core::Method>;
 
 class YamlWriter {
 public:
@@ -105,7 +116,7 @@ public:
             } else {
                 out_ << kUnsetValue;
             }
-        } else if constexpr (std::is_enum_v<T>) {
+        } else if constexpr (kIsNamed<T>) {
             out_ << EnumName(value);
         } else if constexpr (std::is_same_v<T, bool>) {
             out_ << (value ? "true" : "false");
@@ -177,7 +188,7 @@ public:
                 value = child.as<std::vector<double>>();
             } else if constexpr (std::is_same_v<T, std::optional<double>>) {
                 value = child.as<double>();
-            } else if constexpr (std::is_enum_v<T>) {
+            } else if constexpr (kIsNamed<T>) {
                 ParseEnum(child.as<std::string>(), value);
             } else {
                 value = child.as<T>();

@@ -8,8 +8,8 @@ namespace lidarloop::io {
 
 /// Saves a descriptor database (a map to localise against, or a detector's state): "LLDB0001",
 /// the descriptor configuration as YAML (so that new scans are described the same way), then per
-/// scan its time, whether it is valid, and its cumulative histogram row or NDT descriptor set.
-/// Little-endian binary.
+/// scan its time, whether it is valid, and what the method's DescriptorStore::Encode writes (the
+/// cumulative histogram row, the NDT descriptor set). Little-endian binary.
 void SaveDatabase(const std::filesystem::path& file, const pipeline::DescriptorDatabase& database);
 
 /// Loads a database saved by SaveDatabase; ReadError naming what is wrong (magic, config,

@@ -2,6 +2,7 @@
 
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/io/detail/byte_stream.hpp"
+#include "lidarloop/pipeline/descriptor_method.hpp"
 
 namespace lidarloop::io {
 namespace {
@@ -19,11 +20,11 @@ void WriteSimilarityMatrix(const std::filesystem::path& file,
 }
 
 StoredSimilarity ReadSimilarityMatrix(const std::filesystem::path& file) {
-    detail::ByteReader in(file, detail::ReadWholeFile(file));
+    core::ByteReader in = detail::FileReader(file, detail::ReadWholeFile(file));
     in.ExpectMagic(kMagic, "lidarloop similarity matrix");
     StoredSimilarity stored;
     try {
-        stored.method = core::ParseMethod(in.GetString("method name"));
+        stored.method = pipeline::ParseMethod(in.GetString("method name"));
     } catch (const core::ConfigError& e) {
         in.Fail(e.what());
     }

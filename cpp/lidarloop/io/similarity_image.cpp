@@ -28,7 +28,7 @@ Image Paint(const pipeline::SimilarityMatrix& matrix, Shade shade) {
 Image ThresholdImage(const pipeline::SimilarityMatrix& matrix, core::Method method,
                      double threshold) {
     return Paint(matrix, [&](float distance) -> std::uint8_t {
-        return core::IsMatch(method, distance, threshold) ? 0 : 255;
+        return pipeline::IsMatch(method, distance, threshold) ? 0 : 255;
     });
 }
 

@@ -10,86 +10,84 @@ namespace {
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 }  // namespace
 
-DescriptorDatabase::DescriptorDatabase(const core::DescriptorConfig& config) : config_(config) {
+DescriptorDatabase::DescriptorDatabase(const core::DescriptorConfig& config)
+    : config_(config), definition_(&MethodOf(config.method)) {
     config_.Validate();
-    if (core::IsHistogramMethod(config_.method)) histograms_.emplace(config_.histogram.bins);
+    store_ = definition_->MakeStore(config_);
+}
+
+DescriptorDatabase::DescriptorDatabase(const DescriptorDatabase& other)
+    : config_(other.config_),
+      definition_(other.definition_),
+      store_(other.store_->Clone()),
+      times_s_(other.times_s_),
+      valid_(other.valid_) {}
+
+DescriptorDatabase& DescriptorDatabase::operator=(const DescriptorDatabase& other) {
+    if (this != &other) *this = DescriptorDatabase(other);
+    return *this;
 }
 
 void DescriptorDatabase::CheckMethod(const core::Descriptor& descriptor) const {
-    if (descriptor.method != config_.method) {
+    if (!(descriptor.method == config_.method)) {
         throw core::ConfigError("a " + core::ToString(descriptor.method) +
                                 " descriptor cannot join a " + core::ToString(config_.method) +
                                 " database");
     }
 }
 
+std::size_t DescriptorDatabase::Append(double time_s, bool valid) {
+    times_s_.push_back(time_s);
+    valid_.push_back(valid ? 1 : 0);
+    return size() - 1;
+}
+
 std::size_t DescriptorDatabase::Add(const core::Descriptor& descriptor, double time_s) {
     CheckMethod(descriptor);
-    if (histograms_) return AddCumulativeRow(Prepare(descriptor).cumulative_row, time_s, true);
-    return AddNdtSet(descriptor.ndt(), time_s, true);
+    store_->Add(descriptor);
+    return Append(time_s, true);
 }
 
 std::size_t DescriptorDatabase::AddMissing(double time_s) {
-    if (histograms_) {
-        return AddCumulativeRow(std::vector<float>(static_cast<std::size_t>(histograms_->stride())),
-                                time_s, false);
-    }
-    return AddNdtSet({}, time_s, false);
-}
-
-std::size_t DescriptorDatabase::AddCumulativeRow(std::span<const float> row, double time_s,
-                                                 bool valid) {
-    if (!histograms_) throw core::ConfigError("an NDT database holds no histogram rows");
-    histograms_->AddRow(row);
-    times_s_.push_back(time_s);
-    valid_.push_back(valid ? 1 : 0);
-    return size() - 1;
-}
-
-std::size_t DescriptorDatabase::AddNdtSet(core::NdtDescriptorSet set, double time_s, bool valid) {
-    if (histograms_) throw core::ConfigError("a histogram database holds no NDT sets");
-    ndt_sets_.push_back(std::move(set));
-    times_s_.push_back(time_s);
-    valid_.push_back(valid ? 1 : 0);
-    return size() - 1;
+    store_->AddMissing();
+    return Append(time_s, false);
 }
 
 double DescriptorDatabase::Distance(std::size_t i, std::size_t j) const {
     if (!IsValid(i) || !IsValid(j)) return kInfinity;
-    if (histograms_) return histograms_->Distance(i, j);
-    return core::NdtSetDifference(ndt_sets_[i], ndt_sets_[j]);
+    return store_->Distance(i, j);
 }
 
-PreparedQuery DescriptorDatabase::Prepare(const core::Descriptor& descriptor) const {
+std::unique_ptr<PreparedQuery> DescriptorDatabase::Prepare(
+    const core::Descriptor& descriptor) const {
     CheckMethod(descriptor);
-    PreparedQuery query;
-    if (histograms_) {
-        query.cumulative_row = histograms_->MakeRow(descriptor.histogram().mass);
-    } else {
-        query.ndt = descriptor.ndt();
-    }
-    return query;
+    return store_->Prepare(descriptor);
 }
 
-PreparedQuery DescriptorDatabase::PrepareStored(std::size_t i) const {
+std::unique_ptr<PreparedQuery> DescriptorDatabase::PrepareStored(std::size_t i) const {
     if (i >= size() || !IsValid(i)) {
         throw core::ConfigError("scan " + std::to_string(i) + " of the database is " +
                                 (i >= size() ? "not stored" : "missing (it could not be read)"));
     }
-    PreparedQuery query;
-    if (histograms_) {
-        const float* row = histograms_->Row(i);
-        query.cumulative_row.assign(row, row + histograms_->stride());
-    } else {
-        query.ndt = ndt_sets_[i];
-    }
-    return query;
+    return store_->PrepareStored(i);
 }
 
 double DescriptorDatabase::Distance(const PreparedQuery& query, std::size_t j) const {
     if (!IsValid(j)) return kInfinity;
-    if (histograms_) return histograms_->DistanceToRow(query.cumulative_row.data(), j);
-    return core::NdtSetDifference(query.ndt, ndt_sets_[j]);
+    return store_->Distance(query, j);
+}
+
+void DescriptorDatabase::Encode(std::size_t i, core::ByteWriter& out) const {
+    out.Put<double>(TimeS(i));
+    out.Put<std::uint8_t>(valid_[i]);
+    store_->Encode(i, out);
+}
+
+std::size_t DescriptorDatabase::Decode(core::ByteReader& in) {
+    const auto time_s = in.Get<double>("scan time");
+    const bool valid = in.Get<std::uint8_t>("valid flag") != 0;
+    store_->Decode(in, valid);
+    return Append(time_s, valid);
 }
 
 }  // namespace lidarloop::pipeline

@@ -2,32 +2,33 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <optional>
+#include <memory>
 #include <vector>
 
+#include "lidarloop/core/byte_codec.hpp"
 #include "lidarloop/core/descriptor.hpp"
 #include "lidarloop/core/descriptor_config.hpp"
-#include "lidarloop/pipeline/cumulative_histograms.hpp"
+#include "lidarloop/pipeline/descriptor_method.hpp"
 
 namespace lidarloop::pipeline {
 
-/// A descriptor prepared for many comparisons against a database.
-struct PreparedQuery {
-    std::vector<float> cumulative_row;  ///< histogram methods: padded cumulative histogram
-    core::NdtDescriptorSet ndt;         ///< NDT: the descriptor set
-};
-
-/// The descriptors of a sequence of scans, one method, in scan order. A scan that could not be
-/// read has a placeholder entry that matches nothing (distance +inf). Histograms are stored as
-/// cumulative float rows (CumulativeHistograms); NDT descriptor sets as computed.
+/// The descriptors of a sequence of scans, one method, in scan order, with their times. A scan
+/// that could not be read has a placeholder entry that matches nothing (distance +inf). The
+/// method's DescriptorStore keeps them in the form that compares fastest.
 /// Not thread-safe for writing; concurrent reads are safe.
 class DescriptorDatabase {
 public:
-    /// Validates `config` (ConfigError).
+    /// Validates `config` (ConfigError), including that its method is registered.
     explicit DescriptorDatabase(const core::DescriptorConfig& config);
+    DescriptorDatabase(const DescriptorDatabase& other);
+    DescriptorDatabase& operator=(const DescriptorDatabase& other);
+    DescriptorDatabase(DescriptorDatabase&&) noexcept = default;
+    DescriptorDatabase& operator=(DescriptorDatabase&&) noexcept = default;
 
     const core::DescriptorConfig& config() const { return config_; }
-    core::Method method() const { return config_.method; }
+    const core::Method& method() const { return config_.method; }
+    /// The method the descriptors belong to.
+    const DescriptorMethod& definition() const { return *definition_; }
     std::size_t size() const { return times_s_.size(); }
 
     /// Appends the descriptor of the next scan; its method must be the database's.
@@ -39,31 +40,31 @@ public:
     double TimeS(std::size_t i) const { return times_s_[i]; }
     const std::vector<double>& times_s() const { return times_s_; }
 
-    /// Distance between stored scans: W (histograms) or sigma' (NDT); +inf if one is missing.
+    /// The method's distance between stored scans; +inf if one is missing.
     double Distance(std::size_t i, std::size_t j) const;
 
-    PreparedQuery Prepare(const core::Descriptor& descriptor) const;
+    std::unique_ptr<PreparedQuery> Prepare(const core::Descriptor& descriptor) const;
     /// Stored scan i as a query (to search another database with it); it must be valid.
-    PreparedQuery PrepareStored(std::size_t i) const;
+    std::unique_ptr<PreparedQuery> PrepareStored(std::size_t i) const;
     /// Distance between a prepared query and stored scan j; +inf if j is missing.
     double Distance(const PreparedQuery& query, std::size_t j) const;
 
-    /// The histogram rows (nullptr for NDT).
-    const CumulativeHistograms* histograms() const { return histograms_ ? &*histograms_ : nullptr; }
-    /// The NDT sets (empty for histogram methods).
-    const std::vector<core::NdtDescriptorSet>& ndt_sets() const { return ndt_sets_; }
+    const DescriptorStore& store() const { return *store_; }
+    /// Per-scan work figures of the valid scans (e.g. NDT rotation candidates).
+    std::vector<WorkFigure> Work() const { return store_->Work(valid_); }
 
-    /// Appends a raw cumulative row (histogram methods; used when loading a saved database).
-    std::size_t AddCumulativeRow(std::span<const float> row, double time_s, bool valid);
-    /// Appends an NDT set (used when loading a saved database).
-    std::size_t AddNdtSet(core::NdtDescriptorSet set, double time_s, bool valid);
+    /// Writes scan i (time, valid flag, the store's encoding) for a saved database.
+    void Encode(std::size_t i, core::ByteWriter& out) const;
+    /// Appends a scan written by Encode; calls in.Fail for damaged data.
+    std::size_t Decode(core::ByteReader& in);
 
 private:
     void CheckMethod(const core::Descriptor& descriptor) const;
+    std::size_t Append(double time_s, bool valid);
 
     core::DescriptorConfig config_;
-    std::optional<CumulativeHistograms> histograms_;
-    std::vector<core::NdtDescriptorSet> ndt_sets_;
+    const DescriptorMethod* definition_;
+    std::unique_ptr<DescriptorStore> store_;
     std::vector<double> times_s_;
     std::vector<std::uint8_t> valid_;
 };

@@ -6,14 +6,9 @@
 #include <vector>
 
 #include "lidarloop/pipeline/cumulative_histograms.hpp"
+#include "lidarloop/pipeline/descriptor_method.hpp"
 
 namespace lidarloop::pipeline {
-
-/// A stored scan and its distance to a query.
-struct Neighbor {
-    std::size_t index = 0;
-    double distance = 0.0;  ///< W (histograms) or sigma' (NDT)
-};
 
 /// Exact nearest-neighbour search over the rows of a CumulativeHistograms store under Röhling's
 /// W, an L1 distance on cumulative histograms.

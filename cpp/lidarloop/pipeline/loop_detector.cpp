@@ -19,12 +19,12 @@ double SecondRatio(double best, double second) {
 // Fills second_ratio and accepted from the candidates and a search for the best candidate
 // outside the gap around the best match.
 void Finish(LoopQuery& result, const core::MinGap& gap, const std::vector<double>& times_s,
-            core::Method method, double threshold,
+            const DescriptorMethod& method, double threshold,
             const std::function<std::vector<Neighbor>(const std::function<bool(std::size_t)>&)>&
                 search_one) {
     if (!result.has_match()) return;
     const Neighbor best = result.candidates.front();
-    result.accepted = core::IsMatch(method, best.distance, threshold);
+    result.accepted = method.IsMatch(best.distance, threshold);
     const auto other_place = [&](std::size_t j) {
         return gap.Allows(best.index, j, times_s[best.index], times_s[j]);
     };
@@ -75,18 +75,16 @@ LoopDetector::LoopDetector(DescriptorDatabase database, const DetectorConfig& de
       detector_(detector),
       threshold_(detector.ThresholdFor(database_.method())) {
     detector_.Validate();
-    if (database_.histograms() != nullptr) {
-        index_.emplace(*database_.histograms());
-        // One sort instead of n sorted inserts: a loaded map may hold a million scans.
-        index_->InsertAll([this](std::size_t i) { return database_.IsValid(i); });
-    }
+    index_ = database_.store().MakeIndex();
+    // One sort instead of n sorted inserts: a loaded map may hold a million scans.
+    if (index_) index_->InsertAll([this](std::size_t i) { return database_.IsValid(i); });
 }
 
 LoopQuery LoopDetector::Search(const PreparedQuery& query, std::size_t query_index,
                                const std::function<bool(std::size_t)>& eligible) const {
     const auto k = static_cast<std::size_t>(detector_.top_k);
     const auto search = [&](std::size_t count, const std::function<bool(std::size_t)>& filter) {
-        if (index_) return index_->Search(query.cumulative_row.data(), count, filter);
+        if (index_) return index_->Search(query, count, filter);
         return NearestCandidates(
             database_.size(), count, [&](std::size_t j) { return database_.Distance(query, j); },
             filter);
@@ -94,7 +92,7 @@ LoopQuery LoopDetector::Search(const PreparedQuery& query, std::size_t query_ind
     LoopQuery result;
     result.query = query_index;
     result.candidates = search(k, eligible);
-    Finish(result, detector_.min_gap, database_.times_s(), database_.method(), threshold_,
+    Finish(result, detector_.min_gap, database_.times_s(), database_.definition(), threshold_,
            [&](const std::function<bool(std::size_t)>& other_place) {
                return search(1, [&](std::size_t j) { return eligible(j) && other_place(j); });
            });
@@ -102,15 +100,15 @@ LoopQuery LoopDetector::Search(const PreparedQuery& query, std::size_t query_ind
 }
 
 LoopQuery LoopDetector::Process(const core::PointCloud& scan, double time_s) {
-    return Process(core::ComputeDescriptor(scan, database_.config()), time_s);
+    return Process(ComputeDescriptor(scan, database_.config()), time_s);
 }
 
 LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_s) {
-    const PreparedQuery query = database_.Prepare(descriptor);
+    const std::unique_ptr<PreparedQuery> query = database_.Prepare(descriptor);
     const std::size_t query_index = database_.size();
     const auto& times_s = database_.times_s();
     const core::MinGap gap = detector_.min_gap;
-    const LoopQuery result = Search(query, query_index, [&](std::size_t j) {
+    const LoopQuery result = Search(*query, query_index, [&](std::size_t j) {
         return j < query_index && database_.IsValid(j) &&
                gap.Allows(query_index, j, time_s, times_s[j]);
     });
@@ -120,7 +118,7 @@ LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_
 }
 
 LoopQuery LoopDetector::Query(const core::Descriptor& descriptor) const {
-    return Query(database_.Prepare(descriptor), database_.size());
+    return Query(*database_.Prepare(descriptor), database_.size());
 }
 
 LoopQuery LoopDetector::Query(const PreparedQuery& query, std::size_t query_index) const {
@@ -136,7 +134,7 @@ std::vector<LoopQuery> LocaliseSequence(const LoopDetector& map, const Descripto
     std::vector<LoopQuery> results(queries.size());
     const auto localise = [&](std::size_t i) {
         results[i].query = i;
-        if (queries.IsValid(i)) results[i] = map.Query(queries.PrepareStored(i), i);
+        if (queries.IsValid(i)) results[i] = map.Query(*queries.PrepareStored(i), i);
     };
     if (execution == Execution::kSerial) {
         for (std::size_t i = 0; i < queries.size(); ++i) localise(i);
@@ -148,7 +146,8 @@ std::vector<LoopQuery> LocaliseSequence(const LoopDetector& map, const Descripto
 
 std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,
                                         const std::vector<double>& times_s,
-                                        const DetectorConfig& detector, core::Method method) {
+                                        const DetectorConfig& detector,
+                                        const core::Method& method) {
     detector.Validate();
     const double threshold = detector.ThresholdFor(method);
     if (times_s.size() != matrix.size()) {
@@ -165,7 +164,7 @@ std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,
         LoopQuery& result = results[i];
         result.query = i;
         result.candidates = NearestCandidates(i, k, distance_of, eligible);
-        Finish(result, detector.min_gap, times_s, method, threshold,
+        Finish(result, detector.min_gap, times_s, MethodOf(method), threshold,
                [&](const std::function<bool(std::size_t)>& other_place) {
                    return NearestCandidates(i, 1, distance_of, [&](std::size_t j) {
                        return eligible(j) && other_place(j);

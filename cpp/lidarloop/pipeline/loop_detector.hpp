@@ -3,13 +3,14 @@
 #include <cstddef>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <vector>
 
 #include "lidarloop/core/descriptor.hpp"
 #include "lidarloop/core/min_gap.hpp"
 #include "lidarloop/pipeline/descriptor_database.hpp"
-#include "lidarloop/pipeline/histogram_index.hpp"
+#include "lidarloop/pipeline/descriptor_method.hpp"
 #include "lidarloop/pipeline/similarity_matrix.hpp"
 
 namespace lidarloop::pipeline {
@@ -20,12 +21,12 @@ struct DetectorConfig {
     core::MinGap min_gap;
     int top_k = 5;  ///< candidates reported per query, nearest first; 1..1000
     /// The decision threshold, tau (W <= tau, Röhling eq. 7) or t_d (sigma' < t_d, Magnusson
-    /// II-E); empty: the method's default (core::DefaultThreshold).
+    /// II-E); empty: the method's default (pipeline::DefaultThreshold).
     std::optional<double> threshold;
 
     /// `threshold` when set, else the default of `method`.
-    double ThresholdFor(core::Method method) const {
-        return threshold ? *threshold : core::DefaultThreshold(method);
+    double ThresholdFor(const core::Method& method) const {
+        return threshold ? *threshold : DefaultThreshold(method);
     }
     /// Throws ConfigError naming the first invalid field.
     void Validate() const;
@@ -52,8 +53,9 @@ std::vector<Neighbor> NearestCandidates(std::size_t count, std::size_t k,
                                         const std::function<bool(std::size_t)>& eligible);
 
 /// Online loop detection: scans arrive one at a time; each is compared with the stored scans
-/// older than the minimum gap, then stored. Histogram methods use the exact HistogramIndex;
-/// NDT compares every eligible scan. Process is not thread-safe; Query may run concurrently.
+/// older than the minimum gap, then stored. Candidates come from the method's exact index where
+/// it has one (histograms: HistogramIndex), else from comparing every eligible scan (NDT).
+/// Process is not thread-safe; Query may run concurrently.
 /// Neither copyable nor movable: the index refers to the detector's own database.
 class LoopDetector {
 public:
@@ -86,7 +88,7 @@ private:
     DescriptorDatabase database_;
     DetectorConfig detector_;
     double threshold_;
-    std::optional<HistogramIndex> index_;
+    std::unique_ptr<NeighborIndex> index_;  // nullptr: compare every eligible scan
 };
 
 /// Localisation of a whole sequence against a map: LoopDetector::Query for every scan of
@@ -99,6 +101,6 @@ std::vector<LoopQuery> LocaliseSequence(const LoopDetector& map, const Descripto
 /// scans j < i outside the gap, exactly as LoopDetector::Process would give them online.
 std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,
                                         const std::vector<double>& times_s,
-                                        const DetectorConfig& detector, core::Method method);
+                                        const DetectorConfig& detector, const core::Method& method);
 
 }  // namespace lidarloop::pipeline

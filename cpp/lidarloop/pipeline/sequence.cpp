@@ -33,7 +33,7 @@ ScanResult DescribeOne(const ScanSource& source, const core::DescriptorConfig& c
         const core::PointCloud cloud = source.load(i);
         result.load_seconds = SecondsSince(load_start);
         const auto describe_start = Clock::now();
-        result.descriptor = core::ComputeDescriptor(cloud, config);
+        result.descriptor = ComputeDescriptor(cloud, config);
         result.describe_seconds = SecondsSince(describe_start);
     } catch (const core::ConfigError&) {
         throw;  // a bad configuration is not a bad scan

@@ -7,11 +7,11 @@
 
 namespace lidarloop::test {
 
-/// A short demo-town sequence (80 VLP-16 scans, thinned) in KITTI layout in `folder`, with
+/// A short demo-town sequence (200 VLP-16 scans, thinned) in KITTI layout in `folder`, with
 /// poses: small enough for a run-layer test, with revisits.
 inline io::Dataset SmallSequence(const std::filesystem::path& folder) {
     sim::SimulationConfig config = sim::DemoConfig();
-    config.scans = 80;
+    config.scans = 200;
     config.sensor.horizontal_steps = 360;
     app::WriteSimulation(sim::Simulator(config), folder, /*overwrite=*/false, /*threads=*/0);
     return io::OpenDataset(folder);

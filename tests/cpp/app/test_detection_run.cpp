@@ -44,7 +44,7 @@ TEST_F(DetectionRun, EqualsThePipelineOnTheSameDescriptors) {
         const app::DetectOutcome outcome = app::RunDetect(*dataset_, request);
         const auto described =
             pipeline::DescribeSequence(app::SourceOf(*dataset_), request.config.descriptor);
-        const double threshold = core::DefaultThreshold(method);
+        const double threshold = pipeline::DefaultThreshold(method);
         const auto expected = pipeline::DetectFromMatrix(
             pipeline::ComputeSimilarityMatrix(described.database), described.database.times_s(),
             request.config.detection, method);

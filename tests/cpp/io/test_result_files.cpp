@@ -13,6 +13,7 @@
 #include "lidarloop/io/results_csv.hpp"
 #include "lidarloop/io/similarity_file.hpp"
 #include "lidarloop/pipeline/loop_detector.hpp"
+#include "lidarloop/pipeline/ndt_method.hpp"
 #include "test_utils.hpp"
 
 namespace lidarloop::io {
@@ -24,7 +25,8 @@ pipeline::DescriptorDatabase SmallDatabase(core::Method method) {
     config.histogram.bins = 24;
     pipeline::DescriptorDatabase database(config);
     for (unsigned i = 0; i < 6; ++i) {
-        database.Add(core::ComputeDescriptor(test::RandomCloud(3000, i, 5.0f), config), 0.5 * i);
+        database.Add(pipeline::ComputeDescriptor(test::RandomCloud(3000, i, 5.0f), config),
+                     0.5 * i);
     }
     database.AddMissing(3.0);
     return database;
@@ -87,7 +89,7 @@ TEST(DatabaseFile, RoundTripsHistogramAndNdtDatabases) {
         accept_all.threshold = 1.0;
         pipeline::LoopDetector detector(loaded, accept_all);
         const auto query = detector.Query(
-            core::ComputeDescriptor(test::RandomCloud(3000, 2, 5.0f), loaded.config()));
+            pipeline::ComputeDescriptor(test::RandomCloud(3000, 2, 5.0f), loaded.config()));
         ASSERT_TRUE(query.has_match());
         EXPECT_EQ(query.candidates.front().index, 2U);
         EXPECT_EQ(query.candidates.front().distance, 0.0);
@@ -143,7 +145,7 @@ TEST(DatabaseFile, DamagedNdtCountsAreClearErrors) {
     const auto database = SmallDatabase(core::Method::kNdt);
     SaveDatabase(dir / "db.bin", database);
     const std::string good = test::ReadFile(dir / "db.bin");
-    const core::NdtDescriptor& first = database.ndt_sets()[0].descriptors[0];
+    const core::NdtDescriptor& first = pipeline::NdtSets(database)->at(0).descriptors[0];
     const std::string header = DescriptorHeaderBytes(first);
     const auto at = good.find(header);
     ASSERT_NE(at, std::string::npos);

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/pipeline/histogram_method.hpp"
 #include "lidarloop/pipeline/loop_detector.hpp"
 #include "lidarloop/pipeline/sequence.hpp"
 #include "pipeline/pipeline_test_utils.hpp"
@@ -157,9 +158,9 @@ TEST(LocaliseSequence, EqualsBruteForceAgainstTheMap) {
             EXPECT_FALSE(parallel[i].has_match()) << i;
             continue;
         }
-        const PreparedQuery query = queries.PrepareStored(i);
+        const std::unique_ptr<PreparedQuery> query = queries.PrepareStored(i);
         const auto expected = NearestCandidates(
-            map.size(), 4, [&](std::size_t j) { return map.Distance(query, j); },
+            map.size(), 4, [&](std::size_t j) { return map.Distance(*query, j); },
             [&](std::size_t j) { return map.IsValid(j); });
         ASSERT_EQ(parallel[i].candidates.size(), expected.size()) << i;
         for (std::size_t r = 0; r < expected.size(); ++r) {
@@ -191,7 +192,7 @@ TEST(LoopDetector, NdtUsesTheSameRules) {
     }
     const auto offline = DetectFromMatrix(ComputeSimilarityMatrix(online.database()), times,
                                           detector, core::Method::kNdt);
-    EXPECT_EQ(online.threshold(), core::DefaultThreshold(core::Method::kNdt));
+    EXPECT_EQ(online.threshold(), DefaultThreshold(core::Method::kNdt));
     for (std::size_t i = 0; i < results.size(); ++i) ExpectSameQueries(results[i], offline[i]);
     // Scan 4 repeats scan 0 (same seed): found with distance 0.
     ASSERT_TRUE(results[4].has_match());
@@ -261,7 +262,7 @@ TEST(DescribeSequence, SkipsABadScanWhenAskedAndItNeverMatches) {
     EXPECT_EQ(result.database.Distance(7, 3), std::numeric_limits<double>::infinity());
     LoopDetector detector(result.database, Deciding(DetectorConfig{}, 1.0));
     const LoopQuery q =
-        detector.Query(core::ComputeDescriptor(test::RandomCloud(500, 7), HeightConfig(50)));
+        detector.Query(ComputeDescriptor(test::RandomCloud(500, 7), HeightConfig(50)));
     ASSERT_TRUE(q.has_match());
     EXPECT_NE(q.candidates.front().index, 7U);
 }
@@ -272,7 +273,7 @@ TEST(DescribeSequence, ParallelEqualsSerial) {
     ScanSource source = SourceWithBadScan(30, 1000);
     const auto a = DescribeSequence(source, HeightConfig(64), serial);
     const auto b = DescribeSequence(source, HeightConfig(64));
-    EXPECT_EQ(a.database.histograms()->data(), b.database.histograms()->data());
+    EXPECT_EQ(HistogramRows(a.database)->data(), HistogramRows(b.database)->data());
 }
 
 }  // namespace

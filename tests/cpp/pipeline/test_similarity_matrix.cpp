@@ -51,7 +51,7 @@ TEST(SimilarityMatrix, ParallelEqualsSerialForNdt) {
     config.method = core::Method::kNdt;
     DescriptorDatabase database(config);
     for (unsigned seed = 0; seed < 12; ++seed) {
-        database.Add(core::ComputeDescriptor(test::RandomCloud(3000, seed, 4.0f), config), 0.0);
+        database.Add(pipeline::ComputeDescriptor(test::RandomCloud(3000, seed, 4.0f), config), 0.0);
     }
     const SimilarityMatrix serial = ComputeSimilarityMatrix(database, Execution::kSerial);
     EXPECT_EQ(serial.condensed(), ComputeSimilarityMatrix(database).condensed());

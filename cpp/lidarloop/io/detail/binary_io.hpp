@@ -16,13 +16,15 @@
 #include <string>
 #include <vector>
 
+#include "lidarloop/core/byte_codec.hpp"
+
 namespace lidarloop::io::detail {
 
-/// `a * b`, or nullopt when the product does not fit in a size_t.
-inline std::optional<std::size_t> CheckedMul(std::size_t a, std::size_t b) {
-    if (a != 0 && b > std::numeric_limits<std::size_t>::max() / a) return std::nullopt;
-    return a * b;
-}
+using core::CheckedMul;
+using core::Load;
+using core::LoadLittle;
+using core::Store;
+using core::StoreLittle;
 
 /// A byte count for a message: the number, or "more than <SIZE_MAX>" where CheckedMul overflowed.
 std::string BytesText(std::optional<std::size_t> bytes);
@@ -46,36 +48,6 @@ inline float ToFloat(double value) {
     const float magnitude = std::abs(value) < overflow ? std::numeric_limits<float>::max()
                                                        : std::numeric_limits<float>::infinity();
     return value > 0 ? magnitude : -magnitude;
-}
-
-/// The value of type T stored at `bytes` (any alignment) in byte order `order`. Correct on any
-/// host byte order, free of aliasing UB, and a single load where `order` is the host's.
-template <typename T>
-T Load(const char* bytes, std::endian order) {
-    std::array<char, sizeof(T)> buffer;
-    std::memcpy(buffer.data(), bytes, sizeof(T));
-    if (order != std::endian::native) std::reverse(buffer.begin(), buffer.end());
-    return std::bit_cast<T>(buffer);
-}
-
-/// Stores `value` at `bytes` (any alignment) in byte order `order`; the inverse of Load.
-template <typename T>
-void Store(T value, char* bytes, std::endian order) {
-    auto buffer = std::bit_cast<std::array<char, sizeof(T)>>(value);
-    if (order != std::endian::native) std::reverse(buffer.begin(), buffer.end());
-    std::memcpy(bytes, buffer.data(), sizeof(T));
-}
-
-/// Load of little-endian data (KITTI .bin, PCD).
-template <typename T>
-T LoadLittle(const char* bytes) {
-    return Load<T>(bytes, std::endian::little);
-}
-
-/// Store of little-endian data (KITTI .bin, PCD).
-template <typename T>
-void StoreLittle(T value, char* bytes) {
-    Store(value, bytes, std::endian::little);
 }
 
 /// The binary data of a file that starts with a text header, and the number of bytes left in it.

@@ -1,0 +1,104 @@
+#include "lidarloop/pipeline/descriptor_method.hpp"
+
+#include <mutex>
+
+#include "lidarloop/core/error.hpp"
+#include "lidarloop/pipeline/histogram_method.hpp"
+#include "lidarloop/pipeline/ndt_method.hpp"
+
+namespace lidarloop::pipeline {
+namespace {
+
+// Every registered method in registration order. Methods are never removed, so a reference to
+// one stays valid for the life of the process.
+class Registry {
+public:
+    Registry() {
+        // The built-in methods: one line each.
+        Add(std::make_shared<HistogramMethod>(core::Method::kHeight));
+        Add(std::make_shared<HistogramMethod>(core::Method::kRange));
+        Add(std::make_shared<NdtMethod>());
+    }
+
+    void Add(std::shared_ptr<const DescriptorMethod> method) {
+        if (!method) throw core::ConfigError("RegisterMethod: no method given");
+        const std::lock_guard<std::mutex> lock(mutex_);
+        for (const auto& known : methods_) {
+            if (known->method() == method->method()) {
+                throw core::ConfigError("a descriptor method named '" + method->name() +
+                                        "' is already registered");
+            }
+        }
+        methods_.push_back(std::move(method));
+    }
+    const DescriptorMethod* Find(const core::Method& method) const {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        for (const auto& known : methods_) {
+            if (known->method() == method) return known.get();
+        }
+        return nullptr;
+    }
+    std::vector<std::string> Names() const {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        std::vector<std::string> names;
+        for (const auto& known : methods_) names.push_back(known->name());
+        return names;
+    }
+
+private:
+    mutable std::mutex mutex_;
+    std::vector<std::shared_ptr<const DescriptorMethod>> methods_;
+};
+
+Registry& TheRegistry() {
+    static Registry registry;
+    return registry;
+}
+
+[[noreturn]] void FailUnknown(std::string_view name) {
+    std::string valid;
+    for (const std::string& known : MethodNames()) valid += (valid.empty() ? "" : ", ") + known;
+    throw core::ConfigError("unknown method '" + std::string(name) + "' (valid: " + valid + ")");
+}
+
+}  // namespace
+
+void RegisterMethod(std::shared_ptr<const DescriptorMethod> method) {
+    TheRegistry().Add(std::move(method));
+}
+
+const DescriptorMethod& MethodOf(const core::Method& method) {
+    const DescriptorMethod* found = TheRegistry().Find(method);
+    if (found == nullptr) FailUnknown(method.name());
+    return *found;
+}
+
+core::Method ParseMethod(std::string_view name) {
+    if (name.empty() || name.size() > core::Method::kMaxName) FailUnknown(name);
+    const core::Method method(name);
+    if (TheRegistry().Find(method) == nullptr) FailUnknown(name);
+    return method;
+}
+
+std::vector<std::string> MethodNames() { return TheRegistry().Names(); }
+
+core::Descriptor ComputeDescriptor(const core::PointCloud& cloud,
+                                   const core::DescriptorConfig& config) {
+    return MethodOf(config.method).Describe(cloud, config);
+}
+
+double DescriptorDistance(const core::Descriptor& a, const core::Descriptor& b) {
+    if (!(a.method == b.method)) {
+        throw core::ConfigError("cannot compare a " + core::ToString(a.method) +
+                                " descriptor with a " + core::ToString(b.method) + " descriptor");
+    }
+    return MethodOf(a.method).Distance(a, b);
+}
+
+double DefaultThreshold(const core::Method& method) { return MethodOf(method).DefaultThreshold(); }
+
+bool IsMatch(const core::Method& method, double distance, double threshold) {
+    return MethodOf(method).IsMatch(distance, threshold);
+}
+
+}  // namespace lidarloop::pipeline

@@ -1,0 +1,149 @@
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "lidarloop/core/byte_codec.hpp"
+#include "lidarloop/core/descriptor.hpp"
+#include "lidarloop/core/descriptor_config.hpp"
+#include "lidarloop/core/point_cloud.hpp"
+
+namespace lidarloop::pipeline {
+
+/// A stored scan and its distance to a query.
+struct Neighbor {
+    std::size_t index = 0;
+    double distance = 0.0;  ///< the method's distance: W (histograms), sigma' (NDT), ...
+};
+
+/// A descriptor made ready for many comparisons by the store that made it (e.g. a cumulative
+/// histogram row). Only that store, and stores of the same method and config, compare with it.
+class PreparedQuery {
+public:
+    virtual ~PreparedQuery() = default;
+};
+
+/// A number per valid scan that says how much work its descriptor was (e.g. NDT rotation
+/// candidates), for timings.json.
+struct WorkFigure {
+    std::string name;            ///< e.g. "rotation_candidates_per_scan"
+    std::vector<double> values;  ///< one per valid scan
+};
+
+class NeighborIndex;
+
+/// The descriptors of a sequence of scans under one method and config, in scan order, kept in
+/// the form that compares fastest. Entry i of a scan that could not be described is a
+/// placeholder (AddMissing) that the database never compares. Not thread-safe for writing;
+/// concurrent reads are safe.
+class DescriptorStore {
+public:
+    virtual ~DescriptorStore() = default;
+    virtual std::unique_ptr<DescriptorStore> Clone() const = 0;
+
+    virtual void Add(const core::Descriptor& descriptor) = 0;
+    virtual void AddMissing() = 0;
+    /// The method's distance between stored scans i and j (both valid).
+    virtual double Distance(std::size_t i, std::size_t j) const = 0;
+    virtual std::unique_ptr<PreparedQuery> Prepare(const core::Descriptor& descriptor) const = 0;
+    virtual std::unique_ptr<PreparedQuery> PrepareStored(std::size_t i) const = 0;
+    /// The distance between a query prepared by a store like this one and stored scan j (valid).
+    virtual double Distance(const PreparedQuery& query, std::size_t j) const = 0;
+
+    /// An exact k-nearest-neighbour index over this store, which must outlive it; nullptr when
+    /// the method has none (the detector then compares every eligible scan).
+    virtual std::unique_ptr<NeighborIndex> MakeIndex() const { return nullptr; }
+    /// Per-scan work figures of the valid scans (`valid[i]` says which); none by default.
+    virtual std::vector<WorkFigure> Work(const std::vector<std::uint8_t>& /*valid*/) const {
+        return {};
+    }
+
+    /// Appends stored scan i (valid or a placeholder) to a saved database.
+    virtual void Encode(std::size_t i, core::ByteWriter& out) const = 0;
+    /// Reads one scan written by Encode and appends it (`valid` as saved); calls in.Fail for
+    /// damaged data.
+    virtual void Decode(core::ByteReader& in, bool valid) = 0;
+};
+
+/// Exact nearest-neighbour search over a store's valid scans, faster than comparing each.
+class NeighborIndex {
+public:
+    virtual ~NeighborIndex() = default;
+    /// Indexes scan `id` of the store (each once, in any order).
+    virtual void Insert(std::size_t id) = 0;
+    /// Indexes every scan of the store not yet indexed for which `include(id)` holds.
+    virtual void InsertAll(const std::function<bool(std::size_t)>& include) = 0;
+    /// The k indexed scans nearest to `query` for which `eligible(id)` holds (all when empty),
+    /// sorted by (distance, index): exactly what comparing every such scan would give.
+    virtual std::vector<Neighbor> Search(
+        const PreparedQuery& query, std::size_t k,
+        const std::function<bool(std::size_t)>& eligible) const = 0;
+};
+
+/// One place descriptor method: how a scan is described, how two descriptions compare, how
+/// many are stored (and saved), and what decides a loop. Register a new one with RegisterMethod;
+/// the database, the detector, the file formats and every run reach methods only through this.
+/// Implementations must be thread-safe (Describe and Distance run from many threads).
+class DescriptorMethod {
+public:
+    explicit DescriptorMethod(core::Method method) : method_(method) {}
+    virtual ~DescriptorMethod() = default;
+
+    const core::Method& method() const { return method_; }
+    std::string name() const { return core::ToString(method_); }
+
+    /// The descriptor of `cloud`; core::EmptyInputError when nothing in it is usable.
+    virtual core::Descriptor Describe(const core::PointCloud& cloud,
+                                      const core::DescriptorConfig& config) const = 0;
+    /// The distance between two descriptors of this method: smaller is more similar, 0 for
+    /// equal descriptors, symmetric.
+    virtual double Distance(const core::Descriptor& a, const core::Descriptor& b) const = 0;
+    /// An empty store for descriptors made under `config` (validated).
+    virtual std::unique_ptr<DescriptorStore> MakeStore(
+        const core::DescriptorConfig& config) const = 0;
+
+    /// The default decision threshold (detection.threshold when it is not set).
+    virtual double DefaultThreshold() const = 0;
+    /// Whether `distance` says "same place" under `threshold` (default: distance <= threshold).
+    virtual bool IsMatch(double distance, double threshold) const { return distance <= threshold; }
+
+private:
+    core::Method method_;
+};
+
+/// Adds `method` to the methods every part of lidarloop knows, under its name (from then on
+/// ParseMethod finds it, `method: <name>` in a config and `--method <name>` select it).
+/// ConfigError when the name is taken. Thread-safe.
+void RegisterMethod(std::shared_ptr<const DescriptorMethod> method);
+
+/// The registered method `method` names; ConfigError listing the registered names otherwise.
+/// Thread-safe.
+const DescriptorMethod& MethodOf(const core::Method& method);
+
+/// The method called `name`; ConfigError listing the registered names otherwise.
+core::Method ParseMethod(std::string_view name);
+
+/// The names of every registered method: height, range, ndt first, then in registration order.
+std::vector<std::string> MethodNames();
+
+/// MethodOf(config.method).Describe(cloud, config): ConfigError for an invalid config,
+/// EmptyInputError for a scan with nothing usable. Thread-safe.
+core::Descriptor ComputeDescriptor(const core::PointCloud& cloud,
+                                   const core::DescriptorConfig& config);
+
+/// The distance between two descriptors of the same method (ConfigError on mixed methods).
+double DescriptorDistance(const core::Descriptor& a, const core::Descriptor& b);
+
+/// The method's default decision threshold.
+double DefaultThreshold(const core::Method& method);
+
+/// Whether `distance` says "same place" under `threshold`, with the method's own comparison:
+/// W <= tau (Röhling eq. 7), sigma' < t_d (Magnusson II-E, table I).
+bool IsMatch(const core::Method& method, double distance, double threshold);
+
+}  // namespace lidarloop::pipeline

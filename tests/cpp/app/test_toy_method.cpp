@@ -1,0 +1,179 @@
+// A third descriptor registered through the public interface only, then run end to end: online
+// and offline detection, a saved map and localisation against it, and both papers' evaluation.
+// The method: the share of a scan's points in each 5 m range ring (a histogram of point counts
+// per ring), compared by the L1 distance of the shares.
+#include <cmath>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "app_test_utils.hpp"
+#include "lidarloop/app/descriptor_json.hpp"
+#include "lidarloop/app/detection.hpp"
+#include "lidarloop/app/evaluation.hpp"
+#include "lidarloop/core/error.hpp"
+#include "lidarloop/io/config_yaml.hpp"
+#include "lidarloop/pipeline/descriptor_method.hpp"
+#include "test_utils.hpp"
+
+namespace lidarloop {
+namespace {
+
+constexpr int kRings = 16;
+constexpr double kRingWidth_m = 5.0;
+using Shares = std::vector<double>;
+
+double L1(const Shares& a, const Shares& b) {
+    double sum = 0.0;
+    for (std::size_t k = 0; k < a.size(); ++k) sum += std::abs(a[k] - b[k]);
+    return sum;
+}
+
+// The store: the shares of every scan as they are.
+class RingStore : public pipeline::DescriptorStore {
+public:
+    struct Query : pipeline::PreparedQuery {
+        Shares shares;
+    };
+    std::unique_ptr<DescriptorStore> Clone() const override {
+        return std::make_unique<RingStore>(*this);
+    }
+    void Add(const core::Descriptor& d) override { rows_.push_back(d.As<Shares>()); }
+    void AddMissing() override { rows_.emplace_back(kRings, 0.0); }
+    double Distance(std::size_t i, std::size_t j) const override { return L1(rows_[i], rows_[j]); }
+    std::unique_ptr<pipeline::PreparedQuery> Prepare(const core::Descriptor& d) const override {
+        auto query = std::make_unique<Query>();
+        query->shares = d.As<Shares>();
+        return query;
+    }
+    std::unique_ptr<pipeline::PreparedQuery> PrepareStored(std::size_t i) const override {
+        auto query = std::make_unique<Query>();
+        query->shares = rows_[i];
+        return query;
+    }
+    double Distance(const pipeline::PreparedQuery& q, std::size_t j) const override {
+        return L1(static_cast<const Query&>(q).shares, rows_[j]);
+    }
+    void Encode(std::size_t i, core::ByteWriter& out) const override {
+        out.PutArray(rows_[i].data(), rows_[i].size());
+    }
+    void Decode(core::ByteReader& in, bool) override {
+        Shares shares(kRings);
+        in.GetArray(shares.data(), shares.size(), "ring shares");
+        rows_.push_back(std::move(shares));
+    }
+
+private:
+    std::vector<Shares> rows_;
+};
+
+class RingCounts : public pipeline::DescriptorMethod {
+public:
+    RingCounts() : DescriptorMethod(core::Method("rings")) {}
+    core::Descriptor Describe(const core::PointCloud& cloud,
+                              const core::DescriptorConfig&) const override {
+        Shares shares(kRings, 0.0);
+        double counted = 0.0;
+        for (const Eigen::Vector3f& p : cloud) {
+            if (!p.allFinite()) continue;
+            const auto ring = static_cast<int>(p.head<2>().norm() / kRingWidth_m);
+            shares[static_cast<std::size_t>(std::min(ring, kRings - 1))] += 1.0;
+            counted += 1.0;
+        }
+        if (counted == 0.0) throw core::EmptyInputError("no finite point");
+        for (double& share : shares) share /= counted;
+        return {method(), shares};
+    }
+    double Distance(const core::Descriptor& a, const core::Descriptor& b) const override {
+        return L1(a.As<Shares>(), b.As<Shares>());
+    }
+    std::unique_ptr<pipeline::DescriptorStore> MakeStore(
+        const core::DescriptorConfig&) const override {
+        return std::make_unique<RingStore>();
+    }
+    double DefaultThreshold() const override { return 0.1; }
+};
+
+// The one registration line, once per process.
+const core::Method kRingsMethod = [] {
+    pipeline::RegisterMethod(std::make_shared<RingCounts>());
+    return pipeline::ParseMethod("rings");
+}();
+
+class ToyMethod : public ::testing::Test {
+protected:
+    void SetUp() override { dataset_.emplace(test::SmallSequence(dir_ / "sequence")); }
+    io::RunConfig RingsConfig() const {
+        io::RunConfig config;
+        io::ApplyConfigYaml("method: rings\ndetection:\n  min_gap: 10\n", "rings.yaml", config);
+        return config;
+    }
+
+    test::TempDir dir_;
+    std::optional<io::Dataset> dataset_;
+};
+
+TEST_F(ToyMethod, DetectsLoopsExactlyAsComparingEveryEarlierScan) {
+    app::DetectRequest request{RingsConfig(), false, {}, dir_ / "detect"};
+    const app::DetectOutcome outcome = app::RunDetect(*dataset_, request);
+    ASSERT_EQ(outcome.queries.size(), dataset_->size());
+    EXPECT_EQ(outcome.threshold, 0.1);
+    std::vector<Shares> shares;
+    for (std::size_t i = 0; i < dataset_->size(); ++i)
+        shares.push_back(RingCounts().Describe(dataset_->LoadScan(i), {}).As<Shares>());
+    std::size_t accepted = 0;
+    for (std::size_t i = 11; i < dataset_->size(); ++i) {
+        const pipeline::LoopQuery& q = outcome.queries[i];
+        ASSERT_TRUE(q.has_match()) << i;
+        std::size_t best = 0;
+        for (std::size_t j = 1; j + 10 < i; ++j) {
+            if (L1(shares[i], shares[j]) < L1(shares[i], shares[best])) best = j;
+        }
+        EXPECT_EQ(q.candidates.front().index, best) << i;
+        EXPECT_NEAR(q.candidates.front().distance, L1(shares[i], shares[best]), 1e-6) << i;
+        accepted += L1(shares[i], shares[best]) <= 0.1 ? 1 : 0;
+    }
+    EXPECT_EQ(outcome.accepted, accepted);
+    EXPECT_TRUE(std::filesystem::exists(request.out / "database.lldb"));
+}
+
+TEST_F(ToyMethod, ASavedMapLoadsAndLocalisesEveryScanAtItself) {
+    app::DetectRequest request{RingsConfig(), false, {}, dir_ / "detect"};
+    app::RunDetect(*dataset_, request);
+    request.out = dir_ / "localise";
+    const app::DetectOutcome outcome =
+        app::RunLocalise(*dataset_, app::LoadMap(dir_ / "detect" / "database.lldb"), request);
+    EXPECT_EQ(outcome.accepted, dataset_->size());
+    for (const pipeline::LoopQuery& q : outcome.queries) {
+        EXPECT_EQ(q.candidates.front().distance, 0.0) << q.query;
+    }
+}
+
+TEST_F(ToyMethod, IsEvaluatedBesideThePapersMethods) {
+    app::EvaluationRequest request;
+    request.config = RingsConfig();
+    request.methods = {kRingsMethod, core::Method::kRange};
+    request.out = dir_ / "evaluation";
+    const app::EvaluationOutcome outcome = app::RunEvaluation(*dataset_, request);
+    ASSERT_EQ(outcome.methods.size(), 2U);
+    const app::MethodEvaluation& rings = outcome.methods[0];
+    EXPECT_EQ(rings.name, "rings");
+    EXPECT_EQ(rings.default_threshold, 0.1);
+    EXPECT_EQ(rings.pairwise.pairs, outcome.methods[1].pairwise.pairs);
+    EXPECT_GT(rings.pairwise.positives, 0U);
+    std::ifstream metrics_file(request.out / "metrics.json");
+    const nlohmann::json metrics = nlohmann::json::parse(metrics_file);
+    EXPECT_TRUE(metrics["methods"].contains("rings"));
+    EXPECT_NE(test::ReadFile(request.out / "report.md").find("| rings |"), std::string::npos);
+}
+
+TEST_F(ToyMethod, IsNamedInConfigsAndShownByName) {
+    EXPECT_NE(io::DumpConfigYaml({}).find("height | range | ndt | rings"), std::string::npos);
+    const core::Descriptor d =
+        pipeline::ComputeDescriptor(dataset_->LoadScan(0), RingsConfig().descriptor);
+    EXPECT_EQ(app::DescriptorJson(d), (nlohmann::json{{"method", "rings"}}));
+}
+
+}  // namespace
+}  // namespace lidarloop

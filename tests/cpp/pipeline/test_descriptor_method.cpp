@@ -1,0 +1,91 @@
+// The method registry and what every method answers through DescriptorMethod.
+#include <gtest/gtest.h>
+
+#include "lidarloop/core/error.hpp"
+#include "lidarloop/pipeline/descriptor_database.hpp"
+#include "lidarloop/pipeline/descriptor_method.hpp"
+#include "lidarloop/pipeline/histogram_method.hpp"
+#include "lidarloop/pipeline/ndt_method.hpp"
+#include "test_utils.hpp"
+
+namespace lidarloop::pipeline {
+namespace {
+
+std::string ErrorOf(const std::function<void()>& action) {
+    try {
+        action();
+    } catch (const core::ConfigError& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+TEST(DescriptorMethod, TheBuiltInMethodsComeFirstAndTheirNamesRoundTrip) {
+    const std::vector<std::string> names = MethodNames();
+    ASSERT_GE(names.size(), 3U);
+    EXPECT_EQ(std::vector<std::string>(names.begin(), names.begin() + 3),
+              (std::vector<std::string>{"height", "range", "ndt"}));
+    for (const std::string& name : names) {
+        EXPECT_EQ(core::ToString(ParseMethod(name)), name);
+        EXPECT_EQ(MethodOf(ParseMethod(name)).name(), name);
+    }
+}
+
+TEST(DescriptorMethod, AnUnknownNameListsTheValidOnes) {
+    for (const char* name : {"sift", "", "a-name-far-longer-than-thirty-one-characters"}) {
+        const std::string message = ErrorOf([&] { ParseMethod(name); });
+        EXPECT_NE(message.find("unknown method"), std::string::npos) << message;
+        EXPECT_NE(message.find("height, range, ndt"), std::string::npos) << message;
+    }
+    EXPECT_NE(ErrorOf([] { MethodOf(core::Method("sift")); }).find("unknown method 'sift'"),
+              std::string::npos);
+}
+
+TEST(DescriptorMethod, EachPaperDecidesWithItsOwnComparisonAndDefault) {
+    EXPECT_EQ(DefaultThreshold(core::Method::kHeight), 0.005);
+    EXPECT_EQ(DefaultThreshold(core::Method::kRange), 0.005);
+    EXPECT_EQ(DefaultThreshold(core::Method::kNdt), 0.0737);
+    EXPECT_TRUE(IsMatch(core::Method::kHeight, 0.005, 0.005));  // W <= tau (Röhling eq. 7)
+    EXPECT_FALSE(IsMatch(core::Method::kNdt, 0.05, 0.05));      // sigma' < t_d (Magnusson)
+    EXPECT_TRUE(IsMatch(core::Method::kNdt, 0.049, 0.05));
+}
+
+TEST(DescriptorMethod, ANameIsRegisteredOnce) {
+    const std::string message =
+        ErrorOf([] { RegisterMethod(std::make_shared<HistogramMethod>(core::Method::kRange)); });
+    EXPECT_NE(message.find("'range' is already registered"), std::string::npos) << message;
+    EXPECT_THROW(RegisterMethod(nullptr), core::ConfigError);
+    EXPECT_THROW(HistogramMethod(core::Method::kNdt), core::ConfigError);
+}
+
+TEST(DescriptorMethod, DescriptorsOfTwoMethodsAreNotCompared) {
+    core::DescriptorConfig height;
+    core::DescriptorConfig range;
+    range.method = core::Method::kRange;
+    const core::PointCloud cloud = test::RandomCloud(500, 1);
+    const core::Descriptor a = ComputeDescriptor(cloud, height);
+    const core::Descriptor b = ComputeDescriptor(cloud, range);
+    EXPECT_EQ(DescriptorDistance(a, a), 0.0);
+    EXPECT_NE(ErrorOf([&] { DescriptorDistance(a, b); }).find("cannot compare a height"),
+              std::string::npos);
+    EXPECT_THROW(a.ndt(), core::ConfigError);  // holds a histogram
+}
+
+TEST(DescriptorDatabase, TypedViewsBelongToTheirMethodAndCopiesAreDeep) {
+    core::DescriptorConfig config;
+    DescriptorDatabase histograms(config);
+    histograms.Add(ComputeDescriptor(test::RandomCloud(500, 1), config), 0.0);
+    ASSERT_NE(HistogramRows(histograms), nullptr);
+    EXPECT_EQ(NdtSets(histograms), nullptr);
+    DescriptorDatabase copy = histograms;
+    copy.Add(ComputeDescriptor(test::RandomCloud(500, 2), config), 1.0);
+    EXPECT_EQ(HistogramRows(histograms)->size(), 1U);
+    EXPECT_EQ(HistogramRows(copy)->size(), 2U);
+    config.method = core::Method::kNdt;
+    const DescriptorDatabase ndt(config);
+    EXPECT_EQ(HistogramRows(ndt), nullptr);
+    ASSERT_NE(NdtSets(ndt), nullptr);
+}
+
+}  // namespace
+}  // namespace lidarloop::pipeline
