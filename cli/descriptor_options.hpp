@@ -22,6 +22,8 @@ public:
     io::RunConfig Resolve(io::RunConfig base = {}) const;
     /// The first descriptor flag given on the command line ("--bins", ...), or "" when none.
     std::string FirstGiven() const;
+    /// Whether --min or --max was given: they set the value range of one projection.
+    bool GivesValueRange() const { return *min_option_ || *max_option_; }
 
 private:
     void ApplyHistogramFlags(core::DescriptorConfig& descriptor) const;

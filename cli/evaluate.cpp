@@ -48,12 +48,33 @@ CLI::Validator RegisteredMethod() {
         "METHOD");
 }
 
+// --min and --max set the value range of the one histogram method evaluated; with both (or
+// neither) it is not clear which range they mean.
+io::RunConfig ResolveConfig(const EvaluateFlags& flags, const std::vector<core::Method>& methods) {
+    io::RunConfig base;
+    if (flags.descriptor.GivesValueRange()) {
+        std::vector<core::Method> histograms;
+        for (const core::Method& m : methods) {
+            if (core::IsHistogramMethod(m)) histograms.push_back(m);
+        }
+        if (histograms.size() != 1) {
+            throw core::ConfigError(
+                "--min and --max set the value range of one histogram method: evaluate only "
+                "height or only range with them, or set histogram.height_min_m / range_min_m "
+                "(and _max_m) in --config");
+        }
+        base.descriptor.method = histograms.front();
+    }
+    io::RunConfig config = flags.descriptor.Resolve(base);
+    flags.detection.ApplyTo(config);
+    return config;
+}
+
 app::EvaluationRequest RequestOf(const EvaluateFlags& flags) {
     app::EvaluationRequest request;
-    request.config = flags.descriptor.Resolve();
-    flags.detection.ApplyTo(request.config);
     for (const std::string& name : flags.methods)
         request.methods.push_back(pipeline::ParseMethod(name));
+    request.config = ResolveConfig(flags, request.methods);
     request.results_files = flags.results;
     request.distance_m = flags.distance_m;
     request.max_heading_deg = flags.max_heading_deg;
