@@ -85,6 +85,11 @@ TEST(ThresholdLearning, RejectsAbsurdConfigs) {
     EXPECT_EQ(ParseCriterion("mcc"), Criterion::kMcc);
     EXPECT_EQ(ParseCriterion(ToString(Criterion::kF1)), Criterion::kF1);
     EXPECT_THROW(ParseCriterion("auc"), core::ConfigError);
+    try {
+        ParseCriterion("auc");
+    } catch (const core::ConfigError& e) {
+        EXPECT_STREQ(e.what(), "unknown threshold criterion 'auc' (valid: mcc, f1)");
+    }
 }
 
 }  // namespace

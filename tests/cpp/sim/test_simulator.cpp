@@ -60,6 +60,11 @@ TEST(Sensor, BeamPatternsOfTheModels) {
         EXPECT_EQ(ParseSensorModel(ToString(model)), model);
     }
     EXPECT_THROW(ParseSensorModel("hdl32"), core::ConfigError);
+    try {
+        ParseSensorModel("hdl32");
+    } catch (const core::ConfigError& e) {
+        EXPECT_STREQ(e.what(), "unknown sensor 'hdl32' (valid: hdl64, vlp16, tilt180)");
+    }
 }
 
 // The number of points is the number of rays that hit something within range, thinned by the
