@@ -308,7 +308,9 @@ TEST_F(PcdErrors, MissingDataLine) {
 }
 
 TEST_F(PcdErrors, UnknownDataType) {
-    ExpectReadError(Write(XyzHeader(1, "binary_lzma")), "line 10: unknown DATA type 'binary_lzma'");
+    ExpectReadError(Write(XyzHeader(1, "binary_lzma")),
+                    "line 10: unknown DATA type 'binary_lzma' (expected ascii, binary or "
+                    "binary_compressed)");
 }
 
 TEST_F(PcdErrors, UnsupportedVersion) {

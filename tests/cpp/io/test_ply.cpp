@@ -334,7 +334,9 @@ TEST_F(PlyErrors, WrongMagic) {
 TEST_F(PlyErrors, UnknownFormat) {
     std::string text = XyzHeader(PlyEncoding::kAscii, 1) + "1 2 3\n";
     ReplaceOnce(text, "format ascii", "format binary_middle_endian");
-    ExpectReadError(Write(text), "line 2: unknown format 'binary_middle_endian'");
+    ExpectReadError(Write(text),
+                    "line 2: unknown format 'binary_middle_endian' (expected ascii, "
+                    "binary_little_endian or binary_big_endian)");
 }
 
 TEST_F(PlyErrors, UnsupportedVersion) {
