@@ -11,6 +11,7 @@
 #include <string_view>
 
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include "lidarloop/core/point_cloud.hpp"
 
@@ -64,6 +65,24 @@ inline core::PointCloud RandomCloud(std::size_t count, unsigned seed, float half
     core::PointCloud cloud(count);
     for (auto& p : cloud) p = {coordinate(rng), coordinate(rng), coordinate(rng)};
     return cloud;
+}
+
+/// A uniformly random rotation (a normalised quaternion of four normal draws) from the test's own
+/// generator: Eigen's UnitRandom draws from the global std::rand, which makes one test's draws
+/// depend on which tests ran before it.
+inline Eigen::Matrix3d RandomRotation(std::mt19937& rng) {
+    std::normal_distribution<double> normal(0.0, 1.0);
+    return Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng))
+        .normalized()
+        .toRotationMatrix();
+}
+
+/// `cloud` with every point p moved to R p + t.
+inline core::PointCloud Transformed(const core::PointCloud& cloud, const Eigen::Matrix3f& R,
+                                    const Eigen::Vector3f& t = Eigen::Vector3f::Zero()) {
+    core::PointCloud out = cloud;
+    for (auto& p : out) p = R * p + t;
+    return out;
 }
 
 /// Path of a fixture under tests/data.
