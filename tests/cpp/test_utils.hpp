@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
 
+#include "lidarloop/core/error.hpp"
 #include "lidarloop/core/point_cloud.hpp"
 
 namespace lidarloop::test {
@@ -88,6 +89,24 @@ inline core::PointCloud Transformed(const core::PointCloud& cloud, const Eigen::
 /// Path of a fixture under tests/data.
 inline std::filesystem::path DataFile(const std::string& name) {
     return std::filesystem::path(LIDARLOOP_TEST_DATA_DIR) / name;
+}
+
+/// Success when `message` contains `phrase`; the failure shows both.
+inline ::testing::AssertionResult Contains(const std::string& message, std::string_view phrase) {
+    if (message.find(phrase) != std::string::npos) return ::testing::AssertionSuccess();
+    return ::testing::AssertionFailure() << "'" << phrase << "' not in: " << message;
+}
+
+/// The message of the core::ConfigError that `call()` throws; "no ConfigError" when it returns.
+/// Any other exception escapes and fails the test.
+template <typename Call>
+std::string ConfigErrorOf(Call&& call) {
+    try {
+        call();
+    } catch (const core::ConfigError& e) {
+        return e.what();
+    }
+    return "no ConfigError";
 }
 
 /// Replaces the first `from` in `text` by `to`; fails the test when `text` has no `from`.

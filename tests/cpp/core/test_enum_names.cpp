@@ -10,6 +10,7 @@
 #include "lidarloop/core/histogram.hpp"
 #include "lidarloop/core/min_gap.hpp"
 #include "lidarloop/core/projection.hpp"
+#include "test_utils.hpp"
 
 namespace lidarloop::core {
 namespace {
@@ -22,16 +23,7 @@ constexpr auto kColourNames = std::to_array<EnumName<Colour>>({
     {Colour::kBlue, "blue"},
 });
 
-// The what() of the ConfigError that `parse()` throws; "no ConfigError" when it returns.
-template <typename Parse>
-std::string ConfigErrorOf(Parse&& parse) {
-    try {
-        parse();
-    } catch (const ConfigError& e) {
-        return e.what();
-    }
-    return "no ConfigError";
-}
+using test::ConfigErrorOf;
 
 TEST(EnumNames, BothDirectionsComeFromOneTable) {
     static_assert(IsOneToOne(kColourNames));

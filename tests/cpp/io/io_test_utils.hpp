@@ -5,7 +5,6 @@
 #include <filesystem>
 #include <optional>
 #include <string>
-#include <string_view>
 
 #include <gtest/gtest.h>
 
@@ -31,12 +30,6 @@ template <typename Read>
 std::string ReadErrorOf(Read&& read) {
     const auto error = CatchReadError(read);
     return error ? error->what() : "no ReadError";
-}
-
-/// Success when `message` contains `phrase`; the failure shows both.
-inline ::testing::AssertionResult Contains(const std::string& message, std::string_view phrase) {
-    if (message.find(phrase) != std::string::npos) return ::testing::AssertionSuccess();
-    return ::testing::AssertionFailure() << "'" << phrase << "' not in: " << message;
 }
 
 /// Expects `read(file)` (e.g. `read` = io::ReadPcd) to throw an io::ReadError for `file` whose
