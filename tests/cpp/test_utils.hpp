@@ -11,7 +11,9 @@
 #include <string_view>
 
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
+#include "lidarloop/core/error.hpp"
 #include "lidarloop/core/point_cloud.hpp"
 
 namespace lidarloop::test {
@@ -66,9 +68,45 @@ inline core::PointCloud RandomCloud(std::size_t count, unsigned seed, float half
     return cloud;
 }
 
+/// A uniformly random rotation (a normalised quaternion of four normal draws) from the test's own
+/// generator: Eigen's UnitRandom draws from the global std::rand, which makes one test's draws
+/// depend on which tests ran before it.
+inline Eigen::Matrix3d RandomRotation(std::mt19937& rng) {
+    std::normal_distribution<double> normal(0.0, 1.0);
+    return Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng))
+        .normalized()
+        .toRotationMatrix();
+}
+
+/// `cloud` with every point p moved to R p + t.
+inline core::PointCloud Transformed(const core::PointCloud& cloud, const Eigen::Matrix3f& R,
+                                    const Eigen::Vector3f& t = Eigen::Vector3f::Zero()) {
+    core::PointCloud out = cloud;
+    for (auto& p : out) p = R * p + t;
+    return out;
+}
+
 /// Path of a fixture under tests/data.
 inline std::filesystem::path DataFile(const std::string& name) {
     return std::filesystem::path(LIDARLOOP_TEST_DATA_DIR) / name;
+}
+
+/// Success when `message` contains `phrase`; the failure shows both.
+inline ::testing::AssertionResult Contains(const std::string& message, std::string_view phrase) {
+    if (message.find(phrase) != std::string::npos) return ::testing::AssertionSuccess();
+    return ::testing::AssertionFailure() << "'" << phrase << "' not in: " << message;
+}
+
+/// The message of the core::ConfigError that `call()` throws; "no ConfigError" when it returns.
+/// Any other exception escapes and fails the test.
+template <typename Call>
+std::string ConfigErrorOf(Call&& call) {
+    try {
+        call();
+    } catch (const core::ConfigError& e) {
+        return e.what();
+    }
+    return "no ConfigError";
 }
 
 /// Replaces the first `from` in `text` by `to`; fails the test when `text` has no `from`.

@@ -1,6 +1,7 @@
 #include "lidarloop/core/histogram.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -9,6 +10,7 @@
 #include <emmintrin.h>
 #endif
 
+#include "lidarloop/core/enum_names.hpp"
 #include "lidarloop/core/error.hpp"
 
 namespace lidarloop::core {
@@ -139,17 +141,20 @@ PointwiseValues<ValueOfPoint> Pointwise(ValueOfPoint value_of) {
     return {value_of};
 }
 
+constexpr auto kOutOfRangePolicyNames = std::to_array<EnumName<OutOfRangePolicy>>({
+    {OutOfRangePolicy::kClamp, "clamp"},
+    {OutOfRangePolicy::kDrop, "drop"},
+});
+static_assert(IsOneToOne(kOutOfRangePolicyNames));
+
 }  // namespace
 
 std::string ToString(OutOfRangePolicy policy) {
-    return policy == OutOfRangePolicy::kClamp ? "clamp" : "drop";
+    return std::string(NameOf(kOutOfRangePolicyNames, policy));
 }
 
 OutOfRangePolicy ParseOutOfRangePolicy(std::string_view name) {
-    if (name == "clamp") return OutOfRangePolicy::kClamp;
-    if (name == "drop") return OutOfRangePolicy::kDrop;
-    throw ConfigError("unknown out-of-range policy '" + std::string(name) +
-                      "' (valid: clamp, drop)");
+    return ParseEnum(kOutOfRangePolicyNames, name, "out-of-range policy");
 }
 
 void HistogramConfig::Validate() const {

@@ -1,10 +1,21 @@
 #include "lidarloop/core/min_gap.hpp"
 
+#include <array>
 #include <cmath>
 
+#include "lidarloop/core/enum_names.hpp"
 #include "lidarloop/core/error.hpp"
 
 namespace lidarloop::core {
+namespace {
+
+constexpr auto kUnitNames = std::to_array<EnumName<MinGap::Unit>>({
+    {MinGap::Unit::kScans, "scans"},
+    {MinGap::Unit::kSeconds, "seconds"},
+});
+static_assert(IsOneToOne(kUnitNames));
+
+}  // namespace
 
 void MinGap::Validate(const std::string& field) const {
     if (!std::isfinite(value) || value < 0.0) {
@@ -12,14 +23,10 @@ void MinGap::Validate(const std::string& field) const {
     }
 }
 
-std::string ToString(MinGap::Unit unit) {
-    return unit == MinGap::Unit::kScans ? "scans" : "seconds";
-}
+std::string ToString(MinGap::Unit unit) { return std::string(NameOf(kUnitNames, unit)); }
 
 MinGap::Unit ParseMinGapUnit(std::string_view name) {
-    if (name == "scans") return MinGap::Unit::kScans;
-    if (name == "seconds") return MinGap::Unit::kSeconds;
-    throw ConfigError("unknown gap unit '" + std::string(name) + "' (valid: scans, seconds)");
+    return ParseEnum(kUnitNames, name, "gap unit");
 }
 
 }  // namespace lidarloop::core

@@ -1,27 +1,41 @@
 #include "lidarloop/core/projection.hpp"
 
+#include <array>
+
 #include <Eigen/Eigenvalues>
 
+#include "lidarloop/core/enum_names.hpp"
 #include "lidarloop/core/error.hpp"
 
 namespace lidarloop::core {
+namespace {
+
+constexpr auto kProjectionNames = std::to_array<EnumName<Projection>>({
+    {Projection::kHeight, "height"},
+    {Projection::kRange, "range"},
+});
+static_assert(IsOneToOne(kProjectionNames));
+
+constexpr auto kUpVectorModeNames = std::to_array<EnumName<UpVectorMode>>({
+    {UpVectorMode::kFixed, "fixed"},
+    {UpVectorMode::kPca, "pca"},
+});
+static_assert(IsOneToOne(kUpVectorModeNames));
+
+}  // namespace
 
 std::string ToString(Projection projection) {
-    return projection == Projection::kHeight ? "height" : "range";
+    return std::string(NameOf(kProjectionNames, projection));
 }
 
-std::string ToString(UpVectorMode mode) { return mode == UpVectorMode::kFixed ? "fixed" : "pca"; }
+std::string ToString(UpVectorMode mode) { return std::string(NameOf(kUpVectorModeNames, mode)); }
 
 Projection ParseProjection(std::string_view name) {
-    if (name == "height") return Projection::kHeight;
-    if (name == "range") return Projection::kRange;
-    throw ConfigError("unknown projection '" + std::string(name) + "' (valid: height, range)");
+    return ParseEnum(kProjectionNames, name, "projection");
 }
 
 UpVectorMode ParseUpVectorMode(std::string_view name) {
-    if (name == "fixed") return UpVectorMode::kFixed;
-    if (name == "pca") return UpVectorMode::kPca;
-    throw ConfigError("unknown up vector mode '" + std::string(name) + "' (valid: fixed, pca)");
+    return ParseEnum(kUpVectorModeNames, name, "up vector mode");
 }
 
 Eigen::Vector3d EstimateUpVectorPca(const PointCloud& cloud) {

@@ -1,9 +1,11 @@
 #include "lidarloop/eval/per_scan.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 
+#include "lidarloop/core/enum_names.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/eval/pairwise.hpp"
 
@@ -62,23 +64,18 @@ double Ratio(std::size_t numerator, std::size_t denominator) {
                             : static_cast<double>(numerator) / static_cast<double>(denominator);
 }
 
+constexpr auto kScanLabelNames = std::to_array<core::EnumName<ScanLabel>>({
+    {ScanLabel::kTruePositive, "true_positive"},
+    {ScanLabel::kMismatch, "mismatch"},
+    {ScanLabel::kFalsePositive, "false_positive"},
+    {ScanLabel::kTrueNegative, "true_negative"},
+    {ScanLabel::kFalseNegative, "false_negative"},
+});
+static_assert(core::IsOneToOne(kScanLabelNames));
+
 }  // namespace
 
-std::string ToString(ScanLabel label) {
-    switch (label) {
-        case ScanLabel::kTruePositive:
-            return "true_positive";
-        case ScanLabel::kMismatch:
-            return "mismatch";
-        case ScanLabel::kFalsePositive:
-            return "false_positive";
-        case ScanLabel::kTrueNegative:
-            return "true_negative";
-        case ScanLabel::kFalseNegative:
-            break;
-    }
-    return "false_negative";
-}
+std::string ToString(ScanLabel label) { return std::string(core::NameOf(kScanLabelNames, label)); }
 
 double TaxonomyCounts::Recall() const { return Ratio(true_positive, Overlapping()); }
 

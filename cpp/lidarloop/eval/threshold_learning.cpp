@@ -1,18 +1,29 @@
 #include "lidarloop/eval/threshold_learning.hpp"
 
+#include <array>
 #include <cmath>
 
+#include "lidarloop/core/enum_names.hpp"
 #include "lidarloop/core/error.hpp"
 
 namespace lidarloop::eval {
 
-std::string ToString(Criterion criterion) { return criterion == Criterion::kMcc ? "mcc" : "f1"; }
+namespace {
+
+constexpr auto kCriterionNames = std::to_array<core::EnumName<Criterion>>({
+    {Criterion::kMcc, "mcc"},
+    {Criterion::kF1, "f1"},
+});
+static_assert(core::IsOneToOne(kCriterionNames));
+
+}  // namespace
+
+std::string ToString(Criterion criterion) {
+    return std::string(core::NameOf(kCriterionNames, criterion));
+}
 
 Criterion ParseCriterion(std::string_view name) {
-    if (name == "mcc") return Criterion::kMcc;
-    if (name == "f1") return Criterion::kF1;
-    throw core::ConfigError("unknown threshold criterion '" + std::string(name) +
-                            "' (valid: mcc, f1)");
+    return core::ParseEnum(kCriterionNames, name, "threshold criterion");
 }
 
 ThresholdTransfer LearnAndTest(std::span<const ScoredPair> train, std::span<const ScoredPair> test,

@@ -14,6 +14,7 @@
 #include <string_view>
 #include <vector>
 
+#include "lidarloop/core/enum_names.hpp"
 #include "lidarloop/io/detail/binary_io.hpp"
 #include "lidarloop/io/detail/text_parsing.hpp"
 #include "lidarloop/io/read_error.hpp"
@@ -34,6 +35,14 @@ using detail::ToFloat;
 
 // A 3-byte LZF back reference expands to at most 264 bytes; no valid block grows more than that.
 constexpr std::uint64_t kMaxLzfExpansion = 88;
+
+// The DATA line's names, read and written.
+constexpr auto kEncodingNames = std::to_array<core::EnumName<PcdEncoding>>({
+    {PcdEncoding::kAscii, "ascii"},
+    {PcdEncoding::kBinary, "binary"},
+    {PcdEncoding::kBinaryCompressed, "binary_compressed"},
+});
+static_assert(core::IsOneToOne(kEncodingNames));
 
 struct PcdField {
     std::string name;
@@ -117,14 +126,12 @@ void CheckVersion(const LineReader& reader, std::span<const std::string_view> to
 }
 
 PcdEncoding ParseDataType(const LineReader& reader, std::span<const std::string_view> tokens) {
-    if (tokens.size() == 1 && tokens[0] == "ascii") return PcdEncoding::kAscii;
-    if (tokens.size() == 1 && tokens[0] == "binary") return PcdEncoding::kBinary;
-    if (tokens.size() == 1 && tokens[0] == "binary_compressed") {
-        return PcdEncoding::kBinaryCompressed;
+    if (tokens.size() == 1) {
+        if (const auto encoding = core::FindEnum(kEncodingNames, tokens[0])) return *encoding;
     }
     const std::string_view type = tokens.empty() ? std::string_view() : tokens[0];
-    reader.Fail("unknown DATA type " + Quoted(type) +
-                " (expected ascii, binary or binary_compressed)");
+    reader.Fail("unknown DATA type " + Quoted(type) + " (expected " +
+                core::JoinNames(kEncodingNames, " or ") + ")");
 }
 
 // Stores one header line in `raw`; returns the encoding when the line is DATA, the last one.
@@ -432,15 +439,7 @@ core::PointCloud ReadCompressedData(const std::filesystem::path& file, DataStrea
 // Writing
 
 std::string_view EncodingName(PcdEncoding encoding) {
-    switch (encoding) {
-        case PcdEncoding::kAscii:
-            return "ascii";
-        case PcdEncoding::kBinary:
-            return "binary";
-        case PcdEncoding::kBinaryCompressed:
-            return "binary_compressed";
-    }
-    return "ascii";
+    return core::NameOf(kEncodingNames, encoding, "ascii");
 }
 
 void WriteHeader(std::ostream& out, std::size_t points, PcdEncoding encoding) {

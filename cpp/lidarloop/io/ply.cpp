@@ -11,6 +11,7 @@
 #include <string_view>
 #include <vector>
 
+#include "lidarloop/core/enum_names.hpp"
 #include "lidarloop/io/detail/binary_io.hpp"
 #include "lidarloop/io/detail/text_parsing.hpp"
 #include "lidarloop/io/read_error.hpp"
@@ -28,29 +29,32 @@ using detail::ToFloat;
 
 enum class PlyType { kInt8, kUint8, kInt16, kUint16, kInt32, kUint32, kFloat32, kFloat64 };
 
-struct PlyTypeName {
-    std::string_view name;
-    PlyType type;
-};
+// Both spellings of each type (PLY 1.0 and the sized names); read only, never written.
+constexpr auto kTypeNames = std::to_array<core::EnumName<PlyType>>({
+    {PlyType::kInt8, "char"},
+    {PlyType::kInt8, "int8"},
+    {PlyType::kUint8, "uchar"},
+    {PlyType::kUint8, "uint8"},
+    {PlyType::kInt16, "short"},
+    {PlyType::kInt16, "int16"},
+    {PlyType::kUint16, "ushort"},
+    {PlyType::kUint16, "uint16"},
+    {PlyType::kInt32, "int"},
+    {PlyType::kInt32, "int32"},
+    {PlyType::kUint32, "uint"},
+    {PlyType::kUint32, "uint32"},
+    {PlyType::kFloat32, "float"},
+    {PlyType::kFloat32, "float32"},
+    {PlyType::kFloat64, "double"},
+    {PlyType::kFloat64, "float64"},
+});
 
-constexpr std::array<PlyTypeName, 16> kTypeNames = {{
-    {"char", PlyType::kInt8},
-    {"int8", PlyType::kInt8},
-    {"uchar", PlyType::kUint8},
-    {"uint8", PlyType::kUint8},
-    {"short", PlyType::kInt16},
-    {"int16", PlyType::kInt16},
-    {"ushort", PlyType::kUint16},
-    {"uint16", PlyType::kUint16},
-    {"int", PlyType::kInt32},
-    {"int32", PlyType::kInt32},
-    {"uint", PlyType::kUint32},
-    {"uint32", PlyType::kUint32},
-    {"float", PlyType::kFloat32},
-    {"float32", PlyType::kFloat32},
-    {"double", PlyType::kFloat64},
-    {"float64", PlyType::kFloat64},
-}};
+constexpr auto kEncodingNames = std::to_array<core::EnumName<PlyEncoding>>({
+    {PlyEncoding::kAscii, "ascii"},
+    {PlyEncoding::kBinaryLittleEndian, "binary_little_endian"},
+    {PlyEncoding::kBinaryBigEndian, "binary_big_endian"},
+});
+static_assert(core::IsOneToOne(kEncodingNames));
 
 std::size_t TypeSize(PlyType type) {
     switch (type) {
@@ -137,9 +141,7 @@ double LoadScalar(const char* bytes, PlyType type, std::endian order) {
 // Header
 
 PlyType ParseType(const LineReader& reader, std::string_view name) {
-    for (const auto& entry : kTypeNames) {
-        if (entry.name == name) return entry.type;
-    }
+    if (const auto type = core::FindEnum(kTypeNames, name)) return *type;
     reader.Fail("unknown property type " + Quoted(name));
 }
 
@@ -147,11 +149,9 @@ PlyEncoding ParseFormat(const LineReader& reader, const std::vector<std::string_
     if (tokens.size() != 3) reader.Fail("expected 'format <encoding> 1.0'");
     const auto version = detail::ParseDouble(tokens[2]);
     if (!version || *version != 1.0) reader.Fail("unsupported PLY version " + Quoted(tokens[2]));
-    if (tokens[1] == "ascii") return PlyEncoding::kAscii;
-    if (tokens[1] == "binary_little_endian") return PlyEncoding::kBinaryLittleEndian;
-    if (tokens[1] == "binary_big_endian") return PlyEncoding::kBinaryBigEndian;
-    reader.Fail("unknown format " + Quoted(tokens[1]) +
-                " (expected ascii, binary_little_endian or binary_big_endian)");
+    if (const auto encoding = core::FindEnum(kEncodingNames, tokens[1])) return *encoding;
+    reader.Fail("unknown format " + Quoted(tokens[1]) + " (expected " +
+                core::JoinNames(kEncodingNames, " or ") + ")");
 }
 
 PlyElement ParseElement(const LineReader& reader, const std::vector<std::string_view>& tokens) {
@@ -410,15 +410,7 @@ private:
 // Writing
 
 std::string_view EncodingName(PlyEncoding encoding) {
-    switch (encoding) {
-        case PlyEncoding::kAscii:
-            return "ascii";
-        case PlyEncoding::kBinaryLittleEndian:
-            return "binary_little_endian";
-        case PlyEncoding::kBinaryBigEndian:
-            return "binary_big_endian";
-    }
-    return "ascii";
+    return core::NameOf(kEncodingNames, encoding, "ascii");
 }
 
 void WriteHeader(std::ostream& out, std::size_t count, PlyEncoding encoding, PlyScalar scalar) {

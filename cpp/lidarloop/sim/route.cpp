@@ -1,10 +1,12 @@
 #include "lidarloop/sim/route.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <string>
 
+#include "lidarloop/core/enum_names.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/sim/detail/random.hpp"
 #include "lidarloop/sim/detail/text.hpp"
@@ -149,26 +151,19 @@ std::vector<Eigen::Vector2d> Smooth(const std::vector<Eigen::Vector2d>& samples,
     return smooth;
 }
 
+constexpr auto kRouteTypeNames = std::to_array<core::EnumName<RouteType>>({
+    {RouteType::kUTurn, "uturn"},
+    {RouteType::kFigureEight, "figure8"},
+    {RouteType::kGrid, "grid"},
+});
+static_assert(core::IsOneToOne(kRouteTypeNames));
+
 }  // namespace
 
-std::string ToString(RouteType type) {
-    switch (type) {
-        case RouteType::kUTurn:
-            return "uturn";
-        case RouteType::kFigureEight:
-            return "figure8";
-        case RouteType::kGrid:
-            return "grid";
-    }
-    return "unknown";
-}
+std::string ToString(RouteType type) { return std::string(core::NameOf(kRouteTypeNames, type)); }
 
 RouteType ParseRouteType(std::string_view name) {
-    if (name == "uturn") return RouteType::kUTurn;
-    if (name == "figure8") return RouteType::kFigureEight;
-    if (name == "grid") return RouteType::kGrid;
-    throw core::ConfigError("unknown route '" + std::string(name) +
-                            "' (valid: uturn, figure8, grid)");
+    return core::ParseEnum(kRouteTypeNames, name, "route");
 }
 
 void RouteConfig::Validate() const {

@@ -1,10 +1,12 @@
 #include "lidarloop/sim/scene.hpp"
 
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <string>
 #include <vector>
 
+#include "lidarloop/core/enum_names.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/sim/detail/random.hpp"
 #include "lidarloop/sim/detail/scene_builder.hpp"
@@ -83,29 +85,20 @@ void AddStreets(SceneType type, std::uint64_t seed, const NodeRange& nodes,
     }
 }
 
+constexpr auto kSceneTypeNames = std::to_array<core::EnumName<SceneType>>({
+    {SceneType::kUrban, "urban"},
+    {SceneType::kRural, "rural"},
+    {SceneType::kMine, "mine"},
+    {SceneType::kIndoor, "indoor"},
+});
+static_assert(core::IsOneToOne(kSceneTypeNames));
+
 }  // namespace
 
-std::string ToString(SceneType type) {
-    switch (type) {
-        case SceneType::kUrban:
-            return "urban";
-        case SceneType::kRural:
-            return "rural";
-        case SceneType::kMine:
-            return "mine";
-        case SceneType::kIndoor:
-            return "indoor";
-    }
-    return "unknown";
-}
+std::string ToString(SceneType type) { return std::string(core::NameOf(kSceneTypeNames, type)); }
 
 SceneType ParseSceneType(std::string_view name) {
-    if (name == "urban") return SceneType::kUrban;
-    if (name == "rural") return SceneType::kRural;
-    if (name == "mine") return SceneType::kMine;
-    if (name == "indoor") return SceneType::kIndoor;
-    throw core::ConfigError("unknown scene '" + std::string(name) +
-                            "' (valid: urban, rural, mine, indoor)");
+    return core::ParseEnum(kSceneTypeNames, name, "scene");
 }
 
 SceneLayout LayoutOf(SceneType type) {

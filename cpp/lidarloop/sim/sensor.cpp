@@ -1,9 +1,11 @@
 #include "lidarloop/sim/sensor.hpp"
 
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <string>
 
+#include "lidarloop/core/enum_names.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/sim/detail/text.hpp"
 
@@ -21,26 +23,21 @@ void CheckRange(const char* field, double value, double lo, double hi, bool lo_o
     }
 }
 
+constexpr auto kSensorModelNames = std::to_array<core::EnumName<SensorModel>>({
+    {SensorModel::kHdl64, "hdl64"},
+    {SensorModel::kVlp16, "vlp16"},
+    {SensorModel::kTilt180, "tilt180"},
+});
+static_assert(core::IsOneToOne(kSensorModelNames));
+
 }  // namespace
 
 std::string ToString(SensorModel model) {
-    switch (model) {
-        case SensorModel::kHdl64:
-            return "hdl64";
-        case SensorModel::kVlp16:
-            return "vlp16";
-        case SensorModel::kTilt180:
-            return "tilt180";
-    }
-    return "unknown";
+    return std::string(core::NameOf(kSensorModelNames, model));
 }
 
 SensorModel ParseSensorModel(std::string_view name) {
-    if (name == "hdl64") return SensorModel::kHdl64;
-    if (name == "vlp16") return SensorModel::kVlp16;
-    if (name == "tilt180") return SensorModel::kTilt180;
-    throw core::ConfigError("unknown sensor '" + std::string(name) +
-                            "' (valid: hdl64, vlp16, tilt180)");
+    return core::ParseEnum(kSensorModelNames, name, "sensor");
 }
 
 void SensorConfig::Validate() const {

@@ -20,14 +20,8 @@
 namespace lidarloop::core {
 namespace {
 
-// A uniformly random rotation from the test's own generator (Eigen's UnitRandom draws from the
-// global std::rand, which makes one test's draws depend on which tests ran before it).
-Eigen::Matrix3d RandomRotation(std::mt19937& rng) {
-    std::normal_distribution<double> normal(0.0, 1.0);
-    return Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng))
-        .normalized()
-        .toRotationMatrix();
-}
+using test::RandomRotation;
+using test::Transformed;
 
 void ExpectCellsMatchBruteForce(const PointCloud& cloud, double q, int min_points) {
     std::vector<NdtCell> expected = test_reference::BruteForceCells(cloud, q, min_points);
@@ -257,13 +251,6 @@ PointCloud StructuredScan(unsigned seed) {
         cloud.push_back({2.0f + noise(rng), -4.0f + noise(rng), -1.7f + 5 * u(rng)});
     }
     return cloud;
-}
-
-PointCloud Transformed(const PointCloud& cloud, const Eigen::Matrix3f& R,
-                       const Eigen::Vector3f& t = Eigen::Vector3f::Zero()) {
-    PointCloud out = cloud;
-    for (auto& p : out) p = R * p + t;
-    return out;
 }
 
 // The floor any revisit sees: the same scan moved by a fraction of a cell falls differently

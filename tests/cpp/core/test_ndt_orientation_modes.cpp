@@ -12,6 +12,7 @@
 
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/core/ndt_orientation_modes.hpp"
+#include "test_utils.hpp"
 
 namespace lidarloop::core {
 namespace {
@@ -141,13 +142,9 @@ TEST(OrientationModes, RotatingTheLinesRotatesTheModes) {
     const Lines lines = ThreeClustersWithNoise(5);
     const std::vector<OrientationMode> modes = lines.Modes();
     std::mt19937 rng(6);
-    std::normal_distribution<double> normal(0.0, 1.0);
     for (int trial = 0; trial < 10; ++trial) {
         SCOPED_TRACE(trial);
-        const Eigen::Matrix3d R =
-            Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng))
-                .normalized()
-                .toRotationMatrix();
+        const Eigen::Matrix3d R = test::RandomRotation(rng);
         Lines rotated;
         for (std::size_t i = 0; i < lines.size(); ++i) rotated.Add(R * lines.Line(i));
         const std::vector<OrientationMode> turned = rotated.Modes();

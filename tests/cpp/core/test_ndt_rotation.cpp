@@ -13,24 +13,13 @@
 #include "lidarloop/core/ndt_descriptor.hpp"
 #include "lidarloop/core/ndt_shape.hpp"
 #include "lidarloop/core/sphere_partition.hpp"
+#include "test_utils.hpp"
 
 namespace lidarloop::core {
 namespace {
 
-// A uniformly random rotation from the test's own generator.
-Eigen::Matrix3d RandomRotation(std::mt19937& rng) {
-    std::normal_distribution<double> normal(0.0, 1.0);
-    return Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng))
-        .normalized()
-        .toRotationMatrix();
-}
-
-PointCloud Transformed(const PointCloud& cloud, const Eigen::Matrix3d& R) {
-    const Eigen::Matrix3f Rf = R.cast<float>();
-    PointCloud out = cloud;
-    for (auto& p : out) p = Rf * p;
-    return out;
-}
+using test::RandomRotation;
+using test::Transformed;
 
 // A rectangle through `centre` with normal `normal`, sides 2 half_u x 2 half_v, sampled at
 // `per_m2` points per square metre, with Gaussian noise of `noise_m` along the normal (so that
@@ -290,7 +279,8 @@ TEST(NdtRotation, ScanSymmetricAboutTheSensorKeepsBothSigns) {
     for (int trial = 0; trial < 6; ++trial) {
         SCOPED_TRACE(trial);
         const Eigen::Matrix3d R = RandomRotation(rng);
-        const NdtDescriptorSet rotated = ComputeNdtDescriptorSet(Transformed(room, R), config);
+        const NdtDescriptorSet rotated =
+            ComputeNdtDescriptorSet(Transformed(room, R.cast<float>()), config);
         for (const NdtDescriptor& f : reference.descriptors) {
             EXPECT_TRUE(HasAlignment(rotated, R, f.R_aligned_sensor, 2.0 * std::numbers::pi / 180))
                 << f.R_aligned_sensor;
@@ -299,7 +289,8 @@ TEST(NdtRotation, ScanSymmetricAboutTheSensorKeepsBothSigns) {
     // A quarter turn maps the grid onto itself, so nothing but the alignment differs: sigma' ~ 0.
     Eigen::Matrix3d quarter;
     quarter << 1, 0, 0, 0, 0, -1, 0, 1, 0;
-    const NdtDescriptorSet turned = ComputeNdtDescriptorSet(Transformed(room, quarter), config);
+    const NdtDescriptorSet turned =
+        ComputeNdtDescriptorSet(Transformed(room, quarter.cast<float>()), config);
     EXPECT_LT(NdtSetDifference(reference, turned), 1e-6);
 }
 

@@ -11,6 +11,7 @@
 
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/core/sphere_partition.hpp"
+#include "test_utils.hpp"
 
 namespace lidarloop::core {
 namespace {
@@ -324,14 +325,9 @@ TEST(HalfSpherePartition, RejectsInvalidCountsAndDirections) {
     EXPECT_THROW(HalfSpherePartition(10001), ConfigError);
     EXPECT_NO_THROW(HalfSpherePartition(1));
     EXPECT_NO_THROW(HalfSpherePartition(10000));
-    try {
-        HalfSpherePartition bad(10001);
-        FAIL() << "no exception";
-    } catch (const ConfigError& e) {
-        const std::string message = e.what();
-        EXPECT_NE(message.find("[1, 10000]"), std::string::npos) << message;
-        EXPECT_NE(message.find("10001"), std::string::npos) << message;
-    }
+    const std::string message = test::ConfigErrorOf([] { HalfSpherePartition bad(10001); });
+    EXPECT_TRUE(test::Contains(message, "[1, 10000]"));
+    EXPECT_TRUE(test::Contains(message, "10001"));
     const HalfSpherePartition partition(9);
     const double inf = std::numeric_limits<double>::infinity();
     EXPECT_THROW(partition.RegionOf(Eigen::Vector3d::Zero()), Error);

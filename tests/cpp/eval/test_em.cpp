@@ -8,6 +8,7 @@
 
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/eval/em.hpp"
+#include "test_utils.hpp"
 
 namespace lidarloop::eval {
 namespace {
@@ -129,12 +130,7 @@ TEST(Em, VarianceFloorStopsCollapse) {
 void ExpectConfigError(void (*mutate)(EmConfig&), const std::string& field) {
     EmConfig config;
     mutate(config);
-    try {
-        config.Validate();
-        ADD_FAILURE() << "accepted " << field;
-    } catch (const core::ConfigError& e) {
-        EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
-    }
+    EXPECT_TRUE(test::Contains(test::ConfigErrorOf([&] { config.Validate(); }), field));
 }
 
 TEST(Em, RejectsAbsurdConfigsAndSamples) {

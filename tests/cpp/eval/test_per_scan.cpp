@@ -61,7 +61,10 @@ TEST(PerScan, HandMadeSequenceFollowsTableI) {
     // "sigma' < t_d" is strict: at t_d = 0.1 scan 0 is not yet similar.
     EXPECT_EQ(LabelScans(matches, truth, 0.1)[0], L::kFalseNegative);
     EXPECT_EQ(LabelScans(matches, truth, kInf)[3], L::kTruePositive);
+    EXPECT_EQ(ToString(L::kTruePositive), "true_positive");
     EXPECT_EQ(ToString(L::kMismatch), "mismatch");
+    EXPECT_EQ(ToString(L::kFalsePositive), "false_positive");
+    EXPECT_EQ(ToString(L::kTrueNegative), "true_negative");
     EXPECT_EQ(ToString(L::kFalseNegative), "false_negative");
 }
 

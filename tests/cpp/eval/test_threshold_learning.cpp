@@ -6,6 +6,7 @@
 
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/eval/threshold_learning.hpp"
+#include "test_utils.hpp"
 
 namespace lidarloop::eval {
 namespace {
@@ -74,17 +75,15 @@ TEST(ThresholdLearning, RejectsAbsurdConfigs) {
     for (const double fraction : {0.0, 1.0, -0.5, 2.0, std::numeric_limits<double>::quiet_NaN()}) {
         ThresholdLearningConfig config;
         config.train_fraction = fraction;
-        try {
-            config.Validate();
-            ADD_FAILURE() << "accepted " << fraction;
-        } catch (const core::ConfigError& e) {
-            EXPECT_NE(std::string(e.what()).find("threshold_learning.train_fraction"),
-                      std::string::npos);
-        }
+        EXPECT_TRUE(test::Contains(test::ConfigErrorOf([&] { config.Validate(); }),
+                                   "threshold_learning.train_fraction"))
+            << fraction;
     }
     EXPECT_EQ(ParseCriterion("mcc"), Criterion::kMcc);
     EXPECT_EQ(ParseCriterion(ToString(Criterion::kF1)), Criterion::kF1);
     EXPECT_THROW(ParseCriterion("auc"), core::ConfigError);
+    EXPECT_EQ(test::ConfigErrorOf([] { ParseCriterion("auc"); }),
+              "unknown threshold criterion 'auc' (valid: mcc, f1)");
 }
 
 }  // namespace

@@ -38,17 +38,13 @@ using core::PointCloud;
 using test::ExpectSameCloud;
 using test::ReadFile;
 using test::ReplaceOnce;
+using test::ScanRoundTrip;
 using test::TempDir;
 using test::WriteFile;
 
 static_assert(std::endian::native == std::endian::little, "the byte builders assume it");
 
 constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
-
-// Asserts that reading `file` throws a ReadError naming the file and containing `phrase`.
-void ExpectReadError(const std::filesystem::path& file, const std::string& phrase) {
-    test::ExpectReadError(ReadPcd, file, phrase);
-}
 
 template <typename T>
 void Append(std::string& bytes, T value) {
@@ -86,45 +82,19 @@ std::string CompressedBlock(const std::string& unpacked) {
 // ---------------------------------------------------------------------------------------------
 // Round trips
 
-class PcdRoundTrip : public ::testing::TestWithParam<PcdEncoding> {
-protected:
-    PointCloud RoundTrip(const PointCloud& cloud) {
-        WritePcd(dir_ / "cloud.pcd", cloud, GetParam());
-        return ReadPcd(dir_ / "cloud.pcd");
-    }
-    TempDir dir_;
-};
-
-TEST_P(PcdRoundTrip, RandomCloudIsExact) {
-    const PointCloud cloud = test::RandomCloud(2000, 7);
-    ExpectSameCloud(RoundTrip(cloud), cloud);
+// The cases are in test_scan_round_trip.cpp.
+test::ScanFormat Pcd(PcdEncoding encoding) {
+    return {::testing::PrintToString(encoding), ".pcd",
+            [encoding](const std::filesystem::path& file, const PointCloud& cloud) {
+                WritePcd(file, cloud, encoding);
+            },
+            ReadPcd};
 }
 
-TEST_P(PcdRoundTrip, NanPointsSurvive) {
-    PointCloud cloud = test::RandomCloud(300, 8);
-    for (std::size_t i = 0; i < cloud.size(); i += 3) cloud[i] = {kNan, kNan, kNan};
-    const PointCloud read = RoundTrip(cloud);
-    ExpectSameCloud(read, cloud);
-    EXPECT_TRUE(std::isnan(read[0].x()));
-    EXPECT_FALSE(std::isnan(read[1].x()));
-}
-
-TEST_P(PcdRoundTrip, EmptyCloudStaysEmpty) { EXPECT_TRUE(RoundTrip({}).empty()); }
-
-TEST_P(PcdRoundTrip, ExtremeValuesAreExact) {
-    using Limits = std::numeric_limits<float>;
-    const PointCloud cloud = {{Limits::denorm_min(), Limits::min(), Limits::max()},
-                              {Limits::lowest(), -0.0f, 0.0f},
-                              {0.1f, 1.0f / 3.0f, -16777215.0f},
-                              {Limits::infinity(), -Limits::infinity(), 123456.789f},
-                              {std::nextafter(1.0f, 2.0f), -1e-38f, 3.4e38f}};
-    ExpectSameCloud(RoundTrip(cloud), cloud);
-}
-
-INSTANTIATE_TEST_SUITE_P(AllEncodings, PcdRoundTrip,
-                         ::testing::Values(PcdEncoding::kAscii, PcdEncoding::kBinary,
-                                           PcdEncoding::kBinaryCompressed),
-                         ::testing::PrintToStringParamName());
+INSTANTIATE_TEST_SUITE_P(Pcd, ScanRoundTrip,
+                         ::testing::Values(Pcd(PcdEncoding::kAscii), Pcd(PcdEncoding::kBinary),
+                                           Pcd(PcdEncoding::kBinaryCompressed)),
+                         test::ScanFormatName);
 
 // ---------------------------------------------------------------------------------------------
 // Writer output
@@ -276,13 +246,9 @@ TEST(PcdRead, OrganisedCloudKeepsNanPoints) {
 // ---------------------------------------------------------------------------------------------
 // Bad input
 
-class PcdErrors : public ::testing::Test {
+class PcdErrors : public test::ScanReaderErrors {
 protected:
-    // Writes `contents` to a file of the temporary folder and returns its path.
-    std::filesystem::path Write(const std::string& contents) {
-        WriteFile(dir_ / "bad.pcd", contents);
-        return dir_ / "bad.pcd";
-    }
+    PcdErrors() : ScanReaderErrors(ReadPcd, ".pcd") {}
     // A valid file of `points` random points, returned as bytes, and its header length.
     std::string Valid(std::size_t points, PcdEncoding encoding, std::size_t* header_size) {
         WritePcd(dir_ / "valid.pcd", test::RandomCloud(points, 3), encoding);
@@ -292,7 +258,6 @@ protected:
         *header_size = bytes.find(data_line) + data_line.size();
         return bytes;
     }
-    TempDir dir_;
 };
 
 TEST_F(PcdErrors, MissingFile) { ExpectReadError(dir_ / "absent.pcd", "no such file"); }
@@ -308,7 +273,9 @@ TEST_F(PcdErrors, MissingDataLine) {
 }
 
 TEST_F(PcdErrors, UnknownDataType) {
-    ExpectReadError(Write(XyzHeader(1, "binary_lzma")), "line 10: unknown DATA type 'binary_lzma'");
+    ExpectReadError(Write(XyzHeader(1, "binary_lzma")),
+                    "line 10: unknown DATA type 'binary_lzma' (expected ascii, binary or "
+                    "binary_compressed)");
 }
 
 TEST_F(PcdErrors, UnsupportedVersion) {

@@ -7,7 +7,6 @@
 #include <ostream>
 #include <sstream>
 #include <string>
-#include <tuple>
 #include <type_traits>
 #include <vector>
 
@@ -37,17 +36,13 @@ using core::PointCloud;
 using test::ExpectSameCloud;
 using test::ReadFile;
 using test::ReplaceOnce;
+using test::ScanRoundTrip;
 using test::TempDir;
 using test::WriteFile;
 
 static_assert(std::endian::native == std::endian::little, "the byte builders assume it");
 
 constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
-
-// Asserts that reading `file` throws a ReadError naming the file and containing `phrase`.
-void ExpectReadError(const std::filesystem::path& file, const std::string& phrase) {
-    test::ExpectReadError(ReadPly, file, phrase);
-}
 
 std::string FormatLine(PlyEncoding encoding) {
     switch (encoding) {
@@ -116,54 +111,24 @@ std::string XyzHeader(PlyEncoding encoding, std::size_t count) {
 // ---------------------------------------------------------------------------------------------
 // Round trips
 
-using PlyFormat = std::tuple<PlyEncoding, PlyScalar>;
-
-class PlyRoundTrip : public ::testing::TestWithParam<PlyFormat> {
-protected:
-    PointCloud RoundTrip(const PointCloud& cloud) {
-        WritePly(dir_ / "cloud.ply", cloud, std::get<0>(GetParam()), std::get<1>(GetParam()));
-        return ReadPly(dir_ / "cloud.ply");
-    }
-    TempDir dir_;
-};
-
-TEST_P(PlyRoundTrip, RandomCloudIsExact) {
-    const PointCloud cloud = test::RandomCloud(2000, 11);
-    ExpectSameCloud(RoundTrip(cloud), cloud);
-}
-
-TEST_P(PlyRoundTrip, NanPointsSurvive) {
-    PointCloud cloud = test::RandomCloud(300, 12);
-    for (std::size_t i = 1; i < cloud.size(); i += 4) cloud[i] = {kNan, kNan, kNan};
-    const PointCloud read = RoundTrip(cloud);
-    ExpectSameCloud(read, cloud);
-    EXPECT_TRUE(std::isnan(read[1].y()));
-    EXPECT_FALSE(std::isnan(read[0].y()));
-}
-
-TEST_P(PlyRoundTrip, EmptyCloudStaysEmpty) { EXPECT_TRUE(RoundTrip({}).empty()); }
-
-TEST_P(PlyRoundTrip, ExtremeValuesAreExact) {
-    using Limits = std::numeric_limits<float>;
-    const PointCloud cloud = {{Limits::denorm_min(), Limits::min(), Limits::max()},
-                              {Limits::lowest(), -0.0f, 0.0f},
-                              {0.1f, 1.0f / 3.0f, -16777215.0f},
-                              {Limits::infinity(), -Limits::infinity(), 123456.789f},
-                              {std::nextafter(1.0f, 2.0f), -1e-38f, 3.4e38f}};
-    ExpectSameCloud(RoundTrip(cloud), cloud);
-}
-
-std::string FormatName(const ::testing::TestParamInfo<PlyFormat>& param) {
-    const auto [encoding, scalar] = param.param;
-    return ::testing::PrintToString(encoding) + ::testing::PrintToString(scalar);
+// The cases are in test_scan_round_trip.cpp.
+test::ScanFormat Ply(PlyEncoding encoding, PlyScalar scalar) {
+    return {::testing::PrintToString(encoding) + ::testing::PrintToString(scalar), ".ply",
+            [encoding, scalar](const std::filesystem::path& file, const PointCloud& cloud) {
+                WritePly(file, cloud, encoding, scalar);
+            },
+            ReadPly};
 }
 
 INSTANTIATE_TEST_SUITE_P(
-    AllFormats, PlyRoundTrip,
-    ::testing::Combine(::testing::Values(PlyEncoding::kAscii, PlyEncoding::kBinaryLittleEndian,
-                                         PlyEncoding::kBinaryBigEndian),
-                       ::testing::Values(PlyScalar::kFloat32, PlyScalar::kFloat64)),
-    FormatName);
+    Ply, ScanRoundTrip,
+    ::testing::Values(Ply(PlyEncoding::kAscii, PlyScalar::kFloat32),
+                      Ply(PlyEncoding::kAscii, PlyScalar::kFloat64),
+                      Ply(PlyEncoding::kBinaryLittleEndian, PlyScalar::kFloat32),
+                      Ply(PlyEncoding::kBinaryLittleEndian, PlyScalar::kFloat64),
+                      Ply(PlyEncoding::kBinaryBigEndian, PlyScalar::kFloat32),
+                      Ply(PlyEncoding::kBinaryBigEndian, PlyScalar::kFloat64)),
+    test::ScanFormatName);
 
 // ---------------------------------------------------------------------------------------------
 // Writer output: a round trip alone cannot see a byte order swapped both ways.
@@ -314,13 +279,9 @@ TEST(PlyReadHeader, AcceptsCrlfLinesAndSynonymTypes) {
 // ---------------------------------------------------------------------------------------------
 // Bad input
 
-class PlyErrors : public ::testing::Test {
+class PlyErrors : public test::ScanReaderErrors {
 protected:
-    std::filesystem::path Write(const std::string& contents) {
-        WriteFile(dir_ / "bad.ply", contents);
-        return dir_ / "bad.ply";
-    }
-    TempDir dir_;
+    PlyErrors() : ScanReaderErrors(ReadPly, ".ply") {}
 };
 
 TEST_F(PlyErrors, MissingFile) { ExpectReadError(dir_ / "absent.ply", "no such file"); }
@@ -334,7 +295,9 @@ TEST_F(PlyErrors, WrongMagic) {
 TEST_F(PlyErrors, UnknownFormat) {
     std::string text = XyzHeader(PlyEncoding::kAscii, 1) + "1 2 3\n";
     ReplaceOnce(text, "format ascii", "format binary_middle_endian");
-    ExpectReadError(Write(text), "line 2: unknown format 'binary_middle_endian'");
+    ExpectReadError(Write(text),
+                    "line 2: unknown format 'binary_middle_endian' (expected ascii, "
+                    "binary_little_endian or binary_big_endian)");
 }
 
 TEST_F(PlyErrors, UnsupportedVersion) {

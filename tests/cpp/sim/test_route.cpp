@@ -6,6 +6,7 @@
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/sim/route.hpp"
 #include "lidarloop/sim/simulator.hpp"
+#include "test_utils.hpp"
 
 namespace lidarloop::sim {
 namespace {
@@ -36,6 +37,8 @@ TEST(Route, LegsAreClosedLapsOfAdjacentNodes) {
     }
     EXPECT_EQ(RouteLegs(RouteType::kUTurn, 3).size(), 12u);
     EXPECT_THROW(ParseRouteType("spiral"), core::ConfigError);
+    EXPECT_EQ(test::ConfigErrorOf([] { ParseRouteType("spiral"); }),
+              "unknown route 'spiral' (valid: uturn, figure8, grid)");
     const SceneLayout layout = LayoutOf(SceneType::kUrban);
     EXPECT_THROW(RoutePath({{{0, 0}, {2, 0}, 0}, {{2, 0}, {0, 0}, 0}}, layout), core::ConfigError);
     EXPECT_THROW(RoutePath({{{0, 0}, {1, 0}, 0}, {{1, 0}, {1, 1}, 0}}, layout), core::ConfigError);

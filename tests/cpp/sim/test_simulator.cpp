@@ -60,6 +60,8 @@ TEST(Sensor, BeamPatternsOfTheModels) {
         EXPECT_EQ(ParseSensorModel(ToString(model)), model);
     }
     EXPECT_THROW(ParseSensorModel("hdl32"), core::ConfigError);
+    EXPECT_EQ(test::ConfigErrorOf([] { ParseSensorModel("hdl32"); }),
+              "unknown sensor 'hdl32' (valid: hdl64, vlp16, tilt180)");
 }
 
 // The number of points is the number of rays that hit something within range, thinned by the
@@ -220,13 +222,11 @@ void ExpectRejected(const std::function<void(SimulationConfig&)>& change,
                     const std::string& field) {
     SimulationConfig config;
     change(config);
-    try {
+    const std::string message = test::ConfigErrorOf([&] {
         config.Validate();
         Simulator simulator(config);
-        FAIL() << "accepted a config with a bad " << field;
-    } catch (const core::ConfigError& e) {
-        EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
-    }
+    });
+    EXPECT_TRUE(test::Contains(message, field));
 }
 
 TEST(Simulator, ValidateRejectsAbsurdConfigs) {
