@@ -8,7 +8,6 @@
 #include "commands.hpp"
 #include "lidarloop/app/evaluation.hpp"
 #include "lidarloop/app/simulation.hpp"
-#include "lidarloop/eval/per_scan.hpp"
 #include "lidarloop/io/dataset.hpp"
 #include "progress.hpp"
 
@@ -34,10 +33,9 @@ void PrintSequence(const app::DemoSequence& demo, std::size_t scans) {
               << Fixed(demo.generated->seconds, 2) << " s -> " << demo.folder.string() << "\n";
 }
 
-void PrintMethod(const app::MethodEvaluation& e, const eval::GroundTruth& truth) {
+void PrintMethod(const app::MethodEvaluation& e) {
     const double threshold = *e.default_threshold;
-    const eval::TaxonomyCounts at_default =
-        eval::CountLabels(eval::LabelScans(e.best_matches, truth, threshold));
+    const eval::TaxonomyCounts& at_default = *e.per_scan_at_default;
     const std::size_t found =
         at_default.true_positive + at_default.mismatch + at_default.false_positive;
     std::cout << "  " << e.name << ": " << found << " scans matched at the default threshold "
@@ -66,7 +64,7 @@ void RunDemo(const DemoFlags& flags) {
     request.out = out / "evaluation";
     const app::EvaluationOutcome outcome = app::RunEvaluation(dataset, request);
     std::cout << "ground truth: " << outcome.truth.Describe() << "\n";
-    for (const app::MethodEvaluation& e : outcome.methods) PrintMethod(e, outcome.truth);
+    for (const app::MethodEvaluation& e : outcome.methods) PrintMethod(e);
     for (const std::string& note : outcome.notes) std::cout << "  note: " << note << "\n";
     std::cout << "figures and tables: " << (request.out / "report.md").string()
               << " (similarity matrices, ROC, precision-recall, EM fit, counts against t_d)\n";

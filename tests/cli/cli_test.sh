@@ -144,6 +144,12 @@ section_detect() {
     fi
     expect_ok "detect ndt" "method ndt" "$cli" detect "$seq" --method ndt --min-gap 2 --quiet \
         --out "$work/det_ndt"
+    # The effective config holds the threshold applied: the method's default unless given.
+    if grep -q "^  threshold: 0.0737" "$work/det_ndt/config.yaml"; then pass; else
+        fail "detect --method ndt: config.yaml lacks t_d = 0.0737"
+    fi
+    expect_ok "detect ndt --threshold" "threshold 0.02," "$cli" detect "$seq" --method ndt \
+        --min-gap 2 --threshold 0.02 --quiet --out "$work/det_ndt_t"
     # Localisation against the saved map: every scan finds itself (or an identical copy) at
     # distance 0.
     expect_ok "detect --map" "localised against the map" "$cli" detect "$seq" \
@@ -271,6 +277,15 @@ section_evaluate() {
         --out "$work/e2"
     expect_error "evaluate bad distance" "ground_truth.distance_m" "$cli" evaluate "$demo_seq" \
         --distance 0 --quiet --out "$work/e3"
+    # --min/--max belong to the one histogram method evaluated.
+    expect_ok "evaluate range --max" "report:" "$cli" evaluate "$demo_seq" --method range \
+        --max 50 --quiet --out "$work/demo_max"
+    if grep -q "range_max_m: 50" "$work/demo_max/config.yaml" &&
+        grep -q "height_max_m: 7" "$work/demo_max/config.yaml"; then pass; else
+        fail "evaluate --method range --max 50 did not set range_max_m only"
+    fi
+    expect_error "evaluate ambiguous --max" "--min and --max set the value range of one" \
+        "$cli" evaluate "$demo_seq" --max 50 --quiet --out "$work/e5"
     printf 'query,match,distance\n1,999,0.1\n' >"$work/far.csv"
     expect_error "evaluate results beyond" "names a scan beyond the 320" "$cli" evaluate \
         "$demo_seq" --method height --results "$work/far.csv" --quiet --out "$work/e4"
@@ -279,6 +294,12 @@ section_evaluate() {
 # --- dump-config and --config ----------------------------------------------------------------
 section_dump_config() {
     expect_ok "dump-config" "bins: 100" "$cli" dump-config
+    expect_ok "dump-config threshold" "threshold: default" "$cli" dump-config
+    # lidarloop 0.1 kept tau under histogram: its default loads, another value says where it went.
+    legacy="$(dirname "$committed")/legacy"
+    expect_ok "0.1 config loads" "bins: 100" "$cli" dump-config --config "$legacy/config_v0.1.yaml"
+    expect_error "0.1 threshold moved" "moved to 'detection.threshold'" "$cli" dump-config \
+        --config "$legacy/config_v0.1_threshold.yaml"
     printf 'histogram:\n  bins: 12\n' >"$work/twelve.yaml"
     expect_ok "dump-config --config" "bins: 12" "$cli" dump-config --config "$work/twelve.yaml"
     expect_ok "dump-config keeps others" "range_max_m: 80" "$cli" dump-config \

@@ -119,6 +119,10 @@ MethodEvaluation EvaluateMatrix(std::string name, pipeline::SimilarityMatrix mat
     e.fixed_thresholds = fixed_thresholds;
     e.at_fixed = eval::ConfusionsAt(pairs, fixed_thresholds);
     EvaluatePerScan(e, truth);
+    if (default_threshold) {
+        e.per_scan_at_default =
+            eval::CountLabels(eval::LabelScans(e.best_matches, truth, *default_threshold));
+    }
     return e;
 }
 

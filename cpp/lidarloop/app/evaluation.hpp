@@ -27,11 +27,12 @@ struct MethodEvaluation {
     eval::PairwiseEvaluation pairwise;              ///< Röhling IV-B/C
     std::optional<eval::ThresholdTransfer> learnt;  ///< table I: learnt on training pairs
     std::string learnt_on;  ///< where they came from: the first part or another dataset
-    std::optional<eval::Confusion> at_default;  ///< L_tau at the default threshold
-    std::vector<double> fixed_thresholds;       ///< Röhling table II columns
-    std::vector<eval::Confusion> at_fixed;      ///< L_tau at each of them
-    std::vector<eval::BestMatch> best_matches;  ///< per scan (Magnusson II-E)
-    eval::PerScanEvaluation per_scan;           ///< table I taxonomy, fig. 1
+    std::optional<eval::Confusion> at_default;                ///< L_tau at the default threshold
+    std::vector<double> fixed_thresholds;                     ///< Röhling table II columns
+    std::vector<eval::Confusion> at_fixed;                    ///< L_tau at each of them
+    std::vector<eval::BestMatch> best_matches;                ///< per scan (Magnusson II-E)
+    eval::PerScanEvaluation per_scan;                         ///< table I taxonomy, fig. 1
+    std::optional<eval::TaxonomyCounts> per_scan_at_default;  ///< the taxonomy at the default
     std::vector<double> smallest_differences;
     eval::DifferenceThreshold em;  ///< fig. 2
     eval::DistinctivenessSummary distinctiveness;
