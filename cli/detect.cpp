@@ -25,14 +25,15 @@ struct DetectFlags {
     bool quiet = false;
 };
 
-// The map fixes how scans are described; flags and --config may set thresholds and detection
-// keys only.
-io::RunConfig ResolveAgainstMap(const DetectFlags& flags, const pipeline::DescriptorDatabase& map) {
+// The map fixes how scans are described and gives its threshold; flags and --config may set
+// detection keys only.
+io::RunConfig ResolveAgainstMap(const DetectFlags& flags, const app::LoadedMap& map) {
     io::RunConfig base;
-    base.descriptor = map.config();
+    base.descriptor = map.database.config();
+    base.detection.threshold = map.detection.threshold;
     io::RunConfig config = flags.descriptor.Resolve(base);
     flags.detection.ApplyTo(config);
-    if (config.descriptor != map.config()) {
+    if (config.descriptor != map.database.config()) {
         throw core::ConfigError(flags.descriptor.FirstGiven() +
                                 " changes how scans are described, but the map " + flags.map +
                                 " fixes that (its config.yaml beside it shows how)");
@@ -67,7 +68,7 @@ void RunDetect(const DetectFlags& flags) {
     request.out = flags.out;
     if (!flags.map.empty()) {
         app::LoadedMap map = app::LoadMap(flags.map);
-        request.config = ResolveAgainstMap(flags, map.database);
+        request.config = ResolveAgainstMap(flags, map);
         const io::Dataset dataset = flags.dataset.Open();
         PrintOutcome(dataset, request, app::RunLocalise(dataset, std::move(map), request),
                      flags.map);

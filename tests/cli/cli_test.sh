@@ -144,9 +144,10 @@ section_detect() {
     fi
     expect_ok "detect ndt" "method ndt" "$cli" detect "$seq" --method ndt --min-gap 2 --quiet \
         --out "$work/det_ndt"
-    # The effective config holds the threshold applied: the method's default unless given.
-    if grep -q "^  threshold: 0.0737" "$work/det_ndt/config.yaml"; then pass; else
-        fail "detect --method ndt: config.yaml lacks t_d = 0.0737"
+    # The effective config leaves the threshold to the method unless one is given, so that it
+    # can be reused with another method.
+    if grep -q "^  threshold: default" "$work/det_ndt/config.yaml"; then pass; else
+        fail "detect --method ndt: config.yaml does not leave the threshold default"
     fi
     expect_ok "detect ndt --threshold" "threshold 0.02," "$cli" detect "$seq" --method ndt \
         --min-gap 2 --threshold 0.02 --quiet --out "$work/det_ndt_t"
@@ -167,6 +168,11 @@ section_detect() {
     fi
     expect_ok "detect --map ndt" "method ndt" "$cli" detect "$seq" \
         --map "$work/det_ndt/database.lldb" --quiet --out "$work/loc_ndt"
+    # A map keeps the threshold of the detection that made it, as the default for localising.
+    expect_ok "detect --map keeps its threshold" "threshold 0.02," "$cli" detect "$seq" \
+        --map "$work/det_ndt_t/database.lldb" --quiet --out "$work/loc_ndt_t"
+    expect_ok "detect --map of 0.1" "threshold 0.004," "$cli" detect "$seq" \
+        --map "$(dirname "$committed")/legacy/database_v0.1.lldb" --quiet --out "$work/loc_v01"
     expect_error "detect --map with --bins" "--bins changes how scans are described" "$cli" detect \
         "$seq" --map "$work/det/database.lldb" --bins 10 --quiet --out "$work/loc2"
     head -c 100 "$work/det/database.lldb" >"$work/truncated.lldb"

@@ -37,11 +37,12 @@ cd "$work"
 ran=0
 while IFS= read -r line; do
     [ -z "$line" ] && continue
-    line="${line//.\/build\/cli\/lidarloop/$cli}"
+    # The README's own paths first, so that paths of this build (which may lie under /tmp) stay.
+    line="${line//\/tmp\//$work/}"
+    line="${line//poses.txt/$dataset/poses.txt}"
     line="${line//path\/to\/new_scans/$dataset}"
     line="${line//path\/to\/scans/$dataset}"
-    line="${line//poses.txt/$dataset/poses.txt}"
-    line="${line//\/tmp\//$work/}"
+    line="${line//.\/build\/cli\/lidarloop/$cli}"
     echo "+ $line"
     if ! bash -c "$line" >"$work/out.txt" 2>&1; then
         echo "FAIL: README command failed: $line"

@@ -20,12 +20,6 @@ void RequireTimesForSeconds(const io::RunConfig& config, const io::Dataset& data
     }
 }
 
-// The config as the run applies it: the decision threshold resolved to the number used.
-io::RunConfig Effective(io::RunConfig config) {
-    config.detection.threshold = config.detection.ThresholdFor(config.descriptor.method);
-    return config;
-}
-
 void WriteDetectResults(const std::filesystem::path& out_dir, const io::RunConfig& config,
                         const pipeline::SequenceDescriptors& described,
                         const pipeline::SimilarityMatrix& matrix, const DetectOutcome& outcome) {
@@ -36,7 +30,7 @@ void WriteDetectResults(const std::filesystem::path& out_dir, const io::RunConfi
     io::WritePng(out_dir / "similarity.png", io::ThresholdImage(matrix, method, outcome.threshold));
     io::WritePng(out_dir / "similarity_distance.png", io::DistanceImage(matrix));
     WriteSkipped(out_dir, described.skipped);
-    io::SaveDatabase(out_dir / "database.lldb", described.database);
+    io::SaveDatabase(out_dir / "database.lldb", described.database, config.detection);
 }
 
 }  // namespace
@@ -44,9 +38,11 @@ void WriteDetectResults(const std::filesystem::path& out_dir, const io::RunConfi
 DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request) {
     const io::RunConfig& config = request.config;
     config.Validate();
+    pipeline::MethodOf(config.descriptor.method)
+        .ValidateThreshold(config.detection.ThresholdFor(config.descriptor.method));
     RequireTimesForSeconds(config, dataset);
     const std::filesystem::path out_dir = PrepareOutputFolder(request.out);
-    io::WriteConfigYaml(out_dir / "config.yaml", Effective(config));
+    io::WriteConfigYaml(out_dir / "config.yaml", config);
 
     Stopwatch total;
     Stopwatch describe_clock;
@@ -76,8 +72,8 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
 
 LoadedMap LoadMap(const std::filesystem::path& file) {
     Stopwatch clock;
-    pipeline::DescriptorDatabase database = io::LoadDatabase(file);
-    return {file, std::move(database), clock.Seconds()};
+    io::StoredDatabase stored = io::LoadStoredDatabase(file);
+    return {file, std::move(stored.database), stored.detection, clock.Seconds()};
 }
 
 DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const DetectRequest& request) {
@@ -90,7 +86,7 @@ DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const Detec
     }
     const pipeline::LoopDetector detector(std::move(map.database), config.detection);
     const std::filesystem::path out_dir = PrepareOutputFolder(request.out);
-    io::WriteConfigYaml(out_dir / "config.yaml", Effective(config));
+    io::WriteConfigYaml(out_dir / "config.yaml", config);
 
     const pipeline::SequenceDescriptors described = DescribeDataset(
         dataset, config.descriptor,

@@ -31,7 +31,7 @@ struct DetectOutcome {
 /// Offline detection over a whole sequence: describes every scan, computes the similarity
 /// matrix, finds each scan's candidates among the earlier scans outside the minimum gap, and
 /// writes loops.csv, candidates.csv, similarity.bin, similarity.png, similarity_distance.png,
-/// database.lldb, config.yaml (with the threshold applied), timings.json (and skipped.txt) into
+/// database.lldb (with the detection config), config.yaml, timings.json (and skipped.txt) into
 /// request.out.
 DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request);
 
@@ -39,6 +39,9 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
 struct LoadedMap {
     std::filesystem::path file;
     pipeline::DescriptorDatabase database;
+    /// The detection config the map was saved with: its threshold is the one to localise with
+    /// unless the request sets another.
+    pipeline::DetectorConfig detection;
     double load_s = 0.0;
 };
 

@@ -156,6 +156,11 @@ eval::GroundTruthConfig GroundTruthRule(const EvaluationRequest& request) {
 EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequest& request,
                                 const io::Dataset* train_dataset) {
     request.learning.Validate();
+    if (request.config.detection.threshold && request.methods.size() > 1) {
+        throw core::ConfigError(
+            "detection.threshold (" + std::to_string(*request.config.detection.threshold) +
+            ") is the threshold of one method; evaluate one method with it, or leave it default");
+    }
     RequirePoses(dataset, "evaluation", "--poses");
     if (train_dataset != nullptr)
         RequirePoses(*train_dataset, "threshold learning", "--train-poses");

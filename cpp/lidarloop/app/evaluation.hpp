@@ -88,7 +88,8 @@ eval::GroundTruthConfig GroundTruthRule(const EvaluationRequest& request);
 /// writes config.yaml, metrics.json, roc.csv, pr.csv, the images and figures and report.md into
 /// request.out. With `train_dataset` (which needs poses too), each method's threshold is learnt
 /// on all its pairs under the same ground-truth rule and tested on all pairs of `dataset`;
-/// results files keep learning on the first part. ConfigError when a dataset has no poses.
+/// results files keep learning on the first part. ConfigError when a dataset has no poses, or
+/// when config.detection.threshold is set and more than one method is evaluated.
 EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequest& request,
                                 const io::Dataset* train_dataset = nullptr);
 

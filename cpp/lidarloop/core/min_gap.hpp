@@ -27,6 +27,7 @@ struct MinGap {
 
     /// Throws ConfigError naming `field` when value is negative or not finite.
     void Validate(const std::string& field) const;
+    bool operator==(const MinGap&) const = default;
 };
 
 std::string ToString(MinGap::Unit unit);

@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <iterator>
+#include <map>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -166,8 +167,14 @@ const char* ExpectedKind() {
 
 class YamlReader {
 public:
-    YamlReader(const YAML::Node& node, std::string source, std::string prefix, LegacyKeys legacy)
-        : node_(node), source_(std::move(source)), prefix_(std::move(prefix)), legacy_(legacy) {}
+    /// `moved` collects the values of moved keys by their old path (LegacyKeys::kMigrate).
+    YamlReader(const YAML::Node& node, std::string source, std::string prefix, LegacyKeys legacy,
+               std::map<std::string, double>* moved)
+        : node_(node),
+          source_(std::move(source)),
+          prefix_(std::move(prefix)),
+          legacy_(legacy),
+          moved_(moved) {}
 
     template <typename T>
     void Field(const char* key, T& value, const std::string&) {
@@ -205,11 +212,19 @@ public:
     void Moved(const char* key, const char* new_key, double legacy_default) {
         known_.insert(key);
         const YAML::Node child = node_[key];
-        if (!child || legacy_ == LegacyKeys::kIgnore) return;
-        if (child.IsScalar() && detail::ParseDouble(child.Scalar()) == legacy_default) return;
+        if (!child) return;
+        const std::optional<double> value =
+            child.IsScalar() ? detail::ParseDouble(child.Scalar()) : std::nullopt;
+        if (legacy_ == LegacyKeys::kMigrate && value) {
+            (*moved_)[prefix_ + key] = *value;
+            return;
+        }
+        if (value == legacy_default) return;
         Fail(key, std::string("moved to '") + new_key +
-                      "' (the decision threshold is no longer a descriptor parameter); write " +
-                      new_key + ": " + YAML::Dump(child) + " instead");
+                      "' (the decision threshold is no longer a descriptor parameter and applies "
+                      "to the run's method; this one was for " +
+                      (prefix_ == "ndt." ? "ndt" : "height and range") + "): write " + new_key +
+                      ": " + YAML::Dump(child) + " instead");
     }
     template <typename Struct>
     void Section(const char* key, Struct& section) {
@@ -217,7 +232,7 @@ public:
         const YAML::Node child = node_[key];
         if (!child || child.IsNull()) return;
         if (!child.IsMap()) Fail(key, "expected a section of keys");
-        YamlReader reader(child, source_, prefix_ + key + ".", legacy_);
+        YamlReader reader(child, source_, prefix_ + key + ".", legacy_, moved_);
         VisitFields(section, reader);
         reader.RejectUnknownKeys();
     }
@@ -240,8 +255,17 @@ private:
     std::string source_;
     std::string prefix_;
     LegacyKeys legacy_;
+    std::map<std::string, double>* moved_;
     std::set<std::string> known_;
 };
+
+// lidarloop 0.1 kept tau under histogram (height, range) and t_d under ndt.
+void MigrateThreshold(const std::map<std::string, double>& moved, RunConfig& config) {
+    if (config.detection.threshold) return;
+    const char* key =
+        core::IsHistogramMethod(config.descriptor.method) ? "histogram.threshold" : "ndt.threshold";
+    if (const auto it = moved.find(key); it != moved.end()) config.detection.threshold = it->second;
+}
 
 }  // namespace
 
@@ -264,9 +288,11 @@ void ApplyConfigYaml(const std::string& yaml_text, const std::string& source, Ru
     if (!root || root.IsNull()) return;  // an empty file overrides nothing
     if (!root.IsMap()) throw ReadError(source, "expected a map of keys at the top level");
     RunConfig updated = config;
-    YamlReader reader(root, source, "", legacy);
+    std::map<std::string, double> moved;
+    YamlReader reader(root, source, "", legacy, &moved);
     VisitFields(updated, reader);
     reader.RejectUnknownKeys();
+    MigrateThreshold(moved, updated);
     try {
         updated.Validate();
     } catch (const core::ConfigError& e) {

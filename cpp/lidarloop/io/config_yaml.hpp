@@ -29,8 +29,10 @@ enum class LegacyKeys {
     /// A moved key with 0.1's default value (as every 0.1 config.yaml holds) is ignored; another
     /// value is a ReadError saying where it moved.
     kExplain,
-    /// Ignored whatever their value (a saved database: thresholds never changed a descriptor).
-    kIgnore,
+    /// The value under the section of the file's method (histogram for height and range, ndt)
+    /// becomes detection.threshold unless the file sets that; the other is ignored (a saved
+    /// database: its threshold was the one its detection used).
+    kMigrate,
 };
 
 /// Overrides the keys that `yaml_text` names in `config` and validates the result. `source`

@@ -9,24 +9,26 @@ namespace {
 constexpr char kMagic[] = "LLDB0001";
 }  // namespace
 
-void SaveDatabase(const std::filesystem::path& file, const pipeline::DescriptorDatabase& database) {
+void SaveDatabase(const std::filesystem::path& file, const pipeline::DescriptorDatabase& database,
+                  const pipeline::DetectorConfig& detection) {
     core::ByteWriter out;
     out.PutMagic(kMagic);
     RunConfig config;
     config.descriptor = database.config();
+    config.detection = detection;
     out.PutString(DumpConfigYaml(config));
     out.Put<std::uint64_t>(database.size());
     for (std::size_t i = 0; i < database.size(); ++i) database.Encode(i, out);
     detail::WriteWholeFile(file, out.data());
 }
 
-pipeline::DescriptorDatabase LoadDatabase(const std::filesystem::path& file) {
+StoredDatabase LoadStoredDatabase(const std::filesystem::path& file) {
     core::ByteReader in = detail::FileReader(file, detail::ReadWholeFile(file));
     in.ExpectMagic(kMagic, "lidarloop database");
     RunConfig config;
     try {
         ApplyConfigYaml(in.GetString("configuration"), "embedded config", config,
-                        LegacyKeys::kIgnore);
+                        LegacyKeys::kMigrate);
     } catch (const ReadError& e) {
         in.Fail(e.what());
     }
@@ -35,7 +37,11 @@ pipeline::DescriptorDatabase LoadDatabase(const std::filesystem::path& file) {
     in.RequireItems(count, 9, "scans");
     for (std::uint64_t i = 0; i < count; ++i) database.Decode(in);
     if (!in.AtEnd()) in.Fail("trailing bytes after " + std::to_string(count) + " scans");
-    return database;
+    return {std::move(database), config.detection};
+}
+
+pipeline::DescriptorDatabase LoadDatabase(const std::filesystem::path& file) {
+    return LoadStoredDatabase(file).database;
 }
 
 }  // namespace lidarloop::io

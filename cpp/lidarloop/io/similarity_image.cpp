@@ -27,8 +27,9 @@ Image Paint(const pipeline::SimilarityMatrix& matrix, Shade shade) {
 
 Image ThresholdImage(const pipeline::SimilarityMatrix& matrix, core::Method method,
                      double threshold) {
+    const pipeline::DescriptorMethod& decides = pipeline::MethodOf(method);  // once, not per pair
     return Paint(matrix, [&](float distance) -> std::uint8_t {
-        return pipeline::IsMatch(method, distance, threshold) ? 0 : 255;
+        return decides.IsMatch(distance, threshold) ? 0 : 255;
     });
 }
 

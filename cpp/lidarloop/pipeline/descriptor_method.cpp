@@ -1,5 +1,6 @@
 #include "lidarloop/pipeline/descriptor_method.hpp"
 
+#include <cmath>
 #include <mutex>
 
 #include "lidarloop/core/error.hpp"
@@ -62,6 +63,13 @@ Registry& TheRegistry() {
 }
 
 }  // namespace
+
+void DescriptorMethod::ValidateThreshold(double threshold) const {
+    if (!(std::isfinite(threshold) && threshold >= 0.0)) {
+        throw core::ConfigError("detection.threshold must be a finite number >= 0, got " +
+                                std::to_string(threshold));
+    }
+}
 
 void RegisterMethod(std::shared_ptr<const DescriptorMethod> method) {
     TheRegistry().Add(std::move(method));

@@ -44,13 +44,18 @@ class NeighborIndex;
 class DescriptorStore {
 public:
     virtual ~DescriptorStore() = default;
+    /// A deep copy (DescriptorDatabase copies with it).
     virtual std::unique_ptr<DescriptorStore> Clone() const = 0;
 
+    /// Appends the descriptor of the next scan (of this store's method and config).
     virtual void Add(const core::Descriptor& descriptor) = 0;
+    /// Appends a placeholder for a scan that could not be described (never compared).
     virtual void AddMissing() = 0;
     /// The method's distance between stored scans i and j (both valid).
     virtual double Distance(std::size_t i, std::size_t j) const = 0;
+    /// A descriptor (not stored) made ready for comparisons with the stored scans.
     virtual std::unique_ptr<PreparedQuery> Prepare(const core::Descriptor& descriptor) const = 0;
+    /// Stored scan i (valid) made ready for comparisons, e.g. with another database's scans.
     virtual std::unique_ptr<PreparedQuery> PrepareStored(std::size_t i) const = 0;
     /// The distance between a query prepared by a store like this one and stored scan j (valid).
     virtual double Distance(const PreparedQuery& query, std::size_t j) const = 0;
@@ -94,6 +99,7 @@ public:
     explicit DescriptorMethod(core::Method method) : method_(method) {}
     virtual ~DescriptorMethod() = default;
 
+    /// The method's identity; name() is what configs and --method call it.
     const core::Method& method() const { return method_; }
     std::string name() const { return core::ToString(method_); }
 
@@ -111,6 +117,9 @@ public:
     virtual double DefaultThreshold() const = 0;
     /// Whether `distance` says "same place" under `threshold` (default: distance <= threshold).
     virtual bool IsMatch(double distance, double threshold) const { return distance <= threshold; }
+    /// ConfigError naming detection.threshold unless `threshold` can decide this method's
+    /// distances (default: finite and >= 0).
+    virtual void ValidateThreshold(double threshold) const;
 
 private:
     core::Method method_;

@@ -97,6 +97,13 @@ std::unique_ptr<DescriptorStore> HistogramMethod::MakeStore(
     return std::make_unique<HistogramStore>(config.histogram.bins);
 }
 
+void HistogramMethod::ValidateThreshold(double threshold) const {
+    if (!(threshold >= 0.0 && threshold <= 1.0)) {
+        throw core::ConfigError("detection.threshold must be in [0, 1] for " + name() +
+                                " (the range of W), got " + std::to_string(threshold));
+    }
+}
+
 const CumulativeHistograms* HistogramRows(const DescriptorDatabase& database) {
     const auto* store = dynamic_cast<const HistogramStore*>(&database.store());
     return store != nullptr ? &store->rows() : nullptr;

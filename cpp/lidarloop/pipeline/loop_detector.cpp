@@ -75,6 +75,7 @@ LoopDetector::LoopDetector(DescriptorDatabase database, const DetectorConfig& de
       detector_(detector),
       threshold_(detector.ThresholdFor(database_.method())) {
     detector_.Validate();
+    database_.definition().ValidateThreshold(threshold_);
     index_ = database_.store().MakeIndex();
     // One sort instead of n sorted inserts: a loaded map may hold a million scans.
     if (index_) index_->InsertAll([this](std::size_t i) { return database_.IsValid(i); });
@@ -150,6 +151,7 @@ std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,
                                         const core::Method& method) {
     detector.Validate();
     const double threshold = detector.ThresholdFor(method);
+    MethodOf(method).ValidateThreshold(threshold);
     if (times_s.size() != matrix.size()) {
         throw core::ConfigError("DetectFromMatrix: " + std::to_string(times_s.size()) +
                                 " times for " + std::to_string(matrix.size()) + " scans");

@@ -14,6 +14,7 @@
 #include "lidarloop/app/evaluation.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/io/config_yaml.hpp"
+#include "lidarloop/io/read_error.hpp"
 #include "lidarloop/pipeline/descriptor_method.hpp"
 #include "test_utils.hpp"
 
@@ -146,6 +147,7 @@ TEST_F(ToyMethod, ASavedMapLoadsAndLocalisesEveryScanAtItself) {
         app::RunLocalise(*dataset_, app::LoadMap(dir_ / "detect" / "database.lldb"), request);
     EXPECT_EQ(outcome.accepted, dataset_->size());
     for (const pipeline::LoopQuery& q : outcome.queries) {
+        ASSERT_TRUE(q.has_match()) << q.query;
         EXPECT_EQ(q.candidates.front().distance, 0.0) << q.query;
     }
 }
@@ -166,6 +168,23 @@ TEST_F(ToyMethod, IsEvaluatedBesideThePapersMethods) {
     const nlohmann::json metrics = nlohmann::json::parse(metrics_file);
     EXPECT_TRUE(metrics["methods"].contains("rings"));
     EXPECT_NE(test::ReadFile(request.out / "report.md").find("| rings |"), std::string::npos);
+}
+
+TEST_F(ToyMethod, AMapOfAMethodThisProcessLacksIsAClearError) {
+    app::DetectRequest request{RingsConfig(), false, {}, dir_ / "detect"};
+    app::RunDetect(*dataset_, request);
+    std::string saved = test::ReadFile(dir_ / "detect" / "database.lldb");
+    const auto at = saved.find("method: rings");
+    ASSERT_NE(at, std::string::npos);
+    saved.replace(at, 13, "method: rongs");  // as if saved by a program with another method
+    test::WriteFile(dir_ / "other.lldb", saved);
+    try {
+        app::LoadMap(dir_ / "other.lldb");
+        FAIL() << "loaded a database of an unknown method";
+    } catch (const io::ReadError& e) {
+        EXPECT_NE(std::string(e.what()).find("unknown method 'rongs'"), std::string::npos)
+            << e.what();
+    }
 }
 
 TEST_F(ToyMethod, IsNamedInConfigsAndShownByName) {

@@ -148,9 +148,18 @@ TEST(ConfigYaml, AConfigOfVersion01LoadsWithItsDefaultThresholds) {
     }
     EXPECT_NE(ErrorOf("ndt:\n  threshold: 0.05\n").find("key 'ndt.threshold': moved"),
               std::string::npos);
-    RunConfig ignored;
-    ApplyConfigYaml("ndt:\n  threshold: 0.05\n", "db", ignored, LegacyKeys::kIgnore);
-    EXPECT_EQ(DumpConfigYaml(ignored), DumpConfigYaml({}));
+    // A file for ndt with a histogram threshold: the message says whose threshold it was.
+    EXPECT_NE(ErrorOf("method: ndt\nhistogram:\n  threshold: 0.004\n").find("for height and range"),
+              std::string::npos);
+    // A saved database's threshold is that of its method; the other section's is not.
+    RunConfig migrated;
+    ApplyConfigYaml("method: ndt\nhistogram:\n  threshold: 0.004\nndt:\n  threshold: 0.05\n", "db",
+                    migrated, LegacyKeys::kMigrate);
+    EXPECT_EQ(migrated.detection.threshold, 0.05);
+    RunConfig height;
+    ApplyConfigYaml("histogram:\n  threshold: 0.004\nndt:\n  threshold: 0.05\n", "db", height,
+                    LegacyKeys::kMigrate);
+    EXPECT_EQ(height.detection.threshold, 0.004);
 }
 
 TEST(ConfigYaml, FileRoundTripAndMissingFile) {

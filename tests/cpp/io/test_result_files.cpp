@@ -126,13 +126,24 @@ std::string DescriptorHeaderBytes(const core::NdtDescriptor& f) {
     return bytes;
 }
 
-// An NDT descriptor whose stored total disagrees with its counts, or with a negative count, is a
-// damaged file, not a descriptor to compare (sigma would be silently wrong).
-// A 0.1 database embeds its decision threshold (0.004 here) in the descriptor section; it never
-// changed a descriptor, so the map loads.
-TEST(DatabaseFile, ADatabaseOfVersion01Loads) {
-    const auto database = LoadDatabase(std::filesystem::path(LIDARLOOP_TEST_DATA_DIR) / "legacy" /
-                                       "database_v0.1.lldb");
+// A 0.1 database embeds the decision threshold of its detection (0.004 here) in the section of
+// its method; it loads, with that threshold as its detection.threshold.
+TEST(DatabaseFile, KeepsTheDetectionConfigItWasSavedWith) {
+    test::TempDir dir;
+    pipeline::DetectorConfig detection;
+    detection.threshold = 0.01;
+    detection.top_k = 3;
+    SaveDatabase(dir / "db.bin", SmallDatabase(core::Method::kRange), detection);
+    EXPECT_EQ(LoadStoredDatabase(dir / "db.bin").detection, detection);
+    SaveDatabase(dir / "db.bin", SmallDatabase(core::Method::kRange));
+    EXPECT_FALSE(LoadStoredDatabase(dir / "db.bin").detection.threshold.has_value());
+}
+
+TEST(DatabaseFile, ADatabaseOfVersion01LoadsWithItsThreshold) {
+    const auto stored = LoadStoredDatabase(std::filesystem::path(LIDARLOOP_TEST_DATA_DIR) /
+                                           "legacy" / "database_v0.1.lldb");
+    EXPECT_EQ(stored.detection.threshold, 0.004);
+    const pipeline::DescriptorDatabase& database = stored.database;
     EXPECT_EQ(database.method(), core::Method::kRange);
     EXPECT_EQ(database.config().histogram.bins, 20);
     ASSERT_EQ(database.size(), 2U);
@@ -140,6 +151,8 @@ TEST(DatabaseFile, ADatabaseOfVersion01Loads) {
     EXPECT_EQ(database.Distance(0, 1), 0.0);  // two copies of one scan
 }
 
+// An NDT descriptor whose stored total disagrees with its counts, or with a negative count, is a
+// damaged file, not a descriptor to compare (sigma would be silently wrong).
 TEST(DatabaseFile, DamagedNdtCountsAreClearErrors) {
     test::TempDir dir;
     const auto database = SmallDatabase(core::Method::kNdt);

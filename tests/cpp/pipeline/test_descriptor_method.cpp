@@ -1,10 +1,13 @@
 // The method registry and what every method answers through DescriptorMethod.
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/pipeline/descriptor_database.hpp"
 #include "lidarloop/pipeline/descriptor_method.hpp"
 #include "lidarloop/pipeline/histogram_method.hpp"
+#include "lidarloop/pipeline/loop_detector.hpp"
 #include "lidarloop/pipeline/ndt_method.hpp"
 #include "test_utils.hpp"
 
@@ -48,6 +51,24 @@ TEST(DescriptorMethod, EachPaperDecidesWithItsOwnComparisonAndDefault) {
     EXPECT_TRUE(IsMatch(core::Method::kHeight, 0.005, 0.005));  // W <= tau (Röhling eq. 7)
     EXPECT_FALSE(IsMatch(core::Method::kNdt, 0.05, 0.05));      // sigma' < t_d (Magnusson)
     EXPECT_TRUE(IsMatch(core::Method::kNdt, 0.049, 0.05));
+}
+
+TEST(DescriptorMethod, AThresholdMustBeAbleToDecide) {
+    EXPECT_NO_THROW(MethodOf(core::Method::kHeight).ValidateThreshold(1.0));
+    const std::string message =
+        ErrorOf([] { MethodOf(core::Method::kRange).ValidateThreshold(1.5); });
+    EXPECT_NE(message.find("in [0, 1] for range (the range of W)"), std::string::npos) << message;
+    EXPECT_NO_THROW(MethodOf(core::Method::kNdt).ValidateThreshold(1.5));  // sigma' is unbounded
+    for (double bad : {-0.1, std::nan(""), HUGE_VAL}) {
+        EXPECT_THROW(MethodOf(core::Method::kNdt).ValidateThreshold(bad), core::ConfigError);
+    }
+    DetectorConfig detection;
+    detection.threshold = 1.5;
+    core::DescriptorConfig height;
+    EXPECT_THROW(LoopDetector(height, detection), core::ConfigError);
+    EXPECT_THROW(
+        DetectFromMatrix(SimilarityMatrix(2), {0.0, 1.0}, detection, core::Method::kHeight),
+        core::ConfigError);
 }
 
 TEST(DescriptorMethod, ANameIsRegisteredOnce) {
