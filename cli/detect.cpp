@@ -25,12 +25,11 @@ struct DetectFlags {
     bool quiet = false;
 };
 
-// The map fixes how scans are described and gives its threshold; flags and --config may set
-// detection keys only.
+// The map fixes how scans are described (and RunLocalise takes its threshold unless one is
+// given); flags and --config may set detection keys only.
 io::RunConfig ResolveAgainstMap(const DetectFlags& flags, const app::LoadedMap& map) {
     io::RunConfig base;
     base.descriptor = map.database.config();
-    base.detection.threshold = map.detection.threshold;
     io::RunConfig config = flags.descriptor.Resolve(base);
     flags.detection.ApplyTo(config);
     if (config.descriptor != map.database.config()) {

@@ -78,7 +78,8 @@ LoadedMap LoadMap(const std::filesystem::path& file) {
 
 DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const DetectRequest& request) {
     Stopwatch total;
-    const io::RunConfig& config = request.config;
+    io::RunConfig config = request.config;
+    if (!config.detection.threshold) config.detection.threshold = map.detection.threshold;
     config.Validate();
     if (config.descriptor != map.database.config()) {
         throw core::ConfigError("the configuration changes how scans are described, but the map " +

@@ -50,8 +50,9 @@ LoadedMap LoadMap(const std::filesystem::path& file);
 
 /// Localisation: every scan of `dataset` is searched in `map` and not added to it.
 /// request.config.descriptor must equal the map's (ConfigError otherwise): scans are described
-/// as the map's were; its detection keys apply. Writes loops.csv (query scan, map scan),
-/// candidates.csv, config.yaml, timings.json (and skipped.txt) into request.out.
+/// as the map's were; its detection keys apply, and without a threshold the map's saved one
+/// (map.detection.threshold) does, else the method's default. Writes loops.csv (query scan, map
+/// scan), candidates.csv, config.yaml, timings.json (and skipped.txt) into request.out.
 DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const DetectRequest& request);
 
 }  // namespace lidarloop::app

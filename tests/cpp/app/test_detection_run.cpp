@@ -84,6 +84,21 @@ TEST_F(DetectionRun, LocalisingTheSequenceAgainstItsOwnMapFindsEveryScanItself) 
     EXPECT_EQ(outcome.accepted, dataset_->size());
 }
 
+TEST_F(DetectionRun, LocalisationTakesTheMapsThresholdUnlessGivenOne) {
+    app::DetectRequest detect = Request("detect", core::Method::kRange);
+    detect.config.detection.threshold = 0.002;
+    app::RunDetect(*dataset_, detect);
+    app::DetectRequest localise = Request("localise", core::Method::kRange);
+    const auto map = [&] { return app::LoadMap(detect.out / "database.lldb"); };
+    EXPECT_EQ(app::RunLocalise(*dataset_, map(), localise).threshold, 0.002);
+    localise.config.detection.threshold = 0.003;
+    EXPECT_EQ(app::RunLocalise(*dataset_, map(), localise).threshold, 0.003);
+    detect.config.detection.threshold.reset();
+    app::RunDetect(*dataset_, detect);
+    localise.config.detection.threshold.reset();
+    EXPECT_EQ(app::RunLocalise(*dataset_, map(), localise).threshold, 0.005);
+}
+
 TEST_F(DetectionRun, AMapDescribedOtherwiseIsAClearError) {
     const app::DetectRequest detect = Request("detect", core::Method::kRange);
     app::RunDetect(*dataset_, detect);
