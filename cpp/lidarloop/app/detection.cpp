@@ -38,8 +38,8 @@ void WriteDetectResults(const std::filesystem::path& out_dir, const io::RunConfi
 DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request) {
     const io::RunConfig& config = request.config;
     config.Validate();
-    pipeline::MethodOf(config.descriptor.method)
-        .ValidateThreshold(config.detection.ThresholdFor(config.descriptor.method));
+    const double threshold = config.detection.ThresholdFor(config.descriptor.method);
+    pipeline::MethodOf(config.descriptor.method).ValidateThreshold(threshold);
     RequireTimesForSeconds(config, dataset);
     const std::filesystem::path out_dir = PrepareOutputFolder(request.out);
     io::WriteConfigYaml(out_dir / "config.yaml", config);
@@ -55,7 +55,7 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     const pipeline::SimilarityMatrix matrix = pipeline::ComputeSimilarityMatrix(described.database);
     const double matrix_s = matrix_clock.Seconds();
     DetectOutcome outcome;
-    outcome.threshold = config.detection.ThresholdFor(config.descriptor.method);
+    outcome.threshold = threshold;
     outcome.queries = pipeline::DetectFromMatrix(matrix, described.database.times_s(),
                                                  config.detection, config.descriptor.method);
     outcome.accepted = CountAccepted(outcome.queries);

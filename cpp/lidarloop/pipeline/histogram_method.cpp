@@ -97,6 +97,10 @@ std::unique_ptr<DescriptorStore> HistogramMethod::MakeStore(
     return std::make_unique<HistogramStore>(config.histogram.bins);
 }
 
+bool HistogramMethod::IsMatch(double distance, double threshold) const {
+    return core::IsLoop(distance, threshold);
+}
+
 void HistogramMethod::ValidateThreshold(double threshold) const {
     if (!(threshold >= 0.0 && threshold <= 1.0)) {
         throw core::ConfigError("detection.threshold must be in [0, 1] for " + name() +

@@ -26,6 +26,8 @@ public:
     /// tau = 0.005: Röhling table II, MCC is best near 0.005 on every route. Their b and value
     /// range are not published, so treat it as a starting point and learn yours.
     double DefaultThreshold() const override { return 0.005; }
+    /// W <= tau (Röhling eq. 7, core::IsLoop).
+    bool IsMatch(double distance, double threshold) const override;
     /// tau in [0, 1], the range of W.
     void ValidateThreshold(double threshold) const override;
 };
