@@ -10,10 +10,7 @@ void DescriptorOptions::AddTo(CLI::App& command, bool with_method) {
     command.add_option("--config", config_file_, "YAML file overriding the defaults it names")
         ->check(CLI::ExistingFile);
     if (with_method) {
-        std::string names;
-        for (const std::string& name : pipeline::MethodNames())
-            names += (names.empty() ? "" : " | ") + name;
-        command.add_option("--method", method_, "descriptor: " + names);
+        command.add_option("--method", method_, "descriptor: " + pipeline::MethodNamesText(" | "));
     }
     bins_option_ = command.add_option("--bins", bins_, "number of histogram buckets b");
     min_option_ = command.add_option("--min", min_m_, "v_min of the chosen projection, metres");

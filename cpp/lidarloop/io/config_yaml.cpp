@@ -34,12 +34,7 @@ std::string ThresholdHelp() {
            ShortNumber(pipeline::DefaultThreshold(core::Method::kNdt)) + ")";
 }
 
-std::string MethodHelp() {
-    std::string names;
-    for (const std::string& name : pipeline::MethodNames())
-        names += (names.empty() ? "" : " | ") + name;
-    return "descriptor: " + names;
-}
+std::string MethodHelp() { return "descriptor: " + pipeline::MethodNamesText(" | "); }
 
 // The one list of keys. Both the writer and the reader walk it, so a key cannot exist in one and
 // be missing in the other. `visitor.Field(key, value, help)`, `visitor.Section(key, struct)`,

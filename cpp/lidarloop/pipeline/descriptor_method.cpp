@@ -57,9 +57,8 @@ Registry& TheRegistry() {
 }
 
 [[noreturn]] void FailUnknown(std::string_view name) {
-    std::string valid;
-    for (const std::string& known : MethodNames()) valid += (valid.empty() ? "" : ", ") + known;
-    throw core::ConfigError("unknown method '" + std::string(name) + "' (valid: " + valid + ")");
+    throw core::ConfigError("unknown method '" + std::string(name) +
+                            "' (valid: " + MethodNamesText(", ") + ")");
 }
 
 }  // namespace
@@ -89,6 +88,15 @@ core::Method ParseMethod(std::string_view name) {
 }
 
 std::vector<std::string> MethodNames() { return TheRegistry().Names(); }
+
+std::string MethodNamesText(std::string_view separator) {
+    std::string text;
+    for (const std::string& name : MethodNames()) {
+        if (!text.empty()) text += separator;
+        text += name;
+    }
+    return text;
+}
 
 core::Descriptor ComputeDescriptor(const core::PointCloud& cloud,
                                    const core::DescriptorConfig& config) {

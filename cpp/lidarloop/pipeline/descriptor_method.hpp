@@ -139,6 +139,8 @@ core::Method ParseMethod(std::string_view name);
 
 /// The names of every registered method: height, range, ndt first, then in registration order.
 std::vector<std::string> MethodNames();
+/// MethodNames() joined by `separator` ("height | range | ndt"), for help texts and messages.
+std::string MethodNamesText(std::string_view separator);
 
 /// MethodOf(config.method).Describe(cloud, config): ConfigError for an invalid config,
 /// EmptyInputError for a scan with nothing usable. Thread-safe.
