@@ -1,0 +1,183 @@
+#include "lidarloop/registration/coarse_alignment.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "lidarloop/registration/detail/fft2d.hpp"
+
+namespace lidarloop::registration {
+namespace {
+
+using Spectrum = std::vector<std::complex<float>>;
+
+constexpr double kDegToRad = std::numbers::pi / 180.0;
+
+Spectrum ToSpectrum(const std::vector<float>& image, int n) {
+    Spectrum spectrum(image.begin(), image.end());
+    detail::Fft2dForward(spectrum, n);
+    return spectrum;
+}
+
+// The match image, spread: a cell next to an occupied one scores half, so that a query cell one
+// cell off (the yaw step, the cell grid) still counts.
+std::vector<float> Spread(const std::vector<float>& image, int n) {
+    std::vector<float> spread(image);
+    auto at = [&](int x, int y) { return image[static_cast<std::size_t>(y * n + x)]; };
+    for (int y = 1; y + 1 < n; ++y) {
+        for (int x = 1; x + 1 < n; ++x) {
+            const bool beside = at(x - 1, y) > 0.0F || at(x + 1, y) > 0.0F || at(x, y - 1) > 0.0F ||
+                                at(x, y + 1) > 0.0F;
+            if (beside) spread[static_cast<std::size_t>(y * n + x)] = std::max(at(x, y), 0.5F);
+        }
+    }
+    return spread;
+}
+
+// The signed shift of a wrapped correlation index.
+int Signed(int index, int n) { return index < n / 2 ? index : index - n; }
+
+// Sub-cell offset of a peak from the values beside it (a parabola through three samples).
+double ParabolicOffset(double before, double at, double after) {
+    const double curvature = before - 2.0 * at + after;
+    if (curvature >= 0.0) return 0.0;
+    return std::clamp(0.5 * (before - after) / curvature, -0.5, 0.5);
+}
+
+// The best translation of one correlation grid (the real or imaginary part of `grid`) over the
+// searched cells.
+template <class Part>
+PlanarHypothesis Peak(const std::vector<std::complex<float>>& grid, Part part,
+                      const CoarseQuery& query, double yaw_rad) {
+    const int n = query.config().grid_cells;
+    PlanarHypothesis best{yaw_rad, Eigen::Vector2d::Zero(), -1.0};
+    std::uint32_t best_cell = 0;
+    for (const std::uint32_t cell : query.search_cells()) {
+        const double value = part(grid[cell]);
+        if (value > best.score) {
+            best.score = value;
+            best_cell = cell;
+        }
+    }
+    const int best_x = static_cast<int>(best_cell) % n, best_y = static_cast<int>(best_cell) / n;
+    auto at = [&](int x, int y) {
+        return static_cast<double>(
+            part(grid[static_cast<std::size_t>(((y + n) % n) * n + (x + n) % n)]));
+    };
+    const double fx = ParabolicOffset(at(best_x - 1, best_y), best.score, at(best_x + 1, best_y));
+    const double fy = ParabolicOffset(at(best_x, best_y - 1), best.score, at(best_x, best_y + 1));
+    best.translation_m =
+        Eigen::Vector2d(Signed(best_x, n) + fx, Signed(best_y, n) + fy) * query.config().cell_m;
+    return best;
+}
+
+// The searched rows and the rows beside them (wrapped), ascending and unique.
+std::vector<int> RowsWithNeighbors(const std::vector<int>& rows, int n) {
+    std::vector<bool> needed(static_cast<std::size_t>(n), false);
+    for (const int row : rows) {
+        for (const int d : {-1, 0, 1}) needed[static_cast<std::size_t>((row + d + n) % n)] = true;
+    }
+    std::vector<int> result;
+    for (int row = 0; row < n; ++row) {
+        if (needed[static_cast<std::size_t>(row)]) result.push_back(row);
+    }
+    return result;
+}
+
+double YawDistance(double a_rad, double b_rad) {
+    return std::abs(std::remainder(a_rad - b_rad, 2.0 * std::numbers::pi));
+}
+
+// Greedily keeps the best peaks that differ from every kept one in yaw or translation.
+std::vector<PlanarHypothesis> Distinct(std::vector<PlanarHypothesis> peaks,
+                                       const CoarseConfig& config) {
+    std::sort(peaks.begin(), peaks.end(),
+              [](const auto& a, const auto& b) { return a.score > b.score; });
+    std::vector<PlanarHypothesis> kept;
+    for (const auto& peak : peaks) {
+        if (peak.score <= 0.0) break;
+        const bool distinct = std::all_of(kept.begin(), kept.end(), [&](const auto& other) {
+            return YawDistance(peak.yaw_rad, other.yaw_rad) >
+                       2.5 * config.yaw_step_deg * kDegToRad ||
+                   (peak.translation_m - other.translation_m).norm() > 3.0 * config.cell_m;
+        });
+        if (distinct) kept.push_back(peak);
+        if (static_cast<int>(kept.size()) == config.hypotheses) break;
+    }
+    return kept;
+}
+
+}  // namespace
+
+std::vector<float> OccupancyImage(const std::vector<Eigen::Vector3f>& points, double yaw_rad,
+                                  const CoarseConfig& config) {
+    const int n = config.grid_cells;
+    std::vector<float> image(static_cast<std::size_t>(n * n), 0.0F);
+    const Eigen::Rotation2Df rotation(static_cast<float>(yaw_rad));
+    const auto inverse_cell = static_cast<float>(1.0 / config.cell_m);
+    for (const auto& point : points) {
+        const Eigen::Vector2f xy = rotation * point.head<2>();
+        const int x = static_cast<int>(std::floor(xy.x() * inverse_cell)) + n / 2;
+        const int y = static_cast<int>(std::floor(xy.y() * inverse_cell)) + n / 2;
+        if (x < 0 || y < 0 || x >= n || y >= n) continue;
+        image[static_cast<std::size_t>(y * n + x)] = 1.0F;
+    }
+    return image;
+}
+
+CoarseQuery::CoarseQuery(const SurfacePoints& query_structure, const CoarseConfig& config)
+    : config_(config) {
+    const int n = config.grid_cells;
+    const double max_cells = config.max_translation_m / config.cell_m;
+    for (int y = 0; y < n; ++y) {
+        bool row_searched = false;
+        for (int x = 0; x < n; ++x) {
+            if (std::hypot(Signed(x, n), Signed(y, n)) > max_cells) continue;
+            search_cells_.push_back(static_cast<std::uint32_t>(y * n + x));
+            row_searched = true;
+        }
+        // The parabolic refinement reads the rows beside a peak too.
+        if (row_searched) search_rows_.push_back(y);
+    }
+    const int yaws = static_cast<int>(std::lround(360.0 / config.yaw_step_deg));
+    spectra_.reserve(static_cast<std::size_t>(yaws));
+    for (int i = 0; i < yaws; ++i) {
+        Spectrum spectrum = ToSpectrum(
+            OccupancyImage(query_structure.points(), i * 2.0 * std::numbers::pi / yaws, config),
+            config.grid_cells);
+        for (auto& value : spectrum) value = std::conj(value);
+        spectra_.push_back(std::move(spectrum));
+    }
+}
+
+double CoarseQuery::YawOf(int index) const { return index * 2.0 * std::numbers::pi / yaw_count(); }
+
+std::vector<PlanarHypothesis> CoarseAlign(const CoarseQuery& query,
+                                          const SurfacePoints& match_structure) {
+    const CoarseConfig& config = query.config();
+    const int n = config.grid_cells;
+    if (match_structure.size() == 0 || query.yaw_count() == 0) return {};
+    const Spectrum match =
+        ToSpectrum(Spread(OccupancyImage(match_structure.points(), 0.0, config), n), n);
+    std::vector<PlanarHypothesis> peaks;
+    Spectrum product(match.size());
+    const auto rows = RowsWithNeighbors(query.search_rows(), n);
+    auto real = [](std::complex<float> value) { return value.real(); };
+    auto imaginary = [](std::complex<float> value) { return value.imag(); };
+    // Two yaws per inverse FFT: both correlations are real, so one rides in the imaginary part.
+    for (int a = 0; a < query.yaw_count(); a += 2) {
+        const int b = std::min(a + 1, query.yaw_count() - 1);
+        const Spectrum& qa = query.spectrum(a);
+        const Spectrum& qb = query.spectrum(b);
+        for (std::size_t i = 0; i < product.size(); ++i) {
+            const std::complex<float> m = match[i];
+            product[i] = qa[i] * m + std::complex<float>(0.0F, 1.0F) * (qb[i] * m);
+        }
+        detail::Fft2dInverseRows(product, n, rows);
+        peaks.push_back(Peak(product, real, query, query.YawOf(a)));
+        if (b != a) peaks.push_back(Peak(product, imaginary, query, query.YawOf(b)));
+    }
+    return Distinct(std::move(peaks), config);
+}
+
+}  // namespace lidarloop::registration

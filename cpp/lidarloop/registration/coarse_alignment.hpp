@@ -1,0 +1,54 @@
+#pragma once
+
+#include <complex>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "lidarloop/registration/prepared_scan.hpp"
+#include "lidarloop/registration/verification_config.hpp"
+
+namespace lidarloop::registration {
+
+/// A planar pose hypothesis of the coarse search: T_match_query = Translation(x, y, 0) * Rz(yaw).
+struct PlanarHypothesis {
+    double yaw_rad = 0.0;
+    Eigen::Vector2d translation_m = Eigen::Vector2d::Zero();
+    double score = 0.0;  ///< correlation of the occupancy images at the peak (higher: better)
+};
+
+/// The query's side of the coarse search, computed once per query scan and shared by all its
+/// candidates: the spectrum of its top-down structure image at every searched yaw.
+class CoarseQuery {
+public:
+    CoarseQuery(const SurfacePoints& query_structure, const CoarseConfig& config);
+
+    const CoarseConfig& config() const { return config_; }
+    int yaw_count() const { return static_cast<int>(spectra_.size()); }
+    double YawOf(int index) const;
+    const std::vector<std::complex<float>>& spectrum(int index) const { return spectra_[index]; }
+    /// Cells of the correlation grid within max_translation_m (wrapped indices), and their rows.
+    const std::vector<std::uint32_t>& search_cells() const { return search_cells_; }
+    const std::vector<int>& search_rows() const { return search_rows_; }
+
+private:
+    CoarseConfig config_;
+    std::vector<std::uint32_t> search_cells_;
+    std::vector<int> search_rows_;
+    std::vector<std::vector<std::complex<float>>> spectra_;  // one grid_cells^2 spectrum per yaw
+};
+
+/// The top-down occupancy image of `points` after Rz(yaw_rad): grid_cells^2 values, row-major
+/// (row = y cell), the sensor at the centre; 1 in every cell holding a point.
+std::vector<float> OccupancyImage(const std::vector<Eigen::Vector3f>& points, double yaw_rad,
+                                  const CoarseConfig& config);
+
+/// The best distinct planar poses of the query in the match's frame, best first (at most
+/// config.hypotheses): for every yaw, the translation that maximises the cross-correlation of
+/// the query's rotated structure image with the match's (FFT), within max_translation_m.
+/// Empty when either scan has no structure points. Thread-safe.
+std::vector<PlanarHypothesis> CoarseAlign(const CoarseQuery& query,
+                                          const SurfacePoints& match_structure);
+
+}  // namespace lidarloop::registration

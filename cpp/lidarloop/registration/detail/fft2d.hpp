@@ -1,0 +1,16 @@
+#pragma once
+
+#include <complex>
+#include <vector>
+
+namespace lidarloop::registration::detail {
+
+/// In-place 2-D discrete Fourier transform of an n x n row-major grid (Eigen's FFT on rows, then
+/// columns). The inverse is scaled by 1 / n^2, so Inverse(Forward(x)) == x. Thread-safe.
+void Fft2dForward(std::vector<std::complex<float>>& grid, int n);
+void Fft2dInverse(std::vector<std::complex<float>>& grid, int n);
+/// The inverse transform computed only for the rows listed in `rows` (columns first, then those
+/// rows); the other rows hold partial results. For correlations read in a band of rows.
+void Fft2dInverseRows(std::vector<std::complex<float>>& grid, int n, const std::vector<int>& rows);
+
+}  // namespace lidarloop::registration::detail

@@ -1,0 +1,109 @@
+#include "lidarloop/registration/icp.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Cholesky>
+
+namespace lidarloop::registration {
+namespace {
+
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+// The normal equations of one Gauss-Newton step, for increments (rotation, translation) applied
+// on the left of the pose.
+struct NormalEquations {
+    Matrix6d hessian = Matrix6d::Zero();
+    Vector6d gradient = Vector6d::Zero();
+    std::size_t count = 0;
+    std::size_t paired = 0;   // query points given (within the cap)
+    std::size_t inliers = 0;  // of those, within the inlier distance of a plane
+};
+
+// Pairs every stride-th point of `from` (an even subsample of at most `cap` points).
+void Accumulate(const SurfacePoints& from, const SurfacePoints& onto, const Eigen::Isometry3f& T,
+                float max_distance_m, int cap, float inlier_m, NormalEquations& equations) {
+    const double scale_m = max_distance_m / 3.0;
+    const std::size_t stride = std::max<std::size_t>(1, (from.size() + cap - 1) / cap);
+    for (std::size_t i = 0; i < from.size(); i += stride) {
+        const Eigen::Vector3f& point = from.points()[i];
+        ++equations.paired;
+        const Eigen::Vector3f moved = T * point;
+        const auto index = onto.tree().Nearest(moved, max_distance_m);
+        if (index < 0) continue;
+        const Eigen::Vector3d normal =
+            onto.normals()[static_cast<std::size_t>(index)].cast<double>();
+        const Eigen::Vector3d q = moved.cast<double>();
+        const double residual =
+            normal.dot(q - onto.points()[static_cast<std::size_t>(index)].cast<double>());
+        if (std::abs(residual) <= inlier_m) ++equations.inliers;
+        // Geman-McClure weight: residuals far beyond the scale barely pull.
+        const double ratio = residual / scale_m;
+        const double weight = 1.0 / ((1.0 + ratio * ratio) * (1.0 + ratio * ratio));
+        Vector6d jacobian;
+        jacobian << q.cross(normal), normal;
+        equations.hessian.noalias() += weight * jacobian * jacobian.transpose();
+        equations.gradient.noalias() += weight * residual * jacobian;
+        ++equations.count;
+    }
+}
+
+core::Transform Increment(const Vector6d& step) {
+    core::Transform increment = core::Transform::Identity();
+    const Eigen::Vector3d rotation = step.head<3>();
+    const double angle_rad = rotation.norm();
+    if (angle_rad > 0.0)
+        increment.linear() = Eigen::AngleAxisd(angle_rad, rotation / angle_rad).toRotationMatrix();
+    increment.translation() = step.tail<3>();
+    return increment;
+}
+
+// One stage at a fixed correspondence distance; returns true when it settled.
+bool RunStage(const PreparedScan& query, const PreparedScan& match, float max_distance_m,
+              const IcpConfig& config, IcpResult& result) {
+    for (int iteration = 0; iteration < config.max_iterations_per_stage; ++iteration) {
+        NormalEquations equations;
+        const Eigen::Isometry3f T = result.T_match_query.cast<float>();
+        const auto inlier_m = static_cast<float>(config.final_correspondence_m);
+        Accumulate(*query.structure, *match.structure, T, max_distance_m,
+                   config.max_structure_points, inlier_m, equations);
+        result.structure_inliers =
+            equations.paired == 0
+                ? 0.0
+                : static_cast<double>(equations.inliers) / static_cast<double>(equations.paired);
+        Accumulate(*query.ground, *match.ground, T, max_distance_m, config.max_ground_points,
+                   inlier_m, equations);
+        ++result.iterations;
+        result.correspondences = equations.count;
+        if (equations.count < 6) return false;
+        const Vector6d step = equations.hessian.ldlt().solve(-equations.gradient);
+        if (!step.allFinite()) return false;
+        result.T_match_query = Increment(step) * result.T_match_query;
+        if (step.head<3>().norm() + step.tail<3>().norm() < config.convergence_step) return true;
+    }
+    return false;
+}
+
+}  // namespace
+
+IcpResult RefinePointToPlane(const PreparedScan& query, const PreparedScan& match,
+                             const core::Transform& T_initial, const IcpConfig& config) {
+    IcpResult result;
+    result.T_match_query = T_initial;
+    double distance_m = config.initial_correspondence_m;
+    while (true) {
+        result.converged = RunStage(query, match, static_cast<float>(distance_m), config, result);
+        if (distance_m <= config.final_correspondence_m) break;
+        if (distance_m == config.initial_correspondence_m &&
+            result.structure_inliers < config.abandon_below_inliers) {
+            result.abandoned = true;
+            result.converged = false;
+            break;
+        }
+        distance_m = std::max(config.final_correspondence_m, distance_m / 2.0);
+    }
+    return result;
+}
+
+}  // namespace lidarloop::registration

@@ -1,0 +1,30 @@
+#pragma once
+
+#include <cstddef>
+
+#include "lidarloop/core/point_cloud.hpp"
+#include "lidarloop/registration/prepared_scan.hpp"
+#include "lidarloop/registration/verification_config.hpp"
+
+namespace lidarloop::registration {
+
+/// The outcome of RefinePointToPlane.
+struct IcpResult {
+    core::Transform T_match_query = core::Transform::Identity();
+    bool converged = false;           ///< the last stage settled (a step below convergence_step)
+    int iterations = 0;               ///< over all stages
+    std::size_t correspondences = 0;  ///< of the last iteration
+    /// Share of the paired query structure points whose plane distance was within
+    /// final_correspondence_m in the last iteration.
+    double structure_inliers = 0.0;
+    bool abandoned = false;  ///< stopped after the first stage: too few structure inliers
+};
+
+/// Point-to-plane ICP of the query onto the match, from `T_initial` (T_match_query), with the
+/// correspondence distance shrinking stage by stage (coarse to fine). Structure points pair only
+/// with structure points, ground with ground; residuals are distances to the match's planes,
+/// weighted robustly. Thread-safe.
+IcpResult RefinePointToPlane(const PreparedScan& query, const PreparedScan& match,
+                             const core::Transform& T_initial, const IcpConfig& config);
+
+}  // namespace lidarloop::registration

@@ -1,0 +1,35 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace lidarloop::registration {
+
+/// A static k-d tree over float points (metres) for the many approximate-free but
+/// single-precision nearest-neighbour queries of registration. core::KdTree3 is the exact,
+/// double-precision tree for evaluation; this one trades that for speed (float, no callbacks).
+/// nanoflann does the work behind a pimpl. Queries are const and thread-safe.
+class PointTree {
+public:
+    /// Refers to `points`, which must outlive the tree and stay unchanged. Points must be finite.
+    explicit PointTree(const std::vector<Eigen::Vector3f>* points);
+    ~PointTree();
+    PointTree(PointTree&&) noexcept;
+    PointTree& operator=(PointTree&&) noexcept;
+    PointTree(const PointTree&) = delete;
+    PointTree& operator=(const PointTree&) = delete;
+
+    /// Index of the point nearest to `query` when it is closer than `max_distance_m`, else -1.
+    std::int64_t Nearest(const Eigen::Vector3f& query, float max_distance_m) const;
+    /// The indices of the `k` nearest points (fewer when the tree is smaller), nearest first.
+    void Knn(const Eigen::Vector3f& query, int k, std::vector<std::uint32_t>& indices) const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace lidarloop::registration

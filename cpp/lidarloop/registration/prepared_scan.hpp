@@ -1,0 +1,62 @@
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "lidarloop/core/point_cloud.hpp"
+#include "lidarloop/registration/point_tree.hpp"
+#include "lidarloop/registration/verification_config.hpp"
+
+namespace lidarloop::registration {
+
+/// Points of one surface class of a reduced scan, with unit normals and a search tree.
+/// Immutable; neither copyable nor movable (the tree refers to the points), so held by pointer.
+class SurfacePoints {
+public:
+    /// `normals[i]` belongs to `points[i]`; both in the sensor frame, metres.
+    SurfacePoints(std::vector<Eigen::Vector3f> points, std::vector<Eigen::Vector3f> normals);
+    SurfacePoints(const SurfacePoints&) = delete;
+    SurfacePoints& operator=(const SurfacePoints&) = delete;
+
+    const std::vector<Eigen::Vector3f>& points() const { return points_; }
+    const std::vector<Eigen::Vector3f>& normals() const { return normals_; }
+    const PointTree& tree() const { return tree_; }
+    std::size_t size() const { return points_.size(); }
+    /// Heap bytes held: points, normals and an estimate of the tree.
+    std::size_t MemoryBytes() const;
+
+private:
+    void shrink();  // before the tree is built: MemoryBytes counts capacity
+
+    std::vector<Eigen::Vector3f> points_;
+    std::vector<Eigen::Vector3f> normals_;
+    PointTree tree_;
+};
+
+/// What registration keeps of a scan: voxel centroids with normals, split into structure
+/// (normals far from vertical: what tells places apart) and ground (the rest). A few thousand
+/// points instead of a raw scan's ~120k; cheap to copy (shared, immutable parts).
+struct PreparedScan {
+    std::shared_ptr<const SurfacePoints> structure;
+    std::shared_ptr<const SurfacePoints> ground;
+    std::size_t input_points = 0;   ///< points of the raw scan
+    std::size_t usable_points = 0;  ///< finite points within the range limits
+    /// Median RMS distance of a structure point's neighbours to its fitted plane, metres: how
+    /// rough the scan's own surfaces are at this voxel size (sensor noise, vegetation). A pair's
+    /// fit is judged against it (AcceptanceConfig::max_rmse_ratio).
+    double structure_roughness_m = 0.0;
+
+    /// Heap bytes held by the prepared scan (the figure bench reports per stored scan).
+    std::size_t MemoryBytes() const;
+};
+
+/// Reduces `scan` (sensor frame, metres) for registration: range filter, voxel centroids, normals
+/// from the nearest centroids, split by normal tilt, and a deterministic subsample to the size
+/// caps. Never throws on bad points: non-finite ones are skipped, and a scan with too little
+/// left gives an almost empty result that Verify rejects with the reason. Thread-safe.
+PreparedScan PrepareScan(const core::PointCloud& scan, const ScanReductionConfig& config);
+
+}  // namespace lidarloop::registration

@@ -1,0 +1,258 @@
+#include "lidarloop/registration/verification.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Eigenvalues>
+
+#include "lidarloop/registration/icp.hpp"
+
+namespace lidarloop::registration {
+namespace {
+
+// Smallest angle cosine between matched normals (30 degrees): a wall point does not overlap a
+// pole that merely passes near it.
+constexpr float kMinNormalCosine = 0.866F;
+
+// Ground points a scan needs besides its structure: they fix height, roll and pitch.
+constexpr std::size_t kMinGroundPoints = 20;
+
+// A structure point of one scan, moved into the other's frame, lies on the other's surfaces: its
+// nearest structure point there is within overlap_radius_m, that point's plane passes within
+// overlap_plane_m, and the normals agree.
+struct SurfaceHit {
+    bool on_surface = false;
+    float distance_m = 0.0F;  // to the partner's plane
+    Eigen::Vector3f partner_normal;
+};
+
+SurfaceHit HitOnSurface(const Eigen::Vector3f& moved, const Eigen::Vector3f& moved_normal,
+                        const SurfacePoints& onto, const AcceptanceConfig& config) {
+    SurfaceHit hit;
+    const auto index = onto.tree().Nearest(moved, static_cast<float>(config.overlap_radius_m));
+    if (index < 0) return hit;
+    const auto partner = static_cast<std::size_t>(index);
+    hit.partner_normal = onto.normals()[partner];
+    hit.distance_m = hit.partner_normal.dot(moved - onto.points()[partner]);
+    hit.on_surface = std::abs(hit.distance_m) <= config.overlap_plane_m &&
+                     std::abs(hit.partner_normal.dot(moved_normal)) >= kMinNormalCosine;
+    return hit;
+}
+
+bool InView(const Eigen::Vector3f& point, const Eigen::Vector3f& moved, float range_m) {
+    return point.norm() <= range_m && moved.norm() <= range_m;
+}
+
+struct OneWay {
+    std::size_t in_view = 0;
+    std::size_t overlapping = 0;
+    double squared_sum_m2 = 0.0;
+    std::vector<std::uint32_t> overlapping_points;        // indices in `from`
+    std::vector<Eigen::Vector2f> overlapping_partner_xy;  // horizontal part of partner normals
+};
+
+OneWay OverlapOneWay(const SurfacePoints& from, const SurfacePoints& onto,
+                     const Eigen::Isometry3f& T_onto_from, const AcceptanceConfig& config,
+                     bool keep_points) {
+    OneWay result;
+    const auto range_m = static_cast<float>(config.overlap_range_m);
+    for (std::size_t i = 0; i < from.size(); ++i) {
+        const Eigen::Vector3f moved = T_onto_from * from.points()[i];
+        if (!InView(from.points()[i], moved, range_m)) continue;
+        ++result.in_view;
+        const SurfaceHit hit =
+            HitOnSurface(moved, T_onto_from.linear() * from.normals()[i], onto, config);
+        if (!hit.on_surface) continue;
+        ++result.overlapping;
+        result.squared_sum_m2 += static_cast<double>(hit.distance_m) * hit.distance_m;
+        if (keep_points) {
+            result.overlapping_points.push_back(static_cast<std::uint32_t>(i));
+            result.overlapping_partner_xy.push_back(hit.partner_normal.head<2>());
+        }
+    }
+    return result;
+}
+
+double Fraction(std::size_t part, std::size_t whole) {
+    return whole == 0 ? 0.0 : static_cast<double>(part) / static_cast<double>(whole);
+}
+
+// The horizontal direction the overlapping surfaces constrain least: the eigenvector of the
+// smallest eigenvalue of the sum of n n^T over their horizontal normals.
+Eigen::Vector2d WeakestDirection(const std::vector<Eigen::Vector2f>& normals_xy) {
+    Eigen::Matrix2d information = Eigen::Matrix2d::Zero();
+    for (const auto& n : normals_xy) information += n.cast<double>() * n.cast<double>().transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(information);
+    return solver.eigenvectors().col(0);  // eigenvalues ascending
+}
+
+// The degeneracy test (docs/verification.md): the overlapping query points whose surfaces face
+// the weakest direction (normals within 60 degrees of it) pin the position along it; shifted by
+// degeneracy_shift_m both ways, the share of them still on a surface, the larger of the two.
+void MeasureDegeneracy(const SurfacePoints& query, const SurfacePoints& match,
+                       const Eigen::Isometry3f& T_match_query, const OneWay& forward,
+                       const AcceptanceConfig& config, Overlap& overlap) {
+    overlap.weakest_direction = WeakestDirection(forward.overlapping_partner_xy);
+    const Eigen::Vector2f d = overlap.weakest_direction.cast<float>();
+    std::vector<std::uint32_t> constraining;
+    for (std::size_t k = 0; k < forward.overlapping_points.size(); ++k) {
+        if (std::abs(forward.overlapping_partner_xy[k].dot(d)) >= 0.5F)
+            constraining.push_back(forward.overlapping_points[k]);
+    }
+    overlap.constraining_points = constraining.size();
+    overlap.shifted_overlap_ratio = 1.0;
+    if (constraining.empty()) return;
+    double worst = 0.0;
+    for (const float sign : {-1.0F, 1.0F}) {
+        Eigen::Isometry3f shifted = T_match_query;
+        shifted.translation().head<2>() += sign * static_cast<float>(config.degeneracy_shift_m) * d;
+        std::size_t still = 0;
+        for (const std::uint32_t i : constraining) {
+            const Eigen::Vector3f moved = shifted * query.points()[i];
+            still +=
+                HitOnSurface(moved, shifted.linear() * query.normals()[i], match, config).on_surface
+                    ? 1
+                    : 0;
+        }
+        worst = std::max(worst, Fraction(still, constraining.size()));
+    }
+    overlap.shifted_overlap_ratio = worst;
+}
+
+core::Transform PlanarPose(const PlanarHypothesis& hypothesis) {
+    core::Transform pose = core::Transform::Identity();
+    pose.linear() =
+        Eigen::AngleAxisd(hypothesis.yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    pose.translation() << hypothesis.translation_m, 0.0;
+    return pose;
+}
+
+bool TooFewPoints(const PreparedScan& scan, const AcceptanceConfig& config) {
+    return !scan.structure || !scan.ground ||
+           scan.structure->size() < static_cast<std::size_t>(config.min_overlapping_points) ||
+           scan.ground->size() < kMinGroundPoints;
+}
+
+}  // namespace
+
+double AllowedRmse(const PreparedScan& query, const PreparedScan& match,
+                   const AcceptanceConfig& config) {
+    const double roughness_m = std::hypot(query.structure_roughness_m, match.structure_roughness_m);
+    return std::clamp(config.max_rmse_ratio * roughness_m, config.min_allowed_rmse_m,
+                      config.max_rmse_m);
+}
+
+namespace {
+
+// The first acceptance rule the registered pair breaks (kNone: none).
+RejectReason Judge(const PreparedScan& query, const PreparedScan& match,
+                   const Verification& verification, bool converged,
+                   const AcceptanceConfig& config) {
+    const auto min_points = static_cast<std::size_t>(config.min_overlapping_points);
+    const Overlap& overlap = verification.overlap;
+    if (!converged) return RejectReason::kNotConverged;
+    if (overlap.query_overlapping < min_points || overlap.match_overlapping < min_points ||
+        overlap.Min() < config.min_overlap) {
+        return RejectReason::kLowOverlap;
+    }
+    if (overlap.rmse_m > AllowedRmse(query, match, config)) return RejectReason::kHighRmse;
+    if (overlap.constraining_points < min_points / 4 ||
+        overlap.shifted_overlap_ratio > config.max_shifted_overlap_ratio) {
+        return RejectReason::kDegenerate;
+    }
+    return RejectReason::kNone;
+}
+
+// ICP from one coarse hypothesis, then the acceptance rule.
+Verification RegisterFrom(const PreparedScan& query, const PreparedScan& match,
+                          const PlanarHypothesis& hypothesis, const VerificationConfig& config) {
+    const IcpResult icp = RefinePointToPlane(query, match, PlanarPose(hypothesis), config.icp);
+    Verification result;
+    result.T_match_query = icp.T_match_query;
+    result.overlap = MeasureOverlap(query, match, icp.T_match_query, config.acceptance);
+    result.coarse_score = hypothesis.score;
+    result.icp_iterations = icp.iterations;
+    result.shifted_overlap_ratio = result.overlap.shifted_overlap_ratio;
+    result.reason = icp.abandoned ? RejectReason::kLowOverlap
+                                  : Judge(query, match, result, icp.converged, config.acceptance);
+    result.accepted = result.reason == RejectReason::kNone;
+    return result;
+}
+
+}  // namespace
+
+std::string ToString(RejectReason reason) {
+    switch (reason) {
+        case RejectReason::kNone:
+            return "none";
+        case RejectReason::kTooFewPoints:
+            return "too_few_points";
+        case RejectReason::kNoAlignment:
+            return "no_alignment";
+        case RejectReason::kNotConverged:
+            return "not_converged";
+        case RejectReason::kLowOverlap:
+            return "low_overlap";
+        case RejectReason::kHighRmse:
+            return "high_rmse";
+        case RejectReason::kDegenerate:
+            return "degenerate";
+        case RejectReason::kPruned:
+            return "pruned";
+    }
+    return "unknown";
+}
+
+Overlap MeasureOverlap(const PreparedScan& query, const PreparedScan& match,
+                       const core::Transform& T_match_query, const AcceptanceConfig& config) {
+    const Eigen::Isometry3f T = T_match_query.cast<float>();
+    const OneWay forward = OverlapOneWay(*query.structure, *match.structure, T, config, true);
+    const OneWay backward =
+        OverlapOneWay(*match.structure, *query.structure, T.inverse(), config, false);
+    Overlap overlap;
+    overlap.query_fraction = Fraction(forward.overlapping, forward.in_view);
+    overlap.match_fraction = Fraction(backward.overlapping, backward.in_view);
+    overlap.query_overlapping = forward.overlapping;
+    overlap.match_overlapping = backward.overlapping;
+    const std::size_t both = forward.overlapping + backward.overlapping;
+    overlap.rmse_m = both == 0 ? 0.0
+                               : std::sqrt((forward.squared_sum_m2 + backward.squared_sum_m2) /
+                                           static_cast<double>(both));
+    MeasureDegeneracy(*query.structure, *match.structure, T, forward, config, overlap);
+    return overlap;
+}
+
+Verification Verify(const PreparedScan& query, const CoarseQuery& coarse, const PreparedScan& match,
+                    const VerificationConfig& config) {
+    Verification best;
+    if (TooFewPoints(query, config.acceptance) || TooFewPoints(match, config.acceptance)) {
+        best.reason = RejectReason::kTooFewPoints;
+        return best;
+    }
+    const auto hypotheses = CoarseAlign(coarse, *match.structure);
+    if (hypotheses.empty()) {
+        best.reason = RejectReason::kNoAlignment;
+        return best;
+    }
+    // Hypotheses in order of coarse score; the first that passes is the answer, else the one
+    // that overlapped best explains the rejection.
+    for (std::size_t i = 0; i < hypotheses.size(); ++i) {
+        Verification trial = RegisterFrom(query, match, hypotheses[i], config);
+        if (trial.accepted) return trial;
+        if (i == 0 || trial.overlap.Min() > best.overlap.Min()) best = trial;
+    }
+    return best;
+}
+
+Verification VerifyPair(const core::PointCloud& query, const core::PointCloud& match,
+                        const VerificationConfig& config) {
+    config.Validate();
+    const PreparedScan prepared_query = PrepareScan(query, config.reduction);
+    const PreparedScan prepared_match = PrepareScan(match, config.reduction);
+    const CoarseQuery coarse(*prepared_query.structure, config.coarse);
+    return Verify(prepared_query, coarse, prepared_match, config);
+}
+
+}  // namespace lidarloop::registration

@@ -1,0 +1,84 @@
+#pragma once
+
+#include <cstddef>
+#include <limits>
+#include <string>
+
+#include "lidarloop/core/point_cloud.hpp"
+#include "lidarloop/registration/coarse_alignment.hpp"
+#include "lidarloop/registration/prepared_scan.hpp"
+#include "lidarloop/registration/verification_config.hpp"
+
+namespace lidarloop::registration {
+
+/// Why a candidate was not accepted (kNone: it was).
+enum class RejectReason {
+    kNone,
+    kTooFewPoints,  ///< a scan has too few structure or ground points to register
+    kNoAlignment,   ///< the coarse search found no overlap of the two scans at any pose
+    kNotConverged,  ///< ICP did not settle
+    kLowOverlap,    ///< too few structure points of one scan lie on the other's surfaces
+    kHighRmse,      ///< the overlapping points sit too far from the other scan's planes
+    kDegenerate,    ///< sliding along the weakest direction fits as well (street, corridor)
+    kPruned,        ///< not registered: the descriptor distance failed the threshold set
+};
+
+/// "none", "too_few_points", "no_alignment", "not_converged", "low_overlap", "high_rmse",
+/// "degenerate", "pruned": the spelling of loops.csv and `lidarloop verify`.
+std::string ToString(RejectReason reason);
+
+/// How well a query sits on a match at a pose (registration::MeasureOverlap).
+struct Overlap {
+    double query_fraction = 0.0;  ///< query structure points on match surfaces / those in view
+    double match_fraction = 0.0;  ///< the same, the other way
+    std::size_t query_overlapping = 0;
+    std::size_t match_overlapping = 0;
+    double rmse_m = 0.0;  ///< RMS plane distance of the overlapping points, both ways
+    /// Horizontal direction (match frame) the overlapping structure constrains least.
+    Eigen::Vector2d weakest_direction = Eigen::Vector2d::UnitX();
+    /// Overlapping query points whose surfaces face the weakest direction (they pin it).
+    std::size_t constraining_points = 0;
+    /// Share of those still on a surface after shifting by degeneracy_shift_m along the weakest
+    /// direction (the worse sign); 1 when there are none.
+    double shifted_overlap_ratio = 1.0;
+
+    double Min() const { return std::min(query_fraction, match_fraction); }
+};
+
+/// The verdict on one candidate pair.
+struct Verification {
+    bool accepted = false;
+    RejectReason reason = RejectReason::kNone;
+    core::Transform T_match_query = core::Transform::Identity();  ///< query -> match frame
+    Overlap overlap;
+    /// overlap.shifted_overlap_ratio of the registered pose; NaN when not registered.
+    double shifted_overlap_ratio = std::numeric_limits<double>::quiet_NaN();
+    double coarse_score = 0.0;  ///< the coarse correlation of the chosen hypothesis
+    int icp_iterations = 0;
+    /// Confidence for ranking accepted loops: the smaller overlap fraction (0 when rejected
+    /// before registration).
+    double score() const { return overlap.Min(); }
+};
+
+/// The overlap of `query` on `match` at T_match_query (see AcceptanceConfig). Thread-safe.
+Overlap MeasureOverlap(const PreparedScan& query, const PreparedScan& match,
+                       const core::Transform& T_match_query, const AcceptanceConfig& config);
+
+/// The largest RMSE a pair may have: max_rmse_ratio times the scans' combined roughness
+/// (PreparedScan::structure_roughness_m), within [min_allowed_rmse_m, max_rmse_m].
+double AllowedRmse(const PreparedScan& query, const PreparedScan& match,
+                   const AcceptanceConfig& config);
+
+/// Registers one candidate to its query without a prior pose (coarse search, ICP from each
+/// hypothesis, the best overlap wins) and decides by AcceptanceConfig. `coarse` must be built
+/// from `query` with config.coarse. Never throws on bad data: degenerate input is a rejection
+/// with its reason. Thread-safe.
+Verification Verify(const PreparedScan& query, const CoarseQuery& coarse, const PreparedScan& match,
+                    const VerificationConfig& config);
+
+/// The same for two raw scans (sensor frames, metres): prepares both, then verifies. Validates
+/// `config` (core::ConfigError).
+Verification VerifyPair(const core::PointCloud& query, const core::PointCloud& match,
+                        const VerificationConfig& config);
+
+}  // namespace lidarloop::registration

@@ -1,0 +1,80 @@
+#include "lidarloop/registration/verification_config.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "lidarloop/core/error.hpp"
+
+namespace lidarloop::registration {
+namespace {
+
+// Finite and within [low, high]; NaN fails every comparison, so test it explicitly.
+void RequireIn(double value, double low, double high, const std::string& field) {
+    if (!std::isfinite(value) || value < low || value > high) {
+        throw core::ConfigError("verification." + field + " must be in [" + std::to_string(low) +
+                                ", " + std::to_string(high) + "], got " + std::to_string(value));
+    }
+}
+
+void RequireIn(int value, int low, int high, const std::string& field) {
+    if (value < low || value > high) {
+        throw core::ConfigError("verification." + field + " must be in [" + std::to_string(low) +
+                                ", " + std::to_string(high) + "], got " + std::to_string(value));
+    }
+}
+
+}  // namespace
+
+void ScanReductionConfig::Validate() const {
+    RequireIn(min_range_m, 0.0, 1000.0, "reduction.min_range_m");
+    RequireIn(max_range_m, min_range_m + 1e-3, 1000.0, "reduction.max_range_m");
+    RequireIn(voxel_m, 0.05, 10.0, "reduction.voxel_m");
+    RequireIn(normal_neighbors, 5, 100, "reduction.normal_neighbors");
+    RequireIn(structure_min_tilt_deg, 0.0, 90.0, "reduction.structure_min_tilt_deg");
+    RequireIn(max_structure_points, 10, 1'000'000, "reduction.max_structure_points");
+    RequireIn(max_ground_points, 10, 1'000'000, "reduction.max_ground_points");
+}
+
+void CoarseConfig::Validate() const {
+    RequireIn(cell_m, 0.1, 10.0, "coarse.cell_m");
+    RequireIn(grid_cells, 16, 1024, "coarse.grid_cells");
+    if ((grid_cells & (grid_cells - 1)) != 0) {
+        throw core::ConfigError("verification.coarse.grid_cells must be a power of two");
+    }
+    RequireIn(yaw_step_deg, 0.1, 45.0, "coarse.yaw_step_deg");
+    RequireIn(max_translation_m, 0.1, 1000.0, "coarse.max_translation_m");
+    RequireIn(hypotheses, 1, 16, "coarse.hypotheses");
+}
+
+void IcpConfig::Validate() const {
+    RequireIn(initial_correspondence_m, 0.01, 100.0, "icp.initial_correspondence_m");
+    RequireIn(final_correspondence_m, 0.01, initial_correspondence_m, "icp.final_correspondence_m");
+    RequireIn(max_iterations_per_stage, 1, 100, "icp.max_iterations_per_stage");
+    RequireIn(convergence_step, 1e-9, 1.0, "icp.convergence_step");
+    RequireIn(max_structure_points, 10, 1'000'000, "icp.max_structure_points");
+    RequireIn(max_ground_points, 10, 1'000'000, "icp.max_ground_points");
+    RequireIn(abandon_below_inliers, 0.0, 1.0, "icp.abandon_below_inliers");
+}
+
+void AcceptanceConfig::Validate() const {
+    RequireIn(overlap_radius_m, 0.01, 100.0, "acceptance.overlap_radius_m");
+    RequireIn(overlap_plane_m, 0.001, overlap_radius_m, "acceptance.overlap_plane_m");
+    RequireIn(overlap_range_m, 1.0, 1000.0, "acceptance.overlap_range_m");
+    RequireIn(min_overlap, 0.0, 1.0, "acceptance.min_overlap");
+    RequireIn(min_overlapping_points, 1, 1'000'000, "acceptance.min_overlapping_points");
+    RequireIn(max_rmse_ratio, 0.0, 1000.0, "acceptance.max_rmse_ratio");
+    RequireIn(min_allowed_rmse_m, 0.0, 100.0, "acceptance.min_allowed_rmse_m");
+    RequireIn(max_rmse_m, std::max(0.001, min_allowed_rmse_m), 100.0, "acceptance.max_rmse_m");
+    RequireIn(degeneracy_shift_m, 0.0, 100.0, "acceptance.degeneracy_shift_m");
+    RequireIn(max_shifted_overlap_ratio, 0.0, 1.0, "acceptance.max_shifted_overlap_ratio");
+}
+
+void VerificationConfig::Validate() const {
+    reduction.Validate();
+    coarse.Validate();
+    icp.Validate();
+    acceptance.Validate();
+}
+
+}  // namespace lidarloop::registration

@@ -1,0 +1,105 @@
+#pragma once
+
+namespace lidarloop::registration {
+
+/// How a scan is reduced for registration (registration::PrepareScan). Ranges in metres from the
+/// sensor origin, in the sensor frame (z up).
+struct ScanReductionConfig {
+    double min_range_m = 3.0;   ///< closer points are dropped (the vehicle itself), >= 0
+    double max_range_m = 60.0;  ///< farther points are dropped; > min_range_m
+    double voxel_m = 0.5;       ///< edge of the voxels the scan is averaged into, (0.05, 10]
+    int normal_neighbors = 10;  ///< neighbours (voxel centroids) of a normal's PCA, 5..100
+    /// A point is "structure" (distinguishes places) when its normal is at least this far from
+    /// vertical, degrees: walls, poles, trunks, parked cars. The ground and roofs are not.
+    double structure_min_tilt_deg = 45.0;
+    /// Structure points kept at most (a uniform subsample beyond), bounds registration time.
+    int max_structure_points = 3000;
+    /// Other points (mostly ground; they fix z, roll and pitch) kept at most.
+    int max_ground_points = 600;
+
+    /// Throws core::ConfigError naming the first invalid field (prefix "verification.").
+    void Validate() const;
+    bool operator==(const ScanReductionConfig&) const = default;
+};
+
+/// The coarse, prior-free alignment: a yaw search over top-down occupancy images of the
+/// structure points, with an FFT cross-correlation for the translation at every yaw.
+struct CoarseConfig {
+    double cell_m = 1.5;              ///< edge of an image cell, metres, [0.1, 10]
+    int grid_cells = 64;              ///< image edge in cells, a power of two in [16, 1024]
+    double yaw_step_deg = 5.0;        ///< yaw search step, degrees, (0, 45]
+    double max_translation_m = 25.0;  ///< largest planar offset searched, metres, > 0
+    int hypotheses = 2;               ///< best (yaw, translation) peaks refined by ICP, 1..16
+
+    void Validate() const;
+    bool operator==(const CoarseConfig&) const = default;
+};
+
+/// Point-to-plane ICP from coarse to fine (registration::RefinePointToPlane).
+struct IcpConfig {
+    /// Largest correspondence distance of the first stage, metres; each further stage halves it
+    /// down to `final_correspondence_m`.
+    double initial_correspondence_m = 3.0;
+    double final_correspondence_m = 0.6;  ///< > 0, <= initial
+    int max_iterations_per_stage = 10;    ///< 1..100
+    /// A stage ends when an iteration moves the pose by less than this (translation metres plus
+    /// rotation radians).
+    double convergence_step = 1e-3;
+    /// Query points that ICP pairs, at most (an even subsample of the prepared scan's): the
+    /// match side and the overlap measure keep every prepared point.
+    int max_structure_points = 1000;
+    int max_ground_points = 300;
+    /// A hypothesis is abandoned after the first stage when fewer of the query's structure points
+    /// than this share lie within final_correspondence_m of a match plane: no alignment that
+    /// could pass AcceptanceConfig::min_overlap is that far off (saves time on wrong pairs).
+    double abandon_below_inliers = 0.1;
+
+    void Validate() const;
+    bool operator==(const IcpConfig&) const = default;
+};
+
+/// When a registered candidate is accepted as a loop. Every value is physical: metres or a
+/// fraction of points; docs/verification.md explains the rule.
+struct AcceptanceConfig {
+    /// A structure point of one scan overlaps when a structure point of the other scan lies within
+    /// `overlap_radius_m` and its plane (match normal) passes within `overlap_plane_m`.
+    double overlap_radius_m = 1.5;
+    double overlap_plane_m = 0.3;
+    /// Only points within this range of BOTH sensors count (what both could see), metres.
+    double overlap_range_m = 40.0;
+    /// Smallest overlap of structure points, each way (query -> match and match -> query).
+    double min_overlap = 0.35;
+    /// Structure points that overlap, at least, each way: a handful of matched points proves
+    /// nothing whatever the fraction.
+    int min_overlapping_points = 80;
+    /// The RMS plane distance of the overlapping structure points may be at most this many
+    /// times the scans' own roughness (their points' RMS distance to their local planes, both
+    /// scans combined): a right alignment fits about as well as each scan fits itself, on any
+    /// sensor. Clamped to [min_allowed_rmse_m, max_rmse_m] (voxel discretisation; a cap).
+    double max_rmse_ratio = 1.5;
+    double min_allowed_rmse_m = 0.06;
+    double max_rmse_m = 0.3;
+    /// Degeneracy test: the overlapping points whose surfaces face the least-constrained
+    /// horizontal direction must be at least min_overlapping_points / 4, and after shifting the
+    /// solution by degeneracy_shift_m along that direction (both signs) at most
+    /// `max_shifted_overlap_ratio` of them may still lie on a surface; else the geometry does
+    /// not pin the position (a straight street, a corridor, an open field).
+    double degeneracy_shift_m = 2.0;
+    double max_shifted_overlap_ratio = 0.5;
+
+    void Validate() const;
+    bool operator==(const AcceptanceConfig&) const = default;
+};
+
+/// Geometric verification of loop candidates: everything registration::Verify needs.
+struct VerificationConfig {
+    ScanReductionConfig reduction;
+    CoarseConfig coarse;
+    IcpConfig icp;
+    AcceptanceConfig acceptance;
+
+    void Validate() const;
+    bool operator==(const VerificationConfig&) const = default;
+};
+
+}  // namespace lidarloop::registration

@@ -1,0 +1,119 @@
+// Verification on real KITTI HDL-64E scans (../shared/data/kitti-samples, never copied into the
+// repository; skipped with a message when absent). Ground truth and how far to trust it: the
+// folder's README.md.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "lidarloop/io/kitti_bin.hpp"
+#include "lidarloop/registration/verification.hpp"
+
+namespace lidarloop::registration {
+namespace {
+
+const std::filesystem::path kSamples = LIDARLOOP_KITTI_SAMPLES_DIR;
+
+Eigen::Matrix4d ReadRow34(std::istringstream& in) {
+    Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c) in >> m(r, c);
+    return m;
+}
+
+Eigen::Matrix4d Calibration(const std::string& sequence) {
+    std::ifstream in(kSamples / ("calib_" + sequence + ".txt"));
+    std::string line;
+    while (std::getline(in, line)) {
+        if (line.rfind("Tr:", 0) == 0) {
+            std::istringstream values(line.substr(3));
+            return ReadRow34(values);
+        }
+    }
+    throw std::runtime_error("no Tr: line in calib_" + sequence + ".txt");
+}
+
+// T_velo0_veloi = Tr^-1 * P_i * Tr (the README's formula).
+Eigen::Matrix4d LidarPose(const std::string& sequence, int frame) {
+    std::ifstream in(kSamples / "poses" / (sequence + ".txt"));
+    std::string line;
+    for (int i = 0; i <= frame; ++i) std::getline(in, line);
+    std::istringstream values(line);
+    const Eigen::Matrix4d Tr = Calibration(sequence);
+    return Tr.inverse() * ReadRow34(values) * Tr;
+}
+
+core::PointCloud Scan(const std::string& sequence, int frame) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "%06d.bin", frame);
+    return io::ReadKittiBin(kSamples / sequence / "velodyne" / name);
+}
+
+struct Pair {
+    std::string sequence;
+    int match, query;
+};
+
+class KittiSamples : public ::testing::Test {
+protected:
+    void SetUp() override {
+        if (!std::filesystem::exists(kSamples / "README.md"))
+            GTEST_SKIP() << "real KITTI samples not found at " << kSamples
+                         << " (see ../shared/data/kitti-samples/README.md)";
+    }
+    static Verification Run(const Pair& pair) {
+        return VerifyPair(Scan(pair.sequence, pair.query), Scan(pair.sequence, pair.match),
+                          VerificationConfig{});
+    }
+    static Eigen::Matrix4d Truth(const Pair& pair) {
+        return LidarPose(pair.sequence, pair.match).inverse() *
+               LidarPose(pair.sequence, pair.query);
+    }
+    static double YawDeg(const Eigen::Matrix4d& T) {
+        return std::atan2(T(1, 0), T(0, 0)) * 180.0 / M_PI;
+    }
+};
+
+// Both loops of sequence 08, revisited in the opposite direction: the yaw within 2 degrees and
+// the planar translation within 1.5 m of the GPS/INS ground truth (its drift, README).
+TEST_F(KittiSamples, TrueLoopsOf08AreAcceptedWithTheirPose) {
+    for (const Pair& pair : {Pair{"08", 209, 1684}, Pair{"08", 720, 1500}}) {
+        const Verification v = Run(pair);
+        const Eigen::Matrix4d truth = Truth(pair);
+        const Eigen::Matrix4d found = v.T_match_query.matrix();
+        SCOPED_TRACE(pair.sequence + " " + std::to_string(pair.match) + " <- " +
+                     std::to_string(pair.query));
+        EXPECT_TRUE(v.accepted) << ToString(v.reason);
+        EXPECT_LT(std::abs(std::remainder(YawDeg(found) - YawDeg(truth), 360.0)), 2.0);
+        EXPECT_LT((found.block<2, 1>(0, 3) - truth.block<2, 1>(0, 3)).norm(), 1.5);
+    }
+}
+
+// Consecutive scans of 00: the ground truth is accurate to centimetres there.
+TEST_F(KittiSamples, ConsecutiveScansOf00MatchTheTruthToCentimetres) {
+    for (const Pair& pair : {Pair{"00", 94, 95}, Pair{"00", 198, 199}}) {
+        const Verification v = Run(pair);
+        const Eigen::Matrix4d truth = Truth(pair);
+        EXPECT_TRUE(v.accepted) << ToString(v.reason);
+        EXPECT_LT((v.T_match_query.translation() - truth.block<3, 1>(0, 3)).norm(), 0.05);
+        EXPECT_LT(std::abs(std::remainder(YawDeg(v.T_match_query.matrix()) - YawDeg(truth), 360.0)),
+                  0.3);
+    }
+}
+
+// Scans 58 m (00) and 80-100 m (08) apart: never the same place.
+TEST_F(KittiSamples, DifferentPlacesAreRejected) {
+    for (const Pair& pair : {Pair{"00", 94, 198}, Pair{"00", 95, 199}, Pair{"00", 94, 199},
+                             Pair{"00", 95, 198}, Pair{"08", 209, 720}, Pair{"08", 209, 1500},
+                             Pair{"08", 1684, 720}, Pair{"08", 1684, 1500}}) {
+        const Verification v = Run(pair);
+        EXPECT_FALSE(v.accepted) << pair.sequence << " " << pair.match << " <- " << pair.query
+                                 << ": overlap " << v.overlap.Min();
+    }
+}
+
+}  // namespace
+}  // namespace lidarloop::registration

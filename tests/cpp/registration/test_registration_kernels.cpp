@@ -1,0 +1,146 @@
+// Kernels of registration against brute force: the float k-d tree, the 2-D FFT, scan reduction.
+#include <algorithm>
+#include <complex>
+#include <limits>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "lidarloop/registration/detail/fft2d.hpp"
+#include "lidarloop/registration/point_tree.hpp"
+#include "lidarloop/registration/prepared_scan.hpp"
+#include "registration_test_utils.hpp"
+
+namespace lidarloop::registration {
+namespace {
+
+std::vector<Eigen::Vector3f> RandomPoints(std::size_t n, std::uint64_t seed, float extent_m) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<float> u(-extent_m, extent_m);
+    std::vector<Eigen::Vector3f> points(n);
+    for (auto& p : points) p = Eigen::Vector3f(u(rng), u(rng), u(rng));
+    return points;
+}
+
+TEST(PointTree, NearestMatchesBruteForceWithinTheBound) {
+    const auto points = RandomPoints(2000, 1, 20.0F);
+    const PointTree tree(&points);
+    for (const auto& query : RandomPoints(500, 2, 22.0F)) {
+        std::int64_t best = -1;
+        float best_m2 = 1.5F * 1.5F;
+        for (std::size_t i = 0; i < points.size(); ++i) {
+            const float d2 = (points[i] - query).squaredNorm();
+            if (d2 < best_m2) best_m2 = d2, best = static_cast<std::int64_t>(i);
+        }
+        const auto found = tree.Nearest(query, 1.5F);
+        if (best < 0) {
+            EXPECT_EQ(found, -1);
+        } else {
+            ASSERT_GE(found, 0);
+            // Equal distance (ties may pick either index).
+            EXPECT_FLOAT_EQ((points[static_cast<std::size_t>(found)] - query).squaredNorm(),
+                            best_m2);
+        }
+    }
+}
+
+TEST(PointTree, KnnMatchesBruteForce) {
+    const auto points = RandomPoints(1000, 3, 10.0F);
+    const PointTree tree(&points);
+    std::vector<std::uint32_t> found;
+    for (const auto& query : RandomPoints(100, 4, 10.0F)) {
+        tree.Knn(query, 7, found);
+        std::vector<float> all;
+        for (const auto& p : points) all.push_back((p - query).squaredNorm());
+        std::sort(all.begin(), all.end());
+        ASSERT_EQ(found.size(), 7u);
+        for (std::size_t i = 0; i < found.size(); ++i)
+            EXPECT_FLOAT_EQ((points[found[i]] - query).squaredNorm(), all[i]);
+    }
+}
+
+TEST(PointTree, EmptyTreeFindsNothing) {
+    const std::vector<Eigen::Vector3f> none;
+    const PointTree tree(&none);
+    EXPECT_EQ(tree.Nearest(Eigen::Vector3f::Zero(), 10.0F), -1);
+    std::vector<std::uint32_t> found;
+    tree.Knn(Eigen::Vector3f::Zero(), 3, found);
+    EXPECT_TRUE(found.empty());
+}
+
+TEST(Fft2d, MatchesTheDefinitionAndInverts) {
+    const int n = 8;
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<float> u(-1.0F, 1.0F);
+    std::vector<std::complex<float>> grid(n * n);
+    for (auto& v : grid) v = {u(rng), u(rng)};
+    auto spectrum = grid;
+    detail::Fft2dForward(spectrum, n);
+    for (int ky = 0; ky < n; ++ky) {
+        for (int kx = 0; kx < n; ++kx) {
+            std::complex<double> sum = 0.0;
+            for (int y = 0; y < n; ++y)
+                for (int x = 0; x < n; ++x)
+                    sum += std::complex<double>(grid[y * n + x]) *
+                           std::polar(1.0, -2.0 * M_PI * (kx * x + ky * y) / n);
+            EXPECT_NEAR(spectrum[ky * n + kx].real(), sum.real(), 1e-4);
+            EXPECT_NEAR(spectrum[ky * n + kx].imag(), sum.imag(), 1e-4);
+        }
+    }
+    auto back = spectrum;
+    detail::Fft2dInverse(back, n);
+    for (int i = 0; i < n * n; ++i) EXPECT_NEAR(std::abs(back[i] - grid[i]), 0.0, 1e-5);
+    // Only the listed rows are final in the partial inverse; they equal the full one.
+    auto rows = spectrum;
+    detail::Fft2dInverseRows(rows, n, {1, 5});
+    for (const int row : {1, 5})
+        for (int x = 0; x < n; ++x)
+            EXPECT_NEAR(std::abs(rows[row * n + x] - grid[row * n + x]), 0.0, 1e-5);
+}
+
+TEST(PrepareScan, SplitsWallsFromGroundWithUnitNormalsFacingTheSensor) {
+    ScanReductionConfig config;
+    const PreparedScan scan = PrepareScan(test::SyntheticPlace(), config);
+    ASSERT_GT(scan.structure->size(), 100u);
+    ASSERT_GT(scan.ground->size(), 100u);
+    for (std::size_t i = 0; i < scan.structure->size(); ++i) {
+        const Eigen::Vector3f& n = scan.structure->normals()[i];
+        EXPECT_NEAR(n.norm(), 1.0F, 1e-4F);
+        EXPECT_LE(std::abs(n.z()), std::cos(45.0 * M_PI / 180.0) + 1e-6);
+        EXPECT_LE(n.dot(scan.structure->points()[i]), 0.0F);
+    }
+    for (const auto& n : scan.ground->normals()) EXPECT_GT(std::abs(n.z()), 0.7F);
+    EXPECT_LE(scan.structure->size(), static_cast<std::size_t>(config.max_structure_points));
+    EXPECT_LE(scan.ground->size(), static_cast<std::size_t>(config.max_ground_points));
+    EXPECT_GT(scan.MemoryBytes(), (scan.structure->size() + scan.ground->size()) * 24);
+}
+
+TEST(PrepareScan, DropsNonFiniteAndOutOfRangePoints) {
+    ScanReductionConfig config;
+    core::PointCloud cloud = test::SyntheticPlace();
+    const std::size_t valid = PrepareScan(cloud, config).usable_points;
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const float inf = std::numeric_limits<float>::infinity();
+    cloud.emplace_back(nan, 0.0F, 0.0F);
+    cloud.emplace_back(5.0F, inf, 1.0F);
+    cloud.emplace_back(0.5F, 0.0F, 0.0F);    // inside min_range_m
+    cloud.emplace_back(500.0F, 0.0F, 0.0F);  // beyond max_range_m
+    const PreparedScan scan = PrepareScan(cloud, config);
+    EXPECT_EQ(scan.input_points, cloud.size());
+    EXPECT_EQ(scan.usable_points, valid);
+    for (const auto& p : scan.structure->points()) EXPECT_TRUE(p.allFinite());
+}
+
+TEST(PrepareScan, DegenerateScansGiveAlmostNothingAndNoCrash) {
+    ScanReductionConfig config;
+    EXPECT_EQ(PrepareScan({}, config).structure->size(), 0u);
+    const core::PointCloud same(1000, Eigen::Vector3f(10.0F, 2.0F, 0.0F));
+    const PreparedScan coincident = PrepareScan(same, config);
+    EXPECT_EQ(coincident.usable_points, 1000u);
+    EXPECT_EQ(coincident.structure->size() + coincident.ground->size(), 0u);
+    const core::PointCloud nans(100, Eigen::Vector3f::Constant(std::nanf("")));
+    EXPECT_EQ(PrepareScan(nans, config).usable_points, 0u);
+}
+
+}  // namespace
+}  // namespace lidarloop::registration

@@ -1,0 +1,198 @@
+// Verification against known answers: synthetic places moved by known transforms, a corridor,
+// bad input, and simulated scans with exact ground truth.
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "lidarloop/core/error.hpp"
+#include "lidarloop/registration/verification.hpp"
+#include "lidarloop/sim/simulator.hpp"
+#include "registration_test_utils.hpp"
+
+namespace lidarloop::registration {
+namespace {
+
+double YawDeg(const core::Transform& T) {
+    return std::atan2(T.linear()(1, 0), T.linear()(0, 0)) * 180.0 / M_PI;
+}
+
+double YawErrorDeg(const core::Transform& a, const core::Transform& b) {
+    return std::abs(std::remainder(YawDeg(a) - YawDeg(b), 360.0));
+}
+
+double RotationErrorDeg(const core::Transform& a, const core::Transform& b) {
+    return Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle() * 180.0 / M_PI;
+}
+
+// The query is the match place seen from a sensor at T_match_query.
+core::PointCloud QueryOf(const core::PointCloud& match, const core::Transform& T_match_query) {
+    return test::Transformed(match, T_match_query.inverse());
+}
+
+struct Motion {
+    double x_m, y_m, yaw_deg;
+};
+
+class KnownMotion : public ::testing::TestWithParam<Motion> {};
+
+TEST_P(KnownMotion, CoarseSearchLandsNearTheTruth) {
+    const Motion m = GetParam();
+    const core::Transform truth = test::PlanarTransform(m.x_m, m.y_m, m.yaw_deg);
+    const core::PointCloud match = test::SyntheticPlace();
+    VerificationConfig config;
+    const PreparedScan q = PrepareScan(QueryOf(match, truth), config.reduction);
+    const PreparedScan t = PrepareScan(match, config.reduction);
+    const auto hypotheses = CoarseAlign(CoarseQuery(*q.structure, config.coarse), *t.structure);
+    ASSERT_FALSE(hypotheses.empty());
+    const PlanarHypothesis& best = hypotheses.front();
+    EXPECT_LE(std::abs(std::remainder(best.yaw_rad * 180.0 / M_PI - m.yaw_deg, 360.0)),
+              config.coarse.yaw_step_deg);
+    EXPECT_LE((best.translation_m - Eigen::Vector2d(m.x_m, m.y_m)).norm(),
+              2.0 * config.coarse.cell_m);
+}
+
+TEST_P(KnownMotion, VerificationAcceptsWithTheExactPose) {
+    const Motion m = GetParam();
+    const core::Transform truth = test::PlanarTransform(m.x_m, m.y_m, m.yaw_deg, 0.1);
+    const core::PointCloud match = test::SyntheticPlace();
+    const Verification v = VerifyPair(QueryOf(match, truth), match, VerificationConfig{});
+    EXPECT_TRUE(v.accepted) << ToString(v.reason);
+    EXPECT_EQ(v.reason, RejectReason::kNone);
+    EXPECT_LT((v.T_match_query.translation() - truth.translation()).norm(), 0.05);
+    EXPECT_LT(RotationErrorDeg(v.T_match_query, truth), 0.2);
+    EXPECT_GT(v.overlap.Min(), 0.5);
+    EXPECT_LT(v.overlap.rmse_m, 0.05);
+    EXPECT_LE(v.shifted_overlap_ratio, 0.5);
+    EXPECT_GE(v.overlap.constraining_points, 20u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Motions, KnownMotion,
+                         ::testing::Values(Motion{0.0, 0.0, 0.0}, Motion{3.0, -1.0, 12.0},
+                                           Motion{-6.0, 4.0, 180.0}, Motion{8.0, 2.5, -150.0},
+                                           Motion{1.0, 7.0, 91.0}));
+
+TEST(Verification, MirroredPlaceIsRejected) {
+    const core::PointCloud match = test::SyntheticPlace();
+    core::PointCloud mirrored = match;
+    for (auto& p : mirrored) p.y() = -p.y();  // the same parts, arranged differently
+    const Verification v = VerifyPair(mirrored, match, VerificationConfig{});
+    EXPECT_FALSE(v.accepted);
+    EXPECT_NE(v.reason, RejectReason::kNone);
+}
+
+// Two long parallel walls and a floor: every shift along the corridor fits as well.
+core::PointCloud Corridor() {
+    core::PointCloud cloud;
+    for (double x = -40; x <= 40; x += 0.2) {
+        for (double z = -1.7; z <= 2.5; z += 0.2) {
+            cloud.emplace_back(static_cast<float>(x), 3.0F, static_cast<float>(z));
+            cloud.emplace_back(static_cast<float>(x), -3.0F, static_cast<float>(z));
+        }
+        for (double y = -3; y <= 3; y += 0.4)
+            cloud.emplace_back(static_cast<float>(x), static_cast<float>(y), -1.7F);
+    }
+    return cloud;
+}
+
+TEST(Verification, CorridorIsDegenerate) {
+    const core::PointCloud match = Corridor();
+    const core::PointCloud query = QueryOf(match, test::PlanarTransform(4.0, 0.0, 0.0));
+    const Verification v = VerifyPair(query, match, VerificationConfig{});
+    EXPECT_FALSE(v.accepted);
+    EXPECT_EQ(v.reason, RejectReason::kDegenerate);
+    // Nothing pins the position along the corridor but its far ends.
+    EXPECT_LT(v.overlap.constraining_points, 20u);
+}
+
+TEST(Verification, BadScansAreRejectedWithTheReason) {
+    const core::PointCloud place = test::SyntheticPlace();
+    const VerificationConfig config;
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const std::vector<core::PointCloud> bad = {
+        {},
+        core::PointCloud(5000, Eigen::Vector3f(8.0F, 1.0F, 0.5F)),
+        core::PointCloud(5000, Eigen::Vector3f(nan, 1.0F, 0.5F)),
+        core::PointCloud(3, Eigen::Vector3f(8.0F, 1.0F, 0.5F)),
+    };
+    for (const auto& scan : bad) {
+        for (const bool as_query : {true, false}) {
+            const Verification v =
+                as_query ? VerifyPair(scan, place, config) : VerifyPair(place, scan, config);
+            EXPECT_FALSE(v.accepted);
+            EXPECT_EQ(v.reason, RejectReason::kTooFewPoints);
+        }
+    }
+}
+
+TEST(Verification, InvalidConfigIsAConfigError) {
+    const core::PointCloud place = test::SyntheticPlace();
+    const auto expect_error = [&](auto change) {
+        VerificationConfig config;
+        change(config);
+        EXPECT_THROW(VerifyPair(place, place, config), core::ConfigError);
+    };
+    expect_error([](auto& c) { c.reduction.voxel_m = 0.0; });
+    expect_error([](auto& c) { c.reduction.max_range_m = c.reduction.min_range_m; });
+    expect_error([](auto& c) { c.reduction.voxel_m = std::nan(""); });
+    expect_error([](auto& c) { c.coarse.grid_cells = 100; });
+    expect_error([](auto& c) { c.coarse.yaw_step_deg = 0.0; });
+    expect_error(
+        [](auto& c) { c.icp.final_correspondence_m = 2 * c.icp.initial_correspondence_m; });
+    expect_error([](auto& c) { c.acceptance.min_overlap = 1.5; });
+    expect_error([](auto& c) { c.acceptance.max_rmse_m = -1.0; });
+    expect_error([](auto& c) { c.acceptance.overlap_plane_m = 2 * c.acceptance.overlap_radius_m; });
+}
+
+TEST(Verification, ReasonsHaveStableNames) {
+    EXPECT_EQ(ToString(RejectReason::kNone), "none");
+    EXPECT_EQ(ToString(RejectReason::kTooFewPoints), "too_few_points");
+    EXPECT_EQ(ToString(RejectReason::kNoAlignment), "no_alignment");
+    EXPECT_EQ(ToString(RejectReason::kNotConverged), "not_converged");
+    EXPECT_EQ(ToString(RejectReason::kLowOverlap), "low_overlap");
+    EXPECT_EQ(ToString(RejectReason::kHighRmse), "high_rmse");
+    EXPECT_EQ(ToString(RejectReason::kDegenerate), "degenerate");
+    EXPECT_EQ(ToString(RejectReason::kPruned), "pruned");
+}
+
+// Simulated scans: exact ground truth, real ray casting (occlusion, beam pattern, noise).
+class SimulatedRevisit : public ::testing::TestWithParam<sim::SensorModel> {};
+
+TEST_P(SimulatedRevisit, OppositeDirectionRevisitHasTheTruePose) {
+    sim::SimulationConfig config;
+    config.scene = sim::SceneType::kUrban;
+    config.route.type = sim::RouteType::kUTurn;
+    config.sensor.model = GetParam();
+    config.sensor.horizontal_steps = 900;
+    config.scans = 200;
+    const sim::Simulator simulator(config);
+    // The first scan revisited in the opposite direction, with its nearest earlier scan.
+    std::size_t query = 0, match = 0;
+    for (std::size_t i = 60; i < simulator.size() && query == 0; ++i) {
+        const core::Transform Ti = simulator.GroundTruthPose(i).T_world_sensor;
+        for (std::size_t j = 0; j + 30 < i; ++j) {
+            const core::Transform Tj = simulator.GroundTruthPose(j).T_world_sensor;
+            const bool opposite = Ti.linear().col(0).dot(Tj.linear().col(0)) < -0.9;
+            if (opposite && (Ti.translation() - Tj.translation()).norm() < 5.0) {
+                query = i;
+                match = j;
+                break;
+            }
+        }
+    }
+    ASSERT_NE(query, 0u) << "no opposite-direction revisit in the simulated route";
+    const core::Transform truth = simulator.GroundTruthPose(match).T_world_sensor.inverse() *
+                                  simulator.GroundTruthPose(query).T_world_sensor;
+    const Verification v =
+        VerifyPair(simulator.Scan(query), simulator.Scan(match), VerificationConfig{});
+    EXPECT_TRUE(v.accepted) << ToString(v.reason) << " overlap " << v.overlap.Min();
+    EXPECT_LT((v.T_match_query.translation() - truth.translation()).norm(), 0.1);
+    EXPECT_LT(RotationErrorDeg(v.T_match_query, truth), 0.5);
+    EXPECT_LT(YawErrorDeg(v.T_match_query, truth), 0.5);
+}
+
+INSTANTIATE_TEST_SUITE_P(Sensors, SimulatedRevisit,
+                         ::testing::Values(sim::SensorModel::kHdl64, sim::SensorModel::kVlp16));
+
+}  // namespace
+}  // namespace lidarloop::registration
