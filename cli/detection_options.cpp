@@ -12,6 +12,8 @@ void DetectionOptions::AddTo(CLI::App& command, bool decides_loops,
     threshold_option_ = command.add_option(
         "--threshold", threshold_, "tau (height, range) or t_d (ndt); default from the config");
     top_k_option_ = command.add_option("--top-k", top_k_, "candidates per query scan");
+    command.add_flag("--no-verify", no_verify_,
+                     "descriptor only: accept by the threshold, no geometric verification");
 }
 
 void DetectionOptions::ApplyTo(io::RunConfig& config) const {
@@ -20,6 +22,7 @@ void DetectionOptions::ApplyTo(io::RunConfig& config) const {
     if (!min_gap_unit_.empty())
         config.detection.min_gap.unit = core::ParseMinGapUnit(min_gap_unit_);
     if (top_k_option_ != nullptr && *top_k_option_) config.detection.top_k = top_k_;
+    if (no_verify_) config.detection.verify = false;
     config.Validate();
 }
 

@@ -9,7 +9,8 @@
 namespace lidarloop::cli {
 
 /// The detection flags, declared and applied in one place for every command that takes them:
-/// --min-gap and --min-gap-unit always, --threshold and --top-k where a command decides loops.
+/// --min-gap and --min-gap-unit always, --threshold, --top-k and --no-verify where a command
+/// decides loops.
 class DetectionOptions {
 public:
     /// `min_gap_help` says what the gap means to the command.
@@ -22,6 +23,7 @@ private:
     double min_gap_ = 0.0;
     std::string min_gap_unit_;
     int top_k_ = 0;
+    bool no_verify_ = false;
     CLI::Option* threshold_option_ = nullptr;
     CLI::Option* min_gap_option_ = nullptr;
     CLI::Option* top_k_option_ = nullptr;

@@ -133,11 +133,27 @@ section_detect() {
         database.lldb config.yaml timings.json; do
         if [ -s "$work/det/$file" ]; then pass; else fail "detect did not write $file"; fi
     done
-    if head -1 "$work/det/loops.csv" | grep -qx "query,match,distance,second_ratio,accepted"; then
+    verified_header="query,match,distance,second_ratio,accepted,rank,tx,ty,tz,qx,qy,qz,qw"
+    verified_header+=",overlap_query,overlap_match,rmse_m,shifted_overlap,reason"
+    if head -1 "$work/det/loops.csv" | grep -qx "$verified_header"; then
         pass
     else fail "loops.csv header: $(head -1 "$work/det/loops.csv")"; fi
-    if grep -q "^3,0,0,.*,1$" "$work/det/loops.csv"; then pass; else
-        fail "scan 3 (a copy of scan 0) is not an accepted loop: $(cat "$work/det/loops.csv")"
+    # Scan 3 is a copy of scan 0: verified at the identity pose.
+    if grep -q "^3,0,0,,1,1,0,0,0,0,0,0,1,1,1,0,.*,none$" "$work/det/loops.csv"; then pass; else
+        fail "scan 3 (a copy of scan 0) is not a verified loop: $(cat "$work/det/loops.csv")"
+    fi
+    if head -1 "$work/det/candidates.csv" |
+        grep -qx "query,rank,match,distance,accepted,${verified_header#*rank,}"; then
+        pass
+    else fail "candidates.csv header: $(head -1 "$work/det/candidates.csv")"; fi
+    expect_ok "detect --no-verify" "8 scans (folder)" "$cli" detect "$seq" --min-gap 2 --quiet \
+        --no-verify --out "$work/det_descriptor"
+    if head -1 "$work/det_descriptor/loops.csv" |
+        grep -qx "query,match,distance,second_ratio,accepted"; then
+        pass
+    else fail "--no-verify loops.csv header: $(head -1 "$work/det_descriptor/loops.csv")"; fi
+    if grep -q "^3,0,0,.*,1$" "$work/det_descriptor/loops.csv"; then pass; else
+        fail "--no-verify: scan 3 is not an accepted loop: $(cat "$work/det_descriptor/loops.csv")"
     fi
     if grep -q "min_gap: 2" "$work/det/config.yaml"; then pass; else
         fail "config.yaml lacks the gap"

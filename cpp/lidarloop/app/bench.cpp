@@ -93,7 +93,7 @@ nlohmann::json RunBench(const io::Dataset& dataset, const BenchRequest& request)
     // One core, so that the per-scan times are what one scan costs.
     const auto described = DescribeDataset(
         dataset, config.descriptor,
-        {"describing", /*skip_bad=*/false, pipeline::Execution::kSerial, request.progress});
+        {"describing", /*skip_bad=*/false, pipeline::Execution::kSerial, request.progress, {}});
     const auto& database = described.database;
 
     Stopwatch serial_clock;

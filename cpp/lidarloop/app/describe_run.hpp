@@ -27,6 +27,8 @@ struct DescribeRun {
     bool skip_bad = false;  ///< unreadable scans get a placeholder instead of stopping the run
     pipeline::Execution execution = pipeline::Execution::kParallel;
     Progress progress;
+    /// Also given every scan read (pipeline::DescribeOptions::with_cloud), e.g. PreparedScans.
+    std::function<void(std::size_t, const core::PointCloud&)> with_cloud;
 };
 
 /// Describes every scan of `dataset` (pipeline::DescribeSequence), telling `run.progress`.

@@ -2,6 +2,7 @@
 
 #include "lidarloop/app/describe_run.hpp"
 #include "lidarloop/app/results_folder.hpp"
+#include "lidarloop/app/verification_run.hpp"
 #include "lidarloop/core/descriptor.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/io/database_file.hpp"
@@ -46,9 +47,13 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
 
     Stopwatch total;
     Stopwatch describe_clock;
-    const pipeline::SequenceDescriptors described = DescribeDataset(
-        dataset, config.descriptor,
-        {"describing", request.skip_bad, pipeline::Execution::kParallel, request.progress});
+    const bool verify = config.detection.verify;
+    PreparedScans prepared(verify ? dataset.size() : 0);
+    DescribeRun run{
+        "describing", request.skip_bad, pipeline::Execution::kParallel, request.progress, {}};
+    if (verify) run.with_cloud = prepared.Collector(config.detection.verification.reduction);
+    const pipeline::SequenceDescriptors described =
+        DescribeDataset(dataset, config.descriptor, run);
     const double describe_s = describe_clock.Seconds();
 
     Stopwatch matrix_clock;
@@ -58,12 +63,23 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     outcome.threshold = threshold;
     outcome.queries = pipeline::DetectFromMatrix(matrix, described.database.times_s(),
                                                  config.detection, config.descriptor.method);
+    Stopwatch verify_clock;
+    pipeline::VerificationTimes verification_times;
+    if (verify) {
+        verification_times = VerifyAll(outcome.queries, prepared, config.detection,
+                                       config.descriptor.method, request.progress);
+    }
+    const double verify_s = verify_clock.Seconds();
     outcome.accepted = CountAccepted(outcome.queries);
     outcome.skipped = described.skipped;
     WriteDetectResults(out_dir, config, described, matrix, outcome);
 
     nlohmann::json timings = TimingsJson(described, matrix.condensed().size(), matrix_s);
     timings["describe_total_s"] = describe_s;
+    if (verify) {
+        timings["verification"] = VerificationTimingsJson(prepared, verification_times);
+        timings["verification"]["total_s"] = verify_s;
+    }
     outcome.total_s = total.Seconds();
     timings["total_s"] = outcome.total_s;
     WriteJson(out_dir / "timings.json", timings);
@@ -91,7 +107,7 @@ DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const Detec
 
     const pipeline::SequenceDescriptors described = DescribeDataset(
         dataset, config.descriptor,
-        {"describing", request.skip_bad, pipeline::Execution::kParallel, request.progress});
+        {"describing", request.skip_bad, pipeline::Execution::kParallel, request.progress, {}});
     Stopwatch query_clock;
     DetectOutcome outcome;
     outcome.queries = pipeline::LocaliseSequence(detector, described.database);

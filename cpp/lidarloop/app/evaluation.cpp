@@ -57,7 +57,10 @@ TrainingPairs TrainingPairsOf(const EvaluationRequest& request,
     const auto described =
         DescribeDataset(train_dataset, descriptor,
                         {"training set (" + core::ToString(descriptor.method) + ")",
-                         request.skip_bad, pipeline::Execution::kParallel, request.progress});
+                         request.skip_bad,
+                         pipeline::Execution::kParallel,
+                         request.progress,
+                         {}});
     const pipeline::SimilarityMatrix matrix = pipeline::ComputeSimilarityMatrix(described.database);
     const eval::GroundTruth truth =
         eval::BuildGroundTruth(train_dataset.poses(), GroundTruthRule(request));
@@ -73,10 +76,12 @@ MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method m
     std::optional<TrainingPairs> training;
     if (train_dataset != nullptr)
         training = TrainingPairsOf(request, config.descriptor, *train_dataset);
-    const auto described =
-        DescribeDataset(dataset, config.descriptor,
-                        {"describing (" + core::ToString(method) + ")", request.skip_bad,
-                         pipeline::Execution::kParallel, request.progress});
+    const auto described = DescribeDataset(dataset, config.descriptor,
+                                           {"describing (" + core::ToString(method) + ")",
+                                            request.skip_bad,
+                                            pipeline::Execution::kParallel,
+                                            request.progress,
+                                            {}});
     Stopwatch matrix_clock;
     pipeline::SimilarityMatrix matrix = pipeline::ComputeSimilarityMatrix(described.database);
     const double matrix_s = matrix_clock.Seconds();

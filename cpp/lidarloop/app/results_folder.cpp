@@ -44,17 +44,58 @@ void WriteSkipped(const std::filesystem::path& folder, const std::vector<std::st
     if (!out) throw io::WriteError(folder / "skipped.txt", "writing failed");
 }
 
+namespace {
+
+bool AnyVerified(const std::vector<pipeline::LoopQuery>& queries) {
+    return std::any_of(queries.begin(), queries.end(), [](const auto& q) { return q.verified(); });
+}
+
+constexpr char kVerificationColumns[] =
+    "tx,ty,tz,qx,qy,qz,qw,overlap_query,overlap_match,rmse_m,shifted_overlap,reason";
+
+// The verification columns of one candidate: T_match_query (translation in metres, unit
+// quaternion x, y, z, w), the overlap both ways, the RMSE, the degeneracy test's overlap ratio
+// (empty when not reached) and the reason ("none" when accepted).
+// A candidate rejected before registration has empty pose and fit fields.
+void WriteVerification(std::ostream& out, const registration::Verification& v) {
+    const bool registered = v.reason != registration::RejectReason::kTooFewPoints &&
+                            v.reason != registration::RejectReason::kNoAlignment &&
+                            v.reason != registration::RejectReason::kPruned;
+    if (registered) {
+        const Eigen::Vector3d t = v.T_match_query.translation();
+        const Eigen::Quaterniond q(v.T_match_query.rotation());
+        out << t.x() << ',' << t.y() << ',' << t.z() << ',' << q.x() << ',' << q.y() << ',' << q.z()
+            << ',' << q.w() << ',' << v.overlap.query_fraction << ',' << v.overlap.match_fraction
+            << ',' << v.overlap.rmse_m << ',';
+        if (!std::isnan(v.shifted_overlap_ratio)) out << v.shifted_overlap_ratio;
+        out << ',';
+    } else {
+        out << ",,,,,,,,,,,";
+    }
+    out << registration::ToString(v.reason);
+}
+
+}  // namespace
+
 void WriteLoopsCsv(const std::filesystem::path& file,
                    const std::vector<pipeline::LoopQuery>& queries) {
     std::ofstream out(file);
-    out << "query,match,distance,second_ratio,accepted\n";
+    const bool verified = AnyVerified(queries);
+    out << "query,match,distance,second_ratio,accepted";
+    out << (verified ? std::string(",rank,") + kVerificationColumns : std::string()) << "\n";
     out.precision(9);
     for (const auto& q : queries) {
         if (!q.has_match()) continue;
-        out << q.query << ',' << q.candidates.front().index << ',' << q.candidates.front().distance
+        const std::size_t rank = q.loop().value_or(0);
+        out << q.query << ',' << q.candidates[rank].index << ',' << q.candidates[rank].distance
             << ',';
         if (!std::isnan(q.second_ratio)) out << q.second_ratio;
-        out << ',' << (q.accepted ? 1 : 0) << '\n';
+        out << ',' << (q.accepted ? 1 : 0);
+        if (q.verified()) {
+            out << ',' << rank + 1 << ',';
+            WriteVerification(out, q.verifications[rank]);
+        }
+        out << '\n';
     }
     if (!out) throw io::WriteError(file, "writing failed");
 }
@@ -62,12 +103,19 @@ void WriteLoopsCsv(const std::filesystem::path& file,
 void WriteCandidatesCsv(const std::filesystem::path& file,
                         const std::vector<pipeline::LoopQuery>& queries) {
     std::ofstream out(file);
-    out << "query,rank,match,distance\n";
+    const bool verified = AnyVerified(queries);
+    out << "query,rank,match,distance";
+    out << (verified ? std::string(",accepted,") + kVerificationColumns : std::string()) << "\n";
     out.precision(9);
     for (const auto& q : queries) {
         for (std::size_t r = 0; r < q.candidates.size(); ++r) {
             out << q.query << ',' << r + 1 << ',' << q.candidates[r].index << ','
-                << q.candidates[r].distance << '\n';
+                << q.candidates[r].distance;
+            if (q.verified()) {
+                out << ',' << (q.verifications[r].accepted ? 1 : 0) << ',';
+                WriteVerification(out, q.verifications[r]);
+            }
+            out << '\n';
         }
     }
     if (!out) throw io::WriteError(file, "writing failed");

@@ -36,14 +36,18 @@ void WriteJson(const std::filesystem::path& file, const nlohmann::json& json);
 void WriteSkipped(const std::filesystem::path& folder, const std::vector<std::string>& skipped);
 
 /// loops.csv: one row per query scan with a candidate, its best match
-/// (query,match,distance,second_ratio,accepted).
+/// (query,match,distance,second_ratio,accepted). Verified queries: the match is the loop (the
+/// first accepted candidate, else the best one), then its rank and verification columns
+/// (rank,tx,ty,tz,qx,qy,qz,qw,overlap_query,overlap_match,rmse_m,shifted_overlap,reason;
+/// docs/cli.md).
 void WriteLoopsCsv(const std::filesystem::path& file,
                    const std::vector<pipeline::LoopQuery>& queries);
-/// candidates.csv: every candidate of every query (query,rank,match,distance).
+/// candidates.csv: every candidate of every query (query,rank,match,distance), and when verified
+/// accepted and the verification columns of loops.csv.
 void WriteCandidatesCsv(const std::filesystem::path& file,
                         const std::vector<pipeline::LoopQuery>& queries);
 
-/// Query scans whose best match was accepted.
+/// Query scans with an accepted loop.
 std::size_t CountAccepted(const std::vector<pipeline::LoopQuery>& queries);
 
 }  // namespace lidarloop::app

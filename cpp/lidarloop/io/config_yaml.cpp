@@ -76,6 +76,66 @@ void VisitFields(pipeline::DetectorConfig& c, Visitor& v) {
     v.Field("min_gap_unit", c.min_gap.unit, "unit of min_gap: scans | seconds");
     v.Field("top_k", c.top_k, "candidates reported per query scan");
     v.Field("threshold", c.threshold, ThresholdHelp());
+    v.Field("verify", c.verify,
+            "register candidates and accept only verified loops (section verification)");
+}
+
+template <typename Visitor>
+void VisitFields(registration::ScanReductionConfig& c, Visitor& v) {
+    v.Field("min_range_m", c.min_range_m, "closer points are dropped (the vehicle)");
+    v.Field("max_range_m", c.max_range_m, "farther points are dropped");
+    v.Field("voxel_m", c.voxel_m, "edge of the voxels a scan is averaged into");
+    v.Field("normal_neighbors", c.normal_neighbors, "voxel centroids in a normal's fit");
+    v.Field("structure_min_tilt_deg", c.structure_min_tilt_deg,
+            "structure points: normal at least this far from vertical");
+    v.Field("max_structure_points", c.max_structure_points, "structure points kept per scan");
+    v.Field("max_ground_points", c.max_ground_points, "other (ground) points kept per scan");
+}
+
+template <typename Visitor>
+void VisitFields(registration::CoarseConfig& c, Visitor& v) {
+    v.Field("cell_m", c.cell_m, "cell of the top-down structure images");
+    v.Field("grid_cells", c.grid_cells, "image edge in cells (power of two)");
+    v.Field("yaw_step_deg", c.yaw_step_deg, "yaw search step over the full circle");
+    v.Field("max_translation_m", c.max_translation_m, "largest planar offset searched");
+    v.Field("hypotheses", c.hypotheses, "best coarse poses refined by ICP");
+}
+
+template <typename Visitor>
+void VisitFields(registration::IcpConfig& c, Visitor& v) {
+    v.Field("initial_correspondence_m", c.initial_correspondence_m,
+            "pairing distance of the first stage; halved per stage");
+    v.Field("final_correspondence_m", c.final_correspondence_m, "of the last stage");
+    v.Field("max_iterations_per_stage", c.max_iterations_per_stage, "Gauss-Newton steps");
+    v.Field("convergence_step", c.convergence_step, "a stage ends below this step (m + rad)");
+    v.Field("max_structure_points", c.max_structure_points, "query structure points paired");
+    v.Field("max_ground_points", c.max_ground_points, "query ground points paired");
+    v.Field("abandon_below_inliers", c.abandon_below_inliers,
+            "drop a hypothesis after stage 1 below this structure inlier share");
+}
+
+template <typename Visitor>
+void VisitFields(registration::AcceptanceConfig& c, Visitor& v) {
+    v.Field("overlap_radius_m", c.overlap_radius_m, "a structure point's partner is this close");
+    v.Field("overlap_plane_m", c.overlap_plane_m, "and its plane passes this close");
+    v.Field("overlap_range_m", c.overlap_range_m, "only points this close to both sensors count");
+    v.Field("min_overlap", c.min_overlap, "share of structure points overlapping, each way");
+    v.Field("min_overlapping_points", c.min_overlapping_points, "overlapping points, each way");
+    v.Field("max_rmse_ratio", c.max_rmse_ratio,
+            "RMS plane distance of the overlap over the scans' own roughness, at most");
+    v.Field("min_allowed_rmse_m", c.min_allowed_rmse_m, "the allowed RMS is at least this");
+    v.Field("max_rmse_m", c.max_rmse_m, "and at most this");
+    v.Field("degeneracy_shift_m", c.degeneracy_shift_m, "shift along the weakest direction");
+    v.Field("max_shifted_overlap_ratio", c.max_shifted_overlap_ratio,
+            "share of the points pinning that direction still overlapping there, at most");
+}
+
+template <typename Visitor>
+void VisitFields(registration::VerificationConfig& c, Visitor& v) {
+    v.Section("reduction", c.reduction);
+    v.Section("coarse", c.coarse);
+    v.Section("icp", c.icp);
+    v.Section("acceptance", c.acceptance);
 }
 
 template <typename Visitor>
@@ -84,6 +144,7 @@ void VisitFields(RunConfig& c, Visitor& v) {
     v.Section("histogram", c.descriptor.histogram);
     v.Section("ndt", c.descriptor.ndt);
     v.Section("detection", c.detection);
+    v.Section("verification", c.detection.verification);
 }
 
 std::string EnumName(const core::Method& m) { return core::ToString(m); }

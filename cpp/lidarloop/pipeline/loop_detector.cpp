@@ -44,6 +44,15 @@ void DetectorConfig::Validate() const {
         throw core::ConfigError("detection.top_k must be in [1, 1000], got " +
                                 std::to_string(top_k));
     }
+    verification.Validate();
+}
+
+std::optional<std::size_t> LoopQuery::loop() const {
+    if (!verified()) return accepted && has_match() ? std::optional<std::size_t>(0) : std::nullopt;
+    for (std::size_t i = 0; i < verifications.size(); ++i) {
+        if (verifications[i].accepted) return i;
+    }
+    return std::nullopt;
 }
 
 std::vector<Neighbor> NearestCandidates(std::size_t count, std::size_t k,

@@ -12,6 +12,7 @@
 #include "lidarloop/pipeline/descriptor_database.hpp"
 #include "lidarloop/pipeline/descriptor_method.hpp"
 #include "lidarloop/pipeline/similarity_matrix.hpp"
+#include "lidarloop/registration/verification.hpp"
 
 namespace lidarloop::pipeline {
 
@@ -23,6 +24,11 @@ struct DetectorConfig {
     /// The decision threshold, tau (W <= tau, Röhling eq. 7) or t_d (sigma' < t_d, Magnusson
     /// II-E); empty: the method's default (pipeline::DefaultThreshold).
     std::optional<double> threshold;
+    /// Register each candidate to its query and accept only loops that pass (docs/verification.md).
+    /// Needs the scans (or their registration::PreparedScan), not descriptors alone. When on, the
+    /// descriptor ranks candidates and the threshold prunes them only when set explicitly.
+    bool verify = true;
+    registration::VerificationConfig verification;  ///< YAML section `verification`
 
     /// `threshold` when set, else the default of `method`.
     double ThresholdFor(const core::Method& method) const {
@@ -41,9 +47,17 @@ struct LoopQuery {
     /// that lies outside the gap around the best match (another place). Near 1: ambiguous;
     /// near 0: distinctive. NaN when there is no such second candidate; 1 when both are 0.
     double second_ratio = std::numeric_limits<double>::quiet_NaN();
-    bool accepted = false;  ///< the best match passes the threshold (W <= tau, sigma' < t_d)
+    /// Without verification: the best match passes the threshold (W <= tau, sigma' < t_d).
+    /// With: some candidate passed verification (see loop()).
+    bool accepted = false;
+    /// Geometric verification of `candidates`, in their order; empty when not verified.
+    std::vector<registration::Verification> verifications;
 
     bool has_match() const { return !candidates.empty(); }
+    bool verified() const { return !verifications.empty(); }
+    /// The index in `candidates` of the loop: the first candidate verification accepted, or
+    /// without verification the best candidate when accepted; nullopt when there is no loop.
+    std::optional<std::size_t> loop() const;
 };
 
 /// The k nearest of the scans 0..count-1 for which `eligible(j)` holds, by (distance, index),

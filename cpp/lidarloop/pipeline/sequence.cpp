@@ -26,7 +26,8 @@ struct ScanResult {
 };
 
 ScanResult DescribeOne(const ScanSource& source, const core::DescriptorConfig& config,
-                       std::size_t i, bool skip_bad) {
+                       std::size_t i, const DescribeOptions& options) {
+    const bool skip_bad = options.skip_bad;
     ScanResult result;
     try {
         const auto load_start = Clock::now();
@@ -35,6 +36,7 @@ ScanResult DescribeOne(const ScanSource& source, const core::DescriptorConfig& c
         const auto describe_start = Clock::now();
         result.descriptor = ComputeDescriptor(cloud, config);
         result.describe_seconds = SecondsSince(describe_start);
+        if (options.with_cloud) options.with_cloud(i, cloud);
     } catch (const core::ConfigError&) {
         throw;  // a bad configuration is not a bad scan
     } catch (const core::Error& e) {
@@ -53,7 +55,7 @@ SequenceDescriptors DescribeSequence(const ScanSource& source, const core::Descr
     std::vector<ScanResult> results(source.count);
     std::atomic<std::size_t> done{0};
     const auto run = [&](std::size_t i) {
-        results[i] = DescribeOne(source, config, i, options.skip_bad);
+        results[i] = DescribeOne(source, config, i, options);
         const std::size_t finished = ++done;
         if (options.progress) options.progress(finished, source.count);
     };

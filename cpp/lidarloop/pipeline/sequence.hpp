@@ -28,6 +28,9 @@ struct DescribeOptions {
     Execution execution = Execution::kParallel;
     /// Called after each scan with (scans done, total), from any worker thread.
     std::function<void(std::size_t, std::size_t)> progress;
+    /// Also called with (scan index, cloud) for every scan read and described, from any worker
+    /// thread, e.g. to keep what verification needs of it; must not throw.
+    std::function<void(std::size_t, const core::PointCloud&)> with_cloud;
 };
 
 struct SequenceDescriptors {

@@ -40,7 +40,8 @@ protected:
 
 TEST_F(DetectionRun, EqualsThePipelineOnTheSameDescriptors) {
     for (core::Method method : {core::Method::kRange, core::Method::kNdt}) {
-        const app::DetectRequest request = Request("detect_" + core::ToString(method), method);
+        app::DetectRequest request = Request("detect_" + core::ToString(method), method);
+        request.config.detection.verify = false;  // the descriptor's own decision
         const app::DetectOutcome outcome = app::RunDetect(*dataset_, request);
         const auto described =
             pipeline::DescribeSequence(app::SourceOf(*dataset_), request.config.descriptor);
@@ -109,6 +110,38 @@ TEST_F(DetectionRun, AMapDescribedOtherwiseIsAClearError) {
     EXPECT_FALSE(std::filesystem::exists(localise.out));
 }
 
+// Verification inside detect gives what registering each candidate on its own gives.
+TEST_F(DetectionRun, VerifiesEveryCandidateAsRegisteringThePairAlone) {
+    const app::DetectRequest request = Request("verified", core::Method::kRange);
+    const app::DetectOutcome outcome = app::RunDetect(*dataset_, request);
+    const registration::VerificationConfig& config = request.config.detection.verification;
+    std::size_t checked = 0, accepted = 0;
+    for (const pipeline::LoopQuery& q : outcome.queries) {
+        ASSERT_EQ(q.verifications.size(), q.candidates.size()) << q.query;
+        bool any = false;
+        for (std::size_t r = 0; r < q.candidates.size(); ++r) {
+            const registration::Verification& v = q.verifications[r];
+            any = any || v.accepted;
+            if (q.query % 17 != 0) continue;  // a sample: each pair is a registration
+            const registration::Verification alone = registration::VerifyPair(
+                dataset_->LoadScan(q.query), dataset_->LoadScan(q.candidates[r].index), config);
+            EXPECT_EQ(v.accepted, alone.accepted) << q.query << " " << r;
+            EXPECT_EQ(v.reason, alone.reason) << q.query << " " << r;
+            EXPECT_TRUE(v.T_match_query.isApprox(alone.T_match_query, 1e-9));
+            ++checked;
+        }
+        EXPECT_EQ(q.accepted, any) << q.query;
+        accepted += q.accepted ? 1 : 0;
+    }
+    EXPECT_GT(checked, 20u);
+    EXPECT_EQ(outcome.accepted, accepted);
+    EXPECT_EQ(CsvRows(request.out / "candidates.csv"), [&] {
+        std::size_t rows = 0;
+        for (const auto& q : outcome.queries) rows += q.candidates.size();
+        return rows;
+    }());
+}
+
 TEST_F(DetectionRun, ReportsProgressOfEveryScanAndEndsTheStage) {
     app::DetectRequest request = Request("detect", core::Method::kHeight);
     std::mutex mutex;
@@ -121,7 +154,7 @@ TEST_F(DetectionRun, ReportsProgressOfEveryScanAndEndsTheStage) {
         seen.insert(done);
     };
     app::RunDetect(*dataset_, request);
-    EXPECT_EQ(stages, std::set<std::string>{"describing"});
+    EXPECT_EQ(stages, (std::set<std::string>{"describing", "verifying"}));
     EXPECT_EQ(seen.size(), dataset_->size());
     EXPECT_EQ(*seen.rbegin(), dataset_->size());
 }

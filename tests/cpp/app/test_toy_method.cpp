@@ -117,6 +117,7 @@ protected:
 
 TEST_F(ToyMethod, DetectsLoopsExactlyAsComparingEveryEarlierScan) {
     app::DetectRequest request{RingsConfig(), false, {}, dir_ / "detect"};
+    request.config.detection.verify = false;  // the descriptor's own decision
     const app::DetectOutcome outcome = app::RunDetect(*dataset_, request);
     ASSERT_EQ(outcome.queries.size(), dataset_->size());
     EXPECT_EQ(outcome.threshold, 0.1);
