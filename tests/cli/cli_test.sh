@@ -263,6 +263,19 @@ section_evaluate() {
         --out "$work/demo_det"
     expect_ok "evaluate results csv" "results:loops" "$cli" evaluate "$demo_seq" --method height \
         --results "$work/demo_det/loops.csv" --distance 5 --quiet --out "$work/demo_eval"
+    # loops.csv lists one candidate per scan; the pairs it omits are never detected, so no
+    # threshold is +inf (null in metrics.json) and no curve reaches +inf.
+    if ! grep -qE '"(tau|tau_best_mcc|tau_best_f1)": null' "$work/demo_eval/metrics.json" &&
+        ! grep -q '^results:loops,inf,' "$work/demo_eval/roc.csv"; then pass; else
+        fail "evaluate results csv: a threshold is +inf, omitted pairs counted as detected"
+    fi
+    # Two pairs at one distance: too few for the EM fit, which is left out, not an error.
+    printf 'query,match,distance\n100,10,0\n200,20,0\n' >"$work/sparse.csv"
+    expect_ok "evaluate sparse results" "results:sparse" "$cli" evaluate "$demo_seq" \
+        --method height --results "$work/sparse.csv" --quiet --out "$work/demo_sparse"
+    if grep -q '"em": null' "$work/demo_sparse/metrics.json"; then pass; else
+        fail "evaluate sparse results: metrics.json lacks \"em\": null"
+    fi
     # Trained on the test sequence itself, the learnt tau is exactly the best-MCC tau.
     expect_ok "evaluate --train-on" "report:" "$cli" evaluate "$demo_seq" --method height \
         --train-on "$demo_seq" --quiet --out "$work/demo_train"

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "lidarloop/app/describe_run.hpp"
 #include "lidarloop/app/evaluation_report.hpp"
@@ -40,6 +41,23 @@ void EvaluatePerScan(MethodEvaluation& e, const eval::GroundTruth& truth) {
     for (const eval::BestMatch& m : e.best_matches) e.smallest_differences.push_back(m.distance);
     e.em = eval::EstimateDifferenceThreshold(e.smallest_differences);
     e.distinctiveness = eval::SummarizeDistinctiveness(e.best_matches);
+}
+
+// A pair of a results file must name scans of the dataset, and a finite distance must stay
+// finite in the float matrix: overflowing to +inf would silently make it "never detected".
+void CheckResult(const std::filesystem::path& file, const io::ExternalResult& r,
+                 std::size_t scans) {
+    const std::string pair =
+        "pair (" + std::to_string(r.query) + ", " + std::to_string(r.match) + ")";
+    if (r.query >= scans || r.match >= scans) {
+        throw io::ReadError(
+            file, pair + " names a scan beyond the " + std::to_string(scans) + " of the dataset");
+    }
+    if (std::isfinite(r.distance) && !std::isfinite(static_cast<float>(r.distance))) {
+        throw io::ReadError(file, pair +
+                                      ": the distance is beyond the float range (|d| > 3.4e38) "
+                                      "the evaluation stores; scale the distances down");
+    }
 }
 
 void RequirePoses(const io::Dataset& dataset, const std::string& role,
@@ -132,15 +150,12 @@ MethodEvaluation EvaluateMatrix(std::string name, pipeline::SimilarityMatrix mat
 }
 
 pipeline::SimilarityMatrix MatrixOfResults(const std::filesystem::path& file, std::size_t scans) {
+    // +inf: never detected (eval::ScoredPair), the rule for every pair the file leaves out.
     pipeline::SimilarityMatrix matrix(scans);
     std::fill(matrix.condensed().begin(), matrix.condensed().end(),
               std::numeric_limits<float>::infinity());
     for (const io::ExternalResult& r : io::ReadResultsCsv(file)) {
-        if (r.query >= scans || r.match >= scans) {
-            throw io::ReadError(file, "pair (" + std::to_string(r.query) + ", " +
-                                          std::to_string(r.match) + ") names a scan beyond the " +
-                                          std::to_string(scans) + " of the dataset");
-        }
+        CheckResult(file, r, scans);
         if (r.query == r.match) continue;
         const std::size_t i = std::min(r.query, r.match);
         const std::size_t j = std::max(r.query, r.match);

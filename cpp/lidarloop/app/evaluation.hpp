@@ -57,8 +57,9 @@ MethodEvaluation EvaluateMatrix(std::string name, pipeline::SimilarityMatrix mat
                                 const TrainingPairs* training = nullptr);
 
 /// The similarity matrix of an external detector's `query,match,distance` CSV: listed pairs get
-/// their distance (the smallest when listed twice), every other pair +inf (never detected).
-/// io::ReadError when a pair names a scan beyond `scans`.
+/// their distance (the smallest when listed twice), every other pair +inf, which the evaluation
+/// never detects at any threshold (eval::ScoredPair); a scan the file never lists has no match.
+/// io::ReadError when a pair names a scan beyond `scans` or a finite distance overflows a float.
 pipeline::SimilarityMatrix MatrixOfResults(const std::filesystem::path& file, std::size_t scans);
 
 /// What `lidarloop evaluate` (and `lidarloop demo`) asks for.

@@ -84,6 +84,24 @@ io::PlotSeries SampledCurve(std::string title, double lo, double hi, F f) {
     return series;
 }
 
+// `values` (within [lo, hi]) as a density histogram of 40 bins.
+io::PlotSeries DensityHistogram(const std::vector<double>& values, double lo, double hi) {
+    constexpr int kBins = 40;
+    const double width = (hi - lo) / kBins;
+    io::PlotSeries histogram{"scans", {}, {}, io::PlotSeries::Style::kBoxes};
+    std::vector<double> counts(kBins, 0.0);
+    for (double d : values) {
+        counts[static_cast<std::size_t>(std::min(kBins - 1, static_cast<int>((d - lo) / width)))] +=
+            1;
+    }
+    for (int b = 0; b < kBins; ++b) {
+        histogram.x.push_back(lo + (b + 0.5) * width);
+        histogram.y.push_back(counts[static_cast<std::size_t>(b)] /
+                              (static_cast<double>(values.size()) * width));
+    }
+    return histogram;
+}
+
 io::Plot EmPlot(const MethodEvaluation& e) {
     io::Plot plot;
     plot.title = e.name + ": smallest difference of every scan, EM fit (Magnusson fig. 2)";
@@ -97,20 +115,11 @@ io::Plot EmPlot(const MethodEvaluation& e) {
     const auto [lo_it, hi_it] = std::minmax_element(finite.begin(), finite.end());
     const double lo = *lo_it;
     const double hi = *hi_it > lo ? *hi_it : lo + 1.0;
-    constexpr int kBins = 40;
-    const double width = (hi - lo) / kBins;
-    io::PlotSeries histogram{"scans", {}, {}, io::PlotSeries::Style::kBoxes};
-    std::vector<double> counts(kBins, 0.0);
-    for (double d : finite) {
-        counts[static_cast<std::size_t>(std::min(kBins - 1, static_cast<int>((d - lo) / width)))] +=
-            1;
+    plot.series.push_back(DensityHistogram(finite, lo, hi));
+    if (!e.em.Fitted()) {
+        plot.title += " - not fitted: too few distinct values";
+        return plot;
     }
-    for (int b = 0; b < kBins; ++b) {
-        histogram.x.push_back(lo + (b + 0.5) * width);
-        histogram.y.push_back(counts[static_cast<std::size_t>(b)] /
-                              (static_cast<double>(finite.size()) * width));
-    }
-    plot.series.push_back(std::move(histogram));
     const eval::MixtureFit& fit = e.em.fit;
     plot.series.push_back(
         SampledCurve("mixture", lo, hi, [&](double x) { return fit.Density(x); }));

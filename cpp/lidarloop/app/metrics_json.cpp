@@ -54,11 +54,14 @@ void AddThresholdRows(const MethodEvaluation& e, nlohmann::json& json) {
 // Magnusson's per-scan view: the taxonomy at zero errors, the EM fit, distinctiveness.
 void AddPerScanFigures(const MethodEvaluation& e, nlohmann::json& json) {
     json["taxonomy_at_zero_fp"] = TaxonomyJson(e.per_scan.zero_error.counts);
-    nlohmann::json components = nlohmann::json::array();
-    for (const auto& c : e.em.fit.components) {
-        components.push_back({{"weight", c.weight}, {"mean", c.mean}, {"stddev", c.stddev}});
+    json["em"] = nullptr;  // too few distinct smallest differences to fit
+    if (e.em.Fitted()) {
+        nlohmann::json components = nlohmann::json::array();
+        for (const auto& c : e.em.fit.components) {
+            components.push_back({{"weight", c.weight}, {"mean", c.mean}, {"stddev", c.stddev}});
+        }
+        json["em"] = {{"components", components}, {"log_likelihood", e.em.fit.log_likelihood}};
     }
-    json["em"] = {{"components", components}, {"log_likelihood", e.em.fit.log_likelihood}};
     if (e.distinctiveness.ratio) {
         const eval::Summary& r = *e.distinctiveness.ratio;
         json["second_ratio"] = {{"median", r.median}, {"p05", r.p05}, {"p95", r.p95}};

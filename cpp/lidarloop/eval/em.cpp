@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <numbers>
 #include <random>
@@ -255,14 +256,20 @@ std::optional<double> CrossingBetweenMeans(const GaussianComponent& first,
 
 DifferenceThreshold EstimateDifferenceThreshold(std::span<const double> smallest_differences,
                                                 const EmConfig& config) {
+    config.Validate();
     std::vector<double> finite;
     finite.reserve(smallest_differences.size());
     for (const double x : smallest_differences) {
         if (std::isfinite(x)) finite.push_back(x);
     }
     DifferenceThreshold result;
-    result.values_used = finite.size();
     result.values_skipped = smallest_differences.size() - finite.size();
+    // A results file may give few scans a match, or one distance to all (a yes/no detector):
+    // nothing to fit, which is a finding about the detector, not an error of the evaluation.
+    const bool all_equal =
+        std::adjacent_find(finite.begin(), finite.end(), std::not_equal_to<>()) == finite.end();
+    if (finite.size() < static_cast<std::size_t>(config.components) || all_equal) return result;
+    result.values_used = finite.size();
     result.fit = FitGaussianMixture(finite, config);
     result.t_d = CrossingBetweenMeans(result.fit.components[0], result.fit.components[1]);
     return result;

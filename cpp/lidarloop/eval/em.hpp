@@ -68,16 +68,21 @@ std::optional<double> CrossingBetweenMeans(const GaussianComponent& first,
 
 /// Magnusson's t_d from every scan's smallest difference.
 struct DifferenceThreshold {
-    MixtureFit fit;
-    /// Crossing of the first two components (by mean); nullopt when they do not cross.
+    MixtureFit fit;  ///< no components when there was nothing to fit (see Fitted)
+    /// Crossing of the first two components (by mean); nullopt when they do not cross or
+    /// nothing was fitted.
     std::optional<double> t_d;
-    std::size_t values_used = 0;     ///< finite values fitted
+    std::size_t values_used = 0;     ///< finite values fitted (0 when nothing was fitted)
     std::size_t values_skipped = 0;  ///< non-finite values left out (scans without a match)
+
+    /// False when there were fewer finite values than components, or all were equal.
+    bool Fitted() const { return !fit.components.empty(); }
 };
 
 /// Fits the mixture to the finite values of `smallest_differences` (BestMatch::distance per
-/// scan) and returns the crossing of its first two components (Magnusson II-E, fig. 2). Same
-/// errors as FitGaussianMixture.
+/// scan) and returns the crossing of its first two components (Magnusson II-E, fig. 2). With
+/// fewer finite values than components, or all of them equal, nothing is fitted (Fitted() is
+/// false, no t_d). Throws core::ConfigError for an invalid config.
 DifferenceThreshold EstimateDifferenceThreshold(std::span<const double> smallest_differences,
                                                 const EmConfig& config = {});
 

@@ -31,6 +31,15 @@ void CheckThreshold(double threshold) {
     if (std::isnan(threshold)) throw core::Error("evaluation threshold must not be NaN");
 }
 
+// +inf marks a pair that was never scored: a scan that could not be read, or a pair a results
+// file leaves out. No threshold, not even +inf, detects it; otherwise the sweep would end at
+// +inf calling every pair a loop, and a learnt threshold could be +inf.
+bool IsScored(float distance) { return distance != std::numeric_limits<float>::infinity(); }
+
+bool DetectedAt(float distance, double threshold) {
+    return IsScored(distance) && static_cast<double>(distance) <= threshold;
+}
+
 CurvePoint MakePoint(double threshold, const Confusion& c) {
     return {threshold, c, Recall(c), FalsePositiveRate(c), Precision(c)};
 }
@@ -62,6 +71,56 @@ void KeepBest(BestThreshold& best, bool& have, double score, double threshold, c
         best = {threshold, score, c};
         have = true;
     }
+}
+
+// Distance and label of every pair, distance ascending; throws for a NaN distance.
+std::vector<Scored> SortByDistance(std::span<const ScoredPair> pairs) {
+    std::vector<Scored> sorted(pairs.size());
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+        CheckDistance(pairs[k]);
+        sorted[k] = {pairs[k].distance, pairs[k].loop};
+    }
+    std::sort(sorted.begin(), sorted.end(),
+              [](const Scored& a, const Scored& b) { return a.distance < b.distance; });
+    return sorted;
+}
+
+// The curve, AUC and optima over the scored pairs `sorted` (ascending, no +inf). result's pair
+// counts must be set and include the unscored pairs, which stay undetected at every point.
+void Sweep(std::span<const Scored> sorted, const PairwiseConfig& config,
+           PairwiseEvaluation& result) {
+    Confusion c{0, 0, result.negatives, result.positives};
+    CurvePoint previous = MakePoint(-std::numeric_limits<double>::infinity(), c);
+    result.curve.push_back(previous);
+    // Without a scored pair the best detector is the start point: nothing detected.
+    result.best_mcc = {previous.threshold, Mcc(c), c};
+    result.best_f1 = {previous.threshold, F1(c), c};
+    CurveThinner thinner(config.max_curve_points);
+    double area = 0.0;
+    bool have_mcc = false;
+    bool have_f1 = false;
+    for (std::size_t k = 0; k < sorted.size();) {
+        const float distance = sorted[k].distance;
+        for (; k < sorted.size() && sorted[k].distance == distance; ++k) {
+            ++(sorted[k].loop ? c.tp : c.fp);
+            --(sorted[k].loop ? c.fn : c.tn);
+        }
+        const CurvePoint point = MakePoint(distance, c);
+        ++result.distinct_thresholds;
+        area += (point.fpr - previous.fpr) * 0.5 * (point.tpr + previous.tpr);
+        KeepBest(result.best_mcc, have_mcc, Mcc(c), distance, c);
+        KeepBest(result.best_f1, have_f1, F1(c), distance, c);
+        if (k == sorted.size() || thinner.Keep(point)) result.curve.push_back(point);
+        previous = point;
+    }
+    if (result.positives > 0 && result.negatives > 0) result.roc_auc = area;
+}
+
+// Position of the first of the ascending thresholds >= distance (their count when none is).
+std::size_t FirstAtLeast(const std::vector<double>& ascending, float distance) {
+    return static_cast<std::size_t>(
+        std::lower_bound(ascending.begin(), ascending.end(), static_cast<double>(distance)) -
+        ascending.begin());
 }
 
 }  // namespace
@@ -110,47 +169,16 @@ std::vector<ScoredPair> CollectPairs(std::span<const float> condensed, const Gro
 PairwiseEvaluation EvaluatePairs(std::span<const ScoredPair> pairs, const PairwiseConfig& config) {
     config.Validate();
     if (pairs.empty()) throw core::EmptyInputError("pair-wise evaluation: no pairs to evaluate");
-    std::vector<Scored> sorted(pairs.size());
-    for (std::size_t k = 0; k < pairs.size(); ++k) {
-        CheckDistance(pairs[k]);
-        sorted[k] = {pairs[k].distance, pairs[k].loop};
-    }
-    std::sort(sorted.begin(), sorted.end(),
-              [](const Scored& a, const Scored& b) { return a.distance < b.distance; });
-
+    const std::vector<Scored> sorted = SortByDistance(pairs);
     PairwiseEvaluation result;
     result.pairs = sorted.size();
     result.positives = static_cast<std::uint64_t>(
         std::count_if(sorted.begin(), sorted.end(), [](const Scored& s) { return s.loop; }));
     result.negatives = result.pairs - result.positives;
-
-    Confusion c{0, 0, result.negatives, result.positives};
-    CurvePoint previous = MakePoint(-std::numeric_limits<double>::infinity(), c);
-    result.curve.push_back(previous);
-    CurveThinner thinner(config.max_curve_points);
-    double area = 0.0;
-    bool have_mcc = false;
-    bool have_f1 = false;
-    for (std::size_t k = 0; k < sorted.size();) {
-        const float distance = sorted[k].distance;
-        for (; k < sorted.size() && sorted[k].distance == distance; ++k) {
-            if (sorted[k].loop) {
-                ++c.tp;
-                --c.fn;
-            } else {
-                ++c.fp;
-                --c.tn;
-            }
-        }
-        const CurvePoint point = MakePoint(distance, c);
-        ++result.distinct_thresholds;
-        area += (point.fpr - previous.fpr) * 0.5 * (point.tpr + previous.tpr);
-        KeepBest(result.best_mcc, have_mcc, Mcc(c), distance, c);
-        KeepBest(result.best_f1, have_f1, F1(c), distance, c);
-        if (k == sorted.size() || thinner.Keep(point)) result.curve.push_back(point);
-        previous = point;
-    }
-    if (result.positives > 0 && result.negatives > 0) result.roc_auc = area;
+    // +inf sorts last: the sweep stops before the unscored pairs, which stay undetected.
+    const auto scored = std::partition_point(sorted.begin(), sorted.end(),
+                                             [](const Scored& s) { return IsScored(s.distance); });
+    Sweep(std::span<const Scored>(sorted.begin(), scored), config, result);
     return result;
 }
 
@@ -159,7 +187,7 @@ Confusion ConfusionAt(std::span<const ScoredPair> pairs, double threshold) {
     Confusion c;
     for (const auto& pair : pairs) {
         CheckDistance(pair);
-        const bool detected = static_cast<double>(pair.distance) <= threshold;
+        const bool detected = DetectedAt(pair.distance, threshold);
         if (pair.loop) {
             ++(detected ? c.tp : c.fn);
         } else {
@@ -179,16 +207,15 @@ std::vector<Confusion> ConfusionsAt(std::span<const ScoredPair> pairs,
               [&](std::size_t a, std::size_t b) { return thresholds[a] < thresholds[b]; });
     std::vector<double> ascending(thresholds.size());
     for (std::size_t r = 0; r < order.size(); ++r) ascending[r] = thresholds[order[r]];
-    // A pair is detected from the first (ascending) threshold >= its distance on.
+    // A pair is detected from the first (ascending) threshold >= its distance on; an unscored
+    // pair from none (slot T is never summed).
     std::vector<std::uint64_t> loops_from(thresholds.size() + 1, 0);
     std::vector<std::uint64_t> others_from(thresholds.size() + 1, 0);
     std::uint64_t loops = 0;
     for (const auto& pair : pairs) {
         CheckDistance(pair);
-        const auto first =
-            static_cast<std::size_t>(std::lower_bound(ascending.begin(), ascending.end(),
-                                                      static_cast<double>(pair.distance)) -
-                                     ascending.begin());
+        const std::size_t first =
+            IsScored(pair.distance) ? FirstAtLeast(ascending, pair.distance) : thresholds.size();
         ++(pair.loop ? loops_from : others_from)[first];
         loops += pair.loop ? 1 : 0;
     }

@@ -18,8 +18,10 @@ std::size_t CondensedSize(std::size_t n);
 std::size_t CondensedIndex(std::size_t n, std::size_t i, std::size_t j);
 
 /// One evaluated scan pair of the pair-wise protocol (Röhling IV-B): scans i < j, their
-/// descriptor distance (W or sigma'; +inf when a scan is missing) and whether the ground truth
-/// calls them the same place. 16 bytes, so that millions of pairs stay cheap.
+/// descriptor distance and whether the ground truth calls them the same place. The distance is
+/// W or sigma', or +inf for a pair that was never scored (a scan could not be read, or a results
+/// file leaves the pair out): such a pair is never detected, at any threshold, +inf included.
+/// 16 bytes, so that millions of pairs stay cheap.
 struct ScoredPair {
     std::uint32_t i = 0;
     std::uint32_t j = 0;
@@ -44,7 +46,8 @@ struct PairwiseConfig {
     void Validate() const;
 };
 
-/// The classifier L_tau at one threshold: pairs with distance <= threshold are detected loops.
+/// The classifier L_tau at one threshold: pairs with distance <= threshold are detected loops
+/// (never a pair with distance +inf, see ScoredPair).
 struct CurvePoint {
     double threshold = 0.0;  ///< tau; -inf for the start point (nothing detected)
     Confusion confusion;
@@ -62,31 +65,34 @@ struct BestThreshold {
 
 /// Result of the threshold sweep over all pairs (Röhling IV-B/C, fig. 4).
 struct PairwiseEvaluation {
-    std::uint64_t pairs = 0;      ///< pairs evaluated
-    std::uint64_t positives = 0;  ///< pairs that are loops
-    std::uint64_t negatives = 0;  ///< pairs that are not
-    std::size_t distinct_thresholds = 0;
+    std::uint64_t pairs = 0;              ///< pairs evaluated
+    std::uint64_t positives = 0;          ///< pairs that are loops
+    std::uint64_t negatives = 0;          ///< pairs that are not
+    std::size_t distinct_thresholds = 0;  ///< distinct finite distances: the swept thresholds
     /// ROC and precision-recall curve, threshold ascending (so FPR and TPR non-decreasing):
-    /// the start point at -inf, then one point per distinct distance (possibly thinned).
+    /// the start point at -inf, then one point per distinct finite distance (possibly thinned).
+    /// With unscored (+inf) pairs it ends short of (1, 1): they are never detected.
     std::vector<CurvePoint> curve;
     /// Area under the ROC curve by the trapezoid rule over every distinct threshold (ties are
-    /// one diagonal step, i.e. they count half); nullopt without positives or negatives.
+    /// one diagonal step, i.e. they count half); nullopt without positives or negatives. The
+    /// area stops where the curve does, so unscored pairs add none.
     std::optional<double> roc_auc;
-    /// Thresholds maximising MCC and F1 over every distinct distance; on ties the smallest
-    /// threshold (the most conservative detector) wins. Candidates are distances of pairs, so
-    /// at least one pair is detected.
+    /// Thresholds maximising MCC and F1 over every distinct finite distance; on ties the
+    /// smallest threshold (the most conservative detector) wins. Candidates are distances of
+    /// pairs, so at least one pair is detected and the threshold is finite, unless no pair has
+    /// a finite distance: then threshold -inf, nothing detected.
     BestThreshold best_mcc;
     BestThreshold best_f1;
 };
 
-/// Sweeps the threshold over all distinct distances of `pairs` in O(P log P) (one sort).
+/// Sweeps the threshold over all distinct finite distances of `pairs` in O(P log P) (one sort).
 /// Throws core::EmptyInputError when `pairs` is empty and core::Error when a distance is NaN.
 /// Thread-safe.
 PairwiseEvaluation EvaluatePairs(std::span<const ScoredPair> pairs,
                                  const PairwiseConfig& config = {});
 
-/// The confusion of L_tau (distance <= threshold is a loop) on `pairs`, O(P). Throws core::Error
-/// for a NaN threshold or distance. Thread-safe.
+/// The confusion of L_tau (distance <= threshold is a loop; +inf never is) on `pairs`, O(P).
+/// Throws core::Error for a NaN threshold or distance. Thread-safe.
 Confusion ConfusionAt(std::span<const ScoredPair> pairs, double threshold);
 
 /// ConfusionAt for several thresholds (Röhling table II), in the order given, in

@@ -13,7 +13,9 @@ namespace lidarloop::eval {
 /// The most similar scan to one scan (Magnusson table I: S̄), among the scans outside the
 /// minimum gap, and the second most similar one's distance.
 struct BestMatch {
-    std::size_t match = kNoScan;  ///< S̄; kNoScan when no scan outside the gap was compared
+    /// S̄; kNoScan when no scan outside the gap has a finite distance to it (none was compared,
+    /// or every pair is unscored, +inf, as the pairs a results file leaves out)
+    std::size_t match = kNoScan;
     double distance = std::numeric_limits<double>::infinity();  ///< sigma'(S, S̄) or W
     /// The second smallest distance (any other scan outside the gap), for the distinctiveness
     /// ratio; +inf when there is none.
@@ -23,7 +25,9 @@ struct BestMatch {
 /// Per scan, its best match over all other scans outside the gap (offline, both directions, as
 /// Magnusson compares every scan with all others except S_{i-S} .. S_{i+S}). `condensed` is the
 /// upper triangle of the n x n distance matrix (see CondensedIndex). Ties go to the smaller scan
-/// index. Throws core::Error when the size does not match truth.size() or a distance is NaN.
+/// index. A scan whose pairs are all +inf gets no match, so it is never similar (a false or
+/// true negative at every t_d), not a match to an arbitrary scan. Throws core::Error when the
+/// size does not match truth.size() or a distance is NaN.
 /// O(n^2). Thread-safe.
 std::vector<BestMatch> BestMatchesFromCondensed(std::span<const float> condensed,
                                                 const GroundTruth& truth);

@@ -32,6 +32,11 @@ ThresholdTransfer LearnAndTest(std::span<const ScoredPair> train, std::span<cons
     if (test.empty()) throw core::EmptyInputError("threshold learning: no test pairs");
     // Only the optimum is needed; the smallest curve keeps the sweep cheap.
     const PairwiseEvaluation learnt = EvaluatePairs(train, PairwiseConfig{3});
+    // Without a finite training distance the optimum is "detect nothing" at -inf: no threshold
+    // a detector could apply.
+    if (learnt.distinct_thresholds == 0) {
+        throw core::EmptyInputError("threshold learning: no training pair has a finite distance");
+    }
     const BestThreshold& best = criterion == Criterion::kMcc ? learnt.best_mcc : learnt.best_f1;
     ThresholdTransfer result;
     result.criterion = criterion;

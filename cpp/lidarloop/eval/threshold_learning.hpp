@@ -31,10 +31,11 @@ struct ThresholdTransfer {
     double test_mcc = 0.0;     ///< Röhling eq. (10) on the test pairs
 };
 
-/// Learns tau on `train` (exact optimum of `criterion` over every distinct distance, ties to the
-/// smallest tau) and evaluates it on `test`. The two sets may come from the same sequence
-/// (SplitByQuery) or from different data sets. Throws core::EmptyInputError when either is
-/// empty. O(P log P). Thread-safe.
+/// Learns tau on `train` (exact optimum of `criterion` over every distinct finite distance, ties
+/// to the smallest tau, see EvaluatePairs) and evaluates it on `test`; tau is always finite. The
+/// two sets may come from the same sequence (SplitByQuery) or from different data sets. Throws
+/// core::EmptyInputError when either is empty or no training pair has a finite distance.
+/// O(P log P). Thread-safe.
 ThresholdTransfer LearnAndTest(std::span<const ScoredPair> train, std::span<const ScoredPair> test,
                                Criterion criterion);
 
@@ -63,7 +64,8 @@ struct ThresholdLearningConfig {
 };
 
 /// SplitByQuery at round(train_fraction * scan_count), then LearnAndTest. Throws
-/// core::ConfigError for an invalid config and core::EmptyInputError when a part has no pairs.
+/// core::ConfigError for an invalid config and core::EmptyInputError when a part has no pairs
+/// or the training part no finite distance.
 ThresholdTransfer LearnOnFirstPart(std::span<const ScoredPair> pairs, std::size_t scan_count,
                                    const ThresholdLearningConfig& config);
 

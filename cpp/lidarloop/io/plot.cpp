@@ -2,6 +2,7 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
@@ -37,6 +38,29 @@ void WriteRange(std::ostringstream& script, const char* axis, double min, double
     if (min < max) script << "set " << axis << "range [" << min << ":" << max << "]\n";
 }
 
+bool HasPoints(const PlotSeries& series) { return !series.x.empty() && !series.y.empty(); }
+
+// gnuplot fails on a data block without points, and on a plot with nothing to autoscale on
+// (a results file that never detects anything leaves such curves): plot only the series with
+// points, and give an empty plot fixed ranges and a note instead.
+void WritePlotCommand(std::ostringstream& script, const Plot& plot) {
+    if (std::none_of(plot.series.begin(), plot.series.end(), HasPoints)) {
+        if (!(plot.x_min < plot.x_max))
+            script << (plot.x_log ? "set xrange [1:10]\n" : "set xrange [0:1]\n");
+        if (!(plot.y_min < plot.y_max)) script << "set yrange [0:1]\n";
+        script << "set label 1 'no data' at graph 0.5, graph 0.5 center\nplot NaN notitle\n";
+        return;
+    }
+    const char* separator = "plot ";
+    for (std::size_t s = 0; s < plot.series.size(); ++s) {
+        if (!HasPoints(plot.series[s])) continue;
+        script << separator << "$data" << s << " using 1:2 with " << StyleName(plot.series[s].style)
+               << " title " << Quote(plot.series[s].title);
+        separator = ", ";
+    }
+    script << "\n";
+}
+
 }  // namespace
 
 bool GnuplotAvailable() { return std::system("gnuplot --version > /dev/null 2>&1") == 0; }
@@ -65,13 +89,7 @@ std::string GnuplotScript(const std::filesystem::path& png, const Plot& plot) {
         script << "set arrow from " << x << ", graph 0 to " << x
                << ", graph 1 nohead dt 2 lc rgb 'black'\n";
     }
-    script << "plot ";
-    for (std::size_t s = 0; s < plot.series.size(); ++s) {
-        script << (s > 0 ? ", " : "") << "$data" << s << " using 1:2 with "
-               << StyleName(plot.series[s].style) << " title " << Quote(plot.series[s].title);
-    }
-    if (plot.series.empty()) script << "NaN notitle";
-    script << "\n";
+    WritePlotCommand(script, plot);
     return script.str();
 }
 

@@ -31,8 +31,9 @@ struct Plot {
 bool GnuplotAvailable();
 
 /// Renders `plot` to `png` (1000x700) and keeps the gnuplot script with its data beside it
-/// (`png` with extension .gp) so that a user can restyle the figure. Throws WriteError when
-/// gnuplot is missing or fails.
+/// (`png` with extension .gp) so that a user can restyle the figure. Series without points are
+/// left out; a plot with no points at all is drawn empty, marked "no data". Throws WriteError
+/// when gnuplot is missing or fails.
 void RenderPlot(const std::filesystem::path& png, const Plot& plot);
 
 /// The gnuplot script RenderPlot runs (data inline), for tests and for the .gp file.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <string_view>
 
@@ -59,6 +60,20 @@ std::size_t ParseIndex(const detail::LineReader& reader, std::string_view field,
     return *value;
 }
 
+// A number or +inf (the detector rejects the pair, as if it were left out). -inf would be a
+// loop at every threshold, below even the sweep's "nothing detected" start, so it is refused.
+double ParseDistance(const detail::LineReader& reader, std::string_view field) {
+    const auto distance = detail::ParseDouble(field);
+    if (!distance || std::isnan(*distance)) {
+        reader.Fail("distance '" + std::string(field) + "' is not a number");
+    }
+    if (*distance == -std::numeric_limits<double>::infinity()) {
+        reader.Fail("distance '" + std::string(field) +
+                    "' is -inf; a pair the detector rejects is +inf or left out");
+    }
+    return *distance;
+}
+
 }  // namespace
 
 std::vector<ExternalResult> ReadResultsCsv(const std::filesystem::path& file) {
@@ -78,11 +93,7 @@ std::vector<ExternalResult> ReadResultsCsv(const std::filesystem::path& file) {
         ExternalResult result;
         result.query = ParseIndex(reader, fields[columns.query], "query");
         result.match = ParseIndex(reader, fields[columns.match], "match");
-        const auto distance = detail::ParseDouble(fields[columns.distance]);
-        if (!distance || std::isnan(*distance)) {
-            reader.Fail("distance '" + std::string(fields[columns.distance]) + "' is not a number");
-        }
-        result.distance = *distance;
+        result.distance = ParseDistance(reader, fields[columns.distance]);
         results.push_back(result);
     }
     return results;

@@ -10,13 +10,14 @@ namespace lidarloop::io {
 struct ExternalResult {
     std::size_t query = 0;
     std::size_t match = 0;
-    double distance = 0.0;  ///< smaller = more similar (negate a similarity score first)
+    /// Smaller = more similar (negate a similarity score first); +inf = rejected, never detected
+    double distance = 0.0;
 };
 
 /// Reads a CSV with a header naming at least the columns `query`, `match` and `distance` (in any
 /// order; other columns such as lidarloop's `accepted` are ignored). Indices are scan numbers
 /// from 0. Throws ReadError naming the line for a missing column, a non-number, a negative or
-/// fractional index, or a NaN distance.
+/// fractional index, or a NaN or -inf distance.
 std::vector<ExternalResult> ReadResultsCsv(const std::filesystem::path& file);
 
 }  // namespace lidarloop::io

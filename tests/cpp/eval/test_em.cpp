@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -147,8 +148,30 @@ TEST(Em, RejectsAbsurdConfigsAndSamples) {
     EXPECT_THROW(FitGaussianMixture(equal), core::Error);
     std::vector<double> with_nan{0.1, 0.2, 0.3, std::nan("")};
     EXPECT_THROW(FitGaussianMixture(with_nan), core::Error);
-    const std::vector<double> missing(5, std::numeric_limits<double>::infinity());
-    EXPECT_THROW(EstimateDifferenceThreshold(missing), core::EmptyInputError);
+    EmConfig bad;
+    bad.components = 1;
+    EXPECT_THROW(EstimateDifferenceThreshold(MixtureSample(kTruth, 100, 5), bad),
+                 core::ConfigError);
+}
+
+// A results file that gives few scans a match, or one distance to all of them (a yes/no
+// detector), leaves nothing to fit: no EM threshold, not an error that stops the evaluation.
+TEST(Em, NothingToFitGivesNoThreshold) {
+    const double inf = std::numeric_limits<double>::infinity();
+    const std::vector<std::vector<double>> samples{
+        std::vector<double>(5, inf),           // no scan has a match
+        {0.1, inf, 0.2, inf},                  // two values for three Gaussians
+        {0.0, 0.0, inf, 0.0, 0.0, 0.0, inf}};  // one distance for every match
+    for (const auto& sample : samples) {
+        const DifferenceThreshold result = EstimateDifferenceThreshold(sample);
+        EXPECT_FALSE(result.Fitted());
+        EXPECT_FALSE(result.t_d.has_value());
+        EXPECT_EQ(result.values_used, 0u);
+        EXPECT_EQ(result.values_skipped,
+                  static_cast<std::size_t>(std::count(sample.begin(), sample.end(), inf)));
+    }
+    const std::vector<double> three{0.1, 0.2, 0.9};
+    EXPECT_TRUE(EstimateDifferenceThreshold(three).Fitted());
 }
 
 }  // namespace

@@ -34,10 +34,13 @@ std::vector<ScoredPair> RandomPairs(unsigned seed, std::size_t count, double loo
     return pairs;
 }
 
-// Reference optimum: every distinct distance tried with ConfusionAt, ties to the smallest tau.
+// Reference optimum: every distinct finite distance tried with ConfusionAt, ties to the
+// smallest tau (+inf marks an unscored pair, which no threshold may detect).
 BestThreshold BruteBest(const std::vector<ScoredPair>& pairs, double (*metric)(const Confusion&)) {
     std::set<float> distinct;
-    for (const auto& p : pairs) distinct.insert(p.distance);
+    for (const auto& p : pairs) {
+        if (std::isfinite(p.distance)) distinct.insert(p.distance);
+    }
     BestThreshold best;
     bool have = false;
     for (const float tau : distinct) {
@@ -190,19 +193,85 @@ TEST(Pairwise, ConfusionsAtMatchesConfusionAt) {
     EXPECT_THROW(ConfusionAt(pairs, std::numeric_limits<double>::quiet_NaN()), core::Error);
 }
 
-TEST(Pairwise, MissingScansAreNeverDetectedBelowInfinity) {
-    std::vector<ScoredPair> pairs{{0, 5, 0.1f, true},
-                                  {0, 6, std::numeric_limits<float>::infinity(), true},
-                                  {1, 6, 0.7f, false},
-                                  {2, 7, std::numeric_limits<float>::infinity(), false}};
+TEST(Pairwise, UnscoredPairsAreNeverDetected) {
+    constexpr float kUnscored = std::numeric_limits<float>::infinity();
+    std::vector<ScoredPair> pairs{
+        {0, 5, 0.1f, true}, {0, 6, kUnscored, true}, {1, 6, 0.7f, false}, {2, 7, kUnscored, false}};
     const PairwiseEvaluation result = EvaluatePairs(pairs);
-    EXPECT_EQ(result.distinct_thresholds, 3u);
+    EXPECT_EQ(result.pairs, 4u);
+    EXPECT_EQ(result.distinct_thresholds, 2u);
     EXPECT_EQ(result.best_mcc.threshold, static_cast<double>(0.1f));
     EXPECT_EQ(result.best_mcc.confusion, (Confusion{1, 0, 2, 1}));
-    EXPECT_EQ(result.curve.back().threshold, kInf);
-    EXPECT_EQ(ConfusionAt(pairs, 1e30), (Confusion{1, 1, 1, 1}));
-    // ROC: (0,0) -> (0, 1/2) -> (1/2, 1/2) -> (1, 1): area 1/4 + 3/8.
-    EXPECT_DOUBLE_EQ(*result.roc_auc, 0.625);
+    // The sweep ends at the largest finite distance, short of (1, 1).
+    EXPECT_EQ(result.curve.back().threshold, static_cast<double>(0.7f));
+    EXPECT_EQ(result.curve.back().confusion, (Confusion{1, 1, 1, 1}));
+    for (const double tau : {1e30, kInf})
+        EXPECT_EQ(ConfusionAt(pairs, tau), (Confusion{1, 1, 1, 1}));
+    const std::vector<double> taus{kInf, static_cast<double>(0.1f)};
+    EXPECT_EQ(ConfusionsAt(pairs, taus), (std::vector<Confusion>{{1, 1, 1, 1}, {1, 0, 2, 1}}));
+    // ROC: (0,0) -> (0, 1/2) -> (1/2, 1/2), and no further: the unscored pairs add no area.
+    EXPECT_DOUBLE_EQ(*result.roc_auc, 0.25);
+}
+
+// A detector that lists only two non-loops and omits the three loops: calling everything a loop
+// (tau = +inf) would score F1 3/4 and MCC 0, above any listed distance. Omitted pairs are never
+// detected, so the optimum is a listed distance, worse as it is.
+TEST(Pairwise, OmittedPairsNeverMakeTheBestThresholdInfinite) {
+    constexpr float kOmitted = std::numeric_limits<float>::infinity();
+    std::vector<ScoredPair> pairs{{0, 4, 0.1f, false},
+                                  {1, 5, 0.2f, false},
+                                  {0, 6, kOmitted, true},
+                                  {1, 6, kOmitted, true},
+                                  {2, 6, kOmitted, true}};
+    const PairwiseEvaluation result = EvaluatePairs(pairs);
+    // At 0.1: TP 0, FP 1, TN 1, FN 3: F1 0, MCC -3 / sqrt(1 * 3 * 2 * 4). At 0.2 MCC is -1.
+    EXPECT_EQ(result.best_f1.threshold, static_cast<double>(0.1f));
+    EXPECT_EQ(result.best_f1.score, 0.0);
+    EXPECT_EQ(result.best_mcc.threshold, static_cast<double>(0.1f));
+    EXPECT_DOUBLE_EQ(result.best_mcc.score, -3.0 / std::sqrt(24.0));
+    EXPECT_EQ(result.best_mcc.confusion, (Confusion{0, 1, 1, 3}));
+    for (const CurvePoint& point : result.curve) EXPECT_LT(point.threshold, kInf);
+    EXPECT_EQ(result.curve.back().confusion.tp, 0u);
+}
+
+TEST(Pairwise, WithOmittedPairsTheOptimaEqualBruteForceOverFiniteDistances) {
+    for (const unsigned seed : {7u, 8u, 9u}) {
+        auto pairs = RandomPairs(seed, 3000, 0.3, seed % 2 == 0 ? 30 : 0, 0.2);
+        // Omit most loops (the detector listed only its best candidates).
+        for (std::size_t k = 0; k < pairs.size(); ++k) {
+            if (k % 5 != 0 && (pairs[k].loop || k % 3 == 0)) {
+                pairs[k].distance = std::numeric_limits<float>::infinity();
+            }
+        }
+        PairwiseConfig all_points;
+        all_points.max_curve_points = 0;
+        const PairwiseEvaluation result = EvaluatePairs(pairs, all_points);
+        for (const auto& [actual, metric] :
+             {std::pair{result.best_mcc, &Mcc}, std::pair{result.best_f1, &F1}}) {
+            const BestThreshold expected = BruteBest(pairs, metric);
+            EXPECT_EQ(actual.threshold, expected.threshold) << "seed " << seed;
+            EXPECT_EQ(actual.confusion, expected.confusion);
+        }
+        for (std::size_t k = 1; k < result.curve.size(); ++k) {
+            EXPECT_LT(result.curve[k].threshold, kInf);
+            EXPECT_EQ(result.curve[k].confusion, ConfusionAt(pairs, result.curve[k].threshold));
+        }
+        EXPECT_LT(result.curve.back().tpr, 1.0);
+        EXPECT_EQ(result.curve.back().confusion, ConfusionAt(pairs, kInf));
+    }
+}
+
+TEST(Pairwise, WithoutAFiniteDistanceNothingIsEverDetected) {
+    constexpr float kOmitted = std::numeric_limits<float>::infinity();
+    std::vector<ScoredPair> pairs{{0, 4, kOmitted, true}, {1, 5, kOmitted, false}};
+    const PairwiseEvaluation result = EvaluatePairs(pairs);
+    EXPECT_EQ(result.distinct_thresholds, 0u);
+    ASSERT_EQ(result.curve.size(), 1u);
+    EXPECT_EQ(result.best_f1.threshold, -kInf);
+    EXPECT_EQ(result.best_f1.confusion, (Confusion{0, 0, 1, 1}));
+    EXPECT_EQ(result.best_mcc.score, 0.0);
+    EXPECT_EQ(*result.roc_auc, 0.0);
+    EXPECT_EQ(ConfusionAt(pairs, kInf), (Confusion{0, 0, 1, 1}));
 }
 
 TEST(Pairwise, DegenerateAndBadInputs) {

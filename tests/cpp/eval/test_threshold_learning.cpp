@@ -71,6 +71,30 @@ TEST(ThresholdLearning, LearnOnFirstPart) {
     EXPECT_THROW(LearnAndTest(pairs, {}, Criterion::kMcc), core::EmptyInputError);
 }
 
+// A detector that lists one training loop and omits the other and both non-loops, as a top-1
+// results file does. At +inf (everything a loop) training MCC would be 0 and F1 2/3; an omitted
+// pair is never detected, so the learnt tau is the listed distance, finite.
+TEST(ThresholdLearning, OmittedPairsNeverMakeTheLearntThresholdInfinite) {
+    constexpr float kOmitted = std::numeric_limits<float>::infinity();
+    const std::vector<ScoredPair> train{
+        {0, 3, 0.4f, false}, {1, 3, kOmitted, true}, {0, 4, kOmitted, true}, {2, 4, 0.2f, false}};
+    const std::vector<ScoredPair> test{{0, 5, 0.3f, true}, {1, 5, kOmitted, false}};
+    for (const Criterion criterion : {Criterion::kMcc, Criterion::kF1}) {
+        const ThresholdTransfer row = LearnAndTest(train, test, criterion);
+        // At 0.2: TP 0, FP 1, TN 1, FN 2: MCC -2 / sqrt(1 * 2 * 2 * 3), F1 0; at 0.4 MCC -1.
+        EXPECT_EQ(row.threshold, static_cast<double>(0.2f)) << ToString(criterion);
+        EXPECT_EQ(row.train, (Confusion{0, 1, 1, 2}));
+        EXPECT_EQ(row.test, (Confusion{0, 0, 1, 1}));  // the loop at 0.3 > tau is missed
+    }
+}
+
+TEST(ThresholdLearning, NoFiniteTrainingDistanceLearnsNothing) {
+    constexpr float kOmitted = std::numeric_limits<float>::infinity();
+    const std::vector<ScoredPair> train{{0, 3, kOmitted, true}, {1, 3, kOmitted, false}};
+    const std::vector<ScoredPair> test{{0, 5, 0.3f, true}};
+    EXPECT_THROW(LearnAndTest(train, test, Criterion::kF1), core::EmptyInputError);
+}
+
 TEST(ThresholdLearning, RejectsAbsurdConfigs) {
     for (const double fraction : {0.0, 1.0, -0.5, 2.0, std::numeric_limits<double>::quiet_NaN()}) {
         ThresholdLearningConfig config;

@@ -1,5 +1,6 @@
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -230,6 +231,15 @@ TEST(ResultsCsv, BadFilesNameTheLine) {
     expect("query,match,distance\n1,2.5,0.1\n", "line 2: match '2.5' is not a scan number");
     expect("query,match,distance\n1,2,nan\n", "line 2: distance 'nan' is not a number");
     expect("query,match,distance\n1,2,close\n", "line 2: distance 'close' is not a number");
+    expect("query,match,distance\n1,2,0.1\n3,4,-inf\n", "line 3: distance '-inf' is -inf");
+}
+
+TEST(ResultsCsv, InfinityMeansRejected) {
+    test::TempDir dir;
+    test::WriteFile(dir / "r.csv", "query,match,distance\n3,0,inf\n");
+    const auto results = ReadResultsCsv(dir / "r.csv");
+    ASSERT_EQ(results.size(), 1U);
+    EXPECT_EQ(results[0].distance, std::numeric_limits<double>::infinity());
 }
 
 TEST(Plot, ScriptHoldsDataTitlesAndQuotesEscaped) {
@@ -244,6 +254,35 @@ TEST(Plot, ScriptHoldsDataTitlesAndQuotesEscaped) {
     EXPECT_NE(script.find("$data0 << EOD\n0 0\n0.5 0.9\n1 1\nEOD"), std::string::npos);
     EXPECT_NE(script.find("set arrow from 0.25"), std::string::npos);
     EXPECT_NE(script.find("with lines lw 2 title 'height'"), std::string::npos);
+}
+
+// A results file that never detects anything leaves curves without points; gnuplot fails on
+// an empty data block and on a plot with nothing to autoscale on.
+TEST(Plot, SeriesWithoutPointsAreLeftOut) {
+    Plot plot;
+    plot.series.push_back({"empty", {}, {}, PlotSeries::Style::kSteps});
+    plot.series.push_back({"one", {0.5}, {1.0}, PlotSeries::Style::kSteps});
+    const std::string script = GnuplotScript("out.png", plot);
+    EXPECT_NE(script.find("plot $data1 using 1:2"), std::string::npos) << script;
+    EXPECT_EQ(script.find("title 'empty'"), std::string::npos) << script;
+    plot.series.pop_back();
+    const std::string empty = GnuplotScript("out.png", plot);
+    EXPECT_NE(empty.find("set xrange [0:1]\nset yrange [0:1]\n"), std::string::npos) << empty;
+    EXPECT_NE(empty.find("'no data'"), std::string::npos) << empty;
+    EXPECT_NE(empty.find("plot NaN notitle"), std::string::npos) << empty;
+}
+
+TEST(Plot, RendersAPlotWithoutPoints) {
+    if (!GnuplotAvailable()) GTEST_SKIP() << "gnuplot is not installed (scripts/setup installs it)";
+    test::TempDir dir;
+    Plot plot;
+    plot.title = "nothing detected";
+    plot.series.push_back({"a", {}, {}, PlotSeries::Style::kSteps});
+    plot.series.push_back({"b", {}, {}, PlotSeries::Style::kLines});
+    EXPECT_NO_THROW(RenderPlot(dir / "empty.png", plot));
+    plot.series.clear();
+    EXPECT_NO_THROW(RenderPlot(dir / "none.png", plot));
+    EXPECT_EQ(test::ReadFile(dir / "none.png").substr(1, 3), "PNG");
 }
 
 TEST(Plot, RendersAPngWithGnuplot) {
