@@ -51,7 +51,8 @@ bool AnyVerified(const std::vector<pipeline::LoopQuery>& queries) {
 }
 
 constexpr char kVerificationColumns[] =
-    "tx,ty,tz,qx,qy,qz,qw,overlap_query,overlap_match,rmse_m,shifted_overlap,reason";
+    "tx,ty,tz,qx,qy,qz,qw,overlap_query,overlap_match,distinctive_query,distinctive_match,rmse_m,"
+    "shifted_overlap,reason";
 
 // The verification columns of one candidate: T_match_query (translation in metres, unit
 // quaternion x, y, z, w), the overlap both ways, the RMSE, the degeneracy test's overlap ratio
@@ -66,11 +67,12 @@ void WriteVerification(std::ostream& out, const registration::Verification& v) {
         const Eigen::Quaterniond q(v.T_match_query.rotation());
         out << t.x() << ',' << t.y() << ',' << t.z() << ',' << q.x() << ',' << q.y() << ',' << q.z()
             << ',' << q.w() << ',' << v.overlap.query_fraction << ',' << v.overlap.match_fraction
-            << ',' << v.overlap.rmse_m << ',';
+            << ',' << v.overlap.query_distinctive_fraction << ','
+            << v.overlap.match_distinctive_fraction << ',' << v.overlap.rmse_m << ',';
         if (!std::isnan(v.shifted_overlap_ratio)) out << v.shifted_overlap_ratio;
         out << ',';
     } else {
-        out << ",,,,,,,,,,,";
+        out << ",,,,,,,,,,,,,";
     }
     out << registration::ToString(v.reason);
 }

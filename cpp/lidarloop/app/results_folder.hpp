@@ -38,7 +38,8 @@ void WriteSkipped(const std::filesystem::path& folder, const std::vector<std::st
 /// loops.csv: one row per query scan with a candidate, its best match
 /// (query,match,distance,second_ratio,accepted). Verified queries: the match is the loop (the
 /// first accepted candidate, else the best one), then its rank and verification columns
-/// (rank,tx,ty,tz,qx,qy,qz,qw,overlap_query,overlap_match,rmse_m,shifted_overlap,reason;
+/// (rank,tx,ty,tz,qx,qy,qz,qw,overlap_query,overlap_match,distinctive_query,distinctive_match,rmse_m,
+/// shifted_overlap,reason;
 /// docs/cli.md).
 void WriteLoopsCsv(const std::filesystem::path& file,
                    const std::vector<pipeline::LoopQuery>& queries);

@@ -88,6 +88,9 @@ void VisitFields(registration::ScanReductionConfig& c, Visitor& v) {
     v.Field("normal_neighbors", c.normal_neighbors, "voxel centroids in a normal's fit");
     v.Field("structure_min_tilt_deg", c.structure_min_tilt_deg,
             "structure points: normal at least this far from vertical");
+    v.Field("distinctive_neighbors", c.distinctive_neighbors,
+            "centroids that decide whether a structure point is on a large plane");
+    v.Field("max_plane_variation", c.max_plane_variation, "largest surface variation of a plane");
     v.Field("max_structure_points", c.max_structure_points, "structure points kept per scan");
     v.Field("max_ground_points", c.max_ground_points, "other (ground) points kept per scan");
 }
@@ -120,6 +123,8 @@ void VisitFields(registration::AcceptanceConfig& c, Visitor& v) {
     v.Field("overlap_plane_m", c.overlap_plane_m, "and its plane passes this close");
     v.Field("overlap_range_m", c.overlap_range_m, "only points this close to both sensors count");
     v.Field("min_overlap", c.min_overlap, "share of structure points overlapping, each way");
+    v.Field("min_distinctive_overlap", c.min_distinctive_overlap,
+            "the same for the structure points off large planes");
     v.Field("min_overlapping_points", c.min_overlapping_points, "overlapping points, each way");
     v.Field("max_rmse_ratio", c.max_rmse_ratio,
             "RMS plane distance of the overlap over the scans' own roughness, at most");
@@ -128,6 +133,8 @@ void VisitFields(registration::AcceptanceConfig& c, Visitor& v) {
     v.Field("degeneracy_shift_m", c.degeneracy_shift_m, "shift along the weakest direction");
     v.Field("max_shifted_overlap_ratio", c.max_shifted_overlap_ratio,
             "share of the points pinning that direction still overlapping there, at most");
+    v.Field("max_rival_overlap_ratio", c.max_rival_overlap_ratio,
+            "another pose may reach at most this share of the accepted overlap");
 }
 
 template <typename Visitor>

@@ -80,6 +80,27 @@ LocalPlane PlaneAt(const std::vector<Eigen::Vector3f>& points,
     return {normal, std::sqrt(residual_m2)};
 }
 
+// Whether `point` lies on a large plane: the surface variation of its k nearest centroids.
+bool OnLargePlane(const std::vector<Eigen::Vector3f>& centroids, const PointTree& tree,
+                  const Eigen::Vector3f& point, const ScanReductionConfig& config,
+                  std::vector<std::uint32_t>& neighbors) {
+    tree.Knn(point, config.distinctive_neighbors, neighbors);
+    if (neighbors.size() < 5) return false;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const auto index : neighbors) mean += centroids[index].cast<double>();
+    mean /= static_cast<double>(neighbors.size());
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    for (const auto index : neighbors) {
+        const Eigen::Vector3d d = centroids[index].cast<double>() - mean;
+        covariance += d * d.transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+    solver.computeDirect(covariance, Eigen::EigenvaluesOnly);
+    const Eigen::Vector3d eigenvalues = solver.eigenvalues().cwiseMax(0.0);
+    const double total = eigenvalues.sum();
+    return total > 0.0 && eigenvalues(0) / total <= config.max_plane_variation;
+}
+
 double Median(std::vector<double> values) {
     if (values.empty()) return 0.0;
     const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
@@ -120,7 +141,8 @@ std::size_t SurfacePoints::MemoryBytes() const {
 }
 
 std::size_t PreparedScan::MemoryBytes() const {
-    return (structure ? structure->MemoryBytes() : 0) + (ground ? ground->MemoryBytes() : 0);
+    return (structure ? structure->MemoryBytes() : 0) + (ground ? ground->MemoryBytes() : 0) +
+           structure_distinctive.capacity();
 }
 
 PreparedScan PrepareScan(const core::PointCloud& scan, const ScanReductionConfig& config) {
@@ -145,6 +167,11 @@ PreparedScan PrepareScan(const core::PointCloud& scan, const ScanReductionConfig
     prepared.structure_roughness_m = Median(std::move(structure_residuals_m));
     Subsample(structure, structure_normals, config.max_structure_points);
     Subsample(ground, ground_normals, config.max_ground_points);
+    prepared.structure_distinctive.reserve(structure.size());
+    for (const auto& point : structure) {
+        prepared.structure_distinctive.push_back(
+            OnLargePlane(centroids, tree, point, config, neighbors) ? 0 : 1);
+    }
     prepared.structure =
         std::make_shared<const SurfacePoints>(std::move(structure), std::move(structure_normals));
     prepared.ground =

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -48,6 +49,10 @@ struct PreparedScan {
     /// rough the scan's own surfaces are at this voxel size (sensor noise, vegetation). A pair's
     /// fit is judged against it (AcceptanceConfig::max_rmse_ratio).
     double structure_roughness_m = 0.0;
+    /// Per structure point: 1 when it is distinctive, i.e. not part of a large plane (a wall, a
+    /// facade) at the scale of distinctive_neighbors voxels; poles, trunks, cars, door leaves,
+    /// corners. Walls look alike in every street and corridor; these tell places apart.
+    std::vector<std::uint8_t> structure_distinctive;
 
     /// Heap bytes held by the prepared scan (the figure bench reports per stored scan).
     std::size_t MemoryBytes() const;

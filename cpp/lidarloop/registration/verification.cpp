@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <vector>
 
 #include <Eigen/Eigenvalues>
@@ -48,24 +49,29 @@ bool InView(const Eigen::Vector3f& point, const Eigen::Vector3f& moved, float ra
 struct OneWay {
     std::size_t in_view = 0;
     std::size_t overlapping = 0;
+    std::size_t distinctive_in_view = 0;
+    std::size_t distinctive_overlapping = 0;
     double squared_sum_m2 = 0.0;
     std::vector<std::uint32_t> overlapping_points;        // indices in `from`
     std::vector<Eigen::Vector2f> overlapping_partner_xy;  // horizontal part of partner normals
 };
 
-OneWay OverlapOneWay(const SurfacePoints& from, const SurfacePoints& onto,
-                     const Eigen::Isometry3f& T_onto_from, const AcceptanceConfig& config,
-                     bool keep_points) {
+OneWay OverlapOneWay(const SurfacePoints& from, const std::vector<std::uint8_t>& distinctive,
+                     const SurfacePoints& onto, const Eigen::Isometry3f& T_onto_from,
+                     const AcceptanceConfig& config, bool keep_points) {
     OneWay result;
     const auto range_m = static_cast<float>(config.overlap_range_m);
     for (std::size_t i = 0; i < from.size(); ++i) {
         const Eigen::Vector3f moved = T_onto_from * from.points()[i];
         if (!InView(from.points()[i], moved, range_m)) continue;
+        const bool is_distinctive = i < distinctive.size() && distinctive[i] != 0;
         ++result.in_view;
+        result.distinctive_in_view += is_distinctive ? 1 : 0;
         const SurfaceHit hit =
             HitOnSurface(moved, T_onto_from.linear() * from.normals()[i], onto, config);
         if (!hit.on_surface) continue;
         ++result.overlapping;
+        result.distinctive_overlapping += is_distinctive ? 1 : 0;
         result.squared_sum_m2 += static_cast<double>(hit.distance_m) * hit.distance_m;
         if (keep_points) {
             result.overlapping_points.push_back(static_cast<std::uint32_t>(i));
@@ -154,7 +160,8 @@ RejectReason Judge(const PreparedScan& query, const PreparedScan& match,
     const Overlap& overlap = verification.overlap;
     if (!converged) return RejectReason::kNotConverged;
     if (overlap.query_overlapping < min_points || overlap.match_overlapping < min_points ||
-        overlap.Min() < config.min_overlap) {
+        overlap.Min() < config.min_overlap ||
+        overlap.MinDistinctive() < config.min_distinctive_overlap) {
         return RejectReason::kLowOverlap;
     }
     if (overlap.rmse_m > AllowedRmse(query, match, config)) return RejectReason::kHighRmse;
@@ -181,6 +188,33 @@ Verification RegisterFrom(const PreparedScan& query, const PreparedScan& match,
     return result;
 }
 
+// Two registered poses that are the same solution: within 1 m and 5 degrees.
+bool SamePose(const core::Transform& a, const core::Transform& b) {
+    const core::Transform difference = a.inverse() * b;
+    return difference.translation().norm() < 1.0 &&
+           Eigen::AngleAxisd(difference.linear()).angle() < 5.0 * std::numbers::pi / 180.0;
+}
+
+// Whether a pose other than the accepted one also fits: ICP from every other hypothesis, and a
+// rival is a different pose whose overlap reaches max_rival_overlap_ratio of the accepted one
+// within the allowed RMSE. Periodic places (rows of trees, identical corridors) have rivals.
+bool HasRivalPose(const PreparedScan& query, const PreparedScan& match,
+                  const std::vector<PlanarHypothesis>& hypotheses, std::size_t accepted_index,
+                  const Verification& accepted, const VerificationConfig& config) {
+    for (std::size_t j = 0; j < hypotheses.size(); ++j) {
+        if (j == accepted_index) continue;
+        const IcpResult icp =
+            RefinePointToPlane(query, match, PlanarPose(hypotheses[j]), config.icp);
+        if (icp.abandoned || SamePose(icp.T_match_query, accepted.T_match_query)) continue;
+        const Overlap overlap = MeasureOverlap(query, match, icp.T_match_query, config.acceptance);
+        if (overlap.Min() >= config.acceptance.max_rival_overlap_ratio * accepted.overlap.Min() &&
+            overlap.rmse_m <= AllowedRmse(query, match, config.acceptance)) {
+            return true;
+        }
+    }
+    return false;
+}
+
 }  // namespace
 
 std::string ToString(RejectReason reason) {
@@ -199,6 +233,8 @@ std::string ToString(RejectReason reason) {
             return "high_rmse";
         case RejectReason::kDegenerate:
             return "degenerate";
+        case RejectReason::kAmbiguous:
+            return "ambiguous";
         case RejectReason::kPruned:
             return "pruned";
     }
@@ -208,12 +244,17 @@ std::string ToString(RejectReason reason) {
 Overlap MeasureOverlap(const PreparedScan& query, const PreparedScan& match,
                        const core::Transform& T_match_query, const AcceptanceConfig& config) {
     const Eigen::Isometry3f T = T_match_query.cast<float>();
-    const OneWay forward = OverlapOneWay(*query.structure, *match.structure, T, config, true);
-    const OneWay backward =
-        OverlapOneWay(*match.structure, *query.structure, T.inverse(), config, false);
+    const OneWay forward = OverlapOneWay(*query.structure, query.structure_distinctive,
+                                         *match.structure, T, config, true);
+    const OneWay backward = OverlapOneWay(*match.structure, match.structure_distinctive,
+                                          *query.structure, T.inverse(), config, false);
     Overlap overlap;
     overlap.query_fraction = Fraction(forward.overlapping, forward.in_view);
     overlap.match_fraction = Fraction(backward.overlapping, backward.in_view);
+    overlap.query_distinctive_fraction =
+        Fraction(forward.distinctive_overlapping, forward.distinctive_in_view);
+    overlap.match_distinctive_fraction =
+        Fraction(backward.distinctive_overlapping, backward.distinctive_in_view);
     overlap.query_overlapping = forward.overlapping;
     overlap.match_overlapping = backward.overlapping;
     const std::size_t both = forward.overlapping + backward.overlapping;
@@ -236,11 +277,17 @@ Verification Verify(const PreparedScan& query, const CoarseQuery& coarse, const 
         best.reason = RejectReason::kNoAlignment;
         return best;
     }
-    // Hypotheses in order of coarse score; the first that passes is the answer, else the one
-    // that overlapped best explains the rejection.
+    // Hypotheses in order of coarse score; the first that passes is the answer unless another
+    // fits about as well, else the one that overlapped best explains the rejection.
     for (std::size_t i = 0; i < hypotheses.size(); ++i) {
         Verification trial = RegisterFrom(query, match, hypotheses[i], config);
-        if (trial.accepted) return trial;
+        if (trial.accepted) {
+            if (HasRivalPose(query, match, hypotheses, i, trial, config)) {
+                trial.accepted = false;
+                trial.reason = RejectReason::kAmbiguous;
+            }
+            return trial;
+        }
         if (i == 0 || trial.overlap.Min() > best.overlap.Min()) best = trial;
     }
     return best;

@@ -20,17 +20,21 @@ enum class RejectReason {
     kLowOverlap,    ///< too few structure points of one scan lie on the other's surfaces
     kHighRmse,      ///< the overlapping points sit too far from the other scan's planes
     kDegenerate,    ///< sliding along the weakest direction fits as well (street, corridor)
+    kAmbiguous,     ///< another, distinct pose fits about as well (periodic structure)
     kPruned,        ///< not registered: the descriptor distance failed the threshold set
 };
 
 /// "none", "too_few_points", "no_alignment", "not_converged", "low_overlap", "high_rmse",
-/// "degenerate", "pruned": the spelling of loops.csv and `lidarloop verify`.
+/// "degenerate", "ambiguous", "pruned": the spelling of loops.csv and `lidarloop verify`.
 std::string ToString(RejectReason reason);
 
 /// How well a query sits on a match at a pose (registration::MeasureOverlap).
 struct Overlap {
     double query_fraction = 0.0;  ///< query structure points on match surfaces / those in view
     double match_fraction = 0.0;  ///< the same, the other way
+    /// The same over the distinctive structure points only (PreparedScan::structure_distinctive).
+    double query_distinctive_fraction = 0.0;
+    double match_distinctive_fraction = 0.0;
     std::size_t query_overlapping = 0;
     std::size_t match_overlapping = 0;
     double rmse_m = 0.0;  ///< RMS plane distance of the overlapping points, both ways
@@ -43,6 +47,9 @@ struct Overlap {
     double shifted_overlap_ratio = 1.0;
 
     double Min() const { return std::min(query_fraction, match_fraction); }
+    double MinDistinctive() const {
+        return std::min(query_distinctive_fraction, match_distinctive_fraction);
+    }
 };
 
 /// The verdict on one candidate pair.

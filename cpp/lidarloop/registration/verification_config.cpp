@@ -32,6 +32,8 @@ void ScanReductionConfig::Validate() const {
     RequireIn(voxel_m, 0.05, 10.0, "reduction.voxel_m");
     RequireIn(normal_neighbors, 5, 100, "reduction.normal_neighbors");
     RequireIn(structure_min_tilt_deg, 0.0, 90.0, "reduction.structure_min_tilt_deg");
+    RequireIn(distinctive_neighbors, 5, 500, "reduction.distinctive_neighbors");
+    RequireIn(max_plane_variation, 0.0, 1.0 / 3.0, "reduction.max_plane_variation");
     RequireIn(max_structure_points, 10, 1'000'000, "reduction.max_structure_points");
     RequireIn(max_ground_points, 10, 1'000'000, "reduction.max_ground_points");
 }
@@ -62,12 +64,14 @@ void AcceptanceConfig::Validate() const {
     RequireIn(overlap_plane_m, 0.001, overlap_radius_m, "acceptance.overlap_plane_m");
     RequireIn(overlap_range_m, 1.0, 1000.0, "acceptance.overlap_range_m");
     RequireIn(min_overlap, 0.0, 1.0, "acceptance.min_overlap");
+    RequireIn(min_distinctive_overlap, 0.0, 1.0, "acceptance.min_distinctive_overlap");
     RequireIn(min_overlapping_points, 1, 1'000'000, "acceptance.min_overlapping_points");
     RequireIn(max_rmse_ratio, 0.0, 1000.0, "acceptance.max_rmse_ratio");
     RequireIn(min_allowed_rmse_m, 0.0, 100.0, "acceptance.min_allowed_rmse_m");
     RequireIn(max_rmse_m, std::max(0.001, min_allowed_rmse_m), 100.0, "acceptance.max_rmse_m");
     RequireIn(degeneracy_shift_m, 0.0, 100.0, "acceptance.degeneracy_shift_m");
     RequireIn(max_shifted_overlap_ratio, 0.0, 1.0, "acceptance.max_shifted_overlap_ratio");
+    RequireIn(max_rival_overlap_ratio, 0.0, 10.0, "acceptance.max_rival_overlap_ratio");
 }
 
 void VerificationConfig::Validate() const {

@@ -12,6 +12,11 @@ struct ScanReductionConfig {
     /// A point is "structure" (distinguishes places) when its normal is at least this far from
     /// vertical, degrees: walls, poles, trunks, parked cars. The ground and roofs are not.
     double structure_min_tilt_deg = 45.0;
+    /// Neighbours (voxel centroids, about 1.5 m around at 0.5 m voxels) that decide whether a
+    /// structure point lies on a large plane, and the largest surface variation
+    /// lambda0 / (lambda0 + lambda1 + lambda2) of such a plane.
+    int distinctive_neighbors = 30;
+    double max_plane_variation = 0.01;
     /// Structure points kept at most (a uniform subsample beyond), bounds registration time.
     int max_structure_points = 3000;
     /// Other points (mostly ground; they fix z, roll and pitch) kept at most.
@@ -29,7 +34,7 @@ struct CoarseConfig {
     int grid_cells = 64;              ///< image edge in cells, a power of two in [16, 1024]
     double yaw_step_deg = 5.0;        ///< yaw search step, degrees, (0, 45]
     double max_translation_m = 25.0;  ///< largest planar offset searched, metres, > 0
-    int hypotheses = 2;               ///< best (yaw, translation) peaks refined by ICP, 1..16
+    int hypotheses = 3;               ///< best (yaw, translation) peaks refined by ICP, 1..16
 
     void Validate() const;
     bool operator==(const CoarseConfig&) const = default;
@@ -69,6 +74,9 @@ struct AcceptanceConfig {
     double overlap_range_m = 40.0;
     /// Smallest overlap of structure points, each way (query -> match and match -> query).
     double min_overlap = 0.35;
+    /// Smallest overlap of the distinctive structure points (not on large planes), each way:
+    /// walls align in every street and corridor, the details of a place only at the place.
+    double min_distinctive_overlap = 0.0;
     /// Structure points that overlap, at least, each way: a handful of matched points proves
     /// nothing whatever the fraction.
     int min_overlapping_points = 80;
@@ -86,6 +94,11 @@ struct AcceptanceConfig {
     /// not pin the position (a straight street, a corridor, an open field).
     double degeneracy_shift_m = 2.0;
     double max_shifted_overlap_ratio = 0.5;
+    /// Ambiguity test: ICP from the other coarse hypotheses; a pose at least 1 m or 5 degrees
+    /// from the accepted one whose overlap reaches this share of the accepted overlap (within
+    /// the allowed RMSE) makes the place ambiguous: periodic structure, rows of trees, identical
+    /// corridors.
+    double max_rival_overlap_ratio = 0.8;
 
     void Validate() const;
     bool operator==(const AcceptanceConfig&) const = default;

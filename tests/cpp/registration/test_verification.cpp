@@ -152,6 +152,7 @@ TEST(Verification, ReasonsHaveStableNames) {
     EXPECT_EQ(ToString(RejectReason::kLowOverlap), "low_overlap");
     EXPECT_EQ(ToString(RejectReason::kHighRmse), "high_rmse");
     EXPECT_EQ(ToString(RejectReason::kDegenerate), "degenerate");
+    EXPECT_EQ(ToString(RejectReason::kAmbiguous), "ambiguous");
     EXPECT_EQ(ToString(RejectReason::kPruned), "pruned");
 }
 
