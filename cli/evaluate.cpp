@@ -1,3 +1,4 @@
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -97,6 +98,22 @@ std::optional<io::Dataset> TrainingDataset(const EvaluateFlags& flags) {
     return io::OpenDataset(flags.train_on, options);
 }
 
+void PrintLoops(const std::string& label, const eval::LoopRetrievalEvaluation& r) {
+    std::cout << "      " << label << ": " << r.true_loops << " true and " << r.false_loops
+              << " false loops, recall at 100 % precision "
+              << 100.0 * (std::isnan(r.full_precision.recall) ? 0.0 : r.full_precision.recall)
+              << " %\n";
+}
+
+// The online detector's figures: the candidates' ceiling, then each decision rule.
+void PrintRetrieval(const app::RetrievalComparison& r) {
+    std::cout << "    top-" << r.top_k << " candidates of " << r.descriptor.revisiting
+              << " revisiting scans: recall@1 " << 100.0 * r.descriptor.recall_at_1 << " %, recall@"
+              << r.top_k << " " << 100.0 * r.descriptor.recall_at_k << " %\n";
+    PrintLoops("descriptor threshold", r.descriptor);
+    if (r.verified) PrintLoops("verified", *r.verified);
+}
+
 void PrintOutcome(const io::Dataset& dataset, const app::EvaluationOutcome& outcome,
                   const std::filesystem::path& out) {
     std::cout << "lidarloop evaluate: " << dataset.size() << " scans, " << outcome.truth.Describe()
@@ -105,6 +122,7 @@ void PrintOutcome(const io::Dataset& dataset, const app::EvaluationOutcome& outc
         std::cout << "  " << e.name << ": best MCC " << e.pairwise.best_mcc.score << " (tau "
                   << e.pairwise.best_mcc.threshold << "), best F1 " << e.pairwise.best_f1.score
                   << ", recall at zero errors " << 100.0 * e.per_scan.zero_error.recall << " %\n";
+        if (e.retrieval) PrintRetrieval(*e.retrieval);
     }
     for (const std::string& note : outcome.notes) std::cout << "  note: " << note << "\n";
     std::cout << "  report: " << (out / "report.md").string() << "\n";
@@ -126,7 +144,7 @@ void AddGroundTruthFlags(CLI::App& command, EvaluateFlags& flags) {
                        "same place when closer than this, metres (Roehling 10, Magnusson 3-10)");
     command.add_option("--max-heading", flags.max_heading_deg,
                        "and headings differ by less than this, degrees (0: any; Kvarntorp 20)");
-    flags.detection.AddTo(command, /*decides_loops=*/false,
+    flags.detection.AddTo(command, /*decides_loops=*/true,
                           "S: pairs closer in the sequence are not evaluated");
 }
 

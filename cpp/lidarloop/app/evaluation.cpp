@@ -86,20 +86,31 @@ TrainingPairs TrainingPairsOf(const EvaluationRequest& request,
             eval::CollectPairs(matrix.condensed(), truth)};
 }
 
+// Scans prepared for verification once per evaluation: while the first method describes them.
+struct VerificationState {
+    std::optional<PreparedScans> prepared;
+    bool collected = false;
+    pipeline::VerificationCache cache;
+};
+
 MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method method,
                                 const io::Dataset& dataset, const eval::GroundTruth& truth,
-                                const io::Dataset* train_dataset) {
+                                const io::Dataset* train_dataset, VerificationState& verification) {
     io::RunConfig config = request.config;
     config.descriptor.method = method;
     std::optional<TrainingPairs> training;
     if (train_dataset != nullptr)
         training = TrainingPairsOf(request, config.descriptor, *train_dataset);
-    const auto described = DescribeDataset(dataset, config.descriptor,
-                                           {"describing (" + core::ToString(method) + ")",
-                                            request.skip_bad,
-                                            pipeline::Execution::kParallel,
-                                            request.progress,
-                                            {}});
+    DescribeRun run{"describing (" + core::ToString(method) + ")",
+                    request.skip_bad,
+                    pipeline::Execution::kParallel,
+                    request.progress,
+                    {}};
+    if (verification.prepared && !verification.collected) {
+        run.with_cloud = verification.prepared->Collector(config.detection.verification.reduction);
+        verification.collected = true;
+    }
+    const auto described = DescribeDataset(dataset, config.descriptor, run);
     Stopwatch matrix_clock;
     pipeline::SimilarityMatrix matrix = pipeline::ComputeSimilarityMatrix(described.database);
     const double matrix_s = matrix_clock.Seconds();
@@ -109,6 +120,10 @@ MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method m
                                         request.fixed_thresholds, training ? &*training : nullptr);
     e.describe_ms_per_scan_median = 1e3 * Quantile(described.describe_seconds, 0.5);
     e.ns_per_comparison = pairs > 0 ? 1e9 * matrix_s / pairs : 0.0;
+    e.retrieval =
+        CompareRetrieval(e.matrix, described.database.times_s(), config.detection, method, truth,
+                         dataset.poses(), verification.prepared ? &*verification.prepared : nullptr,
+                         &verification.cache, request.progress);
     return e;
 }
 
@@ -188,9 +203,11 @@ EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequ
         eval::BuildGroundTruth(dataset.poses(), GroundTruthRule(request)), {}, {}};
     const std::filesystem::path out_dir = PrepareOutputFolder(request.out);
     io::WriteConfigYaml(out_dir / "config.yaml", request.config);
+    VerificationState verification;
+    if (request.config.detection.verify) verification.prepared.emplace(dataset.size());
     for (core::Method method : request.methods) {
         outcome.methods.push_back(
-            EvaluateMethod(request, method, dataset, outcome.truth, train_dataset));
+            EvaluateMethod(request, method, dataset, outcome.truth, train_dataset, verification));
     }
     for (const std::string& file : request.results_files) {
         outcome.methods.push_back(

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "lidarloop/app/progress.hpp"
+#include "lidarloop/app/retrieval_evaluation.hpp"
 #include "lidarloop/eval/em.hpp"
 #include "lidarloop/eval/ground_truth.hpp"
 #include "lidarloop/eval/pairwise.hpp"
@@ -36,6 +37,8 @@ struct MethodEvaluation {
     std::vector<double> smallest_differences;
     eval::DifferenceThreshold em;  ///< fig. 2
     eval::DistinctivenessSummary distinctiveness;
+    /// The online detector's top-k candidates, descriptor alone and verified (methods only).
+    std::optional<RetrievalComparison> retrieval;
     double describe_ms_per_scan_median = 0.0;
     double ns_per_comparison = 0.0;
 };
@@ -87,10 +90,13 @@ eval::GroundTruthConfig GroundTruthRule(const EvaluationRequest& request);
 
 /// Evaluates every method and results file on one ground truth from the dataset's poses and
 /// writes config.yaml, metrics.json, roc.csv, pr.csv, the images and figures and report.md into
-/// request.out. With `train_dataset` (which needs poses too), each method's threshold is learnt
-/// on all its pairs under the same ground-truth rule and tested on all pairs of `dataset`;
-/// results files keep learning on the first part. ConfigError when a dataset has no poses, or
-/// when config.detection.threshold is set and more than one method is evaluated.
+/// request.out. Every method's top-k candidates (config.detection) are also scored as the
+/// online detector reports them, and with config.detection.verify after geometric verification
+/// (each scan prepared once, each pair registered once for all methods). With `train_dataset`
+/// (which needs poses too), each method's threshold is learnt on all its pairs under the same
+/// ground-truth rule and tested on all pairs of `dataset`; results files keep learning on the first
+/// part. ConfigError when a dataset has no poses, or when config.detection.threshold is set and
+/// more than one method is evaluated.
 EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequest& request,
                                 const io::Dataset* train_dataset = nullptr);
 

@@ -1,5 +1,6 @@
 #include "lidarloop/app/evaluation_report.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -225,6 +226,49 @@ void WritePerScanTable(std::ostream& out, const std::vector<MethodEvaluation>& e
     }
 }
 
+std::string Percent(double rate) {
+    return std::isnan(rate) ? std::string("–") : Number(100.0 * rate, 3) + " %";
+}
+
+std::string MedianMax(const std::optional<eval::Summary>& s, int digits) {
+    if (!s) return "–";
+    return Number(s->median, digits) + " / " + Number(s->max, digits);
+}
+
+void WriteRetrievalRow(std::ostream& out, const std::string& name, const std::string& decision,
+                       const eval::LoopRetrievalEvaluation& r) {
+    out << "| " << name << " | " << decision << " | " << Percent(r.recall_at_1) << " | "
+        << Percent(r.recall_at_k) << " | " << r.true_loops << " / " << r.false_loops << " | "
+        << Percent(r.precision) << " | " << Percent(r.recall) << " | "
+        << Percent(r.full_precision.recall) << " | " << MedianMax(r.pose_error.translation_m, 3)
+        << " | " << MedianMax(r.pose_error.yaw_deg, 3) << " |\n";
+}
+
+void WriteRetrievalTable(std::ostream& out, const std::vector<MethodEvaluation>& evaluations) {
+    const auto with =
+        std::find_if(evaluations.begin(), evaluations.end(),
+                     [](const MethodEvaluation& e) { return e.retrieval.has_value(); });
+    if (with == evaluations.end()) return;
+    out << "\n\n## Loops as the online detector reports them: the descriptor alone and verified "
+           "(k = "
+        << with->retrieval->top_k
+        << " candidates per scan)\n\n"
+           "| method | decided by | recall@1 | recall@k | true / false loops | precision | "
+           "recall | recall at 100 % precision | pose error (m), median / max | yaw error "
+           "(deg), median / max |\n|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const MethodEvaluation& e : evaluations) {
+        if (!e.retrieval) continue;
+        WriteRetrievalRow(out, e.name, "descriptor threshold", e.retrieval->descriptor);
+        if (e.retrieval->verified)
+            WriteRetrievalRow(out, e.name, "verification", *e.retrieval->verified);
+    }
+    out << "\nRecall is over the " << with->retrieval->descriptor.revisiting
+        << " revisiting scans (a true loop among the earlier scans outside the gap). recall@k "
+           "is the ceiling of verification: it only decides among the candidates. A scan's loop "
+           "is its first accepted candidate; pose errors are of the true loops against the "
+           "ground-truth relative pose.";
+}
+
 void WriteFigureGallery(std::ostream& out, const std::vector<MethodEvaluation>& evaluations) {
     out << "\n\n## Similarity matrices (black: pairs under the best-MCC threshold; grey: inside "
            "the minimum gap, not evaluated)\n\n| ground truth |";
@@ -300,6 +344,7 @@ void WriteReport(const std::filesystem::path& folder, const ReportContext& conte
     WritePairwiseTable(out, evaluations);
     WriteFixedThresholdTable(out, evaluations);
     WritePerScanTable(out, evaluations);
+    WriteRetrievalTable(out, evaluations);
     WriteFigureGallery(out, evaluations);
     for (const std::string& note : notes) out << "Note: " << note << "\n\n";
     if (!out) throw io::WriteError(folder / "report.md", "writing failed");

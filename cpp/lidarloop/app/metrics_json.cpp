@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "lidarloop/app/results_folder.hpp"
+
 namespace lidarloop::app {
 namespace {
 
@@ -68,6 +70,48 @@ void AddPerScanFigures(const MethodEvaluation& e, nlohmann::json& json) {
     }
 }
 
+nlohmann::json DistributionJson(const std::optional<eval::Summary>& s) {
+    if (!s) return nullptr;
+    return {{"median", s->median}, {"p95", s->p95}, {"max", s->max}, {"mean", s->mean}};
+}
+
+// NaN (an undefined rate: no denominator) is written as null.
+nlohmann::json Rate(double value) { return Finite(value); }
+
+nlohmann::json RetrievalJson(const eval::LoopRetrievalEvaluation& r) {
+    const eval::PoseErrorSummary& pose = r.pose_error;
+    return {{"queries", r.queries},
+            {"revisiting_scans", r.revisiting},
+            {"recall_at_1", Rate(r.recall_at_1)},
+            {"recall_at_k", Rate(r.recall_at_k)},
+            {"true_loops", r.true_loops},
+            {"false_loops", r.false_loops},
+            {"precision", Rate(r.precision)},
+            {"recall", Rate(r.recall)},
+            {"recall_at_full_precision", Rate(r.full_precision.recall)},
+            {"pose_error",
+             {{"loops", pose.count},
+              {"translation_m", DistributionJson(pose.translation_m)},
+              {"planar_m", DistributionJson(pose.planar_m)},
+              {"yaw_deg", DistributionJson(pose.yaw_deg)},
+              {"rotation_deg", DistributionJson(pose.rotation_deg)}}}};
+}
+
+void AddRetrieval(const MethodEvaluation& e, nlohmann::json& json) {
+    if (!e.retrieval) return;
+    const RetrievalComparison& r = *e.retrieval;
+    json["retrieval"]["k"] = r.top_k;
+    json["retrieval"]["descriptor"] = RetrievalJson(r.descriptor);
+    if (r.verified) {
+        json["retrieval"]["verified"] = RetrievalJson(*r.verified);
+        const auto ms = [](const std::vector<double>& seconds) {
+            return SummaryJson(seconds, 1e3);
+        };
+        json["retrieval"]["verify_ms_per_pair"] = ms(r.verification_times.pair_seconds);
+        json["retrieval"]["pairs_registered"] = r.verification_times.pair_seconds.size();
+    }
+}
+
 }  // namespace
 
 nlohmann::json MetricsJson(const MethodEvaluation& e) {
@@ -90,6 +134,7 @@ nlohmann::json MetricsJson(const MethodEvaluation& e) {
     json["at_best_f1"] = ConfusionJson(p.best_f1.confusion);
     AddThresholdRows(e, json);
     AddPerScanFigures(e, json);
+    AddRetrieval(e, json);
     json["describe_ms_per_scan_median"] = e.describe_ms_per_scan_median;
     json["ns_per_comparison"] = e.ns_per_comparison;
     return json;

@@ -1,6 +1,9 @@
 #include "lidarloop/app/verification_run.hpp"
 
+#include <cmath>
+
 #include "lidarloop/app/results_folder.hpp"
+#include "lidarloop/io/scan_reader.hpp"
 
 namespace lidarloop::app {
 
@@ -24,12 +27,13 @@ std::vector<double> PreparedScans::BytesPerScan() const {
 pipeline::VerificationTimes VerifyAll(std::vector<pipeline::LoopQuery>& queries,
                                       const PreparedScans& prepared,
                                       const pipeline::DetectorConfig& detector,
-                                      const core::Method& method, const Progress& progress) {
+                                      const core::Method& method, const Progress& progress,
+                                      pipeline::VerificationCache* cache) {
     std::function<void(std::size_t, std::size_t)> tell;
     if (progress)
         tell = [&progress](std::size_t done, std::size_t n) { progress("verifying", done, n); };
     return pipeline::VerifyQueries(queries, prepared.scans, detector, method,
-                                   pipeline::Execution::kParallel, tell);
+                                   pipeline::Execution::kParallel, tell, cache);
 }
 
 nlohmann::json VerificationTimingsJson(const PreparedScans& prepared,
@@ -41,6 +45,60 @@ nlohmann::json VerificationTimingsJson(const PreparedScans& prepared,
     json["coarse_images_ms_per_query"] = ms(times.query_seconds);
     json["verify_ms_per_pair"] = ms(times.pair_seconds);
     json["pairs_verified"] = times.pair_seconds.size();
+    return json;
+}
+
+PairVerification VerifyScanFiles(const std::filesystem::path& query_file,
+                                 const std::filesystem::path& match_file,
+                                 const registration::VerificationConfig& config) {
+    config.Validate();
+    const core::PointCloud query = io::ReadScan(query_file);
+    const core::PointCloud match = io::ReadScan(match_file);
+    PairVerification result;
+    result.query_points = query.size();
+    result.match_points = match.size();
+    const Stopwatch prepare_clock;
+    const registration::PreparedScan prepared_query =
+        registration::PrepareScan(query, config.reduction);
+    const registration::PreparedScan prepared_match =
+        registration::PrepareScan(match, config.reduction);
+    result.prepare_ms = 1e3 * prepare_clock.Seconds();
+    const Stopwatch verify_clock;
+    if (prepared_query.structure) {
+        const registration::CoarseQuery coarse(*prepared_query.structure, config.coarse);
+        result.verdict = registration::Verify(prepared_query, coarse, prepared_match, config);
+    } else {
+        result.verdict.reason = registration::RejectReason::kTooFewPoints;
+    }
+    result.verify_ms = 1e3 * verify_clock.Seconds();
+    return result;
+}
+
+nlohmann::json VerificationJson(const registration::Verification& verdict) {
+    const registration::Overlap& overlap = verdict.overlap;
+    nlohmann::json matrix = nlohmann::json::array();
+    const Eigen::Matrix4d T = verdict.T_match_query.matrix();
+    for (int row = 0; row < 4; ++row) {
+        matrix.push_back({T(row, 0), T(row, 1), T(row, 2), T(row, 3)});
+    }
+    nlohmann::json json;
+    json["accepted"] = verdict.accepted;
+    json["reason"] = registration::ToString(verdict.reason);
+    json["T_match_query"] = matrix;
+    json["overlap"] = overlap.Min();
+    json["overlap_query"] = overlap.query_fraction;
+    json["overlap_match"] = overlap.match_fraction;
+    json["distinctive_overlap"] = overlap.MinDistinctive();
+    json["distinctive_overlap_query"] = overlap.query_distinctive_fraction;
+    json["distinctive_overlap_match"] = overlap.match_distinctive_fraction;
+    json["overlapping_points_query"] = overlap.query_overlapping;
+    json["overlapping_points_match"] = overlap.match_overlapping;
+    json["rmse_m"] = overlap.rmse_m;
+    json["shifted_overlap"] = std::isnan(verdict.shifted_overlap_ratio)
+                                  ? nlohmann::json(nullptr)
+                                  : nlohmann::json(verdict.shifted_overlap_ratio);
+    json["coarse_score"] = verdict.coarse_score;
+    json["icp_iterations"] = verdict.icp_iterations;
     return json;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <filesystem>
 #include <functional>
 #include <vector>
 
@@ -10,6 +11,7 @@
 #include "lidarloop/core/point_cloud.hpp"
 #include "lidarloop/pipeline/candidate_verification.hpp"
 #include "lidarloop/registration/prepared_scan.hpp"
+#include "lidarloop/registration/verification.hpp"
 
 namespace lidarloop::app {
 
@@ -32,11 +34,32 @@ struct PreparedScans {
 pipeline::VerificationTimes VerifyAll(std::vector<pipeline::LoopQuery>& queries,
                                       const PreparedScans& prepared,
                                       const pipeline::DetectorConfig& detector,
-                                      const core::Method& method, const Progress& progress);
+                                      const core::Method& method, const Progress& progress,
+                                      pipeline::VerificationCache* cache = nullptr);
 
 /// The figures of a verification run for timings.json: per scan preparation (ms) and memory
 /// (bytes), per query coarse images (ms), per candidate pair (ms), counts.
 nlohmann::json VerificationTimingsJson(const PreparedScans& prepared,
                                        const pipeline::VerificationTimes& times);
+
+/// What `lidarloop verify` computed for one pair of scan files.
+struct PairVerification {
+    registration::Verification verdict;
+    std::size_t query_points = 0;  ///< points read from each file
+    std::size_t match_points = 0;
+    double prepare_ms = 0.0;  ///< preparing both scans
+    double verify_ms = 0.0;   ///< coarse search, ICP and acceptance
+};
+
+/// Reads two scan files (io::ReadScan; errors name the file) and verifies the first as the
+/// query against the second (registration::Verify). Validates `config` (core::ConfigError).
+PairVerification VerifyScanFiles(const std::filesystem::path& query_file,
+                                 const std::filesystem::path& match_file,
+                                 const registration::VerificationConfig& config);
+
+/// One verdict as JSON: accepted, reason, T_match_query (4x4, row-major, nested lists: maps
+/// query points into the match frame, metres), overlap (the smaller fraction), rmse_m, and the
+/// details (both overlap fractions, overlapping points, the degeneracy ratio, coarse score).
+nlohmann::json VerificationJson(const registration::Verification& verdict);
 
 }  // namespace lidarloop::app

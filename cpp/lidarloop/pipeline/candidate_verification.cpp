@@ -24,32 +24,64 @@ registration::Verification Rejected(registration::RejectReason reason) {
 
 }  // namespace
 
-void VerifyQuery(LoopQuery& query,
-                 const std::function<const registration::PreparedScan&(std::size_t)>& scan_of,
+std::uint64_t VerificationCache::Key(std::size_t query, std::size_t match) {
+    return (static_cast<std::uint64_t>(query) << 32U) ^ static_cast<std::uint64_t>(match);
+}
+
+std::optional<registration::Verification> VerificationCache::Find(std::size_t query,
+                                                                  std::size_t match) const {
+    const std::lock_guard lock(mutex_);
+    const auto found = verdicts_.find(Key(query, match));
+    if (found == verdicts_.end()) return std::nullopt;
+    return found->second;
+}
+
+void VerificationCache::Store(std::size_t query, std::size_t match,
+                              const registration::Verification& verdict) {
+    const std::lock_guard lock(mutex_);
+    verdicts_.insert_or_assign(Key(query, match), verdict);
+}
+
+std::size_t VerificationCache::size() const {
+    const std::lock_guard lock(mutex_);
+    return verdicts_.size();
+}
+
+void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
+                 const std::function<const registration::PreparedScan&(std::size_t)>& match_of,
                  const DetectorConfig& detector, const core::Method& method,
-                 VerificationTimes* times) {
+                 VerificationTimes* times, VerificationCache* cache) {
     query.verifications.clear();
     query.accepted = false;
     if (!query.has_match()) return;
-    const registration::PreparedScan& prepared = scan_of(query.query);
     if (!prepared.structure) {  // a skipped scan
         query.verifications.assign(query.candidates.size(),
                                    Rejected(registration::RejectReason::kTooFewPoints));
         return;
     }
-    const auto query_start = Clock::now();
-    const registration::CoarseQuery coarse(*prepared.structure, detector.verification.coarse);
-    if (times) times->query_seconds.push_back(SecondsSince(query_start));
+    std::optional<registration::CoarseQuery> coarse;  // built at the first uncached pair
     const DescriptorMethod& definition = MethodOf(method);
     for (const Neighbor& candidate : query.candidates) {
         if (detector.threshold && !definition.IsMatch(candidate.distance, *detector.threshold)) {
             query.verifications.push_back(Rejected(registration::RejectReason::kPruned));
             continue;
         }
+        if (cache) {
+            if (auto cached = cache->Find(query.query, candidate.index)) {
+                query.verifications.push_back(*cached);
+                continue;
+            }
+        }
+        if (!coarse) {
+            const auto query_start = Clock::now();
+            coarse.emplace(*prepared.structure, detector.verification.coarse);
+            if (times) times->query_seconds.push_back(SecondsSince(query_start));
+        }
         const auto pair_start = Clock::now();
         query.verifications.push_back(registration::Verify(
-            prepared, coarse, scan_of(candidate.index), detector.verification));
+            prepared, *coarse, match_of(candidate.index), detector.verification));
         if (times) times->pair_seconds.push_back(SecondsSince(pair_start));
+        if (cache) cache->Store(query.query, candidate.index, query.verifications.back());
     }
     query.accepted = query.loop().has_value();
 }
@@ -58,14 +90,16 @@ VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
                                 const std::vector<registration::PreparedScan>& scans,
                                 const DetectorConfig& detector, const core::Method& method,
                                 Execution execution,
-                                const std::function<void(std::size_t, std::size_t)>& progress) {
+                                const std::function<void(std::size_t, std::size_t)>& progress,
+                                VerificationCache* cache) {
     const auto scan_of = [&scans](std::size_t i) -> const registration::PreparedScan& {
         return scans.at(i);
     };
     std::vector<VerificationTimes> per_query(queries.size());
     std::atomic<std::size_t> done{0};
     const auto run = [&](std::size_t i) {
-        VerifyQuery(queries[i], scan_of, detector, method, &per_query[i]);
+        VerifyQuery(queries[i], scans.at(queries[i].query), scan_of, detector, method,
+                    &per_query[i], cache);
         const std::size_t finished = ++done;
         if (progress) progress(finished, queries.size());
     };

@@ -1,7 +1,11 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
+#include <mutex>
+#include <optional>
+#include <unordered_map>
 #include <vector>
 
 #include "lidarloop/pipeline/loop_detector.hpp"
@@ -15,14 +19,34 @@ struct VerificationTimes {
     std::vector<double> query_seconds;  ///< per query: its coarse search images (shared by pairs)
 };
 
+/// Verifications already computed, by (query, match) scan pair: runs over the same prepared scans
+/// with the same VerificationConfig (e.g. the methods of one evaluation, whose top-k candidates
+/// overlap) register each pair once. Verify is deterministic, so a cached verdict equals a fresh
+/// one. Thread-safe.
+class VerificationCache {
+public:
+    std::optional<registration::Verification> Find(std::size_t query, std::size_t match) const;
+    void Store(std::size_t query, std::size_t match, const registration::Verification& verdict);
+    std::size_t size() const;
+
+private:
+    static std::uint64_t Key(std::size_t query, std::size_t match);
+
+    mutable std::mutex mutex_;
+    std::unordered_map<std::uint64_t, registration::Verification> verdicts_;
+};
+
 /// Registers the candidates of `query` to it (registration::Verify) and fills
-/// query.verifications and query.accepted. `scan_of(i)` gives scan i prepared with
-/// detector.verification.reduction. A candidate whose distance fails an explicitly set
-/// detector.threshold is not registered (reason kPruned). Appends to `times` when given.
-void VerifyQuery(LoopQuery& query,
-                 const std::function<const registration::PreparedScan&(std::size_t)>& scan_of,
+/// query.verifications and query.accepted. `query_scan` is the query prepared with
+/// detector.verification.reduction, `match_of(j)` candidate j prepared the same way (an empty
+/// PreparedScan, e.g. of a skipped scan, is rejected as kTooFewPoints). A candidate whose
+/// distance fails an explicitly set detector.threshold is not registered (reason kPruned).
+/// Appends to `times` when given (pairs found in `cache` are not timed); takes verdicts from and
+/// adds them to `cache` when given.
+void VerifyQuery(LoopQuery& query, const registration::PreparedScan& query_scan,
+                 const std::function<const registration::PreparedScan&(std::size_t)>& match_of,
                  const DetectorConfig& detector, const core::Method& method,
-                 VerificationTimes* times = nullptr);
+                 VerificationTimes* times = nullptr, VerificationCache* cache = nullptr);
 
 /// VerifyQuery for every query that has candidates (in parallel unless told otherwise);
 /// `scans[i]` is scan i prepared. `progress(done, total)` is called from worker threads.
@@ -30,6 +54,7 @@ VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
                                 const std::vector<registration::PreparedScan>& scans,
                                 const DetectorConfig& detector, const core::Method& method,
                                 Execution execution = Execution::kParallel,
-                                const std::function<void(std::size_t, std::size_t)>& progress = {});
+                                const std::function<void(std::size_t, std::size_t)>& progress = {},
+                                VerificationCache* cache = nullptr);
 
 }  // namespace lidarloop::pipeline

@@ -1,0 +1,55 @@
+#pragma once
+
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "lidarloop/app/progress.hpp"
+#include "lidarloop/app/verification_run.hpp"
+#include "lidarloop/core/descriptor.hpp"
+#include "lidarloop/eval/ground_truth.hpp"
+#include "lidarloop/eval/loop_retrieval.hpp"
+#include "lidarloop/pipeline/candidate_verification.hpp"
+#include "lidarloop/pipeline/loop_detector.hpp"
+#include "lidarloop/pipeline/similarity_matrix.hpp"
+
+namespace lidarloop::app {
+
+/// The online detector's view of one method on a sequence (docs/evaluation.md, "Ranked
+/// candidates"): every scan's top-k candidates by descriptor distance, scored as the descriptor
+/// alone decides them and as geometric verification decides them, on the same ground truth.
+struct RetrievalComparison {
+    std::size_t top_k = 0;  ///< candidates per query (detection.top_k)
+    /// Accepted: a candidate within the method's threshold (W <= tau, sigma' < t_d); score:
+    /// -distance. recall_at_k is the ceiling of verification: it cannot find a loop that is
+    /// not among the candidates.
+    eval::LoopRetrievalEvaluation descriptor;
+    /// Accepted: the candidate passed registration::Verify; score: its overlap. Empty when
+    /// verification is off.
+    std::optional<eval::LoopRetrievalEvaluation> verified;
+    pipeline::VerificationTimes verification_times;  ///< pairs registered by this method's run
+    std::vector<pipeline::LoopQuery> queries;        ///< the candidates and their verdicts
+};
+
+/// The candidates of `queries` as the descriptor alone decides them: accepted when the
+/// distance passes `threshold` under `method`, score -distance.
+std::vector<eval::QueryCandidates> DescriptorCandidates(
+    std::span<const pipeline::LoopQuery> queries, const core::Method& method, double threshold);
+
+/// The candidates of verified `queries`: accepted as verification decided, score the
+/// verification's overlap (Verification::score), with the registered T_match_query of every
+/// candidate that was registered.
+std::vector<eval::QueryCandidates> VerifiedCandidates(std::span<const pipeline::LoopQuery> queries);
+
+/// Detects the top-k candidates of every scan from `matrix` (pipeline::DetectFromMatrix with
+/// `detector`), verifies them when detector.verify (with `prepared`, sharing `cache`), and
+/// scores both against `truth` (built from `poses`).
+RetrievalComparison CompareRetrieval(const pipeline::SimilarityMatrix& matrix,
+                                     const std::vector<double>& times_s,
+                                     const pipeline::DetectorConfig& detector,
+                                     const core::Method& method, const eval::GroundTruth& truth,
+                                     std::span<const core::StampedPose> poses,
+                                     const PreparedScans* prepared,
+                                     pipeline::VerificationCache* cache, const Progress& progress);
+
+}  // namespace lidarloop::app
