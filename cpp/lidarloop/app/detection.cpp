@@ -7,6 +7,7 @@
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/io/database_file.hpp"
 #include "lidarloop/io/png.hpp"
+#include "lidarloop/io/prepared_scans_file.hpp"
 #include "lidarloop/io/similarity_file.hpp"
 #include "lidarloop/io/similarity_image.hpp"
 
@@ -23,7 +24,8 @@ void RequireTimesForSeconds(const io::RunConfig& config, const io::Dataset& data
 
 void WriteDetectResults(const std::filesystem::path& out_dir, const io::RunConfig& config,
                         const pipeline::SequenceDescriptors& described,
-                        const pipeline::SimilarityMatrix& matrix, const DetectOutcome& outcome) {
+                        const pipeline::SimilarityMatrix& matrix, const DetectOutcome& outcome,
+                        const PreparedScans& prepared) {
     const core::Method method = config.descriptor.method;
     WriteLoopsCsv(out_dir / "loops.csv", outcome.queries);
     WriteCandidatesCsv(out_dir / "candidates.csv", outcome.queries);
@@ -32,6 +34,35 @@ void WriteDetectResults(const std::filesystem::path& out_dir, const io::RunConfi
     io::WritePng(out_dir / "similarity_distance.png", io::DistanceImage(matrix));
     WriteSkipped(out_dir, described.skipped);
     io::SaveDatabase(out_dir / "database.lldb", described.database, config.detection);
+    if (config.detection.verify) {
+        io::SavePreparedScans(out_dir / "database.scans", prepared.scans,
+                              config.detection.verification.reduction);
+    }
+}
+
+// The map's prepared scans for verifying against it, checked against the run's reduction.
+std::vector<registration::PreparedScan> MapScansFor(LoadedMap& map,
+                                                    const pipeline::DetectorConfig& detection) {
+    if (!detection.verify) return {};
+    const std::filesystem::path scans_file = io::PreparedScansPathOf(map.file);
+    if (!map.scans) {
+        throw core::ConfigError("the map " + map.file.string() + " has no prepared scans (" +
+                                scans_file.string() +
+                                ") to verify candidates against: rebuild it with `lidarloop "
+                                "detect` (which verifies by default), or localise with "
+                                "--no-verify");
+    }
+    if (map.scans->reduction != detection.verification.reduction) {
+        throw core::ConfigError("verification.reduction differs from the one " +
+                                scans_file.string() +
+                                " was made with; localise with the map's (its config.yaml)");
+    }
+    if (map.scans->scans.size() != map.database.size()) {
+        throw core::ConfigError(scans_file.string() + " holds " +
+                                std::to_string(map.scans->scans.size()) + " scans, the map " +
+                                std::to_string(map.database.size()));
+    }
+    return std::move(map.scans->scans);
 }
 
 }  // namespace
@@ -72,7 +103,7 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     const double verify_s = verify_clock.Seconds();
     outcome.accepted = CountAccepted(outcome.queries);
     outcome.skipped = described.skipped;
-    WriteDetectResults(out_dir, config, described, matrix, outcome);
+    WriteDetectResults(out_dir, config, described, matrix, outcome, prepared);
 
     nlohmann::json timings = TimingsJson(described, matrix.condensed().size(), matrix_s);
     timings["describe_total_s"] = describe_s;
@@ -89,7 +120,10 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
 LoadedMap LoadMap(const std::filesystem::path& file) {
     Stopwatch clock;
     io::StoredDatabase stored = io::LoadStoredDatabase(file);
-    return {file, std::move(stored.database), stored.detection, clock.Seconds()};
+    std::optional<io::StoredPreparedScans> scans;
+    const std::filesystem::path scans_file = io::PreparedScansPathOf(file);
+    if (std::filesystem::exists(scans_file)) scans = io::LoadPreparedScans(scans_file);
+    return {file, std::move(stored.database), stored.detection, std::move(scans), clock.Seconds()};
 }
 
 DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const DetectRequest& request) {
@@ -101,16 +135,23 @@ DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const Detec
         throw core::ConfigError("the configuration changes how scans are described, but the map " +
                                 map.file.string() + " fixes that");
     }
-    const pipeline::LoopDetector detector(std::move(map.database), config.detection);
+    std::vector<registration::PreparedScan> map_scans = MapScansFor(map, config.detection);
+    const pipeline::LoopDetector detector(std::move(map.database), config.detection,
+                                          std::move(map_scans));
     const std::filesystem::path out_dir = PrepareOutputFolder(request.out);
     io::WriteConfigYaml(out_dir / "config.yaml", config);
 
-    const pipeline::SequenceDescriptors described = DescribeDataset(
-        dataset, config.descriptor,
-        {"describing", request.skip_bad, pipeline::Execution::kParallel, request.progress, {}});
+    const bool verify = config.detection.verify;
+    PreparedScans prepared(verify ? dataset.size() : 0);
+    DescribeRun run{
+        "describing", request.skip_bad, pipeline::Execution::kParallel, request.progress, {}};
+    if (verify) run.with_cloud = prepared.Collector(config.detection.verification.reduction);
+    const pipeline::SequenceDescriptors described =
+        DescribeDataset(dataset, config.descriptor, run);
     Stopwatch query_clock;
     DetectOutcome outcome;
-    outcome.queries = pipeline::LocaliseSequence(detector, described.database);
+    outcome.queries = pipeline::LocaliseSequence(detector, described.database,
+                                                 pipeline::Execution::kParallel, prepared.scans);
     const double query_s = query_clock.Seconds();
     outcome.threshold = detector.threshold();
     outcome.map_scans = detector.database().size();
@@ -124,6 +165,13 @@ DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const Detec
     timings["map"] = map.file.string();
     timings["map_scans"] = detector.database().size();
     timings["load_map_s"] = map.load_s;
+    if (verify) {
+        timings["prepare_ms_per_scan"] = SummaryJson(prepared.prepare_seconds, 1e3);
+        timings["map_prepared_bytes_per_scan"] =
+            detector.database().size() == 0 ? 0.0
+                                            : static_cast<double>(detector.prepared_bytes()) /
+                                                  static_cast<double>(detector.database().size());
+    }
     timings["query_ms_per_scan_wall"] =
         outcome.queries.empty() ? 0.0 : 1e3 * query_s / static_cast<double>(outcome.queries.size());
     outcome.total_s = total.Seconds() + map.load_s;

@@ -1,12 +1,14 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "lidarloop/app/progress.hpp"
 #include "lidarloop/io/config_yaml.hpp"
 #include "lidarloop/io/dataset.hpp"
+#include "lidarloop/io/prepared_scans_file.hpp"
 #include "lidarloop/pipeline/loop_detector.hpp"
 
 namespace lidarloop::app {
@@ -32,7 +34,8 @@ struct DetectOutcome {
 /// matrix, finds each scan's candidates among the earlier scans outside the minimum gap, and
 /// writes loops.csv, candidates.csv, similarity.bin, similarity.png, similarity_distance.png,
 /// database.lldb (with the detection config), config.yaml, timings.json (and skipped.txt) into
-/// request.out.
+/// request.out. With config.detection.verify the candidates are verified (registration::Verify)
+/// and the scans reduced for it are saved as database.scans, so the map can verify too.
 DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request);
 
 /// A saved descriptor database to localise against.
@@ -42,10 +45,13 @@ struct LoadedMap {
     /// The detection config the map was saved with: its threshold is the one to localise with
     /// unless the request sets another.
     pipeline::DetectorConfig detection;
+    /// The map's scans reduced for verification (io::PreparedScansPathOf the file), when saved.
+    std::optional<io::StoredPreparedScans> scans;
     double load_s = 0.0;
 };
 
-/// Loads a database.lldb written by RunDetect (io::ReadError naming what is wrong).
+/// Loads a database.lldb written by RunDetect, and its database.scans when present
+/// (io::ReadError naming what is wrong).
 LoadedMap LoadMap(const std::filesystem::path& file);
 
 /// Localisation: every scan of `dataset` is searched in `map` and not added to it.
@@ -53,6 +59,8 @@ LoadedMap LoadMap(const std::filesystem::path& file);
 /// as the map's were; its detection keys apply, and without a threshold the map's saved one
 /// (map.detection.threshold) does, else the method's default. Writes loops.csv (query scan, map
 /// scan), candidates.csv, config.yaml, timings.json (and skipped.txt) into request.out.
+/// With config.detection.verify the candidates are verified against the map's prepared scans:
+/// ConfigError when the map has none or they were reduced with another configuration.
 DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const DetectRequest& request);
 
 }  // namespace lidarloop::app

@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/pipeline/candidate_verification.hpp"
 
 namespace lidarloop::pipeline {
 namespace {
@@ -79,11 +80,19 @@ std::vector<Neighbor> NearestCandidates(std::size_t count, std::size_t k,
 LoopDetector::LoopDetector(const core::DescriptorConfig& descriptor, const DetectorConfig& detector)
     : LoopDetector(DescriptorDatabase(descriptor), detector) {}
 
-LoopDetector::LoopDetector(DescriptorDatabase database, const DetectorConfig& detector)
+LoopDetector::LoopDetector(DescriptorDatabase database, const DetectorConfig& detector,
+                           std::vector<registration::PreparedScan> scans)
     : database_(std::move(database)),
       detector_(detector),
-      threshold_(detector.ThresholdFor(database_.method())) {
+      threshold_(detector.ThresholdFor(database_.method())),
+      scans_(std::move(scans)) {
     detector_.Validate();
+    if (!scans_.empty() && scans_.size() != database_.size()) {
+        throw core::ConfigError("LoopDetector: " + std::to_string(scans_.size()) +
+                                " prepared scans for a database of " +
+                                std::to_string(database_.size()));
+    }
+    scans_.resize(database_.size());
     database_.definition().ValidateThreshold(threshold_);
     index_ = database_.store().MakeIndex();
     // One sort instead of n sorted inserts: a loaded map may hold a million scans.
@@ -109,34 +118,60 @@ LoopQuery LoopDetector::Search(const PreparedQuery& query, std::size_t query_ind
     return result;
 }
 
-LoopQuery LoopDetector::Process(const core::PointCloud& scan, double time_s) {
-    return Process(ComputeDescriptor(scan, database_.config()), time_s);
+void LoopDetector::Verify(LoopQuery& result, const registration::PreparedScan& scan) const {
+    if (!detector_.verify || !scan.structure) return;
+    VerifyQuery(
+        result, scan,
+        [this](std::size_t j) -> const registration::PreparedScan& { return scans_[j]; }, detector_,
+        database_.method());
 }
 
-LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_s) {
+std::size_t LoopDetector::prepared_bytes() const {
+    std::size_t bytes = 0;
+    for (const registration::PreparedScan& scan : scans_) bytes += scan.MemoryBytes();
+    return bytes;
+}
+
+LoopQuery LoopDetector::Process(const core::PointCloud& scan, double time_s) {
+    registration::PreparedScan prepared;
+    if (detector_.verify)
+        prepared = registration::PrepareScan(scan, detector_.verification.reduction);
+    return Process(ComputeDescriptor(scan, database_.config()), time_s, std::move(prepared));
+}
+
+LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_s,
+                                registration::PreparedScan scan) {
     const std::unique_ptr<PreparedQuery> query = database_.Prepare(descriptor);
     const std::size_t query_index = database_.size();
     const auto& times_s = database_.times_s();
     const core::MinGap gap = detector_.min_gap;
-    const LoopQuery result = Search(*query, query_index, [&](std::size_t j) {
+    LoopQuery result = Search(*query, query_index, [&](std::size_t j) {
         return j < query_index && database_.IsValid(j) &&
                gap.Allows(query_index, j, time_s, times_s[j]);
     });
+    Verify(result, scan);
     database_.Add(descriptor, time_s);
+    scans_.push_back(std::move(scan));
     if (index_) index_->Insert(query_index);
     return result;
 }
 
-LoopQuery LoopDetector::Query(const core::Descriptor& descriptor) const {
-    return Query(*database_.Prepare(descriptor), database_.size());
+LoopQuery LoopDetector::Query(const core::Descriptor& descriptor,
+                              const registration::PreparedScan& scan) const {
+    return Query(*database_.Prepare(descriptor), database_.size(), scan);
 }
 
-LoopQuery LoopDetector::Query(const PreparedQuery& query, std::size_t query_index) const {
-    return Search(query, query_index, [&](std::size_t j) { return database_.IsValid(j); });
+LoopQuery LoopDetector::Query(const PreparedQuery& query, std::size_t query_index,
+                              const registration::PreparedScan& scan) const {
+    LoopQuery result =
+        Search(query, query_index, [&](std::size_t j) { return database_.IsValid(j); });
+    Verify(result, scan);
+    return result;
 }
 
-std::vector<LoopQuery> LocaliseSequence(const LoopDetector& map, const DescriptorDatabase& queries,
-                                        Execution execution) {
+std::vector<LoopQuery> LocaliseSequence(
+    const LoopDetector& map, const DescriptorDatabase& queries, Execution execution,
+    const std::vector<registration::PreparedScan>& query_scans) {
     if (queries.config() != map.database().config()) {
         throw core::ConfigError(
             "the query scans were described with another configuration than the map's");
@@ -144,7 +179,10 @@ std::vector<LoopQuery> LocaliseSequence(const LoopDetector& map, const Descripto
     std::vector<LoopQuery> results(queries.size());
     const auto localise = [&](std::size_t i) {
         results[i].query = i;
-        if (queries.IsValid(i)) results[i] = map.Query(*queries.PrepareStored(i), i);
+        if (!queries.IsValid(i)) return;
+        static const registration::PreparedScan kNone;
+        results[i] = map.Query(*queries.PrepareStored(i), i,
+                               i < query_scans.size() ? query_scans[i] : kNone);
     };
     if (execution == Execution::kSerial) {
         for (std::size_t i = 0; i < queries.size(); ++i) localise(i);

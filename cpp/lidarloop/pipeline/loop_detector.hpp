@@ -69,6 +69,11 @@ std::vector<Neighbor> NearestCandidates(std::size_t count, std::size_t k,
 /// Online loop detection: scans arrive one at a time; each is compared with the stored scans
 /// older than the minimum gap, then stored. Candidates come from the method's exact index where
 /// it has one (histograms: HistogramIndex), else from comparing every eligible scan (NDT).
+/// With DetectorConfig::verify, a scan given as a point cloud is also kept reduced for
+/// registration (registration::PreparedScan: a few thousand voxel centroids with normals, about
+/// 0.1 MB instead of a raw HDL-64E scan's 2 MB; prepared_bytes()) and its candidates are
+/// verified against the stored reduced scans; a scan given as a descriptor alone is neither
+/// verified nor verifiable as a candidate (kTooFewPoints).
 /// Process is not thread-safe; Query may run concurrently.
 /// Neither copyable nor movable: the index refers to the detector's own database.
 class LoopDetector {
@@ -76,40 +81,58 @@ public:
     /// Validates the configs.
     LoopDetector(const core::DescriptorConfig& descriptor, const DetectorConfig& detector);
     /// Continues from a loaded database (e.g. a map): every stored scan becomes searchable.
-    LoopDetector(DescriptorDatabase database, const DetectorConfig& detector);
+    /// `scans`: the stored scans prepared for verification (by database index, with
+    /// detector.verification.reduction), or empty when the map has none.
+    LoopDetector(DescriptorDatabase database, const DetectorConfig& detector,
+                 std::vector<registration::PreparedScan> scans = {});
     LoopDetector(const LoopDetector&) = delete;
     LoopDetector& operator=(const LoopDetector&) = delete;
 
-    /// Describes `scan`, finds its candidates among the stored scans, then stores it.
+    /// Describes `scan`, finds its candidates among the stored scans (and verifies them when
+    /// verify is on), then stores it.
     LoopQuery Process(const core::PointCloud& scan, double time_s);
-    LoopQuery Process(const core::Descriptor& descriptor, double time_s);
+    /// The same for a scan described (and, for verification, prepared) by the caller; an empty
+    /// `scan` is not verified.
+    LoopQuery Process(const core::Descriptor& descriptor, double time_s,
+                      registration::PreparedScan scan = {});
     /// Localisation against the stored scans: every stored scan is eligible and the query is not
-    /// stored.
-    LoopQuery Query(const core::Descriptor& descriptor) const;
+    /// stored. Verified when verify is on and `scan` (the query, prepared) is not empty.
+    LoopQuery Query(const core::Descriptor& descriptor,
+                    const registration::PreparedScan& scan = {}) const;
     /// The same for a prepared query (e.g. DescriptorDatabase::PrepareStored of another
     /// database with the same configuration); `query_index` only labels the result.
-    LoopQuery Query(const PreparedQuery& query, std::size_t query_index) const;
+    LoopQuery Query(const PreparedQuery& query, std::size_t query_index,
+                    const registration::PreparedScan& scan = {}) const;
 
     const DescriptorDatabase& database() const { return database_; }
     const DetectorConfig& detector_config() const { return detector_; }
     /// The decision threshold applied (detector_config().ThresholdFor the database's method).
     double threshold() const { return threshold_; }
+    /// The stored scans prepared for verification (by database index; empty ones were given as
+    /// descriptors), and their heap bytes in all.
+    const std::vector<registration::PreparedScan>& prepared_scans() const { return scans_; }
+    std::size_t prepared_bytes() const;
 
 private:
     LoopQuery Search(const PreparedQuery& query, std::size_t query_index,
                      const std::function<bool(std::size_t)>& eligible) const;
+    void Verify(LoopQuery& result, const registration::PreparedScan& scan) const;
 
     DescriptorDatabase database_;
     DetectorConfig detector_;
     double threshold_;
-    std::unique_ptr<NeighborIndex> index_;  // nullptr: compare every eligible scan
+    std::unique_ptr<NeighborIndex> index_;           // nullptr: compare every eligible scan
+    std::vector<registration::PreparedScan> scans_;  // by database index, for verification
 };
 
 /// Localisation of a whole sequence against a map: LoopDetector::Query for every scan of
 /// `queries` (described with the map's configuration, which is checked), in parallel. Result i
-/// belongs to query scan i; a scan that could not be read has no candidates.
-std::vector<LoopQuery> LocaliseSequence(const LoopDetector& map, const DescriptorDatabase& queries,
-                                        Execution execution = Execution::kParallel);
+/// belongs to query scan i; a scan that could not be read has no candidates. `query_scans`
+/// (query scan i prepared, or empty) are verified against the map's prepared scans.
+std::vector<LoopQuery> LocaliseSequence(
+    const LoopDetector& map, const DescriptorDatabase& queries,
+    Execution execution = Execution::kParallel,
+    const std::vector<registration::PreparedScan>& query_scans = {});
 
 /// Offline detection from a full similarity matrix: for every scan i, the candidates among the
 /// scans j < i outside the gap, exactly as LoopDetector::Process would give them online.

@@ -1,0 +1,114 @@
+#include "lidarloop/io/prepared_scans_file.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <memory>
+
+#include "lidarloop/io/config_yaml.hpp"
+#include "lidarloop/io/detail/byte_stream.hpp"
+#include "lidarloop/io/read_error.hpp"
+
+namespace lidarloop::io {
+namespace {
+
+constexpr char kMagic[] = "LLPS0001";
+constexpr std::size_t kPointBytes = 6 * sizeof(float);  // x y z and the normal
+
+void PutSurface(core::ByteWriter& out, const registration::SurfacePoints& surface) {
+    out.Put<std::uint64_t>(surface.size());
+    for (std::size_t i = 0; i < surface.size(); ++i) {
+        out.PutArray(surface.points()[i].data(), 3);
+        out.PutArray(surface.normals()[i].data(), 3);
+    }
+}
+
+std::shared_ptr<const registration::SurfacePoints> GetSurface(core::ByteReader& in,
+                                                              const char* what) {
+    const auto count = in.Get<std::uint64_t>(what);
+    in.RequireItems(count, kPointBytes, what);
+    std::vector<Eigen::Vector3f> points(count);
+    std::vector<Eigen::Vector3f> normals(count);
+    for (std::uint64_t i = 0; i < count; ++i) {
+        in.GetArray(points[i].data(), 3, what);
+        in.GetArray(normals[i].data(), 3, what);
+        if (!points[i].allFinite() || !normals[i].allFinite()) {
+            in.Fail(std::string("non-finite value in ") + what);
+        }
+    }
+    return std::make_shared<const registration::SurfacePoints>(std::move(points),
+                                                               std::move(normals));
+}
+
+void PutScan(core::ByteWriter& out, const registration::PreparedScan& scan) {
+    const bool present = scan.structure && scan.ground;
+    out.Put<std::uint8_t>(present ? 1 : 0);
+    if (!present) return;
+    out.Put<std::uint64_t>(scan.input_points);
+    out.Put<std::uint64_t>(scan.usable_points);
+    out.Put<double>(scan.structure_roughness_m);
+    PutSurface(out, *scan.structure);
+    out.Put<std::uint64_t>(scan.structure_distinctive.size());
+    out.PutArray(scan.structure_distinctive.data(), scan.structure_distinctive.size());
+    PutSurface(out, *scan.ground);
+}
+
+registration::PreparedScan GetScan(core::ByteReader& in) {
+    registration::PreparedScan scan;
+    if (in.Get<std::uint8_t>("scan flag") == 0) return scan;
+    scan.input_points = in.Get<std::uint64_t>("input point count");
+    scan.usable_points = in.Get<std::uint64_t>("usable point count");
+    scan.structure_roughness_m = in.Get<double>("roughness");
+    if (!std::isfinite(scan.structure_roughness_m) || scan.structure_roughness_m < 0.0) {
+        in.Fail("roughness is not a finite number >= 0");
+    }
+    scan.structure = GetSurface(in, "structure points");
+    const auto flags = in.Get<std::uint64_t>("distinctive flag count");
+    if (flags != scan.structure->size()) {
+        in.Fail("distinctive flags do not match the structure points");
+    }
+    scan.structure_distinctive.resize(flags);
+    in.GetArray(scan.structure_distinctive.data(), flags, "distinctive flags");
+    scan.ground = GetSurface(in, "ground points");
+    return scan;
+}
+
+}  // namespace
+
+void SavePreparedScans(const std::filesystem::path& file,
+                       const std::vector<registration::PreparedScan>& scans,
+                       const registration::ScanReductionConfig& reduction) {
+    core::ByteWriter out;
+    out.PutMagic(kMagic);
+    RunConfig config;
+    config.detection.verification.reduction = reduction;
+    out.PutString(DumpConfigYaml(config));
+    out.Put<std::uint64_t>(scans.size());
+    for (const registration::PreparedScan& scan : scans) PutScan(out, scan);
+    detail::WriteWholeFile(file, out.data());
+}
+
+StoredPreparedScans LoadPreparedScans(const std::filesystem::path& file) {
+    core::ByteReader in = detail::FileReader(file, detail::ReadWholeFile(file));
+    in.ExpectMagic(kMagic, "lidarloop prepared scans");
+    RunConfig config;
+    try {
+        ApplyConfigYaml(in.GetString("configuration"), "embedded config", config);
+    } catch (const ReadError& e) {
+        in.Fail(e.what());
+    }
+    StoredPreparedScans stored;
+    stored.reduction = config.detection.verification.reduction;
+    const auto count = in.Get<std::uint64_t>("scan count");
+    in.RequireItems(count, 1, "scans");
+    stored.scans.reserve(count);
+    for (std::uint64_t i = 0; i < count; ++i) stored.scans.push_back(GetScan(in));
+    if (!in.AtEnd()) in.Fail("trailing bytes after " + std::to_string(count) + " scans");
+    return stored;
+}
+
+std::filesystem::path PreparedScansPathOf(const std::filesystem::path& database_file) {
+    std::filesystem::path path = database_file;
+    return path.replace_extension(".scans");
+}
+
+}  // namespace lidarloop::io
