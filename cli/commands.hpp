@@ -13,5 +13,6 @@ void AddDistanceCommand(CLI::App& app);
 void AddDumpConfigCommand(CLI::App& app);
 void AddEvaluateCommand(CLI::App& app);
 void AddSimulateCommand(CLI::App& app);
+void AddVerifyCommand(CLI::App& app);
 
 }  // namespace lidarloop::cli

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
     lidarloop::cli::AddDumpConfigCommand(app);
     lidarloop::cli::AddBenchCommand(app);
     lidarloop::cli::AddSimulateCommand(app);
+    lidarloop::cli::AddVerifyCommand(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -7,7 +7,7 @@
 # folder of its own, so any one runs alone. Every case checks the exit code and a phrase of the
 # output; the last line is "cli <sections>: N passed, N failed".
 set -u
-sections=(describe distance ndt detect bench demo evaluate dump-config bad-input simulate)
+sections=(describe distance ndt verify detect bench demo evaluate dump-config bad-input simulate)
 if [ "${1-}" = "--list" ]; then
     printf '%s\n' "${sections[@]}"
     exit 0
@@ -100,6 +100,31 @@ section_distance() {
     done
 }
 
+# --- verify: one pair, registered without a prior, as JSON --------------------------------------
+section_verify() {
+    expect_ok "verify same place" '"accepted": true' "$cli" verify "$samples/corner_b.ply" \
+        "$samples/corner_a.bin"
+    # T_match_query is 4x4 nested row-major lists with a last row 0 0 0 1, and the reason is none.
+    if "$cli" verify "$samples/corner_b.ply" "$samples/corner_a.bin" | python3 -c '
+import json, sys
+v = json.load(sys.stdin)
+T = v["T_match_query"]
+assert len(T) == 4 and all(len(row) == 4 for row in T), T
+assert T[3] == [0, 0, 0, 1], T[3]
+assert v["reason"] == "none" and 0 < v["overlap"] <= 1 and v["rmse_m"] >= 0, v
+'; then pass; else fail "verify JSON of a true pair is malformed"; fi
+    expect_ok "verify other place" '"accepted": false' "$cli" verify "$samples/courtyard.bin" \
+        "$samples/corner_a.bin"
+    printf '1 2 3\n1 2 3\n' >"$work/two.xyz"
+    expect_ok "verify too few points" '"reason": "too_few_points"' "$cli" verify "$work/two.xyz" \
+        "$samples/corner_a.bin"
+    expect_error "verify missing file" "nothing.bin" "$cli" verify "$work/nothing.bin" \
+        "$samples/corner_a.bin"
+    printf 'verification:\n  acceptance:\n    min_overlap: 2\n' >"$work/bad.yaml"
+    expect_error "verify bad config" "min_overlap" "$cli" verify --config "$work/bad.yaml" \
+        "$samples/corner_b.ply" "$samples/corner_a.bin"
+}
+
 # --- NDT (Magnusson 2009): describe and distance ---------------------------------------------
 section_ndt() {
     expect_ok "describe ndt" '"method":"ndt"' "$cli" describe --method ndt "$samples/corner_a.bin"
@@ -130,16 +155,19 @@ section_detect() {
     make_sequence "$seq"
     expect_ok "detect" "8 scans (folder)" "$cli" detect "$seq" --min-gap 2 --quiet --out "$work/det"
     for file in loops.csv candidates.csv similarity.png similarity_distance.png similarity.bin \
-        database.lldb config.yaml timings.json; do
+        database.lldb database.scans config.yaml timings.json; do
         if [ -s "$work/det/$file" ]; then pass; else fail "detect did not write $file"; fi
     done
     verified_header="query,match,distance,second_ratio,accepted,rank,tx,ty,tz,qx,qy,qz,qw"
-    verified_header+=",overlap_query,overlap_match,rmse_m,shifted_overlap,reason"
+    verified_header+=",overlap_query,overlap_match,distinctive_query,distinctive_match,rmse_m"
+    verified_header+=",shifted_overlap,reason"
     if head -1 "$work/det/loops.csv" | grep -qx "$verified_header"; then
         pass
     else fail "loops.csv header: $(head -1 "$work/det/loops.csv")"; fi
     # Scan 3 is a copy of scan 0: verified at the identity pose.
-    if grep -q "^3,0,0,,1,1,0,0,0,0,0,0,1,1,1,0,.*,none$" "$work/det/loops.csv"; then pass; else
+    if grep -q "^3,0,0,,1,1,0,0,0,0,0,0,1,1,1,[^,]*,[^,]*,0,[^,]*,none$" "$work/det/loops.csv"; then
+        pass
+    else
         fail "scan 3 (a copy of scan 0) is not a verified loop: $(cat "$work/det/loops.csv")"
     fi
     if head -1 "$work/det/candidates.csv" |
@@ -171,7 +199,7 @@ section_detect() {
     # distance 0.
     expect_ok "detect --map" "localised against the map" "$cli" detect "$seq" \
         --map "$work/det/database.lldb" --threshold 0.001 --quiet --out "$work/loc"
-    if [ "$(grep -c ',0,[^,]*,1$' "$work/loc/loops.csv")" -eq 8 ]; then pass; else
+    if [ "$(grep -c '^[0-9]*,[0-9]*,0,[^,]*,1,.*,none$' "$work/loc/loops.csv")" -eq 8 ]; then pass; else
         fail "localisation did not match every scan at distance 0: $(cat "$work/loc/loops.csv")"
     fi
     if grep -q "^6,6,0," "$work/loc/loops.csv" && grep -q "^7,7,0," "$work/loc/loops.csv"; then
@@ -187,8 +215,11 @@ section_detect() {
     # A map keeps the threshold of the detection that made it, as the default for localising.
     expect_ok "detect --map keeps its threshold" "threshold 0.02," "$cli" detect "$seq" \
         --map "$work/det_ndt_t/database.lldb" --quiet --out "$work/loc_ndt_t"
-    expect_ok "detect --map of 0.1" "threshold 0.004," "$cli" detect "$seq" \
+    expect_ok "detect --map of 0.1" "threshold 0.004," "$cli" detect "$seq" --no-verify \
         --map "$(dirname "$committed")/legacy/database_v0.1.lldb" --quiet --out "$work/loc_v01"
+    # A map without prepared scans cannot verify: a clear error, not descriptor-only loops.
+    expect_error "detect --map without scans" "has no prepared scans" "$cli" detect "$seq" \
+        --map "$(dirname "$committed")/legacy/database_v0.1.lldb" --quiet --out "$work/loc_v01b"
     expect_error "detect --map with --bins" "--bins changes how scans are described" "$cli" detect \
         "$seq" --map "$work/det/database.lldb" --bins 10 --quiet --out "$work/loc2"
     head -c 100 "$work/det/database.lldb" >"$work/truncated.lldb"
