@@ -239,6 +239,7 @@ void WriteRetrievalRow(std::ostream& out, const std::string& name, const std::st
                        const eval::LoopRetrievalEvaluation& r) {
     out << "| " << name << " | " << decision << " | " << Percent(r.recall_at_1) << " | "
         << Percent(r.recall_at_k) << " | " << r.true_loops << " / " << r.false_loops << " | "
+        << (r.loops_with_pose > 0 ? std::to_string(r.wrong_pose_loops) : std::string("–")) << " | "
         << Percent(r.precision) << " | " << Percent(r.recall) << " | "
         << Percent(r.full_precision.recall) << " | " << MedianMax(r.pose_error.translation_m, 3)
         << " | " << MedianMax(r.pose_error.yaw_deg, 3) << " |\n";
@@ -253,9 +254,9 @@ void WriteRetrievalTable(std::ostream& out, const std::vector<MethodEvaluation>&
            "(k = "
         << with->retrieval->top_k
         << " candidates per scan)\n\n"
-           "| method | decided by | recall@1 | recall@k | true / false loops | precision | "
-           "recall | recall at 100 % precision | pose error (m), median / max | yaw error "
-           "(deg), median / max |\n|---|---|---|---|---|---|---|---|---|---|\n";
+           "| method | decided by | recall@1 | recall@k | true / false loops | wrong-pose loops | "
+           "precision | recall | recall at 100 % precision | pose error (m), median / max | "
+           "yaw error (deg), median / max |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const MethodEvaluation& e : evaluations) {
         if (!e.retrieval) continue;
         WriteRetrievalRow(out, e.name, "descriptor threshold", e.retrieval->descriptor);
@@ -266,7 +267,10 @@ void WriteRetrievalTable(std::ostream& out, const std::vector<MethodEvaluation>&
         << " revisiting scans (a true loop among the earlier scans outside the gap). recall@k "
            "is the ceiling of verification: it only decides among the candidates. A scan's loop "
            "is its first accepted candidate; pose errors are of the true loops against the "
-           "ground-truth relative pose.";
+           "ground-truth relative pose. A wrong-pose loop is off its true relative pose by more "
+           "than 1 m or 2 degrees, true or false by place: the loops that would bend a pose "
+           "graph. A false loop at the right pose (the same structure seen from beyond the "
+           "distance of the ground truth) is not one.";
 }
 
 void WriteFigureGallery(std::ostream& out, const std::vector<MethodEvaluation>& evaluations) {

@@ -86,6 +86,8 @@ nlohmann::json RetrievalJson(const eval::LoopRetrievalEvaluation& r) {
             {"recall_at_k", Rate(r.recall_at_k)},
             {"true_loops", r.true_loops},
             {"false_loops", r.false_loops},
+            {"loops_with_pose", r.loops_with_pose},
+            {"wrong_pose_loops", r.wrong_pose_loops},
             {"precision", Rate(r.precision)},
             {"recall", Rate(r.recall)},
             {"recall_at_full_precision", Rate(r.full_precision.recall)},

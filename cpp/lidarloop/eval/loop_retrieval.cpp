@@ -79,15 +79,18 @@ bool HitWithin(const QueryCandidates& q, std::size_t k, const GroundTruth& truth
 }
 
 std::optional<AcceptedLoop> FirstAccepted(const QueryCandidates& q, const GroundTruth& truth,
-                                          std::span<const core::StampedPose> poses) {
+                                          std::span<const core::StampedPose> poses,
+                                          const LoopRetrievalConfig& config) {
     for (std::size_t rank = 0; rank < q.ranked.size(); ++rank) {
         const RankedCandidate& c = q.ranked[rank];
         if (!c.accepted) continue;
-        AcceptedLoop loop{q.query, c.match, rank, c.score, truth.IsLoop(q.query, c.match), {}};
-        if (loop.correct && c.T_match_query) {
+        AcceptedLoop loop{q.query, c.match, rank, c.score, truth.IsLoop(q.query, c.match), {}, {}};
+        if (c.T_match_query) {
             loop.pose_error = PoseError(
                 *c.T_match_query,
                 TrueRelativePose(poses[c.match].T_world_sensor, poses[q.query].T_world_sensor));
+            loop.wrong_pose = loop.pose_error->translation_m > config.wrong_pose_m ||
+                              loop.pose_error->rotation_deg > config.wrong_pose_deg;
         }
         return loop;
     }
@@ -121,7 +124,7 @@ FullPrecisionPoint AtFullPrecision(std::vector<AcceptedLoop> loops, std::size_t 
 PoseErrorSummary SummarizePoseErrors(std::span<const AcceptedLoop> loops) {
     std::vector<double> translation, planar, yaw, rotation;
     for (const auto& loop : loops) {
-        if (!loop.pose_error) continue;
+        if (!loop.pose_error || !loop.correct) continue;
         translation.push_back(loop.pose_error->translation_m);
         planar.push_back(loop.pose_error->planar_m);
         yaw.push_back(loop.pose_error->yaw_deg);
@@ -144,6 +147,16 @@ std::size_t LongestList(std::span<const QueryCandidates> queries) {
 }
 
 }  // namespace
+
+void LoopRetrievalConfig::Validate() const {
+    for (const auto& [value, name] :
+         {std::pair{wrong_pose_m, "wrong_pose_m"}, std::pair{wrong_pose_deg, "wrong_pose_deg"}}) {
+        if (!(std::isfinite(value) && value > 0.0)) {
+            throw core::ConfigError(std::string("loop retrieval: ") + name +
+                                    " must be a finite number > 0, got " + std::to_string(value));
+        }
+    }
+}
 
 core::Transform TrueRelativePose(const core::Transform& T_world_match,
                                  const core::Transform& T_world_query) {
@@ -187,11 +200,15 @@ LoopRetrievalEvaluation EvaluateLoopRetrieval(std::span<const QueryCandidates> q
     for (const auto& q : queries) {
         result.hits_at_1 += HitWithin(q, 1, truth);
         result.hits_at_k += HitWithin(q, result.k, truth);
-        if (auto loop = FirstAccepted(q, truth, poses)) result.loops.push_back(*loop);
+        if (auto loop = FirstAccepted(q, truth, poses, config)) result.loops.push_back(*loop);
     }
     std::sort(result.loops.begin(), result.loops.end(),
               [](const AcceptedLoop& a, const AcceptedLoop& b) { return a.query < b.query; });
-    for (const auto& loop : result.loops) (loop.correct ? result.true_loops : result.false_loops)++;
+    for (const auto& loop : result.loops) {
+        (loop.correct ? result.true_loops : result.false_loops)++;
+        result.loops_with_pose += loop.pose_error ? 1 : 0;
+        result.wrong_pose_loops += loop.wrong_pose ? 1 : 0;
+    }
     result.recall_at_1 = Share(result.hits_at_1, result.revisiting);
     result.recall_at_k = Share(result.hits_at_k, result.revisiting);
     result.precision = Share(result.true_loops, result.true_loops + result.false_loops);

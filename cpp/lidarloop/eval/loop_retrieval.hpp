@@ -46,8 +46,14 @@ struct LoopRetrievalConfig {
     /// k of recall@k: the first k candidates of each ranked list count. 0 = the length of the
     /// longest list given (the detector's top_k).
     std::size_t recall_k = 0;
+    /// An accepted loop's estimated pose is wrong when it is off the true relative pose by more
+    /// than this translation (metres) or rotation (degrees): a constraint that would pull a pose
+    /// graph out of shape, whether or not the scans count as the same place. > 0.
+    double wrong_pose_m = 1.0;
+    double wrong_pose_deg = 2.0;
 
-    void Validate() const {}
+    /// Throws core::ConfigError for a tolerance that is not finite and > 0.
+    void Validate() const;
 };
 
 /// The error of an estimated relative pose against the true one. With T_est and T_true both
@@ -85,8 +91,10 @@ struct AcceptedLoop {
     std::size_t rank = 0;  ///< position in the ranked list, 0 = best
     double score = 0.0;
     bool correct = false;  ///< GroundTruth::IsLoop(query, match)
-    /// For correct loops with an estimated pose; nullopt otherwise.
+    /// For loops with an estimated pose (correct or not); nullopt otherwise.
     std::optional<RelativePoseError> pose_error;
+    /// The pose error exceeds LoopRetrievalConfig::wrong_pose_m or wrong_pose_deg.
+    bool wrong_pose = false;
 };
 
 /// The largest recall of the accepted loops at 100 % precision: loops are kept by descending
@@ -105,7 +113,8 @@ struct FullPrecisionPoint {
     double first_false_score = -std::numeric_limits<double>::infinity();
 };
 
-/// Errors of the correct accepted loops that have an estimated pose.
+/// Errors of the correct accepted loops that have an estimated pose (false loops are counted in
+/// LoopRetrievalEvaluation::wrong_pose_loops instead: their errors say nothing about accuracy).
 struct PoseErrorSummary {
     std::size_t count = 0;  ///< correct accepted loops with T_match_query
     /// Distributions (median, max, ...) of the RelativePoseError fields; nullopt when count
@@ -136,6 +145,12 @@ struct LoopRetrievalEvaluation {
     std::size_t false_loops = 0;  ///< wrong loops, including all of non-revisiting queries
     double precision = std::numeric_limits<double>::quiet_NaN();  ///< true / (true + false)
     double recall = std::numeric_limits<double>::quiet_NaN();     ///< true_loops / revisiting
+    /// Loops with an estimated pose, and those whose pose is wrong (AcceptedLoop::wrong_pose):
+    /// false loops at a wrong pose, and correct ones registered wrongly. A false loop at the
+    /// right pose (the same structure seen from beyond the ground truth's distance) is a sound
+    /// constraint and not counted here.
+    std::size_t loops_with_pose = 0;
+    std::size_t wrong_pose_loops = 0;
 
     FullPrecisionPoint full_precision;
     PoseErrorSummary pose_error;

@@ -117,13 +117,18 @@ TEST(LoopRetrieval, HandMadeSequence) {
     ASSERT_EQ(e.loops.size(), 4u);  // 3, 5, 6, 7, query ascending
     const std::size_t query[] = {3, 5, 6, 7}, match[] = {0, 2, 1, 3}, rank[] = {0, 1, 0, 0};
     const bool correct[] = {false, true, true, false};
+    const bool with_pose[] = {true, true, true, false}, wrong_pose[] = {false, false, true, false};
     for (std::size_t k = 0; k < 4; ++k) {
         EXPECT_EQ(e.loops[k].query, query[k]);
         EXPECT_EQ(e.loops[k].match, match[k]);
         EXPECT_EQ(e.loops[k].rank, rank[k]);
         EXPECT_EQ(e.loops[k].correct, correct[k]);
-        EXPECT_EQ(e.loops[k].pose_error.has_value(), correct[k]);
+        EXPECT_EQ(e.loops[k].pose_error.has_value(), with_pose[k]);
+        EXPECT_EQ(e.loops[k].wrong_pose, wrong_pose[k]) << k;
     }
+    // 3 is another place seen at its true relative pose: a sound constraint, not a wrong pose.
+    EXPECT_EQ(e.loops_with_pose, 3u);
+    EXPECT_EQ(e.wrong_pose_loops, 1u);
     EXPECT_EQ(e.true_loops, 2u);
     EXPECT_EQ(e.false_loops, 2u);
     EXPECT_DOUBLE_EQ(e.precision, 0.5);
@@ -144,6 +149,23 @@ TEST(LoopRetrieval, HandMadeSequence) {
     EXPECT_NEAR(e.pose_error.yaw_deg->max, 10.0, 1e-9);
     EXPECT_NEAR(e.pose_error.rotation_deg->max, 10.0, 1e-9);
     EXPECT_NEAR(e.pose_error.rotation_deg->min, 0.0, 1e-9);
+}
+
+TEST(LoopRetrieval, WrongPoseToleranceIsTheConfigs) {
+    LoopRetrievalConfig config;
+    config.wrong_pose_m = 5.5;  // 6 is off by 5 m and 10 deg
+    EXPECT_EQ(
+        EvaluateLoopRetrieval(LineCandidates(), LineTruth(), LinePoses(), config).wrong_pose_loops,
+        1u);
+    config.wrong_pose_deg = 10.5;
+    EXPECT_EQ(
+        EvaluateLoopRetrieval(LineCandidates(), LineTruth(), LinePoses(), config).wrong_pose_loops,
+        0u);
+    for (double bad : {0.0, -1.0, std::nan(""), HUGE_VAL}) {
+        config.wrong_pose_m = bad;
+        EXPECT_THROW(EvaluateLoopRetrieval(LineCandidates(), LineTruth(), LinePoses(), config),
+                     core::ConfigError);
+    }
 }
 
 TEST(LoopRetrieval, ExplicitKAndAFalseLoopBelowTheTie) {
