@@ -102,6 +102,9 @@ void VisitFields(registration::CoarseConfig& c, Visitor& v) {
     v.Field("yaw_step_deg", c.yaw_step_deg, "yaw search step over the full circle");
     v.Field("max_translation_m", c.max_translation_m, "largest planar offset searched");
     v.Field("hypotheses", c.hypotheses, "best coarse poses refined by ICP");
+    v.Field("rival_hypotheses", c.rival_hypotheses,
+            "further coarse poses the ambiguity test registers after an acceptance");
+    v.Field("peaks_per_yaw", c.peaks_per_yaw, "translation peaks kept per yaw");
 }
 
 template <typename Visitor>
@@ -113,8 +116,8 @@ void VisitFields(registration::IcpConfig& c, Visitor& v) {
     v.Field("convergence_step", c.convergence_step, "a stage ends below this step (m + rad)");
     v.Field("max_structure_points", c.max_structure_points, "query structure points paired");
     v.Field("max_ground_points", c.max_ground_points, "query ground points paired");
-    v.Field("abandon_below_inliers", c.abandon_below_inliers,
-            "drop a hypothesis after stage 1 below this structure inlier share");
+    v.Field("abandon_below_overlap", c.abandon_below_overlap,
+            "a pose overlapping less after the first stage is abandoned");
 }
 
 template <typename Visitor>

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include "lidarloop/registration/detail/fft2d.hpp"
 
@@ -44,31 +45,57 @@ double ParabolicOffset(double before, double at, double after) {
     return std::clamp(0.5 * (before - after) / curvature, -0.5, 0.5);
 }
 
-// The best translation of one correlation grid (the real or imaginary part of `grid`) over the
-// searched cells.
+// The peak at `cell` of one correlation grid (the real or imaginary part of `grid`), refined to
+// sub-cell precision.
 template <class Part>
-PlanarHypothesis Peak(const std::vector<std::complex<float>>& grid, Part part,
-                      const CoarseQuery& query, double yaw_rad) {
+PlanarHypothesis PeakAt(const std::vector<std::complex<float>>& grid, Part part, std::uint32_t cell,
+                        const CoarseQuery& query, double yaw_rad) {
     const int n = query.config().grid_cells;
-    PlanarHypothesis best{yaw_rad, Eigen::Vector2d::Zero(), -1.0};
-    std::uint32_t best_cell = 0;
-    for (const std::uint32_t cell : query.search_cells()) {
-        const double value = part(grid[cell]);
-        if (value > best.score) {
-            best.score = value;
-            best_cell = cell;
-        }
-    }
-    const int best_x = static_cast<int>(best_cell) % n, best_y = static_cast<int>(best_cell) / n;
-    auto at = [&](int x, int y) {
+    const int x = static_cast<int>(cell) % n, y = static_cast<int>(cell) / n;
+    auto at = [&](int cx, int cy) {
         return static_cast<double>(
-            part(grid[static_cast<std::size_t>(((y + n) % n) * n + (x + n) % n)]));
+            part(grid[static_cast<std::size_t>(((cy + n) % n) * n + (cx + n) % n)]));
     };
-    const double fx = ParabolicOffset(at(best_x - 1, best_y), best.score, at(best_x + 1, best_y));
-    const double fy = ParabolicOffset(at(best_x, best_y - 1), best.score, at(best_x, best_y + 1));
-    best.translation_m =
-        Eigen::Vector2d(Signed(best_x, n) + fx, Signed(best_y, n) + fy) * query.config().cell_m;
-    return best;
+    const double score = at(x, y);
+    const double fx = ParabolicOffset(at(x - 1, y), score, at(x + 1, y));
+    const double fy = ParabolicOffset(at(x, y - 1), score, at(x, y + 1));
+    return {yaw_rad, Eigen::Vector2d(Signed(x, n) + fx, Signed(y, n) + fy) * query.config().cell_m,
+            score};
+}
+
+// Cells apart on the wrapped correlation grid (the larger of the two axis distances).
+int CellDistance(std::uint32_t a, std::uint32_t b, int n) {
+    const int dx = std::abs(Signed((static_cast<int>(a % n) - static_cast<int>(b % n) + n) % n, n));
+    const int dy = std::abs(Signed((static_cast<int>(a / n) - static_cast<int>(b / n) + n) % n, n));
+    return std::max(dx, dy);
+}
+
+// The best translations of one correlation grid over the searched cells: the highest cell, then
+// the highest more than kPeakSeparationCells from every one taken, up to `count`. In a place
+// that repeats (a row of identical rooms, a colonnade) one yaw has several peaks; the ambiguity
+// test needs them all.
+constexpr int kPeakSeparationCells = 3;
+
+template <class Part>
+void AddPeaks(const std::vector<std::complex<float>>& grid, Part part, const CoarseQuery& query,
+              double yaw_rad, int count, std::vector<PlanarHypothesis>& peaks) {
+    const int n = query.config().grid_cells;
+    std::vector<std::uint32_t> taken;
+    for (int k = 0; k < count; ++k) {
+        double best_score = 0.0;
+        std::optional<std::uint32_t> best;
+        for (const std::uint32_t cell : query.search_cells()) {
+            const double value = part(grid[cell]);
+            if (value <= best_score) continue;
+            const bool apart = std::all_of(taken.begin(), taken.end(), [&](std::uint32_t t) {
+                return CellDistance(cell, t, n) > kPeakSeparationCells;
+            });
+            if (apart) best_score = value, best = cell;
+        }
+        if (!best) return;
+        taken.push_back(*best);
+        peaks.push_back(PeakAt(grid, part, *best, query, yaw_rad));
+    }
 }
 
 // The searched rows and the rows beside them (wrapped), ascending and unique.
@@ -102,7 +129,7 @@ std::vector<PlanarHypothesis> Distinct(std::vector<PlanarHypothesis> peaks,
                    (peak.translation_m - other.translation_m).norm() > 3.0 * config.cell_m;
         });
         if (distinct) kept.push_back(peak);
-        if (static_cast<int>(kept.size()) == config.hypotheses) break;
+        if (static_cast<int>(kept.size()) == config.TotalHypotheses()) break;
     }
     return kept;
 }
@@ -174,8 +201,9 @@ std::vector<PlanarHypothesis> CoarseAlign(const CoarseQuery& query,
             product[i] = qa[i] * m + std::complex<float>(0.0F, 1.0F) * (qb[i] * m);
         }
         detail::Fft2dInverseRows(product, n, rows);
-        peaks.push_back(Peak(product, real, query, query.YawOf(a)));
-        if (b != a) peaks.push_back(Peak(product, imaginary, query, query.YawOf(b)));
+        AddPeaks(product, real, query, query.YawOf(a), config.peaks_per_yaw, peaks);
+        if (b != a)
+            AddPeaks(product, imaginary, query, query.YawOf(b), config.peaks_per_yaw, peaks);
     }
     return Distinct(std::move(peaks), config);
 }

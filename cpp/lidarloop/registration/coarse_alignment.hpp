@@ -45,8 +45,9 @@ std::vector<float> OccupancyImage(const std::vector<Eigen::Vector3f>& points, do
                                   const CoarseConfig& config);
 
 /// The best distinct planar poses of the query in the match's frame, best first (at most
-/// config.hypotheses): for every yaw, the translation that maximises the cross-correlation of
-/// the query's rotated structure image with the match's (FFT), within max_translation_m.
+/// config.TotalHypotheses()): for every yaw, the translations (up to peaks_per_yaw, 3 cells
+/// apart) that maximise the cross-correlation of the query's rotated structure image with the
+/// match's (FFT), within max_translation_m.
 /// Empty when either scan has no structure points. Thread-safe.
 std::vector<PlanarHypothesis> CoarseAlign(const CoarseQuery& query,
                                           const SurfacePoints& match_structure);

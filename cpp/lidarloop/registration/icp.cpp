@@ -88,15 +88,16 @@ bool RunStage(const PreparedScan& query, const PreparedScan& match, float max_di
 }  // namespace
 
 IcpResult RefinePointToPlane(const PreparedScan& query, const PreparedScan& match,
-                             const core::Transform& T_initial, const IcpConfig& config) {
+                             const core::Transform& T_initial, const IcpConfig& config,
+                             const std::function<bool(const core::Transform&)>& keep_going) {
     IcpResult result;
     result.T_match_query = T_initial;
     double distance_m = config.initial_correspondence_m;
     while (true) {
         result.converged = RunStage(query, match, static_cast<float>(distance_m), config, result);
         if (distance_m <= config.final_correspondence_m) break;
-        if (distance_m == config.initial_correspondence_m &&
-            result.structure_inliers < config.abandon_below_inliers) {
+        if (distance_m == config.initial_correspondence_m && keep_going &&
+            !keep_going(result.T_match_query)) {
             result.abandoned = true;
             result.converged = false;
             break;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 
 #include "lidarloop/core/point_cloud.hpp"
 #include "lidarloop/registration/prepared_scan.hpp"
@@ -17,14 +18,16 @@ struct IcpResult {
     /// Share of the paired query structure points whose plane distance was within
     /// final_correspondence_m in the last iteration.
     double structure_inliers = 0.0;
-    bool abandoned = false;  ///< stopped after the first stage: too few structure inliers
+    bool abandoned = false;  ///< stopped after the first stage (`keep_going` said no)
 };
 
 /// Point-to-plane ICP of the query onto the match, from `T_initial` (T_match_query), with the
 /// correspondence distance shrinking stage by stage (coarse to fine). Structure points pair only
 /// with structure points, ground with ground; residuals are distances to the match's planes,
-/// weighted robustly. Thread-safe.
+/// weighted robustly. After the first stage, `keep_going(T_match_query)` (when given) decides
+/// whether the later stages run; when it says no, the result is abandoned. Thread-safe.
 IcpResult RefinePointToPlane(const PreparedScan& query, const PreparedScan& match,
-                             const core::Transform& T_initial, const IcpConfig& config);
+                             const core::Transform& T_initial, const IcpConfig& config,
+                             const std::function<bool(const core::Transform&)>& keep_going = {});
 
 }  // namespace lidarloop::registration

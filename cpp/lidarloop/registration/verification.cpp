@@ -172,10 +172,21 @@ RejectReason Judge(const PreparedScan& query, const PreparedScan& match,
     return RejectReason::kNone;
 }
 
+// ICP from `initial`, abandoned after its first stage when the pose overlaps too little to ever
+// pass (IcpConfig::abandon_below_overlap).
+IcpResult Refine(const PreparedScan& query, const PreparedScan& match,
+                 const core::Transform& initial, const VerificationConfig& config) {
+    return RefinePointToPlane(
+        query, match, initial, config.icp, [&](const core::Transform& T_match_query) {
+            return MeasureOverlap(query, match, T_match_query, config.acceptance).Min() >=
+                   config.icp.abandon_below_overlap;
+        });
+}
+
 // ICP from one coarse hypothesis, then the acceptance rule.
 Verification RegisterFrom(const PreparedScan& query, const PreparedScan& match,
                           const PlanarHypothesis& hypothesis, const VerificationConfig& config) {
-    const IcpResult icp = RefinePointToPlane(query, match, PlanarPose(hypothesis), config.icp);
+    const IcpResult icp = Refine(query, match, PlanarPose(hypothesis), config);
     Verification result;
     result.T_match_query = icp.T_match_query;
     result.overlap = MeasureOverlap(query, match, icp.T_match_query, config.acceptance);
@@ -203,8 +214,7 @@ bool HasRivalPose(const PreparedScan& query, const PreparedScan& match,
                   const Verification& accepted, const VerificationConfig& config) {
     for (std::size_t j = 0; j < hypotheses.size(); ++j) {
         if (j == accepted_index) continue;
-        const IcpResult icp =
-            RefinePointToPlane(query, match, PlanarPose(hypotheses[j]), config.icp);
+        const IcpResult icp = Refine(query, match, PlanarPose(hypotheses[j]), config);
         if (icp.abandoned || SamePose(icp.T_match_query, accepted.T_match_query)) continue;
         const Overlap overlap = MeasureOverlap(query, match, icp.T_match_query, config.acceptance);
         if (overlap.Min() >= config.acceptance.max_rival_overlap_ratio * accepted.overlap.Min() &&
@@ -279,7 +289,9 @@ Verification Verify(const PreparedScan& query, const CoarseQuery& coarse, const 
     }
     // Hypotheses in order of coarse score; the first that passes is the answer unless another
     // fits about as well, else the one that overlapped best explains the rejection.
-    for (std::size_t i = 0; i < hypotheses.size(); ++i) {
+    const auto tried =
+        std::min(hypotheses.size(), static_cast<std::size_t>(config.coarse.hypotheses));
+    for (std::size_t i = 0; i < tried; ++i) {
         Verification trial = RegisterFrom(query, match, hypotheses[i], config);
         if (trial.accepted) {
             if (HasRivalPose(query, match, hypotheses, i, trial, config)) {

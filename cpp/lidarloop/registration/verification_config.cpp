@@ -47,6 +47,8 @@ void CoarseConfig::Validate() const {
     RequireIn(yaw_step_deg, 0.1, 45.0, "coarse.yaw_step_deg");
     RequireIn(max_translation_m, 0.1, 1000.0, "coarse.max_translation_m");
     RequireIn(hypotheses, 1, 16, "coarse.hypotheses");
+    RequireIn(rival_hypotheses, 0, 32, "coarse.rival_hypotheses");
+    RequireIn(peaks_per_yaw, 1, 8, "coarse.peaks_per_yaw");
 }
 
 void IcpConfig::Validate() const {
@@ -56,7 +58,7 @@ void IcpConfig::Validate() const {
     RequireIn(convergence_step, 1e-9, 1.0, "icp.convergence_step");
     RequireIn(max_structure_points, 10, 1'000'000, "icp.max_structure_points");
     RequireIn(max_ground_points, 10, 1'000'000, "icp.max_ground_points");
-    RequireIn(abandon_below_inliers, 0.0, 1.0, "icp.abandon_below_inliers");
+    RequireIn(abandon_below_overlap, 0.0, 1.0, "icp.abandon_below_overlap");
 }
 
 void AcceptanceConfig::Validate() const {

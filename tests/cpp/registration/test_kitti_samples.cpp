@@ -115,5 +115,38 @@ TEST_F(KittiSamples, DifferentPlacesAreRejected) {
     }
 }
 
+// Every `stride`-th point: a 120k-point HDL-64E scan thinned towards a sparse sensor's density.
+core::PointCloud Thinned(const core::PointCloud& scan, std::size_t stride) {
+    core::PointCloud thin;
+    for (std::size_t i = 0; i < scan.size(); i += stride) thin.push_back(scan[i]);
+    return thin;
+}
+
+// The rule is density-aware (voxel centroids, fractions, roughness-relative RMSE): the same
+// decisions on scans thinned to 1/4 (~30k points, a VLP-32's) and 1/8 (~15k, a VLP-16's).
+TEST_F(KittiSamples, DecisionsHoldOnThinnedScans) {
+    const Pair loops[] = {{"08", 209, 1684}, {"08", 720, 1500}, {"00", 94, 95}};
+    const Pair others[] = {{"00", 94, 198}, {"08", 209, 720}, {"08", 1684, 1500}};
+    for (const std::size_t stride : {4, 8}) {
+        SCOPED_TRACE("every " + std::to_string(stride) + "th point");
+        const auto run = [&](const Pair& pair) {
+            return VerifyPair(Thinned(Scan(pair.sequence, pair.query), stride),
+                              Thinned(Scan(pair.sequence, pair.match), stride),
+                              VerificationConfig{});
+        };
+        for (const Pair& pair : loops) {
+            const Verification v = run(pair);
+            EXPECT_TRUE(v.accepted)
+                << pair.match << " <- " << pair.query << ": " << ToString(v.reason);
+            EXPECT_LT(std::abs(std::remainder(
+                          YawDeg(v.T_match_query.matrix()) - YawDeg(Truth(pair)), 360.0)),
+                      2.0);
+        }
+        for (const Pair& pair : others) {
+            EXPECT_FALSE(run(pair).accepted) << pair.match << " <- " << pair.query;
+        }
+    }
+}
+
 }  // namespace
 }  // namespace lidarloop::registration
