@@ -6,6 +6,7 @@
 #include "commands.hpp"
 #include "dataset_options.hpp"
 #include "descriptor_options.hpp"
+#include "detection_options.hpp"
 #include "lidarloop/app/bench.hpp"
 #include "lidarloop/app/results_folder.hpp"
 #include "progress.hpp"
@@ -16,6 +17,7 @@ namespace {
 struct BenchFlags {
     DatasetOptions dataset;
     DescriptorOptions descriptor;
+    DetectionOptions detection;
     app::BenchRequest request;
     std::string json;
     bool quiet = false;
@@ -24,6 +26,7 @@ struct BenchFlags {
 void RunBench(BenchFlags& flags) {
     ProgressPrinter progress(flags.quiet);
     flags.request.config = flags.descriptor.Resolve();
+    flags.detection.ApplyTo(flags.request.config);
     flags.request.progress = progress.Callback();
     const nlohmann::json figures = app::RunBench(flags.dataset.Open(), flags.request);
     std::cout << figures.dump(2) << "\n";
@@ -41,6 +44,11 @@ void AddBenchCommand(CLI::App& app) {
     command->add_option("--queries", flags->request.queries, "query scans to time (default 200)");
     command->add_option("--scale-to", flags->request.scale_to,
                         "also time queries against this many stored histograms (synthetic)");
+    command->add_option("--verify-queries", flags->request.verify_queries,
+                        "query scans whose top-k candidates are verified and timed (default 50; "
+                        "0: none)");
+    flags->detection.AddTo(*command, /*decides_loops=*/true,
+                           "S: candidates at least this far back");
     command->add_option("--json", flags->json, "also write the figures to this file");
     command->add_flag("--quiet", flags->quiet, "no progress bar");
     command->callback([flags] { RunBench(*flags); });

@@ -10,6 +10,7 @@
 #include "lidarloop/app/simulation.hpp"
 #include "lidarloop/io/dataset.hpp"
 #include "progress.hpp"
+#include "retrieval_print.hpp"
 
 namespace lidarloop::cli {
 namespace {
@@ -49,6 +50,8 @@ void PrintMethod(const app::MethodEvaluation& e) {
     }
     std::cout << "; recall at zero errors " << Fixed(100.0 * e.per_scan.zero_error.recall, 1)
               << " %\n";
+    // The online detector on the same scans: the descriptor's threshold against verification.
+    if (e.retrieval) PrintRetrieval(*e.retrieval);
 }
 
 void RunDemo(const DemoFlags& flags) {
@@ -59,7 +62,7 @@ void RunDemo(const DemoFlags& flags) {
     PrintSequence(demo, dataset.size());
     app::EvaluationRequest request;
     request.methods = {core::Method::kHeight, core::Method::kRange, core::Method::kNdt};
-    request.distance_m = 10.0;  // Röhling's d
+    request.distance_m = 10.0;            // Röhling's d
     request.progress = progress.Callback();
     request.out = out / "evaluation";
     const app::EvaluationOutcome outcome = app::RunEvaluation(dataset, request);

@@ -13,6 +13,7 @@
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/pipeline/descriptor_method.hpp"
 #include "progress.hpp"
+#include "retrieval_print.hpp"
 
 namespace lidarloop::cli {
 namespace {
@@ -96,22 +97,6 @@ std::optional<io::Dataset> TrainingDataset(const EvaluateFlags& flags) {
     io::DatasetOptions options;
     options.poses_file = flags.train_poses;
     return io::OpenDataset(flags.train_on, options);
-}
-
-void PrintLoops(const std::string& label, const eval::LoopRetrievalEvaluation& r) {
-    std::cout << "      " << label << ": " << r.true_loops << " true and " << r.false_loops
-              << " false loops, recall at 100 % precision "
-              << 100.0 * (std::isnan(r.full_precision.recall) ? 0.0 : r.full_precision.recall)
-              << " %\n";
-}
-
-// The online detector's figures: the candidates' ceiling, then each decision rule.
-void PrintRetrieval(const app::RetrievalComparison& r) {
-    std::cout << "    top-" << r.top_k << " candidates of " << r.descriptor.revisiting
-              << " revisiting scans: recall@1 " << 100.0 * r.descriptor.recall_at_1 << " %, recall@"
-              << r.top_k << " " << 100.0 * r.descriptor.recall_at_k << " %\n";
-    PrintLoops("descriptor threshold", r.descriptor);
-    if (r.verified) PrintLoops("verified", *r.verified);
 }
 
 void PrintOutcome(const io::Dataset& dataset, const app::EvaluationOutcome& outcome,

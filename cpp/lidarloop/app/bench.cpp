@@ -1,6 +1,7 @@
 #include "lidarloop/app/bench.hpp"
 
 #include <sys/resource.h>
+#include <time.h>
 
 #include <algorithm>
 #include <limits>
@@ -9,6 +10,7 @@
 
 #include "lidarloop/app/describe_run.hpp"
 #include "lidarloop/app/results_folder.hpp"
+#include "lidarloop/app/verification_run.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/pipeline/histogram_index.hpp"
 #include "lidarloop/pipeline/histogram_method.hpp"
@@ -85,15 +87,86 @@ pipeline::DescriptorDatabase Scaled(const pipeline::DescriptorDatabase& source, 
     return scaled;
 }
 
+// CPU time of the calling thread: what a step costs whatever else the machine does.
+double ThreadCpuSeconds() {
+    timespec now{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+    return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
+}
+
+// Wall and thread CPU time of one step, milliseconds.
+struct StepTimes {
+    std::vector<double> wall_ms;
+    std::vector<double> cpu_ms;
+
+    template <typename F>
+    auto Time(F&& step) {
+        const Stopwatch wall;
+        const double cpu_start = ThreadCpuSeconds();
+        auto result = step();
+        cpu_ms.push_back(1e3 * (ThreadCpuSeconds() - cpu_start));
+        wall_ms.push_back(1e3 * wall.Seconds());
+        return result;
+    }
+    nlohmann::json Json() const {
+        return {{"wall", SummaryJson(wall_ms)}, {"thread_cpu", SummaryJson(cpu_ms)}};
+    }
+};
+
+// Verifies the top-k candidates of `queries` evenly spaced scans that have candidates, one pair
+// at a time on this thread.
+nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
+                                const pipeline::SimilarityMatrix& matrix,
+                                const PreparedScans& prepared, const io::RunConfig& config,
+                                std::size_t queries) {
+    std::vector<pipeline::LoopQuery> all = pipeline::DetectFromMatrix(
+        matrix, described.database.times_s(), config.detection, config.descriptor.method);
+    std::erase_if(all, [](const pipeline::LoopQuery& q) { return !q.has_match(); });
+    const registration::VerificationConfig& verification = config.detection.verification;
+    StepTimes coarse_times;
+    StepTimes pair_times;
+    std::size_t accepted = 0;
+    const std::size_t step =
+        std::max<std::size_t>(1, all.size() / std::max<std::size_t>(1, queries));
+    for (std::size_t q = 0; q < all.size() && coarse_times.wall_ms.size() < queries; q += step) {
+        const registration::PreparedScan& query = prepared.scans[all[q].query];
+        if (!query.structure) continue;
+        const auto coarse = coarse_times.Time([&] {
+            return std::make_optional<registration::CoarseQuery>(*query.structure,
+                                                                 verification.coarse);
+        });
+        for (const pipeline::Neighbor& candidate : all[q].candidates) {
+            const registration::Verification verdict = pair_times.Time([&] {
+                return registration::Verify(query, *coarse, prepared.scans[candidate.index],
+                                            verification);
+            });
+            accepted += verdict.accepted ? 1 : 0;
+        }
+    }
+    nlohmann::json json;
+    json["queries"] = coarse_times.wall_ms.size();
+    json["pairs"] = pair_times.wall_ms.size();
+    json["pairs_accepted"] = accepted;
+    json["top_k"] = config.detection.top_k;
+    json["prepare_ms_per_scan"] = SummaryJson(prepared.prepare_seconds, 1e3);
+    json["bytes_per_prepared_scan"] = SummaryJson(prepared.BytesPerScan());
+    json["coarse_images_ms_per_query"] = coarse_times.Json();
+    json["verify_ms_per_pair"] = pair_times.Json();
+    return json;
+}
+
 }  // namespace
 
 nlohmann::json RunBench(const io::Dataset& dataset, const BenchRequest& request) {
     const io::RunConfig& config = request.config;
     config.Validate();
     // One core, so that the per-scan times are what one scan costs.
-    const auto described = DescribeDataset(
-        dataset, config.descriptor,
-        {"describing", /*skip_bad=*/false, pipeline::Execution::kSerial, request.progress, {}});
+    const bool verify = request.verify_queries > 0 && config.detection.verify;
+    PreparedScans prepared(verify ? dataset.size() : 0);
+    DescribeRun run{
+        "describing", /*skip_bad=*/false, pipeline::Execution::kSerial, request.progress, {}};
+    if (verify) run.with_cloud = prepared.Collector(config.detection.verification.reduction);
+    const auto described = DescribeDataset(dataset, config.descriptor, run);
     const auto& database = described.database;
 
     Stopwatch serial_clock;
@@ -118,6 +191,10 @@ nlohmann::json RunBench(const io::Dataset& dataset, const BenchRequest& request)
     if (const auto* rows = pipeline::HistogramRows(database)) {
         json["bytes_per_stored_histogram"] =
             4 * rows->stride() + 4 * pipeline::HistogramIndex::kBlocks + 16 + 9;
+    }
+    if (verify) {
+        json["verification"] =
+            TimeVerification(described, matrix, prepared, config, request.verify_queries);
     }
     json["peak_memory_mib"] = PeakMemoryMiB();
     return json;

@@ -15,12 +15,17 @@ struct BenchRequest {
     io::RunConfig config;
     std::size_t queries = 200;  ///< query scans to time
     std::size_t scale_to = 0;   ///< also time queries against this many histograms (synthetic)
+    /// Query scans whose top-k candidates (config.detection.top_k) are verified on one core, to
+    /// time verification per pair; 0: verification is not timed.
+    std::size_t verify_queries = 50;
     Progress progress;
 };
 
 /// Times describing (one core), the similarity matrix (one core and all cores), and top-1
 /// queries through the index and by brute force on `dataset`; with scale_to, also queries
-/// against a synthetic database of that many perturbed histograms. The figures as JSON (keys in
+/// against a synthetic database of that many perturbed histograms; and geometric verification on
+/// one core: preparing a scan, the query's coarse images, and each candidate pair (wall and
+/// thread CPU time), with the bytes kept per prepared scan. The figures as JSON (keys in
 /// docs/cli.md), with the peak memory of the process.
 nlohmann::json RunBench(const io::Dataset& dataset, const BenchRequest& request);
 

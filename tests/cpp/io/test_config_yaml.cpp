@@ -45,7 +45,7 @@ TEST(ConfigYaml, DumpNamesEveryKeyWithItsDefault) {
           "height_min_m: -3", "height_max_m: 7", "range_min_m: 0", "range_max_m: 80",
           "out_of_range: clamp", "cell_size_m: 0.5", "planar_classes: 9",
           "eigen_ratio_threshold: 0.1", "ambiguity_ratio: 0.6", "range_limits_m: [3, 6, 9, 15]",
-          "normalise_rotation: true", "min_gap: 30", "min_gap_unit: scans", "top_k: 5",
+          "normalise_rotation: true", "min_gap: 30", "min_gap_unit: scans", "top_k: 10",
           "threshold: default"}) {
         EXPECT_NE(dump.find(key), std::string::npos) << key << " missing in\n" << dump;
     }
