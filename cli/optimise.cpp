@@ -37,9 +37,9 @@ void PrintOutcome(const app::OptimiseRequest& request, const app::OptimiseOutcom
     const posegraph::OptimisationResult& r = outcome.result;
     std::cout << "lidarloop optimise: " << outcome.loops.size() << " accepted loops, "
               << r.loops_used << " used, " << r.rejected_by_odometry
-              << " rejected against the odometry, " << r.rejected_by_residual
-              << " by their residual (" << r.solves << " solves, " << Figure(r.seconds, "%.2f")
-              << " s)\n";
+              << " rejected against the odometry, " << r.rejected_by_consistency
+              << " without support, " << r.rejected_by_residual << " by their residual ("
+              << r.solves << " solves, " << Figure(r.seconds, "%.2f") << " s)\n";
     if (outcome.odometry && outcome.optimised) {
         std::cout << "  ATE RMSE: odometry " << Figure(outcome.odometry->ate_rmse_m, "%.3f")
                   << " m -> optimised " << Figure(outcome.optimised->ate_rmse_m, "%.3f")

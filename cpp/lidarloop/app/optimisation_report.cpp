@@ -136,6 +136,7 @@ nlohmann::json OptimisationMetricsJson(const io::Dataset& dataset, const Optimis
                             {"used", r.loops_used},
                             {"rejected_by_odometry", r.rejected_by_odometry},
                             {"rejected_by_residual", r.rejected_by_residual},
+                            {"rejected_by_consistency", r.rejected_by_consistency},
                             {"rejected", rejected}};
     if (!outcome.loop_is_true.empty()) {
         loops["true"] = CountTrue(outcome, false);
@@ -174,7 +175,9 @@ void WriteOptimisationReport(const std::filesystem::path& file, const io::Datase
         << (request.loops_file.empty() ? "detected with verification, detection/"
                                        : "`" + request.loops_file.string() + "`")
         << "); the back end used " << r.loops_used << ", rejected " << r.rejected_by_odometry
-        << " against the odometry and " << r.rejected_by_residual << " by their residual\n";
+        << " against the odometry, " << r.rejected_by_consistency
+        << " without support from neighbouring loops and " << r.rejected_by_residual
+        << " by their residual\n";
     if (!outcome.loop_is_true.empty()) {
         out << "- against the ground truth: " << CountTrue(outcome, false) << " of the "
             << outcome.loops.size() << " loops are true (within "

@@ -161,6 +161,14 @@ void VisitFields(posegraph::RobustConfig& c, Visitor& v) {
             "loops further from the odometry than this many sigmas of its drift are rejected");
     v.Field("gate_min_translation_m", c.gate_min_translation_m, "added to the gate, metres");
     v.Field("gate_min_rotation_deg", c.gate_min_rotation_deg, "added to the gate, degrees");
+    v.Field("gate_translation_percent", c.gate_translation_percent,
+            "systematic drift allowed, per cent of the path");
+    v.Field("gate_rotation_deg_per_100m", c.gate_rotation_deg_per_100m,
+            "systematic drift allowed, degrees per 100 m of path");
+    v.Field("support_window_m", c.support_window_m,
+            "loops whose ends lie this close along the path check each other");
+    v.Field("min_support", c.min_support,
+            "consistent neighbouring loops a loop needs to enter the first optimisation");
     v.Field("cauchy_scale", c.cauchy_scale, "Cauchy loss scale on loops, whitened units");
     v.Field("reject_sigmas", c.reject_sigmas,
             "loops with a larger whitened residual after optimising are dropped");
@@ -172,7 +180,7 @@ template <typename Visitor>
 void VisitFields(posegraph::PoseGraphConfig& c, Visitor& v) {
     v.Section("information", c.information);
     v.Section("robust", c.robust);
-    v.Field("max_iterations", c.max_iterations, "Levenberg-Marquardt iterations per solve");
+    v.Field("max_iterations", c.max_iterations, "Ceres trust-region iterations per solve");
     v.Field("threads", c.threads, "Ceres threads");
 }
 

@@ -15,9 +15,11 @@ enum class LoopVerdict {
     kUsed,                ///< in the optimised graph
     kRejectedByOdometry,  ///< inconsistent with the odometry beyond its drift (the gate)
     kRejectedByResidual,  ///< inconsistent with the optimised graph (whitened residual too large)
+    /// without a consistent neighbouring loop, and inconsistent with the optimised graph
+    kRejectedByConsistency,
 };
 
-/// "used", "rejected_by_odometry", "rejected_by_residual".
+/// "used", "rejected_by_odometry", "rejected_by_residual", "rejected_by_consistency".
 std::string ToString(LoopVerdict verdict);
 
 /// One loop edge of the graph and the back end's verdict on it.
@@ -35,6 +37,7 @@ struct LoopResult {
     /// it took part in; NaN when the gate rejected it).
     double initial_whitened_residual = 0.0;
     double whitened_residual = 0.0;
+    std::size_t support = 0;  ///< consistent neighbouring loops (RobustConfig::min_support)
 };
 
 struct OptimisationResult {
@@ -43,8 +46,9 @@ struct OptimisationResult {
     std::size_t loops_used = 0;
     std::size_t rejected_by_odometry = 0;
     std::size_t rejected_by_residual = 0;
+    std::size_t rejected_by_consistency = 0;
     int solves = 0;             ///< Ceres solves (graduated rounds and re-solves after rejections)
-    int iterations = 0;         ///< Levenberg-Marquardt iterations over all solves
+    int iterations = 0;         ///< trust-region (dogleg) iterations over all solves
     bool converged = true;      ///< every solve ended by a convergence test, not the limit
     double initial_cost = 0.0;  ///< 1/2 sum of squared whitened errors at the odometry, used
                                 ///< loops only, without loss function
@@ -53,12 +57,14 @@ struct OptimisationResult {
     std::string note;  ///< e.g. why the odometry came back unchanged; empty otherwise
 };
 
-/// Optimises the graph with Ceres (Levenberg-Marquardt, sparse Cholesky): every pose has a
-/// position (R^3) and a unit quaternion (Ceres' EigenQuaternionManifold), pose 0 is fixed, and
+/// Optimises the graph with Ceres (trust region with Powell's dogleg, sparse Cholesky): every pose
+/// is a position in R^3 and a unit quaternion (Ceres' ProductManifold of EuclideanManifold<3> and
+/// EigenQuaternionManifold), pose 0 is fixed, and
 /// every edge's error is EdgeError whitened by its information. Wrong loops are kept out in
-/// three steps (docs/posegraph.md#robustness): the odometry gate, a Cauchy loss on loop edges
-/// whose scale shrinks over graduated rounds, and dropping loops whose whitened residual after
-/// optimising exceeds reject_sigmas, then optimising again.
+/// four steps (docs/posegraph.md#robustness): the odometry gate; the support test against
+/// neighbouring loops; a Cauchy loss on loop edges whose scale shrinks over graduated rounds;
+/// then every loop is tested against the optimised graph (whitened residual <= reject_sigmas),
+/// dropped or taken in, and the graph optimised again.
 ///
 /// A graph without loop edges (or whose loops are all rejected by the gate) is returned
 /// unchanged, with a note. Throws core::ConfigError for an invalid config, an empty graph or an

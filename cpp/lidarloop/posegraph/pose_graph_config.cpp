@@ -50,6 +50,10 @@ void PoseGraphConfig::Validate() const {
     Require(r.gate_sigmas, 1.0, 1000.0, false, "robust.gate_sigmas");
     Require(r.gate_min_translation_m, 0.0, 1e4, false, "robust.gate_min_translation_m");
     Require(r.gate_min_rotation_deg, 0.0, 180.0, false, "robust.gate_min_rotation_deg");
+    Require(r.gate_translation_percent, 0.0, 100.0, false, "robust.gate_translation_percent");
+    Require(r.gate_rotation_deg_per_100m, 0.0, 100.0, false, "robust.gate_rotation_deg_per_100m");
+    Require(r.support_window_m, 0.0, 1e4, true, "robust.support_window_m");
+    Require(r.min_support, 0, 1000, "robust.min_support");
     Require(r.cauchy_scale, 0.0, 100.0, true, "robust.cauchy_scale");
     Require(r.reject_sigmas, 0.0, 1000.0, true, "robust.reject_sigmas");
     Require(r.scale_step, 1.5, 100.0, false, "robust.scale_step");

@@ -34,6 +34,19 @@ struct RobustConfig {
     double gate_sigmas = 5.0;
     double gate_min_translation_m = 3.0;  ///< [0, 1e4]
     double gate_min_rotation_deg = 10.0;  ///< [0, 180]
+    /// Systematic drift the gate (and the support test) also allow, growing linearly with the
+    /// path: per cent of it in translation, degrees per 100 m in rotation. [0, 100] each
+    double gate_translation_percent = 3.0;
+    double gate_rotation_deg_per_100m = 1.0;
+    /// Support: a loop is checked against the loops whose two scans both lie within this path
+    /// length of its own (m to m, q to q): the cycle of the two loops and the odometry between
+    /// their ends must close within gate_sigmas times the odometry's drift over those short
+    /// pieces and the two loops' own sigmas, plus the systematic allowance. Loops with fewer
+    /// than min_support consistent neighbours are held out of the first optimisation and taken
+    /// in only when the optimised graph agrees with them (reject_sigmas). When no loop has
+    /// support (a single loop), all are optimised. (0, 1e4]
+    double support_window_m = 30.0;
+    int min_support = 1;  ///< [0, 1000]; 0: no support test
     /// Cauchy loss scale on loop edges in the last round, in sigmas of the loop's own
     /// information (whitened residual norm). (0, 100]
     double cauchy_scale = 2.0;
@@ -53,7 +66,7 @@ struct RobustConfig {
 struct PoseGraphConfig {
     InformationConfig information;
     RobustConfig robust;
-    int max_iterations = 50;  ///< Levenberg-Marquardt iterations per solve, [1, 10000]
+    int max_iterations = 50;  ///< Ceres (dogleg) iterations per solve, [1, 10000]
     int threads = 1;          ///< Ceres threads, [1, 256]
 
     /// Throws core::ConfigError naming the first invalid field ("posegraph.robust.gate_sigmas
