@@ -103,9 +103,9 @@ TEST(Simulator, DefaultOdometryDriftHasRealisticMagnitudes) {
         }
         const eval::RelativePoseError rpe = eval::ComputeRelativePoseError(odometry, truth);
         ASSERT_GT(rpe.segments, 100u);
-        // 1 % scale error and 0.25 deg/100 m: about 1 % on straight roads, less on this compact
+        // 0.2 % scale error and 0.4 deg/100 m: about 1 % on straight roads, less on this compact
         // grid route, whose segments end closer to where they start than their length.
-        EXPECT_GT(rpe.translation_percent, 0.3) << "seed " << seed;
+        EXPECT_GT(rpe.translation_percent, 0.25) << "seed " << seed;
         EXPECT_LT(rpe.translation_percent, 2.0) << "seed " << seed;
         EXPECT_GT(rpe.rotation_deg_per_100m, 0.1) << "seed " << seed;
         EXPECT_LT(rpe.rotation_deg_per_100m, 0.6) << "seed " << seed;
