@@ -237,7 +237,7 @@ section_bench() {
 
 # --- demo ------------------------------------------------------------------------------------
 section_demo() {
-    expect_ok "demo" "figures and tables:" "$cli" demo --out "$work/demo" --quiet
+    expect_ok "demo" "(optimised); top view:" "$cli" demo --out "$work/demo" --quiet
     for file in metrics.json roc.csv pr.csv report.md ground_truth.png similarity_height.png \
         similarity_ndt.png config.yaml; do
         if [ -s "$work/demo/evaluation/$file" ]; then pass; else fail "demo did not write $file"; fi
