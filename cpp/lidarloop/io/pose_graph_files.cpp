@@ -160,13 +160,20 @@ std::vector<LoopRow> ReadLoopsCsv(const std::filesystem::path& file, std::size_t
             header = true;
             continue;
         }
-        if (fields.size() != columns.count) {
+        // A query the detector did not verify has no verification columns: fine when it is not
+        // an accepted loop.
+        const bool short_row = fields.size() < columns.count;
+        if (fields.size() > columns.count || (short_row && fields.size() <= columns.accepted)) {
             reader.Fail("expected " + std::to_string(columns.count) +
                         " fields as the header, got " + std::to_string(fields.size()));
         }
         const std::string_view accepted = fields[columns.accepted];
         if (accepted != "0" && accepted != "1") {
             reader.Fail("accepted " + detail::Quoted(accepted) + " is not 0 or 1");
+        }
+        if (accepted == "1" && short_row) {
+            reader.Fail("an accepted loop without a pose (" + std::to_string(fields.size()) +
+                        " fields, the header has " + std::to_string(columns.count) + ")");
         }
         if (accepted == "1") rows.push_back(ParseLoopRow(reader, fields, columns, scan_count));
     }

@@ -18,11 +18,13 @@ struct LoopRow {
 /// Reads the accepted loops of a loops.csv written by `lidarloop detect` with verification
 /// (docs/cli.md#loopscsv): the rows with accepted = 1, their query and match scans and
 /// T_match_query from tx ty tz (metres) and qx qy qz qw; overlap (the smaller of overlap_query
-/// and overlap_match) and rmse_m when present. Columns are found by the header, in any order.
+/// and overlap_match) and rmse_m when present. Columns are found by the header, in any order; a
+/// row that is not an accepted loop may stop short of them (a query that was not verified).
 /// Throws ReadError naming the file and line for a header without query, match, accepted or the
-/// pose columns (a loops.csv from `detect --no-verify` has no pose), a scan index not below
-/// `scan_count`, a non-number, a non-finite value, or a quaternion whose norm is far from 1
-/// (< 0.9 or > 1.1; others are normalised).
+/// pose columns (a loops.csv from `detect --no-verify` has no pose), an accepted row without a
+/// pose, a row with more fields than the header, a scan index not below `scan_count`, a
+/// non-number, a non-finite value, or a quaternion whose norm is far from 1 (< 0.9 or > 1.1;
+/// others are normalised).
 std::vector<LoopRow> ReadLoopsCsv(const std::filesystem::path& file, std::size_t scan_count);
 
 /// Writes a pose graph in g2o's text format: one `VERTEX_SE3:QUAT id x y z qx qy qz qw` per pose

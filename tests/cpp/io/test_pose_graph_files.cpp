@@ -62,9 +62,12 @@ TEST(ReadLoopsCsv, BadInputNamesTheFileAndLine) {
                          "line 2: quaternion (qx qy qz qw) has norm 3"));
     EXPECT_TRUE(Contains(error("query,match,distance,second_ratio,accepted\n40,3,0.1,,1\n"),
                          "line 1: the header has no loop pose"));
-    EXPECT_TRUE(Contains(error(kHeader + "40,3,0.004\n"), "line 2: expected 18 fields"));
+    EXPECT_TRUE(Contains(error(kHeader + "40,3\n"), "line 2: expected 18 fields"));
+    EXPECT_TRUE(Contains(error(kHeader + "40,3,0.004,,1\n"), "line 2: an accepted loop without"));
+    EXPECT_TRUE(Contains(error(kHeader + "40,3,0.004,,0\n" + row), "no ReadError"));
+    EXPECT_TRUE(Contains(error(kHeader + row.substr(0, row.size() - 1) + ",x\n"),
+                         "line 2: expected 18 fields"));
     EXPECT_TRUE(Contains(error(""), "the file is empty"));
-    EXPECT_TRUE(Contains(error(kHeader + row), "no ReadError"));
     EXPECT_TRUE(Contains(error(kHeader + row), "no ReadError"));
     EXPECT_TRUE(Contains(ReadErrorOf([&] { ReadLoopsCsv(dir / "missing.csv", 5); }),
                          "missing.csv: no such file"));
