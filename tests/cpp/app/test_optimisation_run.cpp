@@ -36,7 +36,7 @@ TEST_F(OptimisationRun, DetectsLoopsAndShrinksTheError) {
     const app::OptimiseOutcome outcome = app::RunOptimisation(*dataset_, request);
     ASSERT_GT(outcome.result.loops_used, 10u);
     ASSERT_TRUE(outcome.odometry && outcome.optimised);
-    EXPECT_LT(outcome.optimised->ate_rmse_m, outcome.odometry->ate_rmse_m / 3.0)
+    EXPECT_LT(outcome.optimised->ate_rmse_m, outcome.odometry->ate_rmse_m / 2.0)
         << outcome.odometry->ate_rmse_m << " -> " << outcome.optimised->ate_rmse_m;
     const auto out = request.out;
     for (const char* file : {"poses_optimised.txt", "graph.g2o", "loop_verdicts.csv",
