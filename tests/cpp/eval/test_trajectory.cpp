@@ -72,10 +72,10 @@ TEST(AbsoluteTrajectoryRmse, MatchesABruteForceYawSearch) {
         p.translation() += Eigen::Vector3d(noise(rng), noise(rng), 0.0);
         estimate.push_back(p);
     }
-    double best = 1e300;
-    for (int k = 0; k < 360000; ++k) {
+    // RMSE at one yaw, with the translation that matches the centroids.
+    const auto rmse_at = [&](double yaw_deg) {
         const Eigen::Matrix3d R =
-            Eigen::AngleAxisd(k * 1e-3 * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+            Eigen::AngleAxisd(yaw_deg * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
         Eigen::Vector3d mean_e = Eigen::Vector3d::Zero(), mean_t = Eigen::Vector3d::Zero();
         for (std::size_t i = 0; i < truth.size(); ++i) {
             mean_e += R * estimate[i].translation();
@@ -86,8 +86,15 @@ TEST(AbsoluteTrajectoryRmse, MatchesABruteForceYawSearch) {
         for (std::size_t i = 0; i < truth.size(); ++i) {
             sum += (truth[i].translation() - R * estimate[i].translation() - t).squaredNorm();
         }
-        best = std::min(best, std::sqrt(sum / static_cast<double>(truth.size())));
+        return std::sqrt(sum / static_cast<double>(truth.size()));
+    };
+    // Every degree, then every 0.001 degree around the best one.
+    double best_deg = 0.0;
+    for (int k = 0; k < 360; ++k) {
+        if (rmse_at(k) < rmse_at(best_deg)) best_deg = k;
     }
+    double best = rmse_at(best_deg);
+    for (int k = -1000; k <= 1000; ++k) best = std::min(best, rmse_at(best_deg + k * 1e-3));
     const double ate = AbsoluteTrajectoryRmse(estimate, truth);
     EXPECT_LE(ate, best + 1e-9);
     EXPECT_NEAR(ate, best, 1e-6);
