@@ -4,10 +4,10 @@
 
 namespace lidarloop::cli {
 
-void DatasetOptions::AddTo(CLI::App& command) {
+void DatasetOptions::AddTo(CLI::App& command, const std::string& format_flag) {
     command.add_option("DATASET", path_, "folder of scans (KITTI layout, scan files, Osnabrueck)")
         ->required();
-    command.add_option("--format", format_, "dataset layout: auto | kitti | folder | osnabrueck")
+    command.add_option(format_flag, format_, "dataset layout: auto | kitti | folder | osnabrueck")
         ->check(CLI::IsMember({"auto", "kitti", "folder", "osnabrueck"}));
     command.add_option("--poses", poses_, "poses file (KITTI or TUM) instead of the usual one")
         ->check(CLI::ExistingFile);

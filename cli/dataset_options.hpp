@@ -11,8 +11,9 @@ namespace lidarloop::cli {
 /// DATASET and the flags that say how to open it, shared by the commands that read sequences.
 class DatasetOptions {
 public:
-    /// Adds the DATASET positional and --format, --poses, --calib.
-    void AddTo(CLI::App& command);
+    /// Adds the DATASET positional and --format, --poses, --calib; `format_flag` renames
+    /// --format for a command whose --format means something else (optimise's pose format).
+    void AddTo(CLI::App& command, const std::string& format_flag = "--format");
     io::Dataset Open() const;
     const std::string& path() const { return path_; }
 

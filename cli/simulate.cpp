@@ -10,6 +10,7 @@
 #include "commands.hpp"
 #include "lidarloop/app/simulation.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/io/poses.hpp"
 #include "progress.hpp"
 
 namespace lidarloop::cli {
@@ -22,6 +23,7 @@ struct SimulateFlags {
     long long scans = 100;
     std::uint64_t seed = 1;
     std::string out;
+    std::string trajectory;  // KITTI or TUM poses to drive instead of the route
     double noise_m = sim::SensorConfig{}.noise_m;
     double dropout = sim::SensorConfig{}.dropout;
     double drift = 1.0;
@@ -51,6 +53,12 @@ sim::SimulationConfig ToConfig(const SimulateFlags& flags) {
         throw core::ConfigError("--drift must be >= 0 (a factor on the default odometry noise)");
     }
     config.scans = static_cast<std::size_t>(flags.scans);
+    if (!flags.trajectory.empty()) {
+        for (const core::StampedPose& pose : io::ReadPoses(flags.trajectory)) {
+            config.trajectory.push_back(pose.T_world_sensor.translation());
+        }
+        config.scans = config.trajectory.size();
+    }
     config.seed = flags.seed;
     config.sensor.noise_m = flags.noise_m;
     config.sensor.dropout = flags.dropout;
@@ -63,6 +71,8 @@ sim::SimulationConfig ToConfig(const SimulateFlags& flags) {
     config.route.uturn_blocks = flags.uturn_blocks.value_or(config.route.uturn_blocks);
     config.odometry.yaw_noise_deg *= flags.drift;
     config.odometry.translation_noise *= flags.drift;
+    config.odometry.yaw_bias_deg_per_100m *= flags.drift;
+    config.odometry.length_bias *= flags.drift;
     config.Validate();
     return config;
 }
@@ -82,10 +92,12 @@ void RunSimulate(const SimulateFlags& flags) {
     char timing[32];
     std::snprintf(timing, sizeof(timing), "%.2f s", summary.seconds);
     std::cout << "simulated " << c.scans << " scans (" << sim::ToString(c.scene) << ", "
-              << sim::ToString(c.route.type) << ", " << sim::ToString(c.sensor.model) << ", seed "
-              << c.seed << ") into " << flags.out << ": " << summary.mean_points
-              << " points per scan (min " << summary.min_points << ", max " << summary.max_points
-              << "), " << summary.revisited_scans << " scans revisit a place (within "
+              << (c.trajectory.empty() ? sim::ToString(c.route.type)
+                                       : "trajectory " + flags.trajectory)
+              << ", " << sim::ToString(c.sensor.model) << ", seed " << c.seed << ") into "
+              << flags.out << ": " << summary.mean_points << " points per scan (min "
+              << summary.min_points << ", max " << summary.max_points << "), "
+              << summary.revisited_scans << " scans revisit a place (within "
               << Number(app::kRevisitDistance_m) << " m of a scan " << app::kRevisitGap
               << "+ earlier), " << timing << "\n";
 }
@@ -103,6 +115,11 @@ void AddSimulateCommand(CLI::App& app) {
         ->capture_default_str();
     command->add_option("--scans", flags->scans, "number of scans, 1-1000000")
         ->capture_default_str();
+    command
+        ->add_option("--trajectory", flags->trajectory,
+                     "drive this trajectory (KITTI 3x4 or TUM poses; positions only, one scan "
+                     "per pose, --scans ignored) through the scene instead of --route")
+        ->check(CLI::ExistingFile);
     command->add_option("--seed", flags->seed, "seed of world, speed, noise and drift")
         ->capture_default_str();
     command->add_option("--out", flags->out, "output folder (velodyne/, poses.txt, times.txt)")

@@ -7,7 +7,8 @@
 # folder of its own, so any one runs alone. Every case checks the exit code and a phrase of the
 # output; the last line is "cli <sections>: N passed, N failed".
 set -u
-sections=(describe distance ndt verify detect bench demo evaluate dump-config bad-input simulate)
+sections=(describe distance ndt verify detect bench demo evaluate dump-config bad-input simulate
+    optimise)
 if [ "${1-}" = "--list" ]; then
     printf '%s\n' "${sections[@]}"
     exit 0
@@ -268,7 +269,7 @@ section_bench() {
 
 # --- demo ------------------------------------------------------------------------------------
 section_demo() {
-    expect_ok "demo" "figures and tables:" "$cli" demo --out "$work/demo" --quiet
+    expect_ok "demo" "(optimised); top view:" "$cli" demo --out "$work/demo" --quiet
     for file in metrics.json roc.csv pr.csv report.md ground_truth.png similarity_height.png \
         similarity_ndt.png config.yaml; do
         if [ -s "$work/demo/evaluation/$file" ]; then pass; else fail "demo did not write $file"; fi
@@ -448,6 +449,35 @@ section_simulate() {
         --dropout 1.5 --out "$work/sim_bad"
     expect_error "simulate into old scans" "already holds 5 .bin scans" "$cli" simulate \
         --sensor vlp16 --scans 2 --out "$work/sim"
+}
+
+# --- optimise: a pose graph of a tiny simulated sequence, and its bad input -----------------------
+section_optimise() {
+    "$cli" simulate --sensor vlp16 --route grid --scans 40 --horizontal-steps 90 --quiet \
+        --out "$work/seq" >/dev/null 2>&1
+    local header="query,match,distance,second_ratio,accepted,rank,tx,ty,tz,qx,qy,qz,qw"
+    printf '%s\n%s\n' "$header" "35,2,0.001,,1,1,0,0,0,0,0,0,1" >"$work/loops.csv"
+    expect_ok "optimise" "ATE RMSE: odometry" "$cli" optimise "$work/seq" --odometry \
+        "$work/seq/poses_odometry.txt" --loops "$work/loops.csv" --format tum --out "$work/opt"
+    if [ -s "$work/opt/graph.g2o" ] && grep -q "ate_rmse_m_optimised" "$work/opt/metrics.json" &&
+        [ "$(awk 'NR == 1 { print NF }' "$work/opt/poses_optimised.txt")" -eq 8 ]; then pass; else
+        fail "optimise wrote no graph.g2o, metrics.json or TUM poses_optimised.txt"
+    fi
+    printf '%s\n%s\n' "$header" "35,2,0.001,,0,1,0,0,0,0,0,0,1" >"$work/none.csv"
+    expect_ok "optimise without loops" "no loop: the odometry is returned unchanged" "$cli" \
+        optimise "$work/seq" --odometry "$work/seq/poses_odometry.txt" --loops "$work/none.csv" \
+        --out "$work/opt_none"
+    head -n 39 "$work/seq/poses_odometry.txt" >"$work/short.txt"
+    expect_error "optimise short odometry" "short.txt: holds 39 poses but" "$cli" optimise \
+        "$work/seq" --odometry "$work/short.txt" --loops "$work/loops.csv" --out "$work/opt_bad"
+    printf '%s\n%s\n' "$header" "99,2,0.001,,1,1,0,0,0,0,0,0,1" >"$work/far.csv"
+    expect_error "optimise missing scan" "line 2: query scan 99 does not exist" "$cli" optimise \
+        "$work/seq" --odometry "$work/seq/poses_odometry.txt" --loops "$work/far.csv" \
+        --out "$work/opt_bad"
+    sed '3s/^[^ ]*/nan/' "$work/seq/poses_odometry.txt" >"$work/inf.txt"
+    expect_error "optimise non-finite odometry" "line 3: 'nan' is not a finite number" "$cli" \
+        optimise "$work/seq" --odometry "$work/inf.txt" --loops "$work/loops.csv" \
+        --out "$work/opt_bad"
 }
 
 # --- run the sections named on the command line -------------------------------------------------

@@ -40,6 +40,8 @@ void WriteSimulationYaml(const std::filesystem::path& file, const sim::Simulator
         << "  spacing_max_m: " << Number(c.route.spacing_max_m) << "\n"
         << "  uturn_blocks: " << c.route.uturn_blocks << "\n"
         << "  lap_length_m: " << Number(simulator.route().lap_length_m()) << "\n"
+        << "trajectory_poses: " << c.trajectory.size()
+        << "  # > 0: a given trajectory, not the route\n"
         << "sensor:\n"
         << "  model: " << sim::ToString(s.model) << "\n"
         << "  beams: " << s.beams << "\n"
@@ -53,6 +55,8 @@ void WriteSimulationYaml(const std::filesystem::path& file, const sim::Simulator
         << "odometry:\n"
         << "  yaw_noise_deg: " << Number(c.odometry.yaw_noise_deg) << "\n"
         << "  translation_noise: " << Number(c.odometry.translation_noise) << "\n"
+        << "  yaw_bias_deg_per_100m: " << Number(c.odometry.yaw_bias_deg_per_100m) << "\n"
+        << "  length_bias: " << Number(c.odometry.length_bias) << "\n"
         << "files:\n"
         << "  scans: velodyne/NNNNNN.bin  # KITTI float32 x y z intensity(0), sensor frame\n"
         << "  poses: poses.txt  # ground truth T_world_sensor, 3x4 row-major, LiDAR frame\n"

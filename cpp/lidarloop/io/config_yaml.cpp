@@ -149,12 +149,59 @@ void VisitFields(registration::VerificationConfig& c, Visitor& v) {
 }
 
 template <typename Visitor>
+void VisitFields(posegraph::InformationConfig& c, Visitor& v) {
+    v.Field("odometry_translation_sigma_m_per_sqrt_m", c.odometry_translation_sigma_m_per_sqrt_m,
+            "odometry position drift: sigma^2 grows by this^2 per metre travelled");
+    v.Field("odometry_rotation_sigma_deg_per_sqrt_m", c.odometry_rotation_sigma_deg_per_sqrt_m,
+            "odometry rotation drift: sigma^2 grows by this^2 per metre travelled");
+    v.Field("odometry_min_translation_sigma_m", c.odometry_min_translation_sigma_m,
+            "odometry step sigma at standstill, metres");
+    v.Field("odometry_min_rotation_sigma_deg", c.odometry_min_rotation_sigma_deg,
+            "odometry step sigma at standstill, degrees");
+    v.Field("loop_translation_sigma_m", c.loop_translation_sigma_m,
+            "loop sigma, combined with the verification RMSE");
+    v.Field("loop_rotation_sigma_deg", c.loop_rotation_sigma_deg, "loop rotation sigma");
+    v.Field("loop_reference_overlap", c.loop_reference_overlap,
+            "loop information scales with overlap / this, within [0.2, 2]");
+}
+
+template <typename Visitor>
+void VisitFields(posegraph::RobustConfig& c, Visitor& v) {
+    v.Field("gate_sigmas", c.gate_sigmas,
+            "loops further from the odometry than this many sigmas of its drift are rejected");
+    v.Field("gate_min_translation_m", c.gate_min_translation_m, "added to the gate, metres");
+    v.Field("gate_min_rotation_deg", c.gate_min_rotation_deg, "added to the gate, degrees");
+    v.Field("gate_translation_percent", c.gate_translation_percent,
+            "systematic drift allowed, per cent of the path");
+    v.Field("gate_rotation_deg_per_100m", c.gate_rotation_deg_per_100m,
+            "systematic drift allowed, degrees per 100 m of path");
+    v.Field("support_window_m", c.support_window_m,
+            "loops whose ends lie this close along the path check each other");
+    v.Field("min_support", c.min_support,
+            "consistent neighbouring loops a loop needs to enter the first optimisation");
+    v.Field("cauchy_scale", c.cauchy_scale, "Cauchy loss scale on loops, whitened units");
+    v.Field("reject_sigmas", c.reject_sigmas,
+            "loops with a larger whitened residual after optimising are dropped");
+    v.Field("scale_step", c.scale_step, "the Cauchy scale shrinks by this factor per round");
+    v.Field("max_reject_rounds", c.max_reject_rounds, "rounds of dropping loops and re-solving");
+}
+
+template <typename Visitor>
+void VisitFields(posegraph::PoseGraphConfig& c, Visitor& v) {
+    v.Section("information", c.information);
+    v.Section("robust", c.robust);
+    v.Field("max_iterations", c.max_iterations, "Ceres trust-region iterations per solve");
+    v.Field("threads", c.threads, "Ceres threads");
+}
+
+template <typename Visitor>
 void VisitFields(RunConfig& c, Visitor& v) {
     v.Field("method", c.descriptor.method, MethodHelp());
     v.Section("histogram", c.descriptor.histogram);
     v.Section("ndt", c.descriptor.ndt);
     v.Section("detection", c.detection);
     v.Section("verification", c.detection.verification);
+    v.Section("posegraph", c.posegraph);
 }
 
 std::string EnumName(const core::Method& m) { return core::ToString(m); }

@@ -5,6 +5,7 @@
 
 #include "lidarloop/core/descriptor_config.hpp"
 #include "lidarloop/pipeline/loop_detector.hpp"
+#include "lidarloop/posegraph/pose_graph_config.hpp"
 
 namespace lidarloop::io {
 
@@ -13,10 +14,12 @@ namespace lidarloop::io {
 struct RunConfig {
     core::DescriptorConfig descriptor;   ///< keys `method`, `histogram.*`, `ndt.*` at the top level
     pipeline::DetectorConfig detection;  ///< keys `detection.*`
+    posegraph::PoseGraphConfig posegraph;  ///< keys `posegraph.*` (lidarloop optimise)
 
     void Validate() const {
         descriptor.Validate();
         detection.Validate();
+        posegraph.Validate();
     }
 };
 

@@ -77,21 +77,10 @@ fs::path ExistingOr(const fs::path& given, const fs::path& fallback) {
     return fs::exists(fallback, ec) ? fallback : fs::path();
 }
 
-// KITTI poses have 12 numbers per line, TUM poses 8; tell them apart by the first data line.
 std::vector<core::StampedPose> ReadPosesFile(const fs::path& file,
                                              const core::Transform& T_cam0_velo,
                                              const fs::path& times_file) {
-    detail::LineReader reader(file);
-    std::string line;
-    while (reader.Next(line)) {
-        const auto fields = detail::SplitFields(line);
-        if (fields.empty() || fields.front().front() == '#') continue;
-        if (fields.size() == 12) return ReadKittiPoses(file, T_cam0_velo, times_file);
-        if (fields.size() == 8) return ReadTumPoses(file);
-        reader.Fail("cannot tell the pose format: expected 12 numbers (KITTI) or 8 (TUM), got " +
-                    std::to_string(fields.size()));
-    }
-    return {};
+    return ReadPoses(file, T_cam0_velo, times_file);
 }
 
 Dataset OpenKitti(const fs::path& root, const DatasetOptions& options) {

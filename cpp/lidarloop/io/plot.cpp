@@ -54,8 +54,11 @@ void WritePlotCommand(std::ostringstream& script, const Plot& plot) {
     const char* separator = "plot ";
     for (std::size_t s = 0; s < plot.series.size(); ++s) {
         if (!HasPoints(plot.series[s])) continue;
-        script << separator << "$data" << s << " using 1:2 with " << StyleName(plot.series[s].style)
-               << " title " << Quote(plot.series[s].title);
+        script << separator << "$data" << s << " using 1:2 with "
+               << StyleName(plot.series[s].style);
+        if (s < plot.colors.size() && !plot.colors[s].empty())
+            script << " lc rgb " << Quote(plot.colors[s]);
+        script << " title " << Quote(plot.series[s].title);
         separator = ", ";
     }
     script << "\n";
@@ -83,6 +86,7 @@ std::string GnuplotScript(const std::filesystem::path& png, const Plot& plot) {
            << "set ylabel " << Quote(plot.y_label) << " noenhanced\n"
            << "set grid\nset key outside right top noenhanced\n";
     if (plot.x_log) script << "set logscale x\n";
+    if (plot.equal_axes) script << "set size ratio -1\nset key below\n";
     WriteRange(script, "x", plot.x_min, plot.x_max);
     WriteRange(script, "y", plot.y_min, plot.y_max);
     for (double x : plot.vertical_lines) {

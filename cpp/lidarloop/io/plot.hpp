@@ -25,6 +25,9 @@ struct Plot {
     /// Axis ranges; min >= max leaves gnuplot's automatic range.
     double x_min = 0.0, x_max = 0.0, y_min = 0.0, y_max = 0.0;
     std::vector<double> vertical_lines;  ///< e.g. a chosen threshold
+    bool equal_axes = false;             ///< one metre is as long on both axes (maps)
+    /// Colours of the series by index ("#1b9e77", "red"); missing or empty: gnuplot's sequence.
+    std::vector<std::string> colors;
 };
 
 /// True when a gnuplot executable is on PATH.

@@ -138,6 +138,19 @@ std::vector<core::StampedPose> ReadTumPoses(const std::filesystem::path& file) {
     return poses;
 }
 
+std::vector<core::StampedPose> ReadPoses(const std::filesystem::path& file,
+                                         const core::Transform& T_cam0_velo,
+                                         const std::filesystem::path& times_file) {
+    detail::LineReader reader(file);
+    std::string line;
+    Fields fields;
+    if (!NextDataLine(reader, line, fields)) return {};
+    if (fields.size() == 12) return ReadKittiPoses(file, T_cam0_velo, times_file);
+    if (fields.size() == 8) return ReadTumPoses(file);
+    reader.Fail("cannot tell the pose format: expected 12 numbers (KITTI) or 8 (TUM), got " +
+                std::to_string(fields.size()));
+}
+
 void WriteTumPoses(const std::filesystem::path& file, const std::vector<core::StampedPose>& poses) {
     std::string text;
     for (const auto& pose : poses) {

@@ -37,6 +37,14 @@ void WriteKittiPoses(const std::filesystem::path& poses_file,
 /// naming the line, as are a line without exactly 8 values, a non-number and a non-finite value.
 std::vector<core::StampedPose> ReadTumPoses(const std::filesystem::path& file);
 
+/// Reads a KITTI (12 numbers a line) or TUM (8 numbers a line) poses file, told apart by its
+/// first data line; `T_cam0_velo` and `times_file` apply to KITTI files as in ReadKittiPoses.
+/// ReadError naming the line when the first data line has another count of numbers.
+std::vector<core::StampedPose> ReadPoses(
+    const std::filesystem::path& file,
+    const core::Transform& T_cam0_velo = core::Transform::Identity(),
+    const std::filesystem::path& times_file = {});
+
 /// Writes poses in TUM format (full double precision).
 void WriteTumPoses(const std::filesystem::path& file, const std::vector<core::StampedPose>& poses);
 

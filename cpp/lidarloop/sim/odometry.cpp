@@ -19,16 +19,30 @@ void OdometryConfig::Validate() const {
         throw core::ConfigError("odometry.translation_noise must be in [0, 0.5], got " +
                                 detail::NumberText(translation_noise));
     }
+    if (!(yaw_bias_deg_per_100m >= 0.0 && yaw_bias_deg_per_100m <= 100.0)) {
+        throw core::ConfigError("odometry.yaw_bias_deg_per_100m must be in [0, 100], got " +
+                                detail::NumberText(yaw_bias_deg_per_100m));
+    }
+    if (!(length_bias >= -0.5 && length_bias <= 0.5)) {
+        throw core::ConfigError("odometry.length_bias must be in [-0.5, 0.5], got " +
+                                detail::NumberText(length_bias));
+    }
 }
 
 core::Transform MeasureStep(const core::Transform& T_prev_next, const OdometryConfig& config,
                             std::uint64_t seed, std::size_t index) {
     detail::Random rng(
         detail::StreamSeed(seed, detail::Stream::kOdometry, {static_cast<std::int64_t>(index)}));
-    const double yaw_error = rng.Normal() * config.yaw_noise_deg * std::numbers::pi / 180.0;
-    const double length_error = rng.Normal() * config.translation_noise;
-    const double side_error = rng.Normal() * config.translation_noise;
+    constexpr double kRadPerDeg = std::numbers::pi / 180.0;
+    // The turn's direction is one draw per sequence, from a stream of its own.
+    detail::Random turn(detail::StreamSeed(seed, detail::Stream::kOdometry, {-1}));
+    const double turn_sign = turn.Uniform() < 0.5 ? -1.0 : 1.0;
     const Eigen::Vector3d t = T_prev_next.translation();
+    const double yaw_error =
+        rng.Normal() * config.yaw_noise_deg * kRadPerDeg +
+        turn_sign * config.yaw_bias_deg_per_100m / 100.0 * kRadPerDeg * t.norm();
+    const double length_error = rng.Normal() * config.translation_noise + config.length_bias;
+    const double side_error = rng.Normal() * config.translation_noise;
     core::Transform measured = T_prev_next;
     measured.translation() =
         t * (1.0 + length_error) + Eigen::Vector3d::UnitY() * (side_error * t.norm());

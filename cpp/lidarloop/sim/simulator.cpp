@@ -1,9 +1,14 @@
 #include "lidarloop/sim/simulator.hpp"
 
 #include <cmath>
+#include <limits>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
+#include <utility>
+
+#include <Eigen/Eigenvalues>
 
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/sim/detail/random.hpp"
@@ -61,11 +66,140 @@ SensorSpec ResolveFor(const SimulationConfig& config, const SceneLayout& layout)
     return spec;
 }
 
+// The world of a sequence: around the route's streets, or around the given trajectory.
+World MakeWorld(const SimulationConfig& config, const SceneLayout& layout, const RoutePath& route,
+                const std::vector<RoutePoint>& trajectory) {
+    if (trajectory.empty()) {
+        return GenerateWorld(config.scene, config.seed, Grow(route.VisitedNodes(), 1));
+    }
+    return WorldAroundPath(config.scene, config.seed, trajectory, layout.road_half_width_m);
+}
+
+// The unit normal of the best-fit plane of `centred` positions, on the side of "up".
+Eigen::Vector3d PlaneNormal(const std::vector<Eigen::Vector3d>& centred) {
+    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+    for (const auto& p : centred) scatter += p * p.transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
+    Eigen::Vector3d normal = eigen.eigenvectors().col(0);  // smallest spread
+    const Eigen::Vector3d up =
+        std::abs(normal.z()) > 0.5 ? Eigen::Vector3d(0, 0, 1) : Eigen::Vector3d(0, -1, 0);
+    return normal.dot(up) < 0.0 ? Eigen::Vector3d(-normal) : normal;
+}
+
 }  // namespace
+
+std::vector<RoutePoint> PlanarTrajectory(const std::vector<Eigen::Vector3d>& positions) {
+    if (positions.size() < 2) {
+        throw core::ConfigError("a trajectory needs at least 2 poses, got " +
+                                std::to_string(positions.size()));
+    }
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const auto& p : positions) {
+        if (!p.allFinite()) throw core::ConfigError("a trajectory position is not finite");
+        mean += p;
+    }
+    mean /= static_cast<double>(positions.size());
+    std::vector<Eigen::Vector3d> centred;
+    double spread = 0.0;
+    for (const auto& p : positions) {
+        centred.push_back(p - mean);
+        spread = std::max(spread, (p - positions.front()).norm());
+    }
+    if (spread < 1.0) throw core::ConfigError("the trajectory stays within 1 m: nothing to drive");
+    const Eigen::Vector3d normal = PlaneNormal(centred);
+    const Eigen::Vector3d e1 = normal.unitOrthogonal();
+    const Eigen::Vector3d e2 = normal.cross(e1);
+    std::vector<RoutePoint> points(positions.size());
+    for (std::size_t i = 0; i < positions.size(); ++i) {
+        const Eigen::Vector3d d = positions[i] - positions.front();
+        points[i].position_m = Eigen::Vector2d(d.dot(e1), d.dot(e2));
+    }
+    double heading = 0.0;
+    std::size_t first_move = points.size();
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        const std::size_t before = i > 0 ? i - 1 : 0;
+        const std::size_t after = std::min(i + 1, points.size() - 1);
+        const Eigen::Vector2d step = points[after].position_m - points[before].position_m;
+        if (step.norm() > 1e-3) {
+            heading = std::atan2(step.y(), step.x());
+            first_move = std::min(first_move, i);
+        }
+        points[i].heading_rad = heading;
+    }
+    // A stop at the start faces where the vehicle goes first.
+    for (std::size_t i = 0; i < first_move && first_move < points.size(); ++i) {
+        points[i].heading_rad = points[first_move].heading_rad;
+    }
+    return points;
+}
+
+World WorldAroundPath(SceneType type, std::uint64_t seed, const std::vector<RoutePoint>& path,
+                      double clearance_m) {
+    const SceneLayout layout = LayoutOf(type);
+    // Path samples every metre, in a hash grid of cells of the clearance.
+    std::vector<Eigen::Vector2d> samples;
+    for (std::size_t i = 0; i + 1 < path.size(); ++i) {
+        const Eigen::Vector2d a = path[i].position_m;
+        const Eigen::Vector2d b = path[i + 1].position_m;
+        const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm())));
+        for (int k = 0; k < steps; ++k)
+            samples.push_back(a + (b - a) * (k / static_cast<double>(steps)));
+    }
+    samples.push_back(path.back().position_m);
+    Eigen::Vector2d low = samples.front(), high = samples.front();
+    for (const auto& p : samples) {
+        low = low.cwiseMin(p);
+        high = high.cwiseMax(p);
+    }
+    const double pitch = layout.block_pitch_m;
+    const NodeRange nodes{static_cast<int>(std::floor(low.x() / pitch)) - 1,
+                          static_cast<int>(std::ceil(high.x() / pitch)) + 1,
+                          static_cast<int>(std::floor(low.y() / pitch)) - 1,
+                          static_cast<int>(std::ceil(high.y() / pitch)) + 1};
+    const World world = GenerateWorld(type, seed, nodes);
+    const double cell = std::max(clearance_m, 1.0);
+    const auto key = [cell](double x, double y) {
+        return std::pair<std::int64_t, std::int64_t>(
+            static_cast<std::int64_t>(std::floor(x / cell)),
+            static_cast<std::int64_t>(std::floor(y / cell)));
+    };
+    std::map<std::pair<std::int64_t, std::int64_t>, std::vector<std::size_t>> grid;
+    for (std::size_t i = 0; i < samples.size(); ++i)
+        grid[key(samples[i].x(), samples[i].y())].push_back(i);
+    std::vector<Shape> kept;
+    for (const Shape& shape : world.objects()) {
+        const Aabb box = Bounds(shape);
+        const Eigen::Vector2d lo = box.min_m.head<2>().array() - clearance_m;
+        const Eigen::Vector2d hi = box.max_m.head<2>().array() + clearance_m;
+        bool near = false;
+        const auto [x0, y0] = key(lo.x(), lo.y());
+        const auto [x1, y1] = key(hi.x(), hi.y());
+        for (std::int64_t x = x0; x <= x1 && !near; ++x) {
+            for (std::int64_t y = y0; y <= y1 && !near; ++y) {
+                const auto cell_samples = grid.find({x, y});
+                if (cell_samples == grid.end()) continue;
+                for (const std::size_t i : cell_samples->second) {
+                    const Eigen::Vector2d& p = samples[i];
+                    if ((p.array() >= lo.array()).all() && (p.array() <= hi.array()).all()) {
+                        near = true;
+                        break;
+                    }
+                }
+            }
+        }
+        if (!near) kept.push_back(shape);
+    }
+    return World(world.ground(), world.ceiling_height_m(), std::move(kept), world.grid_cell_m());
+}
 
 void SimulationConfig::Validate() const {
     if (scans < 1 || scans > kMaxScans) {
         throw core::ConfigError("scans must be in [1, 1000000], got " + std::to_string(scans));
+    }
+    if (!trajectory.empty() && trajectory.size() != scans) {
+        throw core::ConfigError("scans (" + std::to_string(scans) +
+                                ") must equal the trajectory's poses (" +
+                                std::to_string(trajectory.size()) + ")");
     }
     route.Validate();
     sensor.Validate();
@@ -78,8 +212,11 @@ Simulator::Simulator(const SimulationConfig& config)
       layout_(LayoutOf(config.scene)),
       spacing_(config.route.spacing_min_m, config.route.spacing_max_m, config.seed),
       route_(RouteLegs(config.route.type, UturnBlocks(config, layout_)), layout_),
-      world_(GenerateWorld(config.scene, config.seed, Grow(route_.VisitedNodes(), 1))),
+      world_(MakeWorld(config, layout_, route_,
+                       config.trajectory.empty() ? std::vector<RoutePoint>{}
+                                                 : PlanarTrajectory(config.trajectory))),
       directions_(BeamDirections(sensor_)) {
+    if (!config.trajectory.empty()) trajectory_ = PlanarTrajectory(config.trajectory);
     if (config.route.type == RouteType::kUTurn) {
         config_.route.uturn_blocks = UturnBlocks(config, layout_);
     }
@@ -107,11 +244,15 @@ void Simulator::CheckIndex(std::size_t index) const {
     }
 }
 
+RoutePoint Simulator::PointAt(std::size_t index) const {
+    if (!trajectory_.empty()) return trajectory_[index];
+    return route_.At(spacing_.ArcLength(index));
+}
+
 core::StampedPose Simulator::GroundTruthPose(std::size_t index) const {
     CheckIndex(index);
-    const RoutePoint point = route_.At(spacing_.ArcLength(index));
     return {static_cast<double>(index) * sensor_.scan_period_s,
-            VehiclePose(point, world_.ground(), sensor_.mount_height_m)};
+            VehiclePose(PointAt(index), world_.ground(), sensor_.mount_height_m)};
 }
 
 core::StampedPose Simulator::OdometryPose(std::size_t index) const {

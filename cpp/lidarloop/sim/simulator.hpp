@@ -22,6 +22,13 @@ struct SimulationConfig {
     OdometryConfig odometry;
     std::size_t scans = 100;  ///< number of scans, [1, 1e6]
     std::uint64_t seed = 1;   ///< one seed for world, speed profile, noise and drift
+    /// A given trajectory to drive instead of the route (one pose per scan, so `scans` must equal
+    /// its size): only the positions are used, projected onto their best-fit plane (so KITTI's
+    /// camera-frame poses work as they are); the heading follows the direction of travel, and
+    /// the vehicle stands on the scene's ground. The scene is generated over the streets
+    /// around the trajectory, and every object within the road half width of its path is left
+    /// out, so that the vehicle drives through the world as through streets. Empty: the route.
+    std::vector<Eigen::Vector3d> trajectory;
 
     /// Throws core::ConfigError naming the first invalid field ("scans must be ...").
     void Validate() const;
@@ -68,6 +75,7 @@ public:
 
 private:
     void CheckIndex(std::size_t index) const;
+    RoutePoint PointAt(std::size_t index) const;
 
     SimulationConfig config_;
     SensorSpec sensor_;
@@ -77,7 +85,21 @@ private:
     World world_;
     std::vector<Eigen::Vector3d> directions_;
     std::vector<core::Transform> odometry_checkpoints_;  // every kCheckpointStride scans
+    std::vector<RoutePoint> trajectory_;  // config_.trajectory in the plane; empty: the route
 };
+
+/// The points of a given trajectory in its best-fit plane: positions projected onto the two
+/// directions of largest spread, relative to the first position, seen from "up": the plane's
+/// normal on the side of the input's +z, or of its -y when z lies in the plane (a camera frame,
+/// y down, as KITTI's poses); heading along the direction of travel (central differences; a stop
+/// keeps the last heading). Throws core::ConfigError for fewer than 2 positions, all within
+/// 1 m of each other, or a non-finite one.
+std::vector<RoutePoint> PlanarTrajectory(const std::vector<Eigen::Vector3d>& positions);
+
+/// The world of `type` generated over the streets around `path` with every object whose
+/// footprint comes within `clearance_m` of the path (sampled every metre) left out.
+World WorldAroundPath(SceneType type, std::uint64_t seed, const std::vector<RoutePoint>& path,
+                      double clearance_m);
 
 /// How often a place is visited again: the number of scans i that have an earlier scan j with
 /// i - j >= min_index_gap whose ground-truth position is within max_distance_m. O(n) with a

@@ -197,7 +197,7 @@ TEST(Simulator, OdometryDriftsFromTheGroundTruth) {
         EXPECT_TRUE(chunk[k].T_world_sensor.isApprox(simulator.OdometryPose(250 + k).T_world_sensor,
                                                      1e-12));
     }
-    config.odometry = {0.0, 0.0};
+    config.odometry = {0.0, 0.0, 0.0, 0.0};
     const Simulator exact(config);
     EXPECT_LT((exact.OdometryPose(599).T_world_sensor.translation() -
                exact.GroundTruthPose(599).T_world_sensor.translation())

@@ -1,0 +1,98 @@
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "commands.hpp"
+#include "dataset_options.hpp"
+#include "descriptor_options.hpp"
+#include "detection_options.hpp"
+#include "lidarloop/app/optimisation.hpp"
+#include "progress.hpp"
+
+namespace lidarloop::cli {
+namespace {
+
+struct OptimiseFlags {
+    DatasetOptions dataset;
+    DescriptorOptions descriptor;
+    DetectionOptions detection;
+    std::string odometry;
+    std::string loops;
+    std::string out;
+    std::string format = "kitti";
+    bool skip_bad = false;
+    bool quiet = false;
+};
+
+std::string Figure(double value, const char* format) {
+    char text[64];
+    std::snprintf(text, sizeof(text), format, value);
+    return text;
+}
+
+void PrintOutcome(const app::OptimiseRequest& request, const app::OptimiseOutcome& outcome) {
+    const posegraph::OptimisationResult& r = outcome.result;
+    std::cout << "lidarloop optimise: " << outcome.loops.size() << " accepted loops, "
+              << r.loops_used << " used, " << r.rejected_by_odometry
+              << " rejected against the odometry, " << r.rejected_by_consistency
+              << " without support, " << r.rejected_by_residual << " by their residual ("
+              << r.solves << " solves, " << Figure(r.seconds, "%.2f") << " s)\n";
+    if (outcome.odometry && outcome.optimised) {
+        std::cout << "  ATE RMSE: odometry " << Figure(outcome.odometry->ate_rmse_m, "%.3f")
+                  << " m -> optimised " << Figure(outcome.optimised->ate_rmse_m, "%.3f")
+                  << " m; RPE " << Figure(outcome.odometry->rpe.translation_percent, "%.2f")
+                  << " % -> " << Figure(outcome.optimised->rpe.translation_percent, "%.2f")
+                  << " %\n";
+    }
+    for (const std::string& note : outcome.notes) std::cout << "  note: " << note << "\n";
+    std::cout << "  results in " << request.out.string()
+              << "/ (poses_optimised.txt, graph.g2o, loop_verdicts.csv, metrics.json, report.md, "
+                 "trajectory.png, config.yaml)\n";
+}
+
+void RunOptimise(const OptimiseFlags& flags) {
+    ProgressPrinter progress(flags.quiet);
+    app::OptimiseRequest request;
+    request.config = flags.descriptor.Resolve();
+    flags.detection.ApplyTo(request.config);
+    request.odometry_file = flags.odometry;
+    request.loops_file = flags.loops;
+    request.format = flags.format == "tum" ? app::PoseFormat::kTum : app::PoseFormat::kKitti;
+    request.skip_bad = flags.skip_bad;
+    request.progress = progress.Callback();
+    request.out = flags.out;
+    const io::Dataset dataset = flags.dataset.Open();
+    PrintOutcome(request, app::RunOptimisation(dataset, request));
+}
+
+}  // namespace
+
+void AddOptimiseCommand(CLI::App& app) {
+    auto* command = app.add_subcommand(
+        "optimise", "Optimise the odometry with the accepted loops in a pose graph (Ceres)");
+    auto flags = std::make_shared<OptimiseFlags>();
+    flags->dataset.AddTo(*command, "--dataset-format");
+    command->add_option("--odometry", flags->odometry, "odometry poses, KITTI or TUM, one per scan")
+        ->required()
+        ->check(CLI::ExistingFile);
+    command
+        ->add_option("--loops", flags->loops,
+                     "loops.csv of `detect` (with verification); default: detect them first")
+        ->check(CLI::ExistingFile);
+    command->add_option("--out", flags->out, "folder for the results (created)")->required();
+    command->add_option("--format", flags->format, "poses_optimised.txt format: kitti | tum")
+        ->check(CLI::IsMember({"kitti", "tum"}))
+        ->capture_default_str();
+    flags->descriptor.AddTo(*command);
+    flags->detection.AddTo(*command, /*decides_loops=*/true,
+                           "S: candidates at least this far back (default 30 scans)");
+    command->add_flag("--skip-bad", flags->skip_bad,
+                      "skip unreadable scans when detecting instead of stopping");
+    command->add_flag("--quiet", flags->quiet, "no progress bar");
+    command->callback([flags] { RunOptimise(*flags); });
+}
+
+}  // namespace lidarloop::cli

@@ -1,0 +1,156 @@
+#include "lidarloop/app/optimisation.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <numbers>
+
+#include "lidarloop/app/detection.hpp"
+#include "lidarloop/app/optimisation_report.hpp"
+#include "lidarloop/app/results_folder.hpp"
+#include "lidarloop/io/pose_graph_files.hpp"
+#include "lidarloop/io/poses.hpp"
+#include "lidarloop/io/read_error.hpp"
+
+namespace lidarloop::app {
+namespace {
+
+std::vector<core::StampedPose> LoadOdometry(const OptimiseRequest& request,
+                                            const io::Dataset& dataset) {
+    std::vector<core::StampedPose> odometry = io::ReadPoses(request.odometry_file);
+    if (odometry.size() != dataset.size()) {
+        throw io::ReadError(request.odometry_file, "holds " + std::to_string(odometry.size()) +
+                                                       " poses but " + dataset.root().string() +
+                                                       " has " + std::to_string(dataset.size()) +
+                                                       " scans");
+    }
+    return odometry;
+}
+
+// The accepted loops of a detection run with verification (the verified candidate's pose).
+std::vector<posegraph::LoopConstraint> DetectLoops(const io::Dataset& dataset,
+                                                   const OptimiseRequest& request) {
+    DetectRequest detect;
+    detect.config = request.config;
+    detect.config.detection.verify = true;
+    detect.skip_bad = request.skip_bad;
+    detect.progress = request.progress;
+    detect.out = request.out / "detection";
+    const DetectOutcome detected = RunDetect(dataset, detect);
+    std::vector<posegraph::LoopConstraint> loops;
+    for (const pipeline::LoopQuery& query : detected.queries) {
+        const std::optional<std::size_t> rank = query.loop();
+        if (!query.accepted || !rank || !query.verified()) continue;
+        const registration::Verification& v = query.verifications[*rank];
+        loops.push_back({query.query, query.candidates[*rank].index, v.T_match_query,
+                         v.overlap.Min(), v.overlap.rmse_m});
+    }
+    return loops;
+}
+
+std::vector<posegraph::LoopConstraint> LoadLoops(const io::Dataset& dataset,
+                                                 const OptimiseRequest& request) {
+    if (request.loops_file.empty()) return DetectLoops(dataset, request);
+    std::vector<posegraph::LoopConstraint> loops;
+    for (const io::LoopRow& row : io::ReadLoopsCsv(request.loops_file, dataset.size())) {
+        if (row.loop.query == row.loop.match) {
+            throw io::ReadError(request.loops_file,
+                                "line " + std::to_string(row.line) + ": a loop from scan " +
+                                    std::to_string(row.loop.query) + " to itself");
+        }
+        loops.push_back(row.loop);
+    }
+    return loops;
+}
+
+std::vector<core::Transform> Transforms(const std::vector<core::StampedPose>& poses) {
+    std::vector<core::Transform> transforms;
+    transforms.reserve(poses.size());
+    for (const auto& pose : poses) transforms.push_back(pose.T_world_sensor);
+    return transforms;
+}
+
+std::vector<bool> JudgeLoops(const std::vector<posegraph::LoopConstraint>& loops,
+                             const std::vector<core::Transform>& truth,
+                             const OptimiseRequest& request) {
+    std::vector<bool> is_true;
+    for (const auto& loop : loops) {
+        const core::Transform error =
+            (truth[loop.match].inverse() * truth[loop.query]).inverse() * loop.T_match_query;
+        const double angle_deg =
+            Eigen::AngleAxisd(error.linear()).angle() * 180.0 / std::numbers::pi;
+        is_true.push_back(error.translation().norm() <= request.true_loop_translation_m &&
+                          angle_deg <= request.true_loop_rotation_deg);
+    }
+    return is_true;
+}
+
+TrajectoryMetrics Measure(const std::vector<core::Transform>& estimate,
+                          const std::vector<core::Transform>& truth) {
+    return {eval::AbsoluteTrajectoryRmse(estimate, truth),
+            eval::ComputeRelativePoseError(estimate, truth)};
+}
+
+void WritePoses(const std::filesystem::path& file, const OptimiseRequest& request,
+                const std::vector<core::StampedPose>& odometry,
+                const std::vector<core::Transform>& optimised) {
+    std::vector<core::StampedPose> poses = odometry;  // keeps the times
+    for (std::size_t i = 0; i < poses.size(); ++i) poses[i].T_world_sensor = optimised[i];
+    if (request.format == PoseFormat::kTum) {
+        io::WriteTumPoses(file, poses);
+    } else {
+        io::WriteKittiPoses(file, poses);
+    }
+}
+
+void WriteGraph(const std::filesystem::path& file, const posegraph::PoseGraph& graph,
+                const posegraph::OptimisationResult& result) {
+    std::vector<posegraph::Edge> used;
+    std::vector<posegraph::Edge> rejected;
+    std::size_t loop = 0;
+    for (const posegraph::Edge& edge : graph.edges) {
+        const bool is_loop = edge.kind == posegraph::Edge::Kind::kLoop;
+        if (is_loop && result.loops[loop++].verdict != posegraph::LoopVerdict::kUsed) {
+            rejected.push_back(edge);
+        } else {
+            used.push_back(edge);
+        }
+    }
+    io::WriteG2o(file, result.poses, used, rejected);
+}
+
+}  // namespace
+
+OptimiseOutcome RunOptimisation(const io::Dataset& dataset, const OptimiseRequest& request) {
+    Stopwatch total;
+    request.config.Validate();
+    const std::filesystem::path out = PrepareOutputFolder(request.out);
+    io::WriteConfigYaml(out / "config.yaml", request.config);
+    const std::vector<core::StampedPose> odometry = LoadOdometry(request, dataset);
+    OptimiseOutcome outcome;
+    outcome.loops = LoadLoops(dataset, request);
+    const posegraph::PoseGraph graph =
+        posegraph::BuildPoseGraph(Transforms(odometry), outcome.loops, request.config.posegraph);
+    outcome.result = posegraph::Optimise(graph, request.config.posegraph);
+    if (!outcome.result.note.empty()) outcome.notes.push_back(outcome.result.note);
+    if (dataset.HasPoses()) {
+        const std::vector<core::Transform> truth = Transforms(dataset.poses());
+        outcome.loop_is_true = JudgeLoops(outcome.loops, truth, request);
+        outcome.odometry = Measure(graph.poses, truth);
+        outcome.optimised = Measure(outcome.result.poses, truth);
+    } else {
+        outcome.notes.push_back("the dataset has no ground-truth poses: no ATE or RPE");
+    }
+    WritePoses(out / "poses_optimised.txt", request, odometry, outcome.result.poses);
+    WriteGraph(out / "graph.g2o", graph, outcome.result);
+    WriteLoopVerdicts(out / "loop_verdicts.csv", outcome);
+    const std::vector<core::Transform> truth =
+        dataset.HasPoses() ? Transforms(dataset.poses()) : std::vector<core::Transform>{};
+    if (const auto note = DrawTrajectoryPlot(out / "trajectory.png", graph.poses, truth, outcome))
+        outcome.notes.push_back(*note);
+    outcome.total_s = total.Seconds();
+    WriteJson(out / "metrics.json", OptimisationMetricsJson(dataset, request, outcome));
+    WriteOptimisationReport(out / "report.md", dataset, request, outcome);
+    return outcome;
+}
+
+}  // namespace lidarloop::app

@@ -1,0 +1,62 @@
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "lidarloop/app/progress.hpp"
+#include "lidarloop/eval/trajectory.hpp"
+#include "lidarloop/io/config_yaml.hpp"
+#include "lidarloop/io/dataset.hpp"
+#include "lidarloop/posegraph/optimiser.hpp"
+
+namespace lidarloop::app {
+
+/// The file format of poses_optimised.txt.
+enum class PoseFormat { kKitti, kTum };
+
+/// What `lidarloop optimise` asks for.
+struct OptimiseRequest {
+    io::RunConfig config;  ///< `posegraph`; without a loops file also how loops are detected
+    std::filesystem::path odometry_file;  ///< KITTI or TUM, one pose per scan (T_world_sensor)
+    /// Accepted loops with their T_match_query (loops.csv of `detect` with verification). Empty:
+    /// RunDetect with verification runs first, into out/detection.
+    std::filesystem::path loops_file;
+    PoseFormat format = PoseFormat::kKitti;
+    /// With ground truth, a loop is true when its transform is within these of the ground
+    /// truth's relative pose of its scans (for the plot, the report and metrics.json).
+    double true_loop_translation_m = 2.0;
+    double true_loop_rotation_deg = 5.0;
+    bool skip_bad = false;  ///< for the detection run
+    Progress progress;
+    std::filesystem::path out;  ///< the results folder (created)
+};
+
+/// ATE and RPE of one trajectory against the ground truth.
+struct TrajectoryMetrics {
+    double ate_rmse_m = 0.0;
+    eval::RelativePoseError rpe;
+};
+
+struct OptimiseOutcome {
+    std::vector<posegraph::LoopConstraint> loops;  ///< the accepted loops, as read or detected
+    posegraph::OptimisationResult result;
+    /// Per loop: true, judged against the ground truth (empty without ground truth).
+    std::vector<bool> loop_is_true;
+    std::optional<TrajectoryMetrics> odometry;   ///< with ground truth
+    std::optional<TrajectoryMetrics> optimised;  ///< with ground truth
+    std::vector<std::string> notes;              ///< e.g. no loop, no ground truth, no gnuplot
+    double total_s = 0.0;
+};
+
+/// Reads the odometry (io::ReadError naming the file when its pose count differs from the
+/// dataset's scan count; the pose readers name the line of a non-finite value or a 3x3 part that
+/// is no rotation) and the loops (io::ReadLoopsCsv: a scan that does not exist names the line),
+/// or detects them, builds and optimises the pose graph, and writes into request.out:
+/// poses_optimised.txt, graph.g2o (optimised vertices, the odometry edges and the loops used;
+/// rejected loops commented), loop_verdicts.csv, metrics.json, report.md, config.yaml and,
+/// when gnuplot is installed, trajectory.png (top view).
+OptimiseOutcome RunOptimisation(const io::Dataset& dataset, const OptimiseRequest& request);
+
+}  // namespace lidarloop::app

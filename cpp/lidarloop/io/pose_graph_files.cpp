@@ -1,0 +1,206 @@
+#include "lidarloop/io/pose_graph_files.hpp"
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include <Eigen/Geometry>
+
+#include "lidarloop/io/detail/text_parsing.hpp"
+
+namespace lidarloop::io {
+namespace {
+
+constexpr std::size_t kMissing = SIZE_MAX;
+
+// Comma-separated fields, empty ones kept (lidarloop leaves second_ratio and the pose of an
+// unregistered candidate empty); spaces around a field trimmed.
+std::vector<std::string_view> SplitCsv(std::string_view line) {
+    std::vector<std::string_view> fields;
+    const auto trim = [](std::string_view f) {
+        while (!f.empty() && (f.front() == ' ' || f.front() == '\t')) f.remove_prefix(1);
+        while (!f.empty() && (f.back() == ' ' || f.back() == '\t')) f.remove_suffix(1);
+        return f;
+    };
+    std::size_t start = 0;
+    while (true) {
+        const std::size_t comma = line.find(',', start);
+        fields.push_back(trim(line.substr(start, comma - start)));
+        if (comma == std::string_view::npos) break;
+        start = comma + 1;
+    }
+    return fields;
+}
+
+// Column indices of loops.csv; pose = tx ty tz qx qy qz qw.
+struct LoopColumns {
+    std::size_t query = kMissing, match = kMissing, accepted = kMissing;
+    std::array<std::size_t, 7> pose{kMissing, kMissing, kMissing, kMissing,
+                                    kMissing, kMissing, kMissing};
+    std::size_t overlap_query = kMissing, overlap_match = kMissing, rmse = kMissing;
+    std::size_t count = 0;
+};
+
+LoopColumns FindLoopColumns(const detail::LineReader& reader,
+                            const std::vector<std::string_view>& names) {
+    static constexpr std::array<std::string_view, 7> kPose = {"tx", "ty", "tz", "qx",
+                                                              "qy", "qz", "qw"};
+    LoopColumns c;
+    c.count = names.size();
+    for (std::size_t i = 0; i < names.size(); ++i) {
+        if (names[i] == "query") c.query = i;
+        if (names[i] == "match") c.match = i;
+        if (names[i] == "accepted") c.accepted = i;
+        if (names[i] == "overlap_query") c.overlap_query = i;
+        if (names[i] == "overlap_match") c.overlap_match = i;
+        if (names[i] == "rmse_m") c.rmse = i;
+        for (std::size_t k = 0; k < kPose.size(); ++k) {
+            if (names[i] == kPose[k]) c.pose[k] = i;
+        }
+    }
+    if (c.query == kMissing || c.match == kMissing || c.accepted == kMissing) {
+        reader.Fail("the header must name the columns query, match and accepted");
+    }
+    for (const std::size_t column : c.pose) {
+        if (column == kMissing) {
+            reader.Fail(
+                "the header has no loop pose (tx,ty,tz,qx,qy,qz,qw): a loops.csv of "
+                "`detect` with verification is needed (not --no-verify)");
+        }
+    }
+    return c;
+}
+
+std::size_t ParseScan(const detail::LineReader& reader, std::string_view field, const char* name,
+                      std::size_t scan_count) {
+    const auto value = detail::ParseSize(field);
+    if (!value) {
+        reader.Fail(std::string(name) + " " + detail::Quoted(field) +
+                    " is not a scan number (an integer >= 0)");
+    }
+    if (*value >= scan_count) {
+        reader.Fail(std::string(name) + " scan " + std::to_string(*value) +
+                    " does not exist (the dataset has " + std::to_string(scan_count) + " scans)");
+    }
+    return *value;
+}
+
+double ParseFinite(const detail::LineReader& reader, std::string_view field, const char* name) {
+    const auto value = detail::ParseDouble(field);
+    if (!value) reader.Fail(std::string(name) + " " + detail::Quoted(field) + " is not a number");
+    if (!std::isfinite(*value)) {
+        reader.Fail(std::string(name) + " " + detail::Quoted(field) + " is not a finite number");
+    }
+    return *value;
+}
+
+double ParseOptional(const detail::LineReader& reader, const std::vector<std::string_view>& fields,
+                     std::size_t column, const char* name) {
+    if (column == kMissing || fields[column].empty()) return std::nan("");
+    return ParseFinite(reader, fields[column], name);
+}
+
+LoopRow ParseLoopRow(const detail::LineReader& reader, const std::vector<std::string_view>& f,
+                     const LoopColumns& c, std::size_t scan_count) {
+    static constexpr std::array<const char*, 7> kNames = {"tx", "ty", "tz", "qx", "qy", "qz", "qw"};
+    LoopRow row;
+    row.line = reader.line_number();
+    row.loop.query = ParseScan(reader, f[c.query], "query", scan_count);
+    row.loop.match = ParseScan(reader, f[c.match], "match", scan_count);
+    std::array<double, 7> v{};
+    for (std::size_t k = 0; k < v.size(); ++k) {
+        if (f[c.pose[k]].empty()) reader.Fail("an accepted loop without a pose (empty tx..qw)");
+        v[k] = ParseFinite(reader, f[c.pose[k]], kNames[k]);
+    }
+    const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);  // Eigen takes w first
+    if (q.norm() < 0.9 || q.norm() > 1.1) {
+        reader.Fail("quaternion (qx qy qz qw) has norm " + detail::ShortNumber(q.norm()) +
+                    ", expected 1");
+    }
+    row.loop.T_match_query.linear() = q.normalized().toRotationMatrix();
+    row.loop.T_match_query.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
+    const double overlap_query = ParseOptional(reader, f, c.overlap_query, "overlap_query");
+    const double overlap_match = ParseOptional(reader, f, c.overlap_match, "overlap_match");
+    row.loop.overlap = std::fmin(overlap_query, overlap_match);  // NaN only when both are
+    row.loop.rmse_m = ParseOptional(reader, f, c.rmse, "rmse_m");
+    return row;
+}
+
+void AppendEdge(std::string& text, const posegraph::Edge& edge) {
+    text += "EDGE_SE3:QUAT " + std::to_string(edge.from) + ' ' + std::to_string(edge.to) + ' ';
+    const Eigen::Vector3d t = edge.T_from_to.translation();
+    const Eigen::Quaterniond q = Eigen::Quaterniond(edge.T_from_to.linear()).normalized();
+    for (const double value : {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()}) {
+        detail::AppendNumber(text, value, ' ');
+    }
+    for (int row = 0; row < 6; ++row) {
+        for (int col = row; col < 6; ++col) {
+            detail::AppendNumber(text, edge.information(row, col),
+                                 row == 5 && col == 5 ? '\n' : ' ');
+        }
+    }
+}
+
+}  // namespace
+
+std::vector<LoopRow> ReadLoopsCsv(const std::filesystem::path& file, std::size_t scan_count) {
+    detail::LineReader reader(file);
+    std::string line;
+    LoopColumns columns;
+    bool header = false;
+    std::vector<LoopRow> rows;
+    while (reader.Next(line)) {
+        detail::RejectControlCharacters(reader, line, "loops.csv");
+        if (line.empty() || line.front() == '#') continue;
+        const std::vector<std::string_view> fields = SplitCsv(line);
+        if (!header) {
+            columns = FindLoopColumns(reader, fields);
+            header = true;
+            continue;
+        }
+        // A query the detector did not verify has no verification columns: fine when it is not
+        // an accepted loop.
+        const bool short_row = fields.size() < columns.count;
+        if (fields.size() > columns.count || (short_row && fields.size() <= columns.accepted)) {
+            reader.Fail("expected " + std::to_string(columns.count) +
+                        " fields as the header, got " + std::to_string(fields.size()));
+        }
+        const std::string_view accepted = fields[columns.accepted];
+        if (accepted != "0" && accepted != "1") {
+            reader.Fail("accepted " + detail::Quoted(accepted) + " is not 0 or 1");
+        }
+        if (accepted == "1" && short_row) {
+            reader.Fail("an accepted loop without a pose (" + std::to_string(fields.size()) +
+                        " fields, the header has " + std::to_string(columns.count) + ")");
+        }
+        if (accepted == "1") rows.push_back(ParseLoopRow(reader, fields, columns, scan_count));
+    }
+    if (!header) reader.Fail("the file is empty: expected a header naming query,match,accepted");
+    return rows;
+}
+
+void WriteG2o(const std::filesystem::path& file, const std::vector<core::Transform>& poses,
+              const std::vector<posegraph::Edge>& edges,
+              const std::vector<posegraph::Edge>& commented_edges) {
+    std::string text = "# lidarloop pose graph: vertices T_world_sensor, edges T_from_to\n";
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+        text += "VERTEX_SE3:QUAT " + std::to_string(i) + ' ';
+        const Eigen::Vector3d t = poses[i].translation();
+        const Eigen::Quaterniond q = Eigen::Quaterniond(poses[i].linear()).normalized();
+        for (const double value : {t.x(), t.y(), t.z(), q.x(), q.y(), q.z()}) {
+            detail::AppendNumber(text, value, ' ');
+        }
+        detail::AppendNumber(text, q.w(), '\n');
+    }
+    if (!poses.empty()) text += "FIX 0\n";
+    for (const posegraph::Edge& edge : edges) AppendEdge(text, edge);
+    for (const posegraph::Edge& edge : commented_edges) {
+        text += "# rejected ";
+        AppendEdge(text, edge);
+    }
+    detail::WriteTextFile(file, text);
+}
+
+}  // namespace lidarloop::io

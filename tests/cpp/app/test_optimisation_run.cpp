@@ -1,0 +1,102 @@
+// The optimise run: it detects (or reads) the loops, shrinks the odometry's error, writes the
+// results folder, and names the file and line of bad input.
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "app_test_utils.hpp"
+#include "lidarloop/app/optimisation.hpp"
+#include "lidarloop/io/poses.hpp"
+#include "lidarloop/io/read_error.hpp"
+#include "test_utils.hpp"
+
+namespace lidarloop {
+namespace {
+
+class OptimisationRun : public ::testing::Test {
+protected:
+    void SetUp() override { dataset_.emplace(test::SmallSequence(dir_ / "sequence")); }
+    app::OptimiseRequest Request(const std::string& out) const {
+        app::OptimiseRequest request;
+        request.odometry_file = dir_ / "sequence" / "poses_odometry.txt";
+        request.config.detection.min_gap.value = 10;
+        request.config.detection.top_k = 1;  // one candidate to verify per scan: faster
+        request.out = dir_ / out;
+        return request;
+    }
+
+    test::TempDir dir_;
+    std::optional<io::Dataset> dataset_;
+};
+
+TEST_F(OptimisationRun, DetectsLoopsAndShrinksTheError) {
+    app::OptimiseRequest request = Request("optimised");
+    request.format = app::PoseFormat::kTum;
+    const app::OptimiseOutcome outcome = app::RunOptimisation(*dataset_, request);
+    ASSERT_GT(outcome.result.loops_used, 10u);
+    ASSERT_TRUE(outcome.odometry && outcome.optimised);
+    EXPECT_LT(outcome.optimised->ate_rmse_m, outcome.odometry->ate_rmse_m / 2.0)
+        << outcome.odometry->ate_rmse_m << " -> " << outcome.optimised->ate_rmse_m;
+    const auto out = request.out;
+    for (const char* file : {"poses_optimised.txt", "graph.g2o", "loop_verdicts.csv",
+                             "metrics.json", "report.md", "config.yaml", "detection/loops.csv"}) {
+        EXPECT_TRUE(std::filesystem::exists(out / file)) << file;
+    }
+    const auto poses = io::ReadTumPoses(out / "poses_optimised.txt");
+    ASSERT_EQ(poses.size(), dataset_->size());
+    EXPECT_TRUE(poses.back().T_world_sensor.isApprox(outcome.result.poses.back(), 1e-12));
+    std::ifstream in(out / "metrics.json");
+    const nlohmann::json metrics = nlohmann::json::parse(in);
+    EXPECT_DOUBLE_EQ(metrics["ate_rmse_m_optimised"].get<double>(), outcome.optimised->ate_rmse_m);
+    EXPECT_EQ(metrics["loops"]["used"].get<std::size_t>(), outcome.result.loops_used);
+    EXPECT_TRUE(metrics["rpe_optimised"].contains("rpe_translation_percent"));
+
+    // The loops detect wrote, read back: the same graph, the same result.
+    app::OptimiseRequest again = Request("from_file");
+    again.loops_file = out / "detection" / "loops.csv";
+    const app::OptimiseOutcome read = app::RunOptimisation(*dataset_, again);
+    ASSERT_EQ(read.loops.size(), outcome.loops.size());
+    EXPECT_NEAR(read.optimised->ate_rmse_m, outcome.optimised->ate_rmse_m, 1e-3);
+}
+
+TEST_F(OptimisationRun, WithoutLoopsTheOdometryComesBackWithANote) {
+    test::WriteFile(dir_ / "none.csv",
+                    "query,match,distance,second_ratio,accepted,rank,tx,ty,tz,qx,qy,qz,qw\n"
+                    "50,3,0.1,,0,1,0,0,0,0,0,0,1\n");
+    app::OptimiseRequest request = Request("none");
+    request.loops_file = dir_ / "none.csv";
+    const app::OptimiseOutcome outcome = app::RunOptimisation(*dataset_, request);
+    ASSERT_FALSE(outcome.notes.empty());
+    EXPECT_TRUE(test::Contains(outcome.notes.front(), "no loop"));
+    EXPECT_DOUBLE_EQ(outcome.optimised->ate_rmse_m, outcome.odometry->ate_rmse_m);
+}
+
+TEST_F(OptimisationRun, BadInputNamesTheFileAndLine) {
+    const auto odometry = io::ReadKittiPoses(dir_ / "sequence" / "poses_odometry.txt");
+    io::WriteKittiPoses(dir_ / "short.txt",
+                        std::vector<core::StampedPose>(odometry.begin(), odometry.end() - 1));
+    app::OptimiseRequest request = Request("bad");
+    request.odometry_file = dir_ / "short.txt";
+    try {
+        app::RunOptimisation(*dataset_, request);
+        FAIL() << "no error";
+    } catch (const io::ReadError& e) {
+        EXPECT_TRUE(test::Contains(e.what(), "short.txt: holds 199 poses but"));
+    }
+    test::WriteFile(dir_ / "loops.csv",
+                    "query,match,distance,second_ratio,accepted,rank,tx,ty,tz,qx,qy,qz,qw\n"
+                    "50,3,0.1,,1,1,0,0,0,0,0,0,1\n"
+                    "250,3,0.1,,1,1,0,0,0,0,0,0,1\n");
+    request = Request("bad");
+    request.loops_file = dir_ / "loops.csv";
+    try {
+        app::RunOptimisation(*dataset_, request);
+        FAIL() << "no error";
+    } catch (const io::ReadError& e) {
+        EXPECT_TRUE(test::Contains(e.what(), "loops.csv: line 3: query scan 250 does not exist"));
+    }
+}
+
+}  // namespace
+}  // namespace lidarloop

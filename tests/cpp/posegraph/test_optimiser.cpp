@@ -1,0 +1,223 @@
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "lidarloop/core/error.hpp"
+#include "lidarloop/eval/trajectory.hpp"
+#include "lidarloop/posegraph/optimiser.hpp"
+#include "posegraph/posegraph_test_utils.hpp"
+
+namespace lidarloop::posegraph {
+namespace {
+
+using test::DriftingOdometry;
+using test::EllipseLaps;
+using test::PlanarPose;
+using test::TrueLoops;
+using test::WrongLoops;
+
+double MaxPositionError(const std::vector<core::Transform>& a,
+                        const std::vector<core::Transform>& b) {
+    double error = 0.0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        error = std::max(error, (a[i].translation() - b[i].translation()).norm());
+    }
+    return error;
+}
+
+OptimisationResult OptimiseLoops(const std::vector<core::Transform>& odometry,
+                                 const std::vector<LoopConstraint>& loops,
+                                 const PoseGraphConfig& config = {}) {
+    return Optimise(BuildPoseGraph(odometry, loops, config), config);
+}
+
+TEST(EdgeError, ZeroWhenTheEstimatesAgreeAndG2oConventionOtherwise) {
+    const core::Transform a = PlanarPose(1, 2, 0.3, 0.5);
+    const core::Transform b = PlanarPose(4, -1, -1.2, 0.7);
+    EXPECT_LT(EdgeError(a.inverse() * b, a, b).norm(), 1e-12);
+    // Moving `to` by 1 m along its own x axis: translation error (1, 0, 0) in its frame.
+    core::Transform moved = b;
+    moved.translate(Eigen::Vector3d(1, 0, 0));
+    const Vector6d e = EdgeError(a.inverse() * b, a, moved);
+    EXPECT_NEAR(e[0], 1.0, 1e-12);
+    EXPECT_NEAR(e.segment<2>(1).norm() + e.tail<3>().norm(), 0.0, 1e-12);
+    // Turning `to` by 0.2 rad about its z: quaternion vector (0, 0, sin(0.1)).
+    core::Transform turned = b;
+    turned.rotate(Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitZ()));
+    const Vector6d r = EdgeError(a.inverse() * b, a, turned);
+    EXPECT_NEAR(r[5], std::sin(0.1), 1e-12);
+    EXPECT_NEAR(r.head<5>().norm(), 0.0, 1e-12);
+}
+
+TEST(Information, OdometryGrowsWithTheStepAndLoopsWithQuality) {
+    const InformationConfig config;
+    const Matrix6d short_step = OdometryInformation(PlanarPose(0.5, 0, 0), config);
+    const Matrix6d long_step = OdometryInformation(PlanarPose(5, 0, 0), config);
+    EXPECT_GT(short_step(0, 0), long_step(0, 0));
+    EXPECT_GT(short_step(5, 5), long_step(5, 5));
+    // 1 m and 0.3 deg of drift per 100 m: sigma^2 = min^2 + a^2 * l.
+    const double sigma_t = std::sqrt(0.01 * 0.01 + 0.01 * 5);
+    EXPECT_NEAR(long_step(0, 0), 1.0 / (sigma_t * sigma_t), 1e-9);
+    LoopConstraint good;
+    good.overlap = 0.8;
+    good.rmse_m = 0.05;
+    LoopConstraint poor = good;
+    poor.overlap = 0.2;
+    poor.rmse_m = 0.3;
+    EXPECT_GT(LoopInformation(good, config)(0, 0), LoopInformation(poor, config)(0, 0));
+    EXPECT_GT(LoopInformation(good, config)(3, 3), LoopInformation(poor, config)(3, 3));
+}
+
+TEST(Optimise, NoiseFreeGraphStaysAtTheTruth) {
+    const std::vector<core::Transform> truth = EllipseLaps(2);
+    const auto result = OptimiseLoops(truth, TrueLoops(truth, 1, 5, 50, 5.0, 0.0, 0.0));
+    ASSERT_GT(result.loops_used, 10u);
+    EXPECT_EQ(result.rejected_by_odometry + result.rejected_by_residual, 0u);
+    EXPECT_LT(MaxPositionError(result.poses, truth), 1e-6);
+    EXPECT_NEAR(result.final_cost, 0.0, 1e-9);
+}
+
+TEST(Optimise, OneLoopRemovesAKnownInjectedDrift) {
+    // A square driven once with a constant yaw error of 0.1 degree per 2 m step (100 steps):
+    // the odometry misses the start by metres; one exact loop from the last pose to the first
+    // brings every pose back near the truth. The information model is told of the larger drift.
+    std::vector<core::Transform> truth;
+    for (int side = 0; side < 4; ++side) {
+        for (int k = 0; k < 25; ++k) {
+            const double yaw = side * std::numbers::pi / 2;
+            const Eigen::Vector2d corner = side == 0   ? Eigen::Vector2d(0, 0)
+                                           : side == 1 ? Eigen::Vector2d(50, 0)
+                                           : side == 2 ? Eigen::Vector2d(50, 50)
+                                                       : Eigen::Vector2d(0, 50);
+            truth.push_back(PlanarPose(corner.x() + 2.0 * k * std::cos(yaw),
+                                       corner.y() + 2.0 * k * std::sin(yaw), yaw));
+        }
+    }
+    truth.push_back(PlanarPose(0, 0, 0));  // back at the start
+    std::vector<core::Transform> odometry = {truth.front()};
+    for (std::size_t i = 1; i < truth.size(); ++i) {
+        core::Transform step = truth[i - 1].inverse() * truth[i];
+        step.rotate(Eigen::AngleAxisd(0.1 * std::numbers::pi / 180, Eigen::Vector3d::UnitZ()));
+        odometry.push_back(odometry.back() * step);
+    }
+    const LoopConstraint loop{truth.size() - 1, 0, truth.front().inverse() * truth.back()};
+    PoseGraphConfig config;
+    config.information.odometry_rotation_sigma_deg_per_sqrt_m = 0.5;
+    const auto result = OptimiseLoops(odometry, {loop}, config);
+    ASSERT_EQ(result.loops_used, 1u)
+        << ToString(result.loops[0].verdict) << " residual " << result.loops[0].whitened_residual
+        << " odometry error " << result.loops[0].odometry_translation_error_m << " m "
+        << result.loops[0].odometry_rotation_error_deg << " deg, gate "
+        << result.loops[0].gate_translation_m << " m " << result.loops[0].gate_rotation_deg;
+    const double before = eval::AbsoluteTrajectoryRmse(odometry, truth);
+    const double after = eval::AbsoluteTrajectoryRmse(result.poses, truth);
+    EXPECT_GT(before, 1.0);
+    EXPECT_LT(after, before / 5.0);
+    // The loop itself is closed.
+    EXPECT_LT((result.poses.back().translation() - result.poses.front().translation()).norm(), 0.5);
+}
+
+TEST(Optimise, LoopsShrinkTheDriftOfSeveralLaps) {
+    const std::vector<core::Transform> truth = EllipseLaps(3);
+    const std::vector<core::Transform> odometry = DriftingOdometry(truth, 7);
+    const auto result = OptimiseLoops(odometry, TrueLoops(truth, 3));
+    const double before = eval::AbsoluteTrajectoryRmse(odometry, truth);
+    const double after = eval::AbsoluteTrajectoryRmse(result.poses, truth);
+    EXPECT_GT(before, 2.0);
+    EXPECT_LT(after, before / 5.0) << "before " << before << " after " << after;
+    EXPECT_EQ(result.rejected_by_odometry + result.rejected_by_residual, 0u);
+    EXPECT_TRUE(result.converged);
+}
+
+struct WrongLoopCase {
+    std::vector<core::Transform> truth;
+    std::vector<core::Transform> odometry;
+    std::vector<LoopConstraint> good;
+    double clean_ate = 0.0;
+
+    WrongLoopCase() : truth(EllipseLaps(3)), odometry(DriftingOdometry(truth, 11)) {
+        good = TrueLoops(truth, 5);
+        clean_ate = eval::AbsoluteTrajectoryRmse(OptimiseLoops(odometry, good).poses, truth);
+    }
+};
+
+TEST(Optimise, TenPercentWrongLoopsBarelyMatter) {
+    const WrongLoopCase c;
+    for (const std::uint64_t seed : {1u, 2u, 3u}) {
+        std::vector<LoopConstraint> loops = c.good;
+        const auto wrong = WrongLoops(c.truth.size(), (c.good.size() + 9) / 10, seed);
+        loops.insert(loops.end(), wrong.begin(), wrong.end());
+        const auto result = OptimiseLoops(c.odometry, loops);
+        const double ate = eval::AbsoluteTrajectoryRmse(result.poses, c.truth);
+        EXPECT_LT(ate, 1.5 * c.clean_ate) << "seed " << seed << ", clean " << c.clean_ate;
+        // Every wrong loop is rejected by one of the checks.
+        for (const LoopResult& loop : result.loops) {
+            if (loop.loop >= c.good.size()) {
+                EXPECT_NE(loop.verdict, LoopVerdict::kUsed) << "wrong loop " << loop.loop;
+            }
+        }
+    }
+}
+
+TEST(Optimise, OneWrongLoopChangesTheResultByLessThanTenPercent) {
+    const WrongLoopCase c;
+    for (const std::uint64_t seed : {4u, 5u, 6u}) {
+        std::vector<LoopConstraint> loops = c.good;
+        loops.push_back(WrongLoops(c.truth.size(), 1, seed).front());
+        const auto result = OptimiseLoops(c.odometry, loops);
+        const double ate = eval::AbsoluteTrajectoryRmse(result.poses, c.truth);
+        EXPECT_LT(ate, 1.1 * c.clean_ate) << "seed " << seed << ", clean " << c.clean_ate;
+        EXPECT_NE(result.loops.back().verdict, LoopVerdict::kUsed);
+    }
+}
+
+TEST(Optimise, GateRejectsALoopTheOdometryCannotExplain) {
+    const std::vector<core::Transform> truth = EllipseLaps(1);
+    LoopConstraint upside_down{100, 10, PlanarPose(0, 0, 0)};
+    upside_down.T_match_query = truth[10].inverse() * truth[100];
+    upside_down.T_match_query.rotate(Eigen::AngleAxisd(std::numbers::pi, Eigen::Vector3d::UnitX()));
+    const auto result = OptimiseLoops(truth, {upside_down});
+    ASSERT_EQ(result.loops.size(), 1u);
+    EXPECT_EQ(result.loops[0].verdict, LoopVerdict::kRejectedByOdometry);
+    EXPECT_NEAR(result.loops[0].odometry_rotation_error_deg, 180.0, 1e-6);
+    EXPECT_FALSE(result.note.empty());
+    EXPECT_LT(MaxPositionError(result.poses, truth), 1e-12);
+}
+
+TEST(Optimise, WithoutLoopsTheOdometryComesBackUnchangedWithANote) {
+    const std::vector<core::Transform> truth = EllipseLaps(1);
+    const std::vector<core::Transform> odometry = DriftingOdometry(truth, 3);
+    const auto result = OptimiseLoops(odometry, {});
+    EXPECT_EQ(result.solves, 0);
+    EXPECT_NE(result.note.find("no loop"), std::string::npos);
+    for (std::size_t i = 0; i < odometry.size(); ++i) {
+        EXPECT_TRUE(result.poses[i].isApprox(odometry[i], 0.0)) << i;
+    }
+}
+
+TEST(Optimise, BadInput) {
+    const std::vector<core::Transform> poses = EllipseLaps(1);
+    EXPECT_THROW(BuildPoseGraph(poses, {{poses.size(), 0, core::Transform::Identity()}}, {}),
+                 core::ConfigError);
+    EXPECT_THROW(BuildPoseGraph(poses, {{5, 5, core::Transform::Identity()}}, {}),
+                 core::ConfigError);
+    EXPECT_THROW(Optimise(PoseGraph{}, {}), core::ConfigError);
+    PoseGraphConfig config;
+    config.robust.cauchy_scale = 0.0;
+    try {
+        config.Validate();
+        FAIL() << "no error";
+    } catch (const core::ConfigError& e) {
+        EXPECT_NE(std::string(e.what()).find("posegraph.robust.cauchy_scale"), std::string::npos)
+            << e.what();
+    }
+    config = {};
+    config.information.odometry_translation_sigma_m_per_sqrt_m = std::nan("");
+    EXPECT_THROW(config.Validate(), core::ConfigError);
+}
+
+}  // namespace
+}  // namespace lidarloop::posegraph
