@@ -87,7 +87,7 @@ std::vector<bool> JudgeLoops(const std::vector<posegraph::LoopConstraint>& loops
 TrajectoryMetrics Measure(const std::vector<core::Transform>& estimate,
                           const std::vector<core::Transform>& truth) {
     return {eval::AbsoluteTrajectoryRmse(estimate, truth),
-            eval::ComputeRelativePoseError(estimate, truth)};
+            eval::ComputeTrajectoryRpe(estimate, truth)};
 }
 
 void WritePoses(const std::filesystem::path& file, const OptimiseRequest& request,

@@ -36,7 +36,7 @@ struct OptimiseRequest {
 /// ATE and RPE of one trajectory against the ground truth.
 struct TrajectoryMetrics {
     double ate_rmse_m = 0.0;
-    eval::RelativePoseError rpe;
+    eval::TrajectoryRpe rpe;
 };
 
 struct OptimiseOutcome {

@@ -71,9 +71,9 @@ double AbsoluteTrajectoryRmse(const std::vector<core::Transform>& estimate,
     return std::sqrt(sum / static_cast<double>(p_estimate.size()));
 }
 
-RelativePoseError ComputeRelativePoseError(const std::vector<core::Transform>& estimate,
-                                           const std::vector<core::Transform>& truth,
-                                           const RelativePoseErrorConfig& config) {
+TrajectoryRpe ComputeTrajectoryRpe(const std::vector<core::Transform>& estimate,
+                                   const std::vector<core::Transform>& truth,
+                                   const TrajectoryRpeConfig& config) {
     RequireSameSize(estimate.size(), truth.size());
     if (config.step == 0) throw core::ConfigError("the RPE step must be at least 1 pose");
     for (const double length : config.lengths_m) {
@@ -84,7 +84,7 @@ RelativePoseError ComputeRelativePoseError(const std::vector<core::Transform>& e
     for (std::size_t i = 1; i < truth.size(); ++i) {
         path[i] = path[i - 1] + (truth[i].translation() - truth[i - 1].translation()).norm();
     }
-    RelativePoseError result;
+    TrajectoryRpe result;
     double translation_sum = 0.0;
     double rotation_sum = 0.0;
     for (std::size_t first = 0; first < truth.size(); first += config.step) {

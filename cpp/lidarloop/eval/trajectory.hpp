@@ -23,7 +23,7 @@ double AbsoluteTrajectoryRmse(const std::vector<core::Transform>& estimate,
                               const std::vector<core::Transform>& truth);
 
 /// Relative pose error as the KITTI odometry benchmark computes it.
-struct RelativePoseError {
+struct TrajectoryRpe {
     double translation_percent = 0.0;    ///< mean |t(E)| / L, times 100
     double rotation_deg_per_100m = 0.0;  ///< mean angle(E) / L, degrees per 100 m
     std::size_t segments = 0;            ///< pairs averaged; 0: none long enough (values NaN)
@@ -31,18 +31,18 @@ struct RelativePoseError {
 
 /// Which segments RPE averages: from every `step`-th pose i, for every length L, the first
 /// pose j whose ground-truth path length from i is at least L.
-struct RelativePoseErrorConfig {
+struct TrajectoryRpeConfig {
     std::vector<double> lengths_m = {100, 200, 300, 400, 500, 600, 700, 800};
     std::size_t step = 10;
 };
 
-/// KITTI-style RPE: for each segment (i, j) of RelativePoseErrorConfig, the error
+/// KITTI-style RPE: for each segment (i, j) of TrajectoryRpeConfig, the error
 /// E = (truth_i^-1 truth_j)^-1 (estimate_i^-1 estimate_j); its translation norm and rotation
 /// angle are divided by L and averaged over all segments of all lengths (Geiger et al. 2012,
 /// the devkit's evaluate_odometry). No alignment is needed: E is frame independent.
 /// core::ConfigError when the sizes differ, the step is 0 or a length is not positive.
-RelativePoseError ComputeRelativePoseError(const std::vector<core::Transform>& estimate,
-                                           const std::vector<core::Transform>& truth,
-                                           const RelativePoseErrorConfig& config = {});
+TrajectoryRpe ComputeTrajectoryRpe(const std::vector<core::Transform>& estimate,
+                                   const std::vector<core::Transform>& truth,
+                                   const TrajectoryRpeConfig& config = {});
 
 }  // namespace lidarloop::eval

@@ -108,17 +108,17 @@ TEST(AbsoluteTrajectoryRmse, BadInput) {
 
 // A straight line driven 1 % too long and turning 0.3 degrees per 100 m: KITTI RPE is exactly
 // 1 % translation (the heading error adds a little) and 0.3 deg / 100 m.
-TEST(RelativePoseError, KnownAnswerForScaleAndHeadingDrift) {
+TEST(TrajectoryRpe, KnownAnswerForScaleAndHeadingDrift) {
     std::vector<core::Transform> truth, scaled, turning;
     for (int i = 0; i <= 1000; ++i) {
         truth.push_back(Pose(i, 0, 0, 0));
         scaled.push_back(Pose(1.01 * i, 0, 0, 0));
         turning.push_back(Pose(i, 0, 0, 0.003 * kDeg * i));
     }
-    const RelativePoseError s = ComputeRelativePoseError(scaled, truth);
+    const TrajectoryRpe s = ComputeTrajectoryRpe(scaled, truth);
     EXPECT_NEAR(s.translation_percent, 1.0, 1e-9);
     EXPECT_NEAR(s.rotation_deg_per_100m, 0.0, 1e-9);
-    const RelativePoseError r = ComputeRelativePoseError(turning, truth);
+    const TrajectoryRpe r = ComputeTrajectoryRpe(turning, truth);
     EXPECT_NEAR(r.rotation_deg_per_100m, 0.3, 1e-9);
     // Segments: from poses 0, 10, ..., 1000, every length L with first + L <= 1000.
     std::size_t expected = 0;
@@ -126,11 +126,11 @@ TEST(RelativePoseError, KnownAnswerForScaleAndHeadingDrift) {
         for (int L = 100; L <= 800; L += 100) expected += first + L <= 1000 ? 1 : 0;
     }
     EXPECT_EQ(s.segments, expected);
-    EXPECT_NEAR(ComputeRelativePoseError(truth, truth).translation_percent, 0.0, 1e-12);
+    EXPECT_NEAR(ComputeTrajectoryRpe(truth, truth).translation_percent, 0.0, 1e-12);
 }
 
 // Against a plain re-computation from its definition on a curved, noisy path.
-TEST(RelativePoseError, MatchesAPlainReference) {
+TEST(TrajectoryRpe, MatchesAPlainReference) {
     const auto truth = Wiggle(900);
     std::mt19937_64 rng(9);
     std::normal_distribution<double> noise(0.0, 0.01);
@@ -159,19 +159,19 @@ TEST(RelativePoseError, MatchesAPlainReference) {
             ++count;
         }
     }
-    const RelativePoseError rpe = ComputeRelativePoseError(estimate, truth);
+    const TrajectoryRpe rpe = ComputeTrajectoryRpe(estimate, truth);
     ASSERT_EQ(rpe.segments, count);
     EXPECT_NEAR(rpe.translation_percent, 100.0 * t_sum / static_cast<double>(count), 1e-9);
     EXPECT_NEAR(rpe.rotation_deg_per_100m, 100.0 * r_sum / static_cast<double>(count) / kDeg, 1e-6);
 }
 
-TEST(RelativePoseError, ShortTrajectoryHasNoSegment) {
+TEST(TrajectoryRpe, ShortTrajectoryHasNoSegment) {
     const auto truth = Wiggle(50);
-    const RelativePoseError rpe = ComputeRelativePoseError(truth, truth);
+    const TrajectoryRpe rpe = ComputeTrajectoryRpe(truth, truth);
     EXPECT_EQ(rpe.segments, 0u);
     EXPECT_TRUE(std::isnan(rpe.translation_percent));
-    EXPECT_THROW(ComputeRelativePoseError(Wiggle(49), truth), core::ConfigError);
-    EXPECT_THROW(ComputeRelativePoseError(truth, truth, {{100.0}, 0}), core::ConfigError);
+    EXPECT_THROW(ComputeTrajectoryRpe(Wiggle(49), truth), core::ConfigError);
+    EXPECT_THROW(ComputeTrajectoryRpe(truth, truth, {{100.0}, 0}), core::ConfigError);
 }
 
 }  // namespace

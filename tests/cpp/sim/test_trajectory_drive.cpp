@@ -101,7 +101,7 @@ TEST(Simulator, DefaultOdometryDriftHasRealisticMagnitudes) {
         for (const auto& pose : simulator.OdometryPoses(0, simulator.size())) {
             odometry.push_back(pose.T_world_sensor);
         }
-        const eval::RelativePoseError rpe = eval::ComputeRelativePoseError(odometry, truth);
+        const eval::TrajectoryRpe rpe = eval::ComputeTrajectoryRpe(odometry, truth);
         ASSERT_GT(rpe.segments, 100u);
         // 0.2 % scale error and 0.4 deg/100 m: about 1 % on straight roads, less on this compact
         // grid route, whose segments end closer to where they start than their length.
