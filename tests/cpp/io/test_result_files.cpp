@@ -111,6 +111,13 @@ TEST(DatabaseFile, BadFilesAreClearErrors) {
     config.replace(at, 8, "binz: 24");
     test::WriteFile(dir / "config.bin", config);
     test::ExpectReadError(LoadDatabase, dir / "config.bin", "key 'histogram.binz': unknown key");
+    // An embedded config with a key that is no name (found by fuzzing).
+    std::string keyed = good;
+    const auto key_at = keyed.find("  bins: 24");
+    ASSERT_NE(key_at, std::string::npos);
+    keyed.replace(key_at, 10, "  {b: 1}: ");
+    test::WriteFile(dir / "key.bin", keyed);
+    test::ExpectReadError(LoadDatabase, dir / "key.bin", "is a map, not a name");
     test::WriteFile(dir / "long.bin", good + "\x01");
     test::ExpectReadError(LoadDatabase, dir / "long.bin", "trailing bytes");
 }
