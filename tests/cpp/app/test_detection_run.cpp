@@ -10,6 +10,7 @@
 #include "lidarloop/app/describe_run.hpp"
 #include "lidarloop/app/detection.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/io/kitti_bin.hpp"
 #include "lidarloop/io/results_csv.hpp"
 #include "test_utils.hpp"
 
@@ -140,6 +141,25 @@ TEST_F(DetectionRun, VerifiesEveryCandidateAsRegisteringThePairAlone) {
         for (const auto& q : outcome.queries) rows += q.candidates.size();
         return rows;
     }());
+}
+
+// A scan file emptied to zero bytes reads as a scan without points; the skip message names the
+// file, as it does for a file that cannot be read.
+TEST(DescribeDataset, AnEmptiedScanFileIsNamedInTheSkipMessage) {
+    test::TempDir dir;
+    for (int i = 0; i < 4; ++i) {
+        const auto file = dir / ("scan" + std::to_string(i) + ".bin");
+        io::WriteKittiBin(file, test::RandomCloud(200, static_cast<unsigned>(i)));
+    }
+    std::filesystem::resize_file(dir / "scan2.bin", 0);
+    const io::Dataset dataset = io::OpenDataset(dir.path());
+    app::DescribeRun run;
+    run.skip_bad = true;
+    const auto described = app::DescribeDataset(dataset, core::DescriptorConfig{}, run);
+    ASSERT_EQ(described.skipped.size(), 1U);
+    EXPECT_NE(described.skipped[0].find("scan 2: " + (dir / "scan2.bin").string() + ": "),
+              std::string::npos)
+        << described.skipped[0];
 }
 
 TEST_F(DetectionRun, ReportsProgressOfEveryScanAndEndsTheStage) {
