@@ -61,7 +61,8 @@ struct LoopQuery {
 };
 
 /// The k nearest of the scans 0..count-1 for which `eligible(j)` holds, by (distance, index),
-/// with `distance_of(j)`: the brute-force search both detectors share.
+/// with `distance_of(j)` (called for eligible scans only; +inf and NaN are never candidates):
+/// the brute-force search both detectors share. O(k) memory (a bounded heap).
 std::vector<Neighbor> NearestCandidates(std::size_t count, std::size_t k,
                                         const std::function<double(std::size_t)>& distance_of,
                                         const std::function<bool(std::size_t)>& eligible);
@@ -116,5 +117,13 @@ std::vector<LoopQuery> LocaliseSequence(const LoopDetector& map, const Descripto
 std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,
                                         const std::vector<double>& times_s,
                                         const DetectorConfig& detector, const core::Method& method);
+
+/// Offline detection without the similarity matrix: exactly DetectFromMatrix on
+/// ComputeSimilarityMatrix(database) (distances rounded to float as the matrix holds them), a
+/// query at a time, in parallel unless told otherwise. Memory: the results plus one row of n
+/// floats per thread, instead of the matrix's 2 n^2 bytes; the same n(n-1)/2 comparisons.
+std::vector<LoopQuery> DetectStreaming(const DescriptorDatabase& database,
+                                       const DetectorConfig& detector,
+                                       Execution execution = Execution::kParallel);
 
 }  // namespace lidarloop::pipeline
