@@ -139,12 +139,19 @@ void VisitFields(registration::VerificationConfig& c, Visitor& v) {
 }
 
 template <typename Visitor>
+void VisitFields(OutputConfig& c, Visitor& v) {
+    v.Field("similarity_matrix_mib", c.similarity_matrix_mib,
+            "detect keeps the similarity matrix (similarity.bin, images) up to this size; 0 never");
+}
+
+template <typename Visitor>
 void VisitFields(RunConfig& c, Visitor& v) {
     v.Field("method", c.descriptor.method, MethodHelp());
     v.Section("histogram", c.descriptor.histogram);
     v.Section("ndt", c.descriptor.ndt);
     v.Section("detection", c.detection);
     v.Section("verification", c.detection.verification);
+    v.Section("output", c.output);
 }
 
 std::string EnumName(const core::Method& m) { return core::ToString(m); }

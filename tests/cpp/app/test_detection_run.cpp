@@ -71,6 +71,38 @@ TEST_F(DetectionRun, EqualsThePipelineOnTheSameDescriptors) {
     }
 }
 
+// Past the memory budget of the similarity matrix, detect finds the same loops without it and
+// writes neither similarity.bin nor the images.
+TEST_F(DetectionRun, WithoutTheMatrixGivesTheSameResults) {
+    for (core::Method method : {core::Method::kRange, core::Method::kNdt}) {
+        app::DetectRequest with = Request("with_" + core::ToString(method), method);
+        with.config.detection.verify = false;
+        app::DetectRequest without = with;
+        without.out = dir_ / ("without_" + core::ToString(method));
+        without.config.output.similarity_matrix_mib = 0;
+        const app::DetectOutcome a = app::RunDetect(*dataset_, with);
+        const app::DetectOutcome b = app::RunDetect(*dataset_, without);
+        ASSERT_EQ(a.queries.size(), b.queries.size());
+        for (std::size_t i = 0; i < a.queries.size(); ++i) {
+            ASSERT_EQ(a.queries[i].candidates.size(), b.queries[i].candidates.size()) << i;
+            for (std::size_t r = 0; r < a.queries[i].candidates.size(); ++r) {
+                EXPECT_EQ(a.queries[i].candidates[r].index, b.queries[i].candidates[r].index);
+                EXPECT_EQ(a.queries[i].candidates[r].distance, b.queries[i].candidates[r].distance);
+            }
+            EXPECT_EQ(a.queries[i].accepted, b.queries[i].accepted) << i;
+        }
+        EXPECT_EQ(a.accepted, b.accepted);
+        EXPECT_EQ(test::ReadFile(with.out / "loops.csv"),
+                  test::ReadFile(without.out / "loops.csv"));
+        EXPECT_EQ(test::ReadFile(with.out / "candidates.csv"),
+                  test::ReadFile(without.out / "candidates.csv"));
+        for (const char* file : {"similarity.bin", "similarity.png", "similarity_distance.png"}) {
+            EXPECT_TRUE(std::filesystem::exists(with.out / file)) << file;
+            EXPECT_FALSE(std::filesystem::exists(without.out / file)) << file;
+        }
+    }
+}
+
 TEST_F(DetectionRun, LocalisingTheSequenceAgainstItsOwnMapFindsEveryScanItself) {
     const app::DetectRequest detect = Request("detect", core::Method::kRange);
     app::RunDetect(*dataset_, detect);
