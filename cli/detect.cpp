@@ -51,12 +51,16 @@ void PrintOutcome(const io::Dataset& dataset, const app::DetectRequest& request,
               << outcome.threshold << ", " << outcome.accepted << " scans with an accepted "
               << (map.empty() ? "loop" : "match");
     if (!outcome.skipped.empty()) std::cout << ", " << outcome.skipped.size() << " skipped";
+    const bool matrix = request.config.output.KeepsSimilarityMatrix(dataset.size());
     std::cout << "\n  results in " << request.out.string() << "/ "
-              << (map.empty() ? "(loops.csv, candidates.csv, similarity.png, "
-                                "similarity_distance.png, similarity.bin, database.lldb, "
-                                "config.yaml, timings.json)\n"
-                              : "(loops.csv: query scan, map scan; candidates.csv, config.yaml, "
-                                "timings.json)\n");
+              << (!map.empty() ? "(loops.csv: query scan, map scan; candidates.csv, config.yaml, "
+                                 "timings.json)\n"
+                  : matrix     ? "(loops.csv, candidates.csv, similarity.png, "
+                                 "similarity_distance.png, similarity.bin, database.lldb, "
+                                 "config.yaml, timings.json)\n"
+                               : "(loops.csv, candidates.csv, database.lldb, config.yaml, "
+                                 "timings.json; no similarity matrix: it would exceed "
+                                 "output.similarity_matrix_mib)\n");
 }
 
 void RunDetect(const DetectFlags& flags) {
