@@ -387,6 +387,7 @@ RunConfig LoadConfigYaml(const std::filesystem::path& file, RunConfig base) {
 void WriteConfigYaml(const std::filesystem::path& file, const RunConfig& config) {
     auto out = detail::OpenForWriting(file, /*binary=*/false);
     out << DumpConfigYaml(config);
+    out.close();  // flushes: a full disk fails here, not silently in the destructor
     if (!out) throw WriteError(file, "write failed");
 }
 
