@@ -11,6 +11,7 @@
 #include "lidarloop/core/descriptor.hpp"
 #include "lidarloop/core/error.hpp"
 #include "progress.hpp"
+#include "run_output.hpp"
 
 namespace lidarloop::cli {
 namespace {
@@ -22,6 +23,7 @@ struct DetectFlags {
     std::string out;
     std::string map;  // a database.lldb to localise against (query-only mode)
     bool skip_bad = false;
+    bool overwrite = false;
     bool quiet = false;
 };
 
@@ -73,14 +75,25 @@ void RunDetect(const DetectFlags& flags) {
         app::LoadedMap map = app::LoadMap(flags.map);
         request.config = ResolveAgainstMap(flags, map);
         const io::Dataset dataset = flags.dataset.Open();
-        PrintOutcome(dataset, request, app::RunLocalise(dataset, std::move(map), request),
-                     flags.map);
+        const app::DetectOutcome outcome = RunInFolder(
+            flags.out, dataset.root(), flags.overwrite, [&](const std::filesystem::path& staging) {
+                app::DetectRequest staged = request;
+                staged.out = staging;
+                return app::RunLocalise(dataset, std::move(map), staged);
+            });
+        PrintOutcome(dataset, request, outcome, flags.map);
         return;
     }
     request.config = flags.descriptor.Resolve();
     flags.detection.ApplyTo(request.config);
     const io::Dataset dataset = flags.dataset.Open();
-    PrintOutcome(dataset, request, app::RunDetect(dataset, request), "");
+    const app::DetectOutcome outcome = RunInFolder(flags.out, dataset.root(), flags.overwrite,
+                                                   [&](const std::filesystem::path& staging) {
+                                                       app::DetectRequest staged = request;
+                                                       staged.out = staging;
+                                                       return app::RunDetect(dataset, staged);
+                                                   });
+    PrintOutcome(dataset, request, outcome, "");
 }
 
 }  // namespace
@@ -101,6 +114,8 @@ void AddDetectCommand(CLI::App& app) {
         ->check(CLI::ExistingFile);
     command->add_flag("--skip-bad", flags->skip_bad,
                       "skip unreadable scans (listed in skipped.txt) instead of stopping");
+    command->add_flag("--overwrite", flags->overwrite,
+                      "write into a non-empty folder that holds no earlier lidarloop run");
     command->add_flag("--quiet", flags->quiet, "no progress bar");
     command->callback([flags] { RunDetect(*flags); });
 }
