@@ -120,8 +120,11 @@ std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,
 
 /// Offline detection without the similarity matrix: exactly DetectFromMatrix on
 /// ComputeSimilarityMatrix(database) (distances rounded to float as the matrix holds them), a
-/// query at a time, in parallel unless told otherwise. Memory: the results plus one row of n
-/// floats per thread, instead of the matrix's 2 n^2 bytes; the same n(n-1)/2 comparisons.
+/// query at a time, in parallel unless told otherwise. Candidates come from the method's exact
+/// index where it has one (histograms: a few more than asked, re-ranked by the float distance;
+/// when a float tie at the last place could hide another scan, from comparing them all), else
+/// from comparing every eligible scan (NDT). Memory: the results, the index and one row of n
+/// floats per thread, instead of the matrix's 2 n^2 bytes.
 std::vector<LoopQuery> DetectStreaming(const DescriptorDatabase& database,
                                        const DetectorConfig& detector,
                                        Execution execution = Execution::kParallel);

@@ -274,6 +274,21 @@ TEST(DetectStreaming, EqualsDetectFromMatrixExactly) {
     }
 }
 
+// Many scans with equal descriptors: ties at the k-th place, where the index's answer is not
+// enough and the search compares every eligible scan instead.
+TEST(DetectStreaming, EqualsDetectFromMatrixWithManyTies) {
+    const auto patterns = test::ClusteredHistograms(10, 30, 5, 11);
+    DescriptorDatabase database(HeightConfig(30));
+    for (std::size_t i = 0; i < 200; ++i)
+        database.Add(test::HistogramDescriptor(patterns[i % patterns.size()]),
+                     0.1 * static_cast<double>(i));
+    DetectorConfig detector = Deciding(DetectorConfig{}, 0.01);
+    detector.min_gap = {5.0, core::MinGap::Unit::kScans};
+    ExpectIdenticalQueries(DetectStreaming(database, detector),
+                           DetectFromMatrix(ComputeSimilarityMatrix(database), database.times_s(),
+                                            detector, core::Method::kHeight));
+}
+
 TEST(DetectStreaming, EqualsDetectFromMatrixForNdt) {
     core::DescriptorConfig config;
     config.method = core::Method::kNdt;
