@@ -11,6 +11,7 @@
 #include "lidarloop/core/descriptor.hpp"
 #include "lidarloop/core/error.hpp"
 #include "progress.hpp"
+#include "run_output.hpp"
 
 namespace lidarloop::cli {
 namespace {
@@ -22,6 +23,7 @@ struct DetectFlags {
     std::string out;
     std::string map;  // a database.lldb to localise against (query-only mode)
     bool skip_bad = false;
+    bool overwrite = false;
     bool quiet = false;
 };
 
@@ -51,12 +53,16 @@ void PrintOutcome(const io::Dataset& dataset, const app::DetectRequest& request,
               << outcome.threshold << ", " << outcome.accepted << " scans with an accepted "
               << (map.empty() ? "loop" : "match");
     if (!outcome.skipped.empty()) std::cout << ", " << outcome.skipped.size() << " skipped";
+    const bool matrix = request.config.output.KeepsSimilarityMatrix(dataset.size());
     std::cout << "\n  results in " << request.out.string() << "/ "
-              << (map.empty() ? "(loops.csv, candidates.csv, similarity.png, "
-                                "similarity_distance.png, similarity.bin, database.lldb, "
-                                "config.yaml, timings.json)\n"
-                              : "(loops.csv: query scan, map scan; candidates.csv, config.yaml, "
-                                "timings.json)\n");
+              << (!map.empty() ? "(loops.csv: query scan, map scan; candidates.csv, config.yaml, "
+                                 "timings.json)\n"
+                  : matrix     ? "(loops.csv, candidates.csv, similarity.png, "
+                                 "similarity_distance.png, similarity.bin, database.lldb, "
+                                 "config.yaml, timings.json)\n"
+                               : "(loops.csv, candidates.csv, database.lldb, config.yaml, "
+                                 "timings.json; no similarity matrix: it would exceed "
+                                 "output.similarity_matrix_mib)\n");
 }
 
 void RunDetect(const DetectFlags& flags) {
@@ -69,14 +75,25 @@ void RunDetect(const DetectFlags& flags) {
         app::LoadedMap map = app::LoadMap(flags.map);
         request.config = ResolveAgainstMap(flags, map);
         const io::Dataset dataset = flags.dataset.Open();
-        PrintOutcome(dataset, request, app::RunLocalise(dataset, std::move(map), request),
-                     flags.map);
+        const app::DetectOutcome outcome = RunInFolder(
+            flags.out, dataset.root(), flags.overwrite, [&](const std::filesystem::path& staging) {
+                app::DetectRequest staged = request;
+                staged.out = staging;
+                return app::RunLocalise(dataset, std::move(map), staged);
+            });
+        PrintOutcome(dataset, request, outcome, flags.map);
         return;
     }
     request.config = flags.descriptor.Resolve();
     flags.detection.ApplyTo(request.config);
     const io::Dataset dataset = flags.dataset.Open();
-    PrintOutcome(dataset, request, app::RunDetect(dataset, request), "");
+    const app::DetectOutcome outcome = RunInFolder(flags.out, dataset.root(), flags.overwrite,
+                                                   [&](const std::filesystem::path& staging) {
+                                                       app::DetectRequest staged = request;
+                                                       staged.out = staging;
+                                                       return app::RunDetect(dataset, staged);
+                                                   });
+    PrintOutcome(dataset, request, outcome, "");
 }
 
 }  // namespace
@@ -97,6 +114,8 @@ void AddDetectCommand(CLI::App& app) {
         ->check(CLI::ExistingFile);
     command->add_flag("--skip-bad", flags->skip_bad,
                       "skip unreadable scans (listed in skipped.txt) instead of stopping");
+    command->add_flag("--overwrite", flags->overwrite,
+                      "write into a non-empty folder that holds no earlier lidarloop run");
     command->add_flag("--quiet", flags->quiet, "no progress bar");
     command->callback([flags] { RunDetect(*flags); });
 }

@@ -14,6 +14,7 @@
 #include "lidarloop/pipeline/descriptor_method.hpp"
 #include "progress.hpp"
 #include "retrieval_print.hpp"
+#include "run_output.hpp"
 
 namespace lidarloop::cli {
 namespace {
@@ -33,6 +34,7 @@ struct EvaluateFlags {
     std::string train_poses;
     std::string out;
     bool skip_bad = false;
+    bool overwrite = false;
     bool quiet = false;
 };
 
@@ -119,8 +121,12 @@ void RunEvaluate(const EvaluateFlags& flags) {
     request.progress = progress.Callback();
     const io::Dataset dataset = flags.dataset.Open();
     const std::optional<io::Dataset> train_dataset = TrainingDataset(flags);
-    const app::EvaluationOutcome outcome =
-        app::RunEvaluation(dataset, request, train_dataset ? &*train_dataset : nullptr);
+    const app::EvaluationOutcome outcome = RunInFolder(
+        flags.out, dataset.root(), flags.overwrite, [&](const std::filesystem::path& staging) {
+            app::EvaluationRequest staged = request;
+            staged.out = staging;
+            return app::RunEvaluation(dataset, staged, train_dataset ? &*train_dataset : nullptr);
+        });
     PrintOutcome(dataset, outcome, request.out);
 }
 
@@ -171,6 +177,8 @@ void AddEvaluateCommand(CLI::App& app) {
     AddLearningFlags(*command, *flags);
     command->add_option("--out", flags->out, "folder for the results (created)")->required();
     command->add_flag("--skip-bad", flags->skip_bad, "skip unreadable scans instead of stopping");
+    command->add_flag("--overwrite", flags->overwrite,
+                      "write into a non-empty folder that holds no earlier lidarloop run");
     command->add_flag("--quiet", flags->quiet, "no progress bar");
     command->callback([flags] { RunEvaluate(*flags); });
 }

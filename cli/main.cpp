@@ -5,8 +5,10 @@
 
 #include "commands.hpp"
 #include "lidarloop/core/error.hpp"
+#include "run_output.hpp"
 
 int main(int argc, char** argv) {
+    lidarloop::cli::InstallInterruptHandler(argc, argv);  // first: before any other thread
     CLI::App app{"lidarloop: loop closure detection in sequences of 3-D LiDAR scans"};
     app.set_version_flag("--version", std::string("lidarloop ") + LIDARLOOP_VERSION);
     app.require_subcommand(1);

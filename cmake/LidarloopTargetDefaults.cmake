@@ -16,6 +16,14 @@ function(lidarloop_target_defaults target)
             -fno-sanitize-recover=all -fno-omit-frame-pointer -Wno-maybe-uninitialized)
         target_link_options(${target} PUBLIC -fsanitize=address,undefined)
     endif()
+    if(LIDARLOOP_BUILD_FUZZERS)
+        # Coverage for libFuzzer in every target; the fuzzers link libFuzzer itself
+        # (tests/fuzz/CMakeLists.txt). Unlike GCC's, clang's -fsanitize=undefined also
+        # checks float-to-integer casts.
+        target_compile_options(${target} PRIVATE -fsanitize=fuzzer-no-link,address,undefined
+            -fno-sanitize-recover=all -fno-omit-frame-pointer)
+        target_link_options(${target} PUBLIC -fsanitize=address,undefined)
+    endif()
 endfunction()
 
 # lidarloop_add_library(<name> SOURCES ... PUBLIC_DEPS ... PRIVATE_DEPS ...): one folder, one

@@ -236,6 +236,22 @@ section_detect() {
     fi
     if grep -q "^3," "$work/det3/loops.csv"; then fail "a skipped scan got a match"; else pass; fi
     rm "$seq/scan3.bin"
+    # Results folders never lie: a clean run into det3 leaves no stale skipped.txt, a failed run
+    # no results, and run.json says how each ended.
+    expect_ok "detect into the same folder" "7 scans" "$cli" detect "$seq" --min-gap 2 --quiet \
+        --no-verify --out "$work/det3"
+    if [ -e "$work/det3/skipped.txt" ]; then fail "a stale skipped.txt survived"; else pass; fi
+    if grep -q '"status": "complete"' "$work/det3/run.json"; then pass; else
+        fail "run.json does not say complete"
+    fi
+    expect_error "detect failing into a results folder" "detection.top_k" "$cli" detect "$seq" \
+        --top-k 0 --quiet --out "$work/det3"
+    mkdir -p "$work/foreign" && touch "$work/foreign/thesis.tex"
+    expect_error "detect into a folder of other files" "holds no lidarloop run.json" "$cli" \
+        detect "$seq" --quiet --out "$work/foreign"
+    expect_error "detect into the dataset" "lies inside the dataset" "$cli" detect "$seq" \
+        --quiet --out "$seq/results"
+    if [ -e "$seq/results" ]; then fail "a results folder was made inside the dataset"; else pass; fi
     expect_error "detect seconds without times" "needs scan times" "$cli" detect "$seq" \
         --min-gap 1 --min-gap-unit seconds --quiet --out "$work/det4"
     expect_error "detect bad top-k" "detection.top_k must be in" "$cli" detect "$seq" --top-k 0 \

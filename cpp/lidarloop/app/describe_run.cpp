@@ -16,6 +16,7 @@ pipeline::ScanSource SourceOf(const io::Dataset& dataset) {
     source.time_s = [&dataset](std::size_t i) {
         return dataset.HasPoses() ? dataset.poses()[i].time_s : static_cast<double>(i);
     };
+    source.name = [&dataset](std::size_t i) { return dataset.ScanPath(i).string(); };
     return source;
 }
 

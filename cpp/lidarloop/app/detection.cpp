@@ -1,5 +1,7 @@
 #include "lidarloop/app/detection.hpp"
 
+#include <optional>
+
 #include "lidarloop/app/describe_run.hpp"
 #include "lidarloop/app/results_folder.hpp"
 #include "lidarloop/app/verification_run.hpp"
@@ -22,16 +24,20 @@ void RequireTimesForSeconds(const io::RunConfig& config, const io::Dataset& data
     }
 }
 
+// `matrix` is null when the sequence was detected without one (output.similarity_matrix_mib).
 void WriteDetectResults(const std::filesystem::path& out_dir, const io::RunConfig& config,
                         const pipeline::SequenceDescriptors& described,
-                        const pipeline::SimilarityMatrix& matrix, const DetectOutcome& outcome,
+                        const pipeline::SimilarityMatrix* matrix, const DetectOutcome& outcome,
                         const PreparedScans& prepared) {
     const core::Method method = config.descriptor.method;
     WriteLoopsCsv(out_dir / "loops.csv", outcome.queries);
     WriteCandidatesCsv(out_dir / "candidates.csv", outcome.queries);
-    io::WriteSimilarityMatrix(out_dir / "similarity.bin", matrix, method);
-    io::WritePng(out_dir / "similarity.png", io::ThresholdImage(matrix, method, outcome.threshold));
-    io::WritePng(out_dir / "similarity_distance.png", io::DistanceImage(matrix));
+    if (matrix != nullptr) {
+        io::WriteSimilarityMatrix(out_dir / "similarity.bin", *matrix, method);
+        io::WritePng(out_dir / "similarity.png",
+                     io::ThresholdImage(*matrix, method, outcome.threshold));
+        io::WritePng(out_dir / "similarity_distance.png", io::DistanceImage(*matrix));
+    }
     WriteSkipped(out_dir, described.skipped);
     io::SaveDatabase(out_dir / "database.lldb", described.database, config.detection);
     if (config.detection.verify) {
@@ -87,13 +93,19 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
         DescribeDataset(dataset, config.descriptor, run);
     const double describe_s = describe_clock.Seconds();
 
+    // All pairs either way; the matrix only when it fits the budget (same results without).
     Stopwatch matrix_clock;
-    const pipeline::SimilarityMatrix matrix = pipeline::ComputeSimilarityMatrix(described.database);
-    const double matrix_s = matrix_clock.Seconds();
+    std::optional<pipeline::SimilarityMatrix> matrix;
     DetectOutcome outcome;
     outcome.threshold = threshold;
-    outcome.queries = pipeline::DetectFromMatrix(matrix, described.database.times_s(),
-                                                 config.detection, config.descriptor.method);
+    if (config.output.KeepsSimilarityMatrix(dataset.size())) {
+        matrix = pipeline::ComputeSimilarityMatrix(described.database);
+        outcome.queries = pipeline::DetectFromMatrix(*matrix, described.database.times_s(),
+                                                     config.detection, config.descriptor.method);
+    } else {
+        outcome.queries = pipeline::DetectStreaming(described.database, config.detection);
+    }
+    const double matrix_s = matrix_clock.Seconds();
     Stopwatch verify_clock;
     pipeline::VerificationTimes verification_times;
     if (verify) {
@@ -103,9 +115,11 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     const double verify_s = verify_clock.Seconds();
     outcome.accepted = CountAccepted(outcome.queries);
     outcome.skipped = described.skipped;
-    WriteDetectResults(out_dir, config, described, matrix, outcome, prepared);
+    WriteDetectResults(out_dir, config, described, matrix ? &*matrix : nullptr, outcome, prepared);
 
-    nlohmann::json timings = TimingsJson(described, matrix.condensed().size(), matrix_s);
+    const std::size_t n = dataset.size();
+    nlohmann::json timings = TimingsJson(described, n > 1 ? n * (n - 1) / 2 : 0, matrix_s);
+    timings["similarity_matrix_kept"] = matrix.has_value();
     timings["describe_total_s"] = describe_s;
     if (verify) {
         timings["verification"] = VerificationTimingsJson(prepared, verification_times);

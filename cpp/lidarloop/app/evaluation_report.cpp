@@ -308,6 +308,8 @@ void WriteCurveCsvs(const std::filesystem::path& folder,
             }
         }
     }
+    roc.close();  // flushes: a full disk fails here, not silently in the destructor
+    pr.close();
     if (!roc) throw io::WriteError(folder / "roc.csv", "writing failed");
     if (!pr) throw io::WriteError(folder / "pr.csv", "writing failed");
 }
@@ -351,6 +353,7 @@ void WriteReport(const std::filesystem::path& folder, const ReportContext& conte
     WriteRetrievalTable(out, evaluations);
     WriteFigureGallery(out, evaluations);
     for (const std::string& note : notes) out << "Note: " << note << "\n\n";
+    out.close();
     if (!out) throw io::WriteError(folder / "report.md", "writing failed");
 }
 

@@ -34,6 +34,7 @@ nlohmann::json SummaryJson(const std::vector<double>& values, double scale) {
 void WriteJson(const std::filesystem::path& file, const nlohmann::json& json) {
     std::ofstream out(file);
     out << json.dump(2) << "\n";
+    out.close();  // flushes: a full disk fails here, not silently in the destructor
     if (!out) throw io::WriteError(file, "writing failed");
 }
 
@@ -41,6 +42,7 @@ void WriteSkipped(const std::filesystem::path& folder, const std::vector<std::st
     if (skipped.empty()) return;
     std::ofstream out(folder / "skipped.txt");
     for (const std::string& line : skipped) out << line << "\n";
+    out.close();
     if (!out) throw io::WriteError(folder / "skipped.txt", "writing failed");
 }
 
@@ -99,6 +101,7 @@ void WriteLoopsCsv(const std::filesystem::path& file,
         }
         out << '\n';
     }
+    out.close();
     if (!out) throw io::WriteError(file, "writing failed");
 }
 
@@ -120,6 +123,7 @@ void WriteCandidatesCsv(const std::filesystem::path& file,
             out << '\n';
         }
     }
+    out.close();
     if (!out) throw io::WriteError(file, "writing failed");
 }
 

@@ -195,6 +195,12 @@ void VisitFields(posegraph::PoseGraphConfig& c, Visitor& v) {
 }
 
 template <typename Visitor>
+void VisitFields(OutputConfig& c, Visitor& v) {
+    v.Field("similarity_matrix_mib", c.similarity_matrix_mib,
+            "detect keeps the similarity matrix (similarity.bin, images) up to this size; 0 never");
+}
+
+template <typename Visitor>
 void VisitFields(RunConfig& c, Visitor& v) {
     v.Field("method", c.descriptor.method, MethodHelp());
     v.Section("histogram", c.descriptor.histogram);
@@ -202,6 +208,7 @@ void VisitFields(RunConfig& c, Visitor& v) {
     v.Section("detection", c.detection);
     v.Section("verification", c.detection.verification);
     v.Section("posegraph", c.posegraph);
+    v.Section("output", c.output);
 }
 
 std::string EnumName(const core::Method& m) { return core::ToString(m); }
@@ -351,7 +358,8 @@ public:
     }
     void RejectUnknownKeys() const {
         for (const auto& entry : node_) {
-            const auto key = entry.first.as<std::string>();
+            if (!entry.first.IsScalar()) FailKeyNotAName(entry.first);
+            const std::string& key = entry.first.Scalar();
             if (known_.count(key) != 0) continue;
             std::string valid;
             for (const auto& k : known_) valid += (valid.empty() ? "" : ", ") + k;
@@ -362,6 +370,15 @@ public:
 private:
     [[noreturn]] void Fail(const std::string& key, const std::string& problem) const {
         throw ReadError(source_, "key '" + prefix_ + key + "': " + problem);
+    }
+    // A key that is a list, a map or empty (`[a]: 1`, `{x: 1}: 2`, `? :`) names no setting.
+    [[noreturn]] void FailKeyNotAName(const YAML::Node& key) const {
+        const char* kind = key.IsSequence() ? "a list" : key.IsMap() ? "a map" : "empty";
+        const std::string where =
+            prefix_.empty() ? "at the top level"
+                            : "in section '" + prefix_.substr(0, prefix_.size() - 1) + "'";
+        throw ReadError(source_, "line " + std::to_string(key.Mark().line + 1) + ": a key " +
+                                     where + " is " + kind + ", not a name");
     }
 
     YAML::Node node_;
@@ -393,19 +410,22 @@ std::string DumpConfigYaml(const RunConfig& config) {
 void ApplyConfigYaml(const std::string& yaml_text, const std::string& source, RunConfig& config,
                      LegacyKeys legacy) {
     YAML::Node root;
+    RunConfig updated = config;
     try {
         root = YAML::Load(yaml_text);
+        if (!root || root.IsNull()) return;  // an empty file overrides nothing
+        if (!root.IsMap()) throw ReadError(source, "expected a map of keys at the top level");
+        std::map<std::string, double> moved;
+        YamlReader reader(root, source, "", legacy, &moved);
+        VisitFields(updated, reader);
+        reader.RejectUnknownKeys();
+        MigrateThreshold(moved, updated);
     } catch (const YAML::ParserException& e) {
         throw ReadError(source, "line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
+    } catch (const YAML::Exception& e) {
+        // The reader checks every node it converts; this is the net for what it does not foresee.
+        throw ReadError(source, std::string("unreadable YAML: ") + e.what());
     }
-    if (!root || root.IsNull()) return;  // an empty file overrides nothing
-    if (!root.IsMap()) throw ReadError(source, "expected a map of keys at the top level");
-    RunConfig updated = config;
-    std::map<std::string, double> moved;
-    YamlReader reader(root, source, "", legacy, &moved);
-    VisitFields(updated, reader);
-    reader.RejectUnknownKeys();
-    MigrateThreshold(moved, updated);
     try {
         updated.Validate();
     } catch (const core::ConfigError& e) {
@@ -424,6 +444,7 @@ RunConfig LoadConfigYaml(const std::filesystem::path& file, RunConfig base) {
 void WriteConfigYaml(const std::filesystem::path& file, const RunConfig& config) {
     auto out = detail::OpenForWriting(file, /*binary=*/false);
     out << DumpConfigYaml(config);
+    out.close();  // flushes: a full disk fails here, not silently in the destructor
     if (!out) throw WriteError(file, "write failed");
 }
 

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstddef>
 #include <filesystem>
 #include <string>
 
@@ -9,12 +10,30 @@
 
 namespace lidarloop::io {
 
+/// What a run writes besides its results.
+struct OutputConfig {
+    /// detect keeps the full similarity matrix, and writes similarity.bin and the similarity
+    /// images from it, when its n(n-1)/2 floats take at most this many MiB (1024: up to 23,170
+    /// scans); a longer sequence is detected a query at a time, with the same results, in memory
+    /// linear in the scans. 0: never keep it.
+    std::size_t similarity_matrix_mib = 1024;
+
+    /// True when the matrix of `scans` scans fits similarity_matrix_mib.
+    bool KeepsSimilarityMatrix(std::size_t scans) const {
+        const double bytes =
+            0.5 * static_cast<double>(scans) * (static_cast<double>(scans) - 1) * sizeof(float);
+        return bytes <= static_cast<double>(similarity_matrix_mib) * 1024.0 * 1024.0;
+    }
+    bool operator==(const OutputConfig&) const = default;
+};
+
 /// Every setting of a lidarloop run. The defaults live in the C++ config structs it holds; YAML
 /// files and command-line flags override only the keys they name.
 struct RunConfig {
     core::DescriptorConfig descriptor;   ///< keys `method`, `histogram.*`, `ndt.*` at the top level
     pipeline::DetectorConfig detection;  ///< keys `detection.*`
     posegraph::PoseGraphConfig posegraph;  ///< keys `posegraph.*` (lidarloop optimise)
+    OutputConfig output;                 ///< keys `output.*`
 
     void Validate() const {
         descriptor.Validate();

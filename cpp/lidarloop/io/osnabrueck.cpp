@@ -42,6 +42,7 @@
 
 #include <Eigen/Geometry>
 
+#include "lidarloop/io/detail/binary_io.hpp"
 #include "lidarloop/io/detail/rotation_check.hpp"
 #include "lidarloop/io/detail/text_parsing.hpp"
 #include "lidarloop/io/read_error.hpp"
@@ -140,7 +141,10 @@ core::PointCloud ReadOsnabrueck3d(const std::filesystem::path& file) {
         if (is_header) continue;
         double p[3];
         reader.ParseXyz(fields, p);
-        cloud.push_back(FromOsnabrueckCoordinates({p[0], p[1], p[2]}).cast<float>());
+        // ToFloat: a plain narrowing is undefined beyond the float range (1e41 cm in a file).
+        const Eigen::Vector3d point_m = FromOsnabrueckCoordinates({p[0], p[1], p[2]});
+        cloud.emplace_back(detail::ToFloat(point_m.x()), detail::ToFloat(point_m.y()),
+                           detail::ToFloat(point_m.z()));
     }
     return cloud;
 }

@@ -1,7 +1,12 @@
 #include "lidarloop/io/similarity_file.hpp"
 
+#include <algorithm>
+#include <fstream>
+#include <vector>
+
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/io/detail/byte_stream.hpp"
+#include "lidarloop/io/detail/text_parsing.hpp"
 #include "lidarloop/pipeline/descriptor_method.hpp"
 
 namespace lidarloop::io {
@@ -11,12 +16,26 @@ constexpr char kMagic[] = "LLSIM001";
 
 void WriteSimilarityMatrix(const std::filesystem::path& file,
                            const pipeline::SimilarityMatrix& matrix, core::Method method) {
-    detail::ByteWriter out;
-    out.PutMagic(kMagic);
-    out.PutString(core::ToString(method));
-    out.Put<std::uint64_t>(matrix.size());
-    out.PutArray(matrix.condensed().data(), matrix.condensed().size());
-    detail::WriteWholeFile(file, out.data());
+    detail::ByteWriter header;
+    header.PutMagic(kMagic);
+    header.PutString(core::ToString(method));
+    header.Put<std::uint64_t>(matrix.size());
+    // The distances in blocks, not assembled in memory: they can be gigabytes.
+    std::ofstream out = detail::OpenForWriting(file, /*binary=*/true);
+    out.write(header.data().data(), static_cast<std::streamsize>(header.data().size()));
+    constexpr std::size_t kBlock = std::size_t{1} << 18;  // distances, 1 MiB
+    std::vector<char> bytes(kBlock * sizeof(float));
+    const std::vector<float>& values = matrix.condensed();
+    for (std::size_t begin = 0; begin < values.size() && out; begin += kBlock) {
+        const std::size_t count = std::min(kBlock, values.size() - begin);
+        for (std::size_t k = 0; k < count; ++k)
+            detail::StoreLittle(values[begin + k], bytes.data() + k * sizeof(float));
+        out.write(bytes.data(), static_cast<std::streamsize>(count * sizeof(float)));
+    }
+    out.close();
+    if (!out) {
+        throw WriteError(file, "writing " + std::to_string(values.size()) + " distances failed");
+    }
 }
 
 StoredSimilarity ReadSimilarityMatrix(const std::filesystem::path& file) {

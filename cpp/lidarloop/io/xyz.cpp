@@ -3,6 +3,7 @@
 #include <string>
 #include <string_view>
 
+#include "lidarloop/io/detail/binary_io.hpp"
 #include "lidarloop/io/detail/text_parsing.hpp"
 #include "lidarloop/io/read_error.hpp"
 
@@ -31,8 +32,9 @@ core::PointCloud ReadXyz(const std::filesystem::path& file) {
         if (is_count_line) continue;
         double xyz[3];
         reader.ParseXyz(fields, xyz);
-        cloud.emplace_back(static_cast<float>(xyz[0]), static_cast<float>(xyz[1]),
-                           static_cast<float>(xyz[2]));
+        // ToFloat: a plain narrowing is undefined beyond the float range (1e39 in a text file).
+        cloud.emplace_back(detail::ToFloat(xyz[0]), detail::ToFloat(xyz[1]),
+                           detail::ToFloat(xyz[2]));
     }
     return cloud;
 }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include "lidarloop/core/error.hpp"
@@ -33,6 +34,61 @@ void Finish(LoopQuery& result, const core::MinGap& gap, const std::vector<double
     if (!second.empty()) result.second_ratio = SecondRatio(best.distance, second.front().distance);
 }
 
+// Validates an offline detection and returns its threshold.
+double CheckOfflineDetection(const DetectorConfig& detector, const core::Method& method,
+                             const std::vector<double>& times_s, std::size_t scans) {
+    detector.Validate();
+    const double threshold = detector.ThresholdFor(method);
+    MethodOf(method).ValidateThreshold(threshold);
+    if (times_s.size() != scans) {
+        throw core::ConfigError("offline detection: " + std::to_string(times_s.size()) +
+                                " times for " + std::to_string(scans) + " scans");
+    }
+    return threshold;
+}
+
+using Filter = std::function<bool(std::size_t)>;
+// The `count` best scans `filter` admits, by (distance, index), with the distances the matrix
+// holds (rounded to float).
+using CandidateSearch = std::function<std::vector<Neighbor>(std::size_t count, const Filter&)>;
+
+// Scan i's candidates among the scans j < i outside the gap, as LoopDetector::Process gives them
+// online.
+LoopQuery DetectOne(std::size_t i, const CandidateSearch& search,
+                    const std::vector<double>& times_s, const DetectorConfig& detector,
+                    const DescriptorMethod& method, double threshold) {
+    const auto eligible = [&](std::size_t j) {
+        return j < i && detector.min_gap.Allows(i, j, times_s[i], times_s[j]);
+    };
+    LoopQuery result;
+    result.query = i;
+    result.candidates = search(static_cast<std::size_t>(detector.top_k), eligible);
+    Finish(result, detector.min_gap, times_s, method, threshold, [&](const Filter& other_place) {
+        return search(1, [&](std::size_t j) { return eligible(j) && other_place(j); });
+    });
+    return result;
+}
+
+// Extra neighbours asked of the index, so that float ties at the k-th place can be seen.
+constexpr std::size_t kIndexMargin = 4;
+
+// The first `count` of `found` (the index's answer to `asked` neighbours, by double distance)
+// by (float-rounded distance, index), as the matrix ranks them; nullopt when a scan the index
+// did not return could tie in float with the last of them.
+std::optional<std::vector<Neighbor>> RankedAsTheMatrix(std::vector<Neighbor> found,
+                                                       std::size_t count, std::size_t asked) {
+    for (Neighbor& n : found) n.distance = double{static_cast<float>(n.distance)};
+    if (found.size() == asked && count > 0 && count < asked &&
+        !(found[count - 1].distance < found.back().distance)) {
+        return std::nullopt;
+    }
+    std::stable_sort(found.begin(), found.end(), [](const Neighbor& a, const Neighbor& b) {
+        return a.distance < b.distance || (a.distance == b.distance && a.index < b.index);
+    });
+    if (found.size() > count) found.resize(count);
+    return found;
+}
+
 }  // namespace
 
 void DetectorConfig::Validate() const {
@@ -59,22 +115,28 @@ std::optional<std::size_t> LoopQuery::loop() const {
 std::vector<Neighbor> NearestCandidates(std::size_t count, std::size_t k,
                                         const std::function<double(std::size_t)>& distance_of,
                                         const std::function<bool(std::size_t)>& eligible) {
-    std::vector<Neighbor> all;
-    for (std::size_t j = 0; j < count; ++j) {
-        if (!eligible || eligible(j)) all.push_back({j, distance_of(j)});
-    }
     const auto before = [](const Neighbor& a, const Neighbor& b) {
         return a.distance < b.distance || (a.distance == b.distance && a.index < b.index);
     };
-    const std::size_t keep = std::min(k, all.size());
-    std::partial_sort(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(keep), all.end(),
-                      before);
-    all.resize(keep);
-    // A missing scan (+inf) is never a candidate.
-    while (!all.empty() && !(all.back().distance < std::numeric_limits<double>::infinity())) {
-        all.pop_back();
+    // A bounded max-heap of the k best so far (the worst on top): O(k) memory, not O(count).
+    std::vector<Neighbor> best;
+    best.reserve(std::min(k, count));
+    for (std::size_t j = 0; j < count && k > 0; ++j) {
+        if (eligible && !eligible(j)) continue;
+        const Neighbor candidate{j, distance_of(j)};
+        // A missing scan (+inf) is never a candidate (NaN neither).
+        if (!(candidate.distance < std::numeric_limits<double>::infinity())) continue;
+        if (best.size() < k) {
+            best.push_back(candidate);
+            std::push_heap(best.begin(), best.end(), before);
+        } else if (before(candidate, best.front())) {
+            std::pop_heap(best.begin(), best.end(), before);
+            best.back() = candidate;
+            std::push_heap(best.begin(), best.end(), before);
+        }
     }
-    return all;
+    std::sort_heap(best.begin(), best.end(), before);
+    return best;
 }
 
 LoopDetector::LoopDetector(const core::DescriptorConfig& descriptor, const DetectorConfig& detector)
@@ -196,29 +258,64 @@ std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,
                                         const std::vector<double>& times_s,
                                         const DetectorConfig& detector,
                                         const core::Method& method) {
-    detector.Validate();
-    const double threshold = detector.ThresholdFor(method);
-    MethodOf(method).ValidateThreshold(threshold);
-    if (times_s.size() != matrix.size()) {
-        throw core::ConfigError("DetectFromMatrix: " + std::to_string(times_s.size()) +
-                                " times for " + std::to_string(matrix.size()) + " scans");
-    }
-    const auto k = static_cast<std::size_t>(detector.top_k);
+    const double threshold = CheckOfflineDetection(detector, method, times_s, matrix.size());
     std::vector<LoopQuery> results(matrix.size());
     for (std::size_t i = 0; i < matrix.size(); ++i) {
         const auto distance_of = [&](std::size_t j) { return double{matrix.at(i, j)}; };
-        const auto eligible = [&](std::size_t j) {
-            return j < i && detector.min_gap.Allows(i, j, times_s[i], times_s[j]);
-        };
-        LoopQuery& result = results[i];
-        result.query = i;
-        result.candidates = NearestCandidates(i, k, distance_of, eligible);
-        Finish(result, detector.min_gap, times_s, MethodOf(method), threshold,
-               [&](const std::function<bool(std::size_t)>& other_place) {
-                   return NearestCandidates(i, 1, distance_of, [&](std::size_t j) {
-                       return eligible(j) && other_place(j);
-                   });
-               });
+        results[i] = DetectOne(
+            i,
+            [&](std::size_t count, const Filter& filter) {
+                return NearestCandidates(i, count, distance_of, filter);
+            },
+            times_s, detector, MethodOf(method), threshold);
+    }
+    return results;
+}
+
+std::vector<LoopQuery> DetectStreaming(const DescriptorDatabase& database,
+                                       const DetectorConfig& detector, Execution execution) {
+    const std::vector<double>& times_s = database.times_s();
+    const std::size_t n = database.size();
+    const double threshold = CheckOfflineDetection(detector, database.method(), times_s, n);
+    // The method's exact index (histograms), over the valid scans; candidates are filtered to
+    // j < i, so one index over all scans serves every query.
+    std::unique_ptr<NeighborIndex> index = database.store().MakeIndex();
+    if (index) index->InsertAll([&](std::size_t j) { return database.IsValid(j); });
+    std::vector<LoopQuery> results(n);
+    const auto detect_rows = [&](const tbb::blocked_range<std::size_t>& rows) {
+        std::vector<float> row;  // the query's distances to the earlier scans, as the matrix holds
+        for (std::size_t i = rows.begin(); i < rows.end(); ++i) {
+            const std::unique_ptr<PreparedQuery> query =
+                index && database.IsValid(i) ? database.PrepareStored(i) : nullptr;
+            bool row_filled = false;
+            const auto fill_row = [&] {
+                row.resize(i);
+                for (std::size_t j = 0; j < i; ++j) {
+                    // Distance(j, i) with j < i, rounded to float: the matrix's entry (j, i).
+                    if (detector.min_gap.Allows(i, j, times_s[i], times_s[j]))
+                        row[j] = static_cast<float>(database.Distance(j, i));
+                }
+                row_filled = true;
+            };
+            const CandidateSearch search = [&](std::size_t count, const Filter& filter) {
+                if (query) {
+                    const std::size_t asked = count + kIndexMargin;
+                    if (auto ranked =
+                            RankedAsTheMatrix(index->Search(*query, asked, filter), count, asked))
+                        return *ranked;
+                }
+                if (!row_filled) fill_row();
+                return NearestCandidates(
+                    i, count, [&](std::size_t j) { return double{row[j]}; }, filter);
+            };
+            results[i] = DetectOne(i, search, times_s, detector, database.definition(), threshold);
+        }
+    };
+    const tbb::blocked_range<std::size_t> all(0, n);
+    if (execution == Execution::kSerial) {
+        detect_rows(all);
+    } else {
+        tbb::parallel_for(all, detect_rows);
     }
     return results;
 }

@@ -64,7 +64,8 @@ struct LoopQuery {
 };
 
 /// The k nearest of the scans 0..count-1 for which `eligible(j)` holds, by (distance, index),
-/// with `distance_of(j)`: the brute-force search both detectors share.
+/// with `distance_of(j)` (called for eligible scans only; +inf and NaN are never candidates):
+/// the brute-force search both detectors share. O(k) memory (a bounded heap).
 std::vector<Neighbor> NearestCandidates(std::size_t count, std::size_t k,
                                         const std::function<double(std::size_t)>& distance_of,
                                         const std::function<bool(std::size_t)>& eligible);
@@ -142,5 +143,16 @@ std::vector<LoopQuery> LocaliseSequence(
 std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,
                                         const std::vector<double>& times_s,
                                         const DetectorConfig& detector, const core::Method& method);
+
+/// Offline detection without the similarity matrix: exactly DetectFromMatrix on
+/// ComputeSimilarityMatrix(database) (distances rounded to float as the matrix holds them), a
+/// query at a time, in parallel unless told otherwise. Candidates come from the method's exact
+/// index where it has one (histograms: a few more than asked, re-ranked by the float distance;
+/// when a float tie at the last place could hide another scan, from comparing them all), else
+/// from comparing every eligible scan (NDT). Memory: the results, the index and one row of n
+/// floats per thread, instead of the matrix's 2 n^2 bytes.
+std::vector<LoopQuery> DetectStreaming(const DescriptorDatabase& database,
+                                       const DetectorConfig& detector,
+                                       Execution execution = Execution::kParallel);
 
 }  // namespace lidarloop::pipeline

@@ -25,6 +25,17 @@ struct ScanResult {
     double describe_seconds = 0.0;
 };
 
+core::Descriptor DescribeNamed(const ScanSource& source, std::size_t i,
+                               const core::PointCloud& cloud,
+                               const core::DescriptorConfig& config) {
+    try {
+        return ComputeDescriptor(cloud, config);
+    } catch (const core::EmptyInputError& e) {
+        if (!source.name) throw;
+        throw core::EmptyInputError(source.name(i) + ": " + e.what());
+    }
+}
+
 ScanResult DescribeOne(const ScanSource& source, const core::DescriptorConfig& config,
                        std::size_t i, const DescribeOptions& options) {
     const bool skip_bad = options.skip_bad;
@@ -34,7 +45,7 @@ ScanResult DescribeOne(const ScanSource& source, const core::DescriptorConfig& c
         const core::PointCloud cloud = source.load(i);
         result.load_seconds = SecondsSince(load_start);
         const auto describe_start = Clock::now();
-        result.descriptor = ComputeDescriptor(cloud, config);
+        result.descriptor = DescribeNamed(source, i, cloud, config);
         result.describe_seconds = SecondsSince(describe_start);
         if (options.with_cloud) options.with_cloud(i, cloud);
     } catch (const core::ConfigError&) {

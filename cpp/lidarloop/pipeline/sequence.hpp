@@ -19,6 +19,9 @@ struct ScanSource {
     std::size_t count = 0;
     std::function<core::PointCloud(std::size_t)> load;
     std::function<double(std::size_t)> time_s;  ///< recording time of scan i, seconds
+    /// Names scan i (its file) in the message of a scan that loads but has nothing usable in it
+    /// (an empty file); optional. `load`'s own errors name what they read.
+    std::function<std::string(std::size_t)> name;
 };
 
 struct DescribeOptions {

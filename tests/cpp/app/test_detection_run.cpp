@@ -10,6 +10,7 @@
 #include "lidarloop/app/describe_run.hpp"
 #include "lidarloop/app/detection.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/io/kitti_bin.hpp"
 #include "lidarloop/io/results_csv.hpp"
 #include "test_utils.hpp"
 
@@ -67,6 +68,38 @@ TEST_F(DetectionRun, EqualsThePipelineOnTheSameDescriptors) {
             EXPECT_TRUE(std::filesystem::exists(request.out / file)) << file;
         }
         EXPECT_FALSE(std::filesystem::exists(request.out / "skipped.txt"));
+    }
+}
+
+// Past the memory budget of the similarity matrix, detect finds the same loops without it and
+// writes neither similarity.bin nor the images.
+TEST_F(DetectionRun, WithoutTheMatrixGivesTheSameResults) {
+    for (core::Method method : {core::Method::kRange, core::Method::kNdt}) {
+        app::DetectRequest with = Request("with_" + core::ToString(method), method);
+        with.config.detection.verify = false;
+        app::DetectRequest without = with;
+        without.out = dir_ / ("without_" + core::ToString(method));
+        without.config.output.similarity_matrix_mib = 0;
+        const app::DetectOutcome a = app::RunDetect(*dataset_, with);
+        const app::DetectOutcome b = app::RunDetect(*dataset_, without);
+        ASSERT_EQ(a.queries.size(), b.queries.size());
+        for (std::size_t i = 0; i < a.queries.size(); ++i) {
+            ASSERT_EQ(a.queries[i].candidates.size(), b.queries[i].candidates.size()) << i;
+            for (std::size_t r = 0; r < a.queries[i].candidates.size(); ++r) {
+                EXPECT_EQ(a.queries[i].candidates[r].index, b.queries[i].candidates[r].index);
+                EXPECT_EQ(a.queries[i].candidates[r].distance, b.queries[i].candidates[r].distance);
+            }
+            EXPECT_EQ(a.queries[i].accepted, b.queries[i].accepted) << i;
+        }
+        EXPECT_EQ(a.accepted, b.accepted);
+        EXPECT_EQ(test::ReadFile(with.out / "loops.csv"),
+                  test::ReadFile(without.out / "loops.csv"));
+        EXPECT_EQ(test::ReadFile(with.out / "candidates.csv"),
+                  test::ReadFile(without.out / "candidates.csv"));
+        for (const char* file : {"similarity.bin", "similarity.png", "similarity_distance.png"}) {
+            EXPECT_TRUE(std::filesystem::exists(with.out / file)) << file;
+            EXPECT_FALSE(std::filesystem::exists(without.out / file)) << file;
+        }
     }
 }
 
@@ -140,6 +173,25 @@ TEST_F(DetectionRun, VerifiesEveryCandidateAsRegisteringThePairAlone) {
         for (const auto& q : outcome.queries) rows += q.candidates.size();
         return rows;
     }());
+}
+
+// A scan file emptied to zero bytes reads as a scan without points; the skip message names the
+// file, as it does for a file that cannot be read.
+TEST(DescribeDataset, AnEmptiedScanFileIsNamedInTheSkipMessage) {
+    test::TempDir dir;
+    for (int i = 0; i < 4; ++i) {
+        const auto file = dir / ("scan" + std::to_string(i) + ".bin");
+        io::WriteKittiBin(file, test::RandomCloud(200, static_cast<unsigned>(i)));
+    }
+    std::filesystem::resize_file(dir / "scan2.bin", 0);
+    const io::Dataset dataset = io::OpenDataset(dir.path());
+    app::DescribeRun run;
+    run.skip_bad = true;
+    const auto described = app::DescribeDataset(dataset, core::DescriptorConfig{}, run);
+    ASSERT_EQ(described.skipped.size(), 1U);
+    EXPECT_NE(described.skipped[0].find("scan 2: " + (dir / "scan2.bin").string() + ": "),
+              std::string::npos)
+        << described.skipped[0];
 }
 
 TEST_F(DetectionRun, ReportsProgressOfEveryScanAndEndsTheStage) {

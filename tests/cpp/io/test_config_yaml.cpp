@@ -90,6 +90,22 @@ TEST(ConfigYaml, BadInputNamesFileKeyAndProblem) {
     expect_error("detection:\n  min_gap: -3\n", "detection.min_gap must be");
 }
 
+// Keys that are no plain name were found by fuzzing: yaml-cpp's conversion of such a key to a
+// string threw its own exception, which escaped as an internal error.
+TEST(ConfigYaml, AKeyThatIsNoNameIsAReadError) {
+    const auto expect_error = [](const std::string& yaml, const std::string& phrase) {
+        const std::string message = ErrorOf(yaml);
+        EXPECT_NE(message.find("my.yaml"), std::string::npos) << yaml << ": " << message;
+        EXPECT_NE(message.find(phrase), std::string::npos) << yaml << ": " << message;
+    };
+    expect_error("? :\n", "line 1: a key at the top level is");
+    expect_error("~: 1\n", "line 1: a key at the top level is empty, not a name");
+    expect_error("[a]: 1\n", "line 1: a key at the top level is a list, not a name");
+    expect_error("histogram:\n  {x: 1}: 2\n",
+                 "line 2: a key in section 'histogram' is a map, not a name");
+    expect_error("verification:\n  icp:\n    [1, 2]: 3\n", "in section 'verification.icp'");
+}
+
 TEST(ConfigYaml, NdtSectionWithListsAndBooleans) {
     RunConfig config;
     ApplyConfigYaml("method: ndt\nndt:\n  range_limits_m: [2, 4.5]\n  regrid_rotations: true\n",

@@ -1,5 +1,6 @@
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <sstream>
@@ -104,6 +105,18 @@ TEST(Osnabrueck, EmptyScanGivesEmptyCloud) {
     EXPECT_TRUE(ReadOsnabrueck3d(dir / "scan.3d").empty());
     test::WriteFile(dir / "header.3d", "1024 x 768\n");
     EXPECT_TRUE(ReadOsnabrueck3d(dir / "header.3d").empty());
+}
+
+// Centimetres beyond the float range in metres: rounded as IEEE does, never a plain narrowing
+// (undefined behaviour there).
+TEST(Osnabrueck, CoordinatesBeyondTheFloatRangeBecomeInfinite) {
+    test::TempDir dir;
+    test::WriteFile(dir / "scan.3d", "1e41 1 -1e300\n");
+    const core::PointCloud cloud = ReadOsnabrueck3d(dir / "scan.3d");
+    ASSERT_EQ(cloud.size(), 1U);
+    EXPECT_EQ(cloud[0].x(), -std::numeric_limits<float>::infinity());  // x = z_3dtk / 100
+    EXPECT_EQ(cloud[0].y(), -std::numeric_limits<float>::infinity());  // y = -x_3dtk / 100
+    EXPECT_EQ(cloud[0].z(), 0.01f);                                    // z = y_3dtk / 100
 }
 
 TEST(Osnabrueck, BadScanLinesNameTheLine) {

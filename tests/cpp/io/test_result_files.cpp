@@ -13,6 +13,7 @@
 #include "lidarloop/io/png.hpp"
 #include "lidarloop/io/results_csv.hpp"
 #include "lidarloop/io/similarity_file.hpp"
+#include "lidarloop/io/similarity_image.hpp"
 #include "lidarloop/pipeline/loop_detector.hpp"
 #include "lidarloop/pipeline/ndt_method.hpp"
 #include "test_utils.hpp"
@@ -111,6 +112,13 @@ TEST(DatabaseFile, BadFilesAreClearErrors) {
     config.replace(at, 8, "binz: 24");
     test::WriteFile(dir / "config.bin", config);
     test::ExpectReadError(LoadDatabase, dir / "config.bin", "key 'histogram.binz': unknown key");
+    // An embedded config with a key that is no name (found by fuzzing).
+    std::string keyed = good;
+    const auto key_at = keyed.find("  bins: 24");
+    ASSERT_NE(key_at, std::string::npos);
+    keyed.replace(key_at, 10, "  {b: 1}: ");
+    test::WriteFile(dir / "key.bin", keyed);
+    test::ExpectReadError(LoadDatabase, dir / "key.bin", "is a map, not a name");
     test::WriteFile(dir / "long.bin", good + "\x01");
     test::ExpectReadError(LoadDatabase, dir / "long.bin", "trailing bytes");
 }
@@ -197,6 +205,56 @@ TEST(Png, BadImagesAndPathsAreErrors) {
     EXPECT_THROW(WritePng(dir / "a.png", Image{0, 0, 1, {}}), core::ConfigError);
     EXPECT_THROW(WritePng(dir / "a.png", Image{1, 1, 2, {1, 2}}), core::ConfigError);
     EXPECT_THROW(WritePng(dir / "no" / "such" / "a.png", Image{1, 1, 1, {0}}), WriteError);
+}
+
+// A matrix of n scans: pair (i, j) at distance 0.001 * (i + j), pair (1, 8) at 0, scan 5
+// missing (+inf).
+pipeline::SimilarityMatrix TestMatrix(std::size_t n) {
+    pipeline::SimilarityMatrix matrix(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        for (std::size_t j = i + 1; j < n; ++j) {
+            matrix.set(i, j,
+                       i == 5 || j == 5 ? std::numeric_limits<float>::infinity()
+                                        : 0.001f * static_cast<float>(i + j));
+        }
+    }
+    if (n > 8) matrix.set(1, 8, 0.0f);
+    return matrix;
+}
+
+TEST(SimilarityImage, OnePixelPerPairUpToTheLimit) {
+    const pipeline::SimilarityMatrix matrix = TestMatrix(12);
+    const Image image = ThresholdImage(matrix, core::Method::kHeight, 0.005);
+    ASSERT_EQ(image.width, 12);
+    ASSERT_EQ(image.height, 12);
+    for (std::size_t i = 0; i < 12; ++i) {
+        for (std::size_t j = 0; j < 12; ++j) {
+            const bool match = matrix.at(i, j) <= 0.005f;
+            EXPECT_EQ(image.pixels[i * 12 + j], match ? 0 : 255) << i << " " << j;
+        }
+    }
+    const Image grey = DistanceImage(matrix);
+    EXPECT_EQ(grey.pixels[1 * 12 + 8], 0);
+    EXPECT_EQ(grey.pixels[5 * 12 + 2], 255);  // missing
+}
+
+TEST(SimilarityImage, ABigMatrixIsDrawnInBlocksKeepingEveryMatch) {
+    const pipeline::SimilarityMatrix matrix = TestMatrix(12);
+    // 12 scans in at most 5 pixels: 3 scans a pixel, 4 x 4 pixels.
+    const Image image = ThresholdImage(matrix, core::Method::kHeight, 0.0, 5);
+    ASSERT_EQ(image.width, 4);
+    ASSERT_EQ(image.height, 4);
+    for (std::size_t r = 0; r < 4; ++r) {
+        for (std::size_t c = 0; c < 4; ++c) {
+            // Only the diagonal (distance 0 to itself) and the block of pair (1, 8) match.
+            const bool match = r == c || (r == 0 && c == 2) || (r == 2 && c == 0);
+            EXPECT_EQ(image.pixels[r * 4 + c], match ? 0 : 255) << r << " " << c;
+        }
+    }
+    const Image grey = DistanceImage(matrix, 5);
+    EXPECT_EQ(grey.width, 4);
+    EXPECT_EQ(grey.pixels[0 * 4 + 2], 0);
+    EXPECT_GT(grey.pixels[3 * 4 + 1], 0);  // smallest of scans 9..11 x 3..5: 0.012, grey
 }
 
 TEST(ResultsCsv, ReadsColumnsByNameAndKeepsEmptyFields) {

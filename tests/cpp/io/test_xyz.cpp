@@ -82,6 +82,18 @@ TEST(Xyz, KeepsNanAndInf) {
     EXPECT_EQ(again[1], cloud[1]);
 }
 
+// Beyond the float range a plain double -> float narrowing is undefined behaviour; the reader
+// rounds as IEEE does: to infinity, or down to FLT_MAX within half an ulp above it.
+TEST(Xyz, NumbersBeyondTheFloatRangeBecomeInfinite) {
+    test::TempDir dir;
+    test::WriteFile(dir / "a.xyz", "1e39 -1e300 3.4028235e38\n");
+    const core::PointCloud cloud = ReadXyz(dir / "a.xyz");
+    ASSERT_EQ(cloud.size(), 1U);
+    EXPECT_EQ(cloud[0].x(), std::numeric_limits<float>::infinity());
+    EXPECT_EQ(cloud[0].y(), -std::numeric_limits<float>::infinity());
+    EXPECT_EQ(cloud[0].z(), std::numeric_limits<float>::max());
+}
+
 TEST(Xyz, EmptyOrCommentOnlyFileGivesEmptyCloud) {
     test::TempDir dir;
     test::WriteFile(dir / "empty.xyz", "");

@@ -201,6 +201,109 @@ TEST(LoopDetector, NdtUsesTheSameRules) {
     EXPECT_EQ(results[4].candidates.front().distance, 0.0);
 }
 
+// The bounded heap against sorting every eligible scan, with ties, missing (+inf) scans and k
+// from 0 to beyond the count.
+TEST(NearestCandidates, EqualsSortingEveryEligibleScan) {
+    std::mt19937 rng(7);
+    std::uniform_int_distribution<int> level(0, 6);  // few levels: many ties
+    for (std::size_t count : {0U, 1U, 5U, 40U}) {
+        std::vector<double> distances(count);
+        for (double& d : distances) {
+            const int l = level(rng);
+            d = l == 6 ? HUGE_VAL : 0.1 * l;
+        }
+        const auto eligible = [](std::size_t j) { return j % 7 != 3; };
+        std::vector<Neighbor> all;
+        for (std::size_t j = 0; j < count; ++j) {
+            if (eligible(j) && distances[j] < HUGE_VAL) all.push_back({j, distances[j]});
+        }
+        std::stable_sort(all.begin(), all.end(), [](const Neighbor& a, const Neighbor& b) {
+            return a.distance < b.distance;
+        });
+        for (std::size_t k = 0; k <= count + 2; ++k) {
+            const auto got = NearestCandidates(
+                count, k, [&](std::size_t j) { return distances[j]; }, eligible);
+            ASSERT_EQ(got.size(), std::min(k, all.size())) << count << " " << k;
+            for (std::size_t r = 0; r < got.size(); ++r) {
+                EXPECT_EQ(got[r].index, all[r].index) << count << " " << k << " " << r;
+                EXPECT_EQ(got[r].distance, all[r].distance);
+            }
+        }
+    }
+}
+
+void ExpectIdenticalQueries(const std::vector<LoopQuery>& a, const std::vector<LoopQuery>& b) {
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        ASSERT_EQ(a[i].query, b[i].query);
+        ASSERT_EQ(a[i].candidates.size(), b[i].candidates.size()) << i;
+        for (std::size_t r = 0; r < a[i].candidates.size(); ++r) {
+            EXPECT_EQ(a[i].candidates[r].index, b[i].candidates[r].index) << i;
+            EXPECT_EQ(a[i].candidates[r].distance, b[i].candidates[r].distance) << i;
+        }
+        EXPECT_EQ(a[i].accepted, b[i].accepted) << i;
+        EXPECT_TRUE(a[i].second_ratio == b[i].second_ratio ||
+                    (std::isnan(a[i].second_ratio) && std::isnan(b[i].second_ratio)))
+            << i;
+    }
+}
+
+// Detection without the matrix gives exactly what detection from the matrix gives: the same
+// float-rounded distances, candidates, second ratios and decisions.
+TEST(DetectStreaming, EqualsDetectFromMatrixExactly) {
+    const auto histograms = test::ClusteredHistograms(300, 40, 20, 3);
+    DescriptorDatabase database(HeightConfig(40));
+    for (std::size_t i = 0; i < histograms.size(); ++i) {
+        const double time_s = 0.1 * static_cast<double>(i) + (i % 3 == 0 ? 0.05 : 0.0);
+        if (i % 50 == 7) {
+            database.AddMissing(time_s);
+        } else {
+            database.Add(test::HistogramDescriptor(histograms[i]), time_s);
+        }
+    }
+    const SimilarityMatrix matrix = ComputeSimilarityMatrix(database);
+    for (const core::MinGap gap : {core::MinGap{30.0, core::MinGap::Unit::kScans},
+                                   core::MinGap{2.5, core::MinGap::Unit::kSeconds},
+                                   core::MinGap{0.0, core::MinGap::Unit::kScans}}) {
+        DetectorConfig detector = Deciding(DetectorConfig{}, 0.01);
+        detector.min_gap = gap;
+        detector.top_k = 4;
+        const auto expected =
+            DetectFromMatrix(matrix, database.times_s(), detector, core::Method::kHeight);
+        ExpectIdenticalQueries(DetectStreaming(database, detector), expected);
+        ExpectIdenticalQueries(DetectStreaming(database, detector, Execution::kSerial), expected);
+    }
+}
+
+// Many scans with equal descriptors: ties at the k-th place, where the index's answer is not
+// enough and the search compares every eligible scan instead.
+TEST(DetectStreaming, EqualsDetectFromMatrixWithManyTies) {
+    const auto patterns = test::ClusteredHistograms(10, 30, 5, 11);
+    DescriptorDatabase database(HeightConfig(30));
+    for (std::size_t i = 0; i < 200; ++i)
+        database.Add(test::HistogramDescriptor(patterns[i % patterns.size()]),
+                     0.1 * static_cast<double>(i));
+    DetectorConfig detector = Deciding(DetectorConfig{}, 0.01);
+    detector.min_gap = {5.0, core::MinGap::Unit::kScans};
+    ExpectIdenticalQueries(DetectStreaming(database, detector),
+                           DetectFromMatrix(ComputeSimilarityMatrix(database), database.times_s(),
+                                            detector, core::Method::kHeight));
+}
+
+TEST(DetectStreaming, EqualsDetectFromMatrixForNdt) {
+    core::DescriptorConfig config;
+    config.method = core::Method::kNdt;
+    DescriptorDatabase database(config);
+    for (unsigned i = 0; i < 12; ++i) {
+        database.Add(ComputeDescriptor(test::RandomCloud(2000, i % 4, 3.0f), config), i);
+    }
+    DetectorConfig detector;
+    detector.min_gap = {2.0, core::MinGap::Unit::kScans};
+    ExpectIdenticalQueries(DetectStreaming(database, detector),
+                           DetectFromMatrix(ComputeSimilarityMatrix(database), database.times_s(),
+                                            detector, core::Method::kNdt));
+}
+
 TEST(LoopDetector, RejectsBadConfigAndMixedMethods) {
     DetectorConfig detector;
     detector.top_k = 0;

@@ -1,0 +1,65 @@
+#include "run_output.hpp"
+
+#include <pthread.h>
+#include <signal.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <mutex>
+#include <thread>
+
+namespace lidarloop::cli {
+namespace {
+
+std::string command_line;
+std::mutex active_mutex;
+app::RunFolder* active = nullptr;  // guarded by active_mutex
+
+sigset_t InterruptSignals() {
+    sigset_t signals;
+    sigemptyset(&signals);
+    sigaddset(&signals, SIGINT);
+    sigaddset(&signals, SIGTERM);
+    return signals;
+}
+
+[[noreturn]] void WatchInterrupts(sigset_t signals) {
+    int signal = 0;
+    while (sigwait(&signals, &signal) != 0) {
+    }
+    const std::lock_guard<std::mutex> lock(active_mutex);  // held until the process ends
+    if (active != nullptr) {
+        active->Abandon(app::RunStatus::kInterrupted,
+                        "interrupted by signal " + std::to_string(signal));
+        std::fprintf(stderr, "\nlidarloop: interrupted; %s/run.json says so, no result was kept\n",
+                     active->folder().c_str());
+    } else {
+        std::fprintf(stderr, "\nlidarloop: interrupted\n");
+    }
+    std::_Exit(128 + signal);
+}
+
+}  // namespace
+
+void InstallInterruptHandler(int argc, char** argv) {
+    for (int a = 0; a < argc; ++a) command_line += (a > 0 ? " " : "") + std::string(argv[a]);
+    const sigset_t signals = InterruptSignals();
+    // Blocked here, before any thread starts, so every later thread (oneTBB's workers) inherits
+    // the mask and only the watcher receives them.
+    pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+    std::thread(WatchInterrupts, signals).detach();
+}
+
+const std::string& CommandLine() { return command_line; }
+
+InterruptScope::InterruptScope(app::RunFolder& folder) {
+    const std::lock_guard<std::mutex> lock(active_mutex);
+    active = &folder;
+}
+
+InterruptScope::~InterruptScope() {
+    const std::lock_guard<std::mutex> lock(active_mutex);
+    active = nullptr;
+}
+
+}  // namespace lidarloop::cli
