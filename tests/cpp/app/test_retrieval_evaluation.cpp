@@ -1,0 +1,117 @@
+// evaluate's ranked-candidate figures recounted by hand from detect's verified candidates and the
+// poses: the same candidates, verdicts and ground truth must give the same numbers.
+#include <cmath>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "app_test_utils.hpp"
+#include "lidarloop/app/detection.hpp"
+#include "lidarloop/app/evaluation.hpp"
+#include "test_utils.hpp"
+
+namespace lidarloop {
+namespace {
+
+constexpr double kDistanceM = 10.0;
+constexpr std::size_t kGapScans = 10;
+
+struct Recount {
+    std::size_t revisiting = 0, hits_at_1 = 0, hits_at_k = 0;
+    std::size_t true_loops = 0, false_loops = 0, wrong_pose = 0;
+};
+
+bool SamePlace(const io::Dataset& dataset, std::size_t a, std::size_t b) {
+    const auto& poses = dataset.poses();
+    return (poses[a].T_world_sensor.translation() - poses[b].T_world_sensor.translation()).norm() <
+           kDistanceM;
+}
+
+// Brute force over the poses: a scan revisits when an earlier scan more than the gap back is
+// within the distance; a loop is the first accepted candidate.
+Recount RecountFrom(const io::Dataset& dataset, const std::vector<pipeline::LoopQuery>& queries,
+                    bool verified) {
+    Recount r;
+    for (std::size_t i = 0; i < dataset.size(); ++i) {
+        for (std::size_t j = 0; j + kGapScans < i; ++j) {
+            if (SamePlace(dataset, i, j)) {
+                ++r.revisiting;
+                break;
+            }
+        }
+    }
+    for (const pipeline::LoopQuery& q : queries) {
+        if (!q.has_match()) continue;
+        r.hits_at_1 += SamePlace(dataset, q.query, q.candidates.front().index) ? 1 : 0;
+        bool hit = false;
+        for (const auto& c : q.candidates) hit = hit || SamePlace(dataset, q.query, c.index);
+        r.hits_at_k += hit ? 1 : 0;
+        const std::optional<std::size_t> loop = q.loop();
+        if (!loop) continue;
+        const std::size_t match = q.candidates[*loop].index;
+        (SamePlace(dataset, q.query, match) ? r.true_loops : r.false_loops)++;
+        if (!verified) continue;
+        const core::Transform truth = dataset.poses()[match].T_world_sensor.inverse() *
+                                      dataset.poses()[q.query].T_world_sensor;
+        const core::Transform error = truth.inverse() * q.verifications[*loop].T_match_query;
+        const bool wrong = error.translation().norm() > 1.0 ||
+                           Eigen::AngleAxisd(error.linear()).angle() * 180.0 / M_PI > 2.0;
+        r.wrong_pose += wrong ? 1 : 0;
+    }
+    return r;
+}
+
+void ExpectSame(const Recount& r, const eval::LoopRetrievalEvaluation& e, std::size_t scans) {
+    EXPECT_EQ(e.revisiting, r.revisiting);
+    EXPECT_EQ(e.hits_at_1, r.hits_at_1);
+    EXPECT_EQ(e.hits_at_k, r.hits_at_k);
+    EXPECT_EQ(e.true_loops, r.true_loops);
+    EXPECT_EQ(e.false_loops, r.false_loops);
+    EXPECT_DOUBLE_EQ(e.recall,
+                     static_cast<double>(r.true_loops) / static_cast<double>(r.revisiting));
+    EXPECT_EQ(e.scans, scans);
+}
+
+TEST(RetrievalEvaluation, EvaluateRecountsFromDetectsCandidates) {
+    const test::TempDir dir;
+    const io::Dataset dataset = test::SmallSequence(dir / "sequence");
+    io::RunConfig config;
+    config.descriptor.method = core::Method::kRange;
+    config.detection.min_gap.value = static_cast<double>(kGapScans);
+    config.detection.top_k = 4;
+
+    app::EvaluationRequest request;
+    request.methods = {core::Method::kRange};
+    request.config = config;
+    request.distance_m = kDistanceM;
+    request.out = dir / "evaluation";
+    const app::EvaluationOutcome evaluated = app::RunEvaluation(dataset, request);
+    ASSERT_EQ(evaluated.methods.size(), 1U);
+    ASSERT_TRUE(evaluated.methods[0].retrieval.has_value());
+    const app::RetrievalComparison& r = *evaluated.methods[0].retrieval;
+    ASSERT_TRUE(r.verified.has_value());
+
+    app::DetectRequest detect{config, false, {}, dir / "detection"};
+    const app::DetectOutcome detected = app::RunDetect(dataset, detect);
+    const Recount verified = RecountFrom(dataset, detected.queries, true);
+    ExpectSame(verified, *r.verified, dataset.size());
+    EXPECT_EQ(r.verified->wrong_pose_loops, verified.wrong_pose);
+    EXPECT_GT(verified.true_loops, 10U);  // the sequence revisits: the test has something to count
+
+    config.detection.verify = false;
+    detect.config = config;
+    detect.out = dir / "descriptor";
+    const app::DetectOutcome descriptor = app::RunDetect(dataset, detect);
+    ExpectSame(RecountFrom(dataset, descriptor.queries, false), r.descriptor, dataset.size());
+
+    std::ifstream file(dir / "evaluation" / "metrics.json");
+    const nlohmann::json metrics = nlohmann::json::parse(file)["methods"]["range"]["retrieval"];
+    EXPECT_EQ(metrics["k"], 4);
+    EXPECT_EQ(metrics["verified"]["true_loops"], verified.true_loops);
+    EXPECT_EQ(metrics["verified"]["wrong_pose_loops"], verified.wrong_pose);
+    EXPECT_EQ(metrics["descriptor"]["revisiting_scans"], verified.revisiting);
+}
+
+}  // namespace
+}  // namespace lidarloop
