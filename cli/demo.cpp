@@ -77,7 +77,7 @@ void RunDemo(const DemoFlags& flags) {
     PrintSequence(demo, dataset.size());
     app::EvaluationRequest request;
     request.methods = {core::Method::kHeight, core::Method::kRange, core::Method::kNdt};
-    request.distance_m = 10.0;            // Röhling's d
+    request.distance_m = 10.0;  // Röhling's d
     request.progress = progress.Callback();
     request.out = out / "evaluation";
     const app::EvaluationOutcome outcome = app::RunEvaluation(dataset, request);

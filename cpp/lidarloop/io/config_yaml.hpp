@@ -33,7 +33,7 @@ struct RunConfig {
     core::DescriptorConfig descriptor;   ///< keys `method`, `histogram.*`, `ndt.*` at the top level
     pipeline::DetectorConfig detection;  ///< keys `detection.*`
     posegraph::PoseGraphConfig posegraph;  ///< keys `posegraph.*` (lidarloop optimise)
-    OutputConfig output;                 ///< keys `output.*`
+    OutputConfig output;                   ///< keys `output.*`
 
     void Validate() const {
         descriptor.Validate();
