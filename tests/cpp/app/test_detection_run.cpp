@@ -31,6 +31,9 @@ protected:
         app::DetectRequest request;
         request.config.descriptor.method = method;
         request.config.detection.min_gap.value = 10;
+        // Two candidates per scan: every test verifies its detections, and registration is
+        // the slow part under the sanitizers.
+        request.config.detection.top_k = 2;
         request.out = dir_ / out;
         return request;
     }
@@ -104,9 +107,11 @@ TEST_F(DetectionRun, WithoutTheMatrixGivesTheSameResults) {
 }
 
 TEST_F(DetectionRun, LocalisingTheSequenceAgainstItsOwnMapFindsEveryScanItself) {
-    const app::DetectRequest detect = Request("detect", core::Method::kRange);
+    app::DetectRequest detect = Request("detect", core::Method::kRange);
+    detect.config.detection.top_k = 1;
     app::RunDetect(*dataset_, detect);
     app::DetectRequest localise = Request("localise", core::Method::kRange);
+    localise.config.detection.top_k = 1;  // itself, verified at the identity
     const app::DetectOutcome outcome =
         app::RunLocalise(*dataset_, app::LoadMap(detect.out / "database.lldb"), localise);
     EXPECT_EQ(outcome.map_scans, dataset_->size());
@@ -121,8 +126,10 @@ TEST_F(DetectionRun, LocalisingTheSequenceAgainstItsOwnMapFindsEveryScanItself) 
 TEST_F(DetectionRun, LocalisationTakesTheMapsThresholdUnlessGivenOne) {
     app::DetectRequest detect = Request("detect", core::Method::kRange);
     detect.config.detection.threshold = 0.002;
+    detect.config.detection.verify = false;  // thresholds only
     app::RunDetect(*dataset_, detect);
     app::DetectRequest localise = Request("localise", core::Method::kRange);
+    localise.config.detection.verify = false;
     const auto map = [&] { return app::LoadMap(detect.out / "database.lldb"); };
     EXPECT_EQ(app::RunLocalise(*dataset_, map(), localise).threshold, 0.002);
     localise.config.detection.threshold = 0.003;
@@ -134,7 +141,8 @@ TEST_F(DetectionRun, LocalisationTakesTheMapsThresholdUnlessGivenOne) {
 }
 
 TEST_F(DetectionRun, AMapDescribedOtherwiseIsAClearError) {
-    const app::DetectRequest detect = Request("detect", core::Method::kRange);
+    app::DetectRequest detect = Request("detect", core::Method::kRange);
+    detect.config.detection.verify = false;  // the descriptor check comes first
     app::RunDetect(*dataset_, detect);
     app::DetectRequest localise = Request("localise", core::Method::kRange);
     localise.config.descriptor.histogram.bins = 50;
@@ -196,6 +204,7 @@ TEST(DescribeDataset, AnEmptiedScanFileIsNamedInTheSkipMessage) {
 
 TEST_F(DetectionRun, ReportsProgressOfEveryScanAndEndsTheStage) {
     app::DetectRequest request = Request("detect", core::Method::kHeight);
+    request.config.detection.top_k = 1;
     std::mutex mutex;
     std::set<std::size_t> seen;
     std::set<std::string> stages;

@@ -36,6 +36,7 @@ TEST(DemoSequence, LoopsFoundAtAThresholdLearntOnAnotherSeed) {
     const io::Dataset test = SimulateDemo(1, dir / "seed1");
     app::EvaluationRequest request;
     request.methods = {core::Method::kHeight, core::Method::kNdt};
+    request.config.detection.verify = false;  // learnt thresholds of the descriptors
     request.out = dir / "evaluation";  // Röhling's rule: same place within 10 m, gap 30 scans
     const app::EvaluationOutcome outcome = app::RunEvaluation(test, request, &train);
     ASSERT_EQ(outcome.methods.size(), 2U);
