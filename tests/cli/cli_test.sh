@@ -307,9 +307,9 @@ section_evaluate() {
         return
     fi
     demo_seq="$work/demo/sequence"
-    expect_ok "detect on demo" "320 scans (kitti)" "$cli" detect "$demo_seq" --quiet \
+    expect_ok "detect on demo" "320 scans (kitti)" "$cli" detect "$demo_seq" --top-k 2 --quiet \
         --out "$work/demo_det"
-    expect_ok "evaluate results csv" "results:loops" "$cli" evaluate "$demo_seq" --method height \
+    expect_ok "evaluate results csv" "results:loops" "$cli" evaluate "$demo_seq" --no-verify --method height \
         --results "$work/demo_det/loops.csv" --distance 5 --quiet --out "$work/demo_eval"
     # loops.csv lists one candidate per scan; the pairs it omits are never detected, so no
     # threshold is +inf (null in metrics.json) and no curve reaches +inf.
@@ -319,13 +319,13 @@ section_evaluate() {
     fi
     # Two pairs at one distance: too few for the EM fit, which is left out, not an error.
     printf 'query,match,distance\n100,10,0\n200,20,0\n' >"$work/sparse.csv"
-    expect_ok "evaluate sparse results" "results:sparse" "$cli" evaluate "$demo_seq" \
+    expect_ok "evaluate sparse results" "results:sparse" "$cli" evaluate "$demo_seq" --no-verify \
         --method height --results "$work/sparse.csv" --quiet --out "$work/demo_sparse"
     if grep -q '"em": null' "$work/demo_sparse/metrics.json"; then pass; else
         fail "evaluate sparse results: metrics.json lacks \"em\": null"
     fi
     # Trained on the test sequence itself, the learnt tau is exactly the best-MCC tau.
-    expect_ok "evaluate --train-on" "report:" "$cli" evaluate "$demo_seq" --method height \
+    expect_ok "evaluate --train-on" "report:" "$cli" evaluate "$demo_seq" --no-verify --method height \
         --train-on "$demo_seq" --quiet --out "$work/demo_train"
     json_number() {
         grep -o "\"$1\": [-0-9.e]*" "$work/demo_train/metrics.json" | head -1 | cut -d' ' -f2
@@ -341,12 +341,12 @@ section_evaluate() {
         fail "metrics.json does not say where the threshold was learnt"
     fi
     expect_error "evaluate --train-on without poses" "has no poses; threshold learning needs" \
-        "$cli" evaluate "$demo_seq" --method height --train-on "$seq" --quiet \
+        "$cli" evaluate "$demo_seq" --no-verify --method height --train-on "$seq" --quiet \
         --out "$work/demo_train2"
     expect_error "evaluate --train-poses alone" "--train-poses needs --train-on" "$cli" evaluate \
         "$demo_seq" --method height --train-poses "$demo_seq/poses.txt" --quiet \
         --out "$work/demo_train3"
-    expect_ok "evaluate fixed thresholds" "report:" "$cli" evaluate "$demo_seq" --method range \
+    expect_ok "evaluate fixed thresholds" "report:" "$cli" evaluate "$demo_seq" --no-verify --method range \
         --fixed-thresholds 0.003,0.005,0.007 --quiet --out "$work/demo_fixed"
     if grep -q "L_0.003 | L_0.005 | L_0.007" "$work/demo_fixed/report.md"; then pass; else
         fail "report.md lacks the fixed-threshold table"
@@ -356,22 +356,22 @@ section_evaluate() {
     fi
     expect_error "evaluate without poses" "has no poses" "$cli" evaluate "$seq" --quiet \
         --out "$work/e1"
-    expect_error "evaluate bad method" "--method" "$cli" evaluate "$demo_seq" --method sift \
+    expect_error "evaluate bad method" "--method" "$cli" evaluate "$demo_seq" --no-verify --method sift \
         --out "$work/e2"
-    expect_error "evaluate bad distance" "ground_truth.distance_m" "$cli" evaluate "$demo_seq" \
+    expect_error "evaluate bad distance" "ground_truth.distance_m" "$cli" evaluate "$demo_seq" --no-verify \
         --distance 0 --quiet --out "$work/e3"
     # --min/--max belong to the one histogram method evaluated.
-    expect_ok "evaluate range --max" "report:" "$cli" evaluate "$demo_seq" --method range \
+    expect_ok "evaluate range --max" "report:" "$cli" evaluate "$demo_seq" --no-verify --method range \
         --max 50 --quiet --out "$work/demo_max"
     if grep -q "range_max_m: 50" "$work/demo_max/config.yaml" &&
         grep -q "height_max_m: 7" "$work/demo_max/config.yaml"; then pass; else
         fail "evaluate --method range --max 50 did not set range_max_m only"
     fi
     expect_error "evaluate ambiguous --max" "--min and --max set the value range of one" \
-        "$cli" evaluate "$demo_seq" --max 50 --quiet --out "$work/e5"
+        "$cli" evaluate "$demo_seq" --no-verify --max 50 --quiet --out "$work/e5"
     printf 'query,match,distance\n1,999,0.1\n' >"$work/far.csv"
     expect_error "evaluate results beyond" "names a scan beyond the 320" "$cli" evaluate \
-        "$demo_seq" --method height --results "$work/far.csv" --quiet --out "$work/e4"
+        "$demo_seq" --no-verify --method height --results "$work/far.csv" --quiet --out "$work/e4"
 }
 
 # --- dump-config and --config ----------------------------------------------------------------
