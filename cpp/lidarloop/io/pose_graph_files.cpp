@@ -15,25 +15,6 @@ namespace {
 
 constexpr std::size_t kMissing = SIZE_MAX;
 
-// Comma-separated fields, empty ones kept (lidarloop leaves second_ratio and the pose of an
-// unregistered candidate empty); spaces around a field trimmed.
-std::vector<std::string_view> SplitCsv(std::string_view line) {
-    std::vector<std::string_view> fields;
-    const auto trim = [](std::string_view f) {
-        while (!f.empty() && (f.front() == ' ' || f.front() == '\t')) f.remove_prefix(1);
-        while (!f.empty() && (f.back() == ' ' || f.back() == '\t')) f.remove_suffix(1);
-        return f;
-    };
-    std::size_t start = 0;
-    while (true) {
-        const std::size_t comma = line.find(',', start);
-        fields.push_back(trim(line.substr(start, comma - start)));
-        if (comma == std::string_view::npos) break;
-        start = comma + 1;
-    }
-    return fields;
-}
-
 // Column indices of loops.csv; pose = tx ty tz qx qy qz qw.
 struct LoopColumns {
     std::size_t query = kMissing, match = kMissing, accepted = kMissing;
@@ -154,7 +135,7 @@ std::vector<LoopRow> ReadLoopsCsv(const std::filesystem::path& file, std::size_t
     while (reader.Next(line)) {
         detail::RejectControlCharacters(reader, line, "loops.csv");
         if (line.empty() || line.front() == '#') continue;
-        const std::vector<std::string_view> fields = SplitCsv(line);
+        const std::vector<std::string_view> fields = detail::SplitCsv(line);
         if (!header) {
             columns = FindLoopColumns(reader, fields);
             header = true;

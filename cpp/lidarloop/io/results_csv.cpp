@@ -11,27 +11,6 @@
 namespace lidarloop::io {
 namespace {
 
-// Comma-separated fields, empty ones kept (lidarloop writes an empty second_ratio), spaces and
-// a trailing '\r' trimmed.
-std::vector<std::string_view> SplitCsv(std::string_view line) {
-    std::vector<std::string_view> fields;
-    const auto trim = [](std::string_view f) {
-        while (!f.empty() && (f.front() == ' ' || f.front() == '\t')) f.remove_prefix(1);
-        while (!f.empty() && (f.back() == ' ' || f.back() == '\t' || f.back() == '\r')) {
-            f.remove_suffix(1);
-        }
-        return f;
-    };
-    std::size_t start = 0;
-    while (true) {
-        const std::size_t comma = line.find(',', start);
-        fields.push_back(trim(line.substr(start, comma - start)));
-        if (comma == std::string_view::npos) break;
-        start = comma + 1;
-    }
-    return fields;
-}
-
 struct Columns {
     std::size_t query = SIZE_MAX;
     std::size_t match = SIZE_MAX;
@@ -80,12 +59,12 @@ std::vector<ExternalResult> ReadResultsCsv(const std::filesystem::path& file) {
     detail::LineReader reader(file);
     std::string line;
     if (!reader.Next(line)) reader.Fail("empty file; expected a header line");
-    const Columns columns = FindColumns(reader, SplitCsv(line));
+    const Columns columns = FindColumns(reader, detail::SplitCsv(line));
     const std::size_t needed = std::max({columns.query, columns.match, columns.distance}) + 1;
     std::vector<ExternalResult> results;
     while (reader.Next(line)) {
         if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-        const auto fields = SplitCsv(line);
+        const auto fields = detail::SplitCsv(line);
         if (fields.size() < needed) {
             reader.Fail("expected at least " + std::to_string(needed) + " columns, got " +
                         std::to_string(fields.size()));

@@ -29,6 +29,25 @@ std::ofstream OpenForWriting(const std::filesystem::path& file, bool binary) {
     return out;
 }
 
+std::vector<std::string_view> SplitCsv(std::string_view line) {
+    std::vector<std::string_view> fields;
+    const auto trim = [](std::string_view f) {
+        while (!f.empty() && (f.front() == ' ' || f.front() == '\t')) f.remove_prefix(1);
+        while (!f.empty() && (f.back() == ' ' || f.back() == '\t' || f.back() == '\r')) {
+            f.remove_suffix(1);
+        }
+        return f;
+    };
+    std::size_t start = 0;
+    while (true) {
+        const std::size_t comma = line.find(',', start);
+        fields.push_back(trim(line.substr(start, comma - start)));
+        if (comma == std::string_view::npos) break;
+        start = comma + 1;
+    }
+    return fields;
+}
+
 std::vector<std::string_view> SplitFields(std::string_view line) {
     std::vector<std::string_view> fields;
     const auto is_separator = [](char c) {

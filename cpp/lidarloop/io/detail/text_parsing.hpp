@@ -26,6 +26,10 @@ std::ofstream OpenForWriting(const std::filesystem::path& file, bool binary);
 /// Splits `line` into fields separated by spaces, tabs, commas or a trailing '\r'.
 std::vector<std::string_view> SplitFields(std::string_view line);
 
+/// Splits `line` at commas, keeping empty fields (lidarloop leaves second_ratio and the pose of
+/// an unregistered candidate empty); spaces, tabs and a trailing '\r' around a field trimmed.
+std::vector<std::string_view> SplitCsv(std::string_view line);
+
 /// Parses a whole token as a double ("nan", "inf", a leading '+' accepted); nullopt when the token
 /// is not exactly one number.
 std::optional<double> ParseDouble(std::string_view token);
