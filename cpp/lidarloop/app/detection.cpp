@@ -71,6 +71,20 @@ std::vector<registration::PreparedScan> MapScansFor(LoadedMap& map,
     return std::move(map.scans->scans);
 }
 
+// Describes every scan of `dataset`; with verification, also prepares each scan for
+// registration into `prepared` in the same pass (one read per scan).
+pipeline::SequenceDescriptors DescribeAndPrepare(const io::Dataset& dataset,
+                                                 const io::RunConfig& config,
+                                                 const DetectRequest& request,
+                                                 PreparedScans& prepared) {
+    DescribeRun run{
+        "describing", request.skip_bad, pipeline::Execution::kParallel, request.progress, {}};
+    if (config.detection.verify) {
+        run.with_cloud = prepared.Collector(config.detection.verification.reduction);
+    }
+    return DescribeDataset(dataset, config.descriptor, run);
+}
+
 }  // namespace
 
 DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request) {
@@ -86,11 +100,8 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     Stopwatch describe_clock;
     const bool verify = config.detection.verify;
     PreparedScans prepared(verify ? dataset.size() : 0);
-    DescribeRun run{
-        "describing", request.skip_bad, pipeline::Execution::kParallel, request.progress, {}};
-    if (verify) run.with_cloud = prepared.Collector(config.detection.verification.reduction);
     const pipeline::SequenceDescriptors described =
-        DescribeDataset(dataset, config.descriptor, run);
+        DescribeAndPrepare(dataset, config, request, prepared);
     const double describe_s = describe_clock.Seconds();
 
     // All pairs either way; the matrix only when it fits the budget (same results without).
@@ -157,11 +168,8 @@ DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const Detec
 
     const bool verify = config.detection.verify;
     PreparedScans prepared(verify ? dataset.size() : 0);
-    DescribeRun run{
-        "describing", request.skip_bad, pipeline::Execution::kParallel, request.progress, {}};
-    if (verify) run.with_cloud = prepared.Collector(config.detection.verification.reduction);
     const pipeline::SequenceDescriptors described =
-        DescribeDataset(dataset, config.descriptor, run);
+        DescribeAndPrepare(dataset, config, request, prepared);
     Stopwatch query_clock;
     DetectOutcome outcome;
     outcome.queries = pipeline::LocaliseSequence(detector, described.database,
