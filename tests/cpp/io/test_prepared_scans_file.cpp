@@ -1,0 +1,74 @@
+// database.scans: a round trip keeps every point, normal, flag and figure; damaged files are read
+// errors naming the file, never a crash.
+#include <cmath>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "lidarloop/io/prepared_scans_file.hpp"
+#include "lidarloop/io/read_error.hpp"
+#include "registration/registration_test_utils.hpp"
+#include "test_utils.hpp"
+
+namespace lidarloop::io {
+namespace {
+
+std::vector<registration::PreparedScan> TwoScansAndAGap() {
+    const registration::ScanReductionConfig reduction;
+    return {registration::PrepareScan(test::SyntheticPlace(1), reduction),
+            {},
+            registration::PrepareScan(test::SyntheticPlace(2), reduction)};
+}
+
+TEST(PreparedScansFile, RoundTripKeepsEverything) {
+    const test::TempDir dir;
+    const auto scans = TwoScansAndAGap();
+    registration::ScanReductionConfig reduction;
+    reduction.voxel_m = 0.4;
+    SavePreparedScans(dir / "m.scans", scans, reduction);
+    const StoredPreparedScans loaded = LoadPreparedScans(dir / "m.scans");
+    EXPECT_EQ(loaded.reduction, reduction);
+    ASSERT_EQ(loaded.scans.size(), 3U);
+    EXPECT_FALSE(loaded.scans[1].structure);
+    for (const std::size_t i : {0, 2}) {
+        const auto& a = scans[i];
+        const auto& b = loaded.scans[i];
+        ASSERT_TRUE(b.structure && b.ground);
+        EXPECT_EQ(a.structure->points(), b.structure->points());
+        EXPECT_EQ(a.structure->normals(), b.structure->normals());
+        EXPECT_EQ(a.ground->points(), b.ground->points());
+        EXPECT_EQ(a.structure_distinctive, b.structure_distinctive);
+        EXPECT_EQ(a.structure_roughness_m, b.structure_roughness_m);
+        EXPECT_EQ(a.input_points, b.input_points);
+    }
+    EXPECT_EQ(PreparedScansPathOf(dir / "database.lldb"), dir / "database.scans");
+}
+
+TEST(PreparedScansFile, DamagedFilesAreReadErrors) {
+    const test::TempDir dir;
+    SavePreparedScans(dir / "m.scans", TwoScansAndAGap(), {});
+    const std::string bytes = test::ReadFile(dir / "m.scans");
+    const auto error_of = [&](const std::string& content) {
+        test::WriteFile(dir / "bad.scans", content);
+        try {
+            LoadPreparedScans(dir / "bad.scans");
+        } catch (const ReadError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no ReadError");
+    };
+    EXPECT_NE(error_of("").find("bad.scans"), std::string::npos);
+    EXPECT_NE(error_of("LLDB0001" + bytes.substr(8)).find("wrong magic"), std::string::npos);
+    EXPECT_NE(error_of(bytes.substr(0, bytes.size() / 2)).find("truncated"), std::string::npos);
+    EXPECT_NE(error_of(bytes + "x").find("trailing"), std::string::npos);
+    // The last float of the file is a ground normal's z: make it NaN.
+    std::string nan_bytes = bytes;
+    const float nan = std::nanf("");
+    nan_bytes.replace(nan_bytes.size() - sizeof(float), sizeof(float),
+                      reinterpret_cast<const char*>(&nan), sizeof(float));
+    EXPECT_NE(error_of(nan_bytes).find("non-finite"), std::string::npos);
+    EXPECT_THROW(LoadPreparedScans(dir / "missing.scans"), ReadError);
+}
+
+}  // namespace
+}  // namespace lidarloop::io
