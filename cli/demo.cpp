@@ -2,6 +2,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <utility>
 
 #include <CLI/CLI.hpp>
 
@@ -12,6 +13,7 @@
 #include "lidarloop/io/dataset.hpp"
 #include "progress.hpp"
 #include "retrieval_print.hpp"
+#include "run_output.hpp"
 
 namespace lidarloop::cli {
 namespace {
@@ -55,6 +57,13 @@ void PrintMethod(const app::MethodEvaluation& e) {
     if (e.retrieval) PrintRetrieval(*e.retrieval);
 }
 
+// A results folder of the demo (evaluation, optimised) with the guarantees of every results
+// folder; the demo owns its layout, so it replaces what an earlier demo left there.
+template <typename Run>
+auto RunDemoStage(const std::filesystem::path& out, const io::Dataset& dataset, Run&& run) {
+    return RunInFolder(out, dataset.root(), /*overwrite=*/true, std::forward<Run>(run));
+}
+
 // The loops closed: detect with verification, then the pose graph on the simulated odometry.
 void RunDemoOptimisation(const io::Dataset& dataset, const std::filesystem::path& out,
                          ProgressPrinter& progress) {
@@ -62,7 +71,12 @@ void RunDemoOptimisation(const io::Dataset& dataset, const std::filesystem::path
     request.odometry_file = dataset.root() / "poses_odometry.txt";
     request.progress = progress.Callback();
     request.out = out / "optimised";
-    const app::OptimiseOutcome outcome = app::RunOptimisation(dataset, request);
+    const app::OptimiseOutcome outcome =
+        RunDemoStage(request.out, dataset, [&](const auto& staging) {
+            app::OptimiseRequest staged = request;
+            staged.out = staging;
+            return app::RunOptimisation(dataset, staged);
+        });
     std::cout << "loops closed: " << outcome.result.loops_used << " of " << outcome.loops.size()
               << " verified loops in the pose graph; ATE " << Fixed(outcome.odometry->ate_rmse_m, 2)
               << " m (odometry) -> " << Fixed(outcome.optimised->ate_rmse_m, 2)
@@ -80,7 +94,12 @@ void RunDemo(const DemoFlags& flags) {
     request.distance_m = 10.0;  // Röhling's d
     request.progress = progress.Callback();
     request.out = out / "evaluation";
-    const app::EvaluationOutcome outcome = app::RunEvaluation(dataset, request);
+    const app::EvaluationOutcome outcome =
+        RunDemoStage(request.out, dataset, [&](const auto& staging) {
+            app::EvaluationRequest staged = request;
+            staged.out = staging;
+            return app::RunEvaluation(dataset, staged);
+        });
     std::cout << "ground truth: " << outcome.truth.Describe() << "\n";
     for (const app::MethodEvaluation& e : outcome.methods) PrintMethod(e);
     for (const std::string& note : outcome.notes) std::cout << "  note: " << note << "\n";

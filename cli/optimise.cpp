@@ -11,6 +11,7 @@
 #include "detection_options.hpp"
 #include "lidarloop/app/optimisation.hpp"
 #include "progress.hpp"
+#include "run_output.hpp"
 
 namespace lidarloop::cli {
 namespace {
@@ -24,6 +25,7 @@ struct OptimiseFlags {
     std::string out;
     std::string format = "kitti";
     bool skip_bad = false;
+    bool overwrite = false;
     bool quiet = false;
 };
 
@@ -65,7 +67,13 @@ void RunOptimise(const OptimiseFlags& flags) {
     request.progress = progress.Callback();
     request.out = flags.out;
     const io::Dataset dataset = flags.dataset.Open();
-    PrintOutcome(request, app::RunOptimisation(dataset, request));
+    const app::OptimiseOutcome outcome =
+        RunInFolder(flags.out, dataset.root(), flags.overwrite, [&](const auto& staging) {
+            app::OptimiseRequest staged = request;
+            staged.out = staging;
+            return app::RunOptimisation(dataset, staged);
+        });
+    PrintOutcome(request, outcome);
 }
 
 }  // namespace
@@ -91,6 +99,8 @@ void AddOptimiseCommand(CLI::App& app) {
                            "S: candidates at least this far back (default 30 scans)");
     command->add_flag("--skip-bad", flags->skip_bad,
                       "skip unreadable scans when detecting instead of stopping");
+    command->add_flag("--overwrite", flags->overwrite,
+                      "write into a non-empty folder that holds no lidarloop run.json");
     command->add_flag("--quiet", flags->quiet, "no progress bar");
     command->callback([flags] { RunOptimise(*flags); });
 }

@@ -5,15 +5,12 @@
 
 #include <cstdio>
 #include <cstdlib>
-#include <mutex>
 #include <thread>
 
 namespace lidarloop::cli {
 namespace {
 
 std::string command_line;
-std::mutex active_mutex;
-app::RunFolder* active = nullptr;  // guarded by active_mutex
 
 sigset_t InterruptSignals() {
     sigset_t signals;
@@ -27,12 +24,11 @@ sigset_t InterruptSignals() {
     int signal = 0;
     while (sigwait(&signals, &signal) != 0) {
     }
-    const std::lock_guard<std::mutex> lock(active_mutex);  // held until the process ends
-    if (active != nullptr) {
-        active->Abandon(app::RunStatus::kInterrupted,
-                        "interrupted by signal " + std::to_string(signal));
+    const std::filesystem::path folder = app::AbandonActiveRun(
+        app::RunStatus::kInterrupted, "interrupted by signal " + std::to_string(signal));
+    if (!folder.empty()) {
         std::fprintf(stderr, "\nlidarloop: interrupted; %s/run.json says so, no result was kept\n",
-                     active->folder().c_str());
+                     folder.c_str());
     } else {
         std::fprintf(stderr, "\nlidarloop: interrupted\n");
     }
@@ -51,15 +47,5 @@ void InstallInterruptHandler(int argc, char** argv) {
 }
 
 const std::string& CommandLine() { return command_line; }
-
-InterruptScope::InterruptScope(app::RunFolder& folder) {
-    const std::lock_guard<std::mutex> lock(active_mutex);
-    active = &folder;
-}
-
-InterruptScope::~InterruptScope() {
-    const std::lock_guard<std::mutex> lock(active_mutex);
-    active = nullptr;
-}
 
 }  // namespace lidarloop::cli

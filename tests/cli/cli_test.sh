@@ -290,6 +290,11 @@ section_demo() {
         similarity_ndt.png config.yaml; do
         if [ -s "$work/demo/evaluation/$file" ]; then pass; else fail "demo did not write $file"; fi
     done
+    for stage in evaluation optimised; do
+        if grep -q '"status": "complete"' "$work/demo/$stage/run.json"; then pass; else
+            fail "demo's $stage/run.json does not say complete"
+        fi
+    done
     for key in best_mcc tau_best_mcc best_f1 tau_best_f1 roc_auc recall_at_zero_fp tau_zero_fp \
         em_threshold; do
         if grep -q "\"$key\"" "$work/demo/evaluation/metrics.json"; then pass; else
@@ -479,6 +484,11 @@ section_optimise() {
         [ "$(awk 'NR == 1 { print NF }' "$work/opt/poses_optimised.txt")" -eq 8 ]; then pass; else
         fail "optimise wrote no graph.g2o, metrics.json or TUM poses_optimised.txt"
     fi
+    if grep -q '"status": "complete"' "$work/opt/run.json"; then pass; else
+        fail "optimise's run.json does not say complete"
+    fi
+    expect_error "optimise into the dataset" "lies inside the dataset" "$cli" optimise "$work/seq" \
+        --odometry "$work/seq/poses_odometry.txt" --loops "$work/loops.csv" --out "$work/seq/opt"
     printf '%s\n%s\n' "$header" "35,2,0.001,,0,1,0,0,0,0,0,0,1" >"$work/none.csv"
     expect_ok "optimise without loops" "no loop: the odometry is returned unchanged" "$cli" \
         optimise "$work/seq" --odometry "$work/seq/poses_odometry.txt" --loops "$work/none.csv" \

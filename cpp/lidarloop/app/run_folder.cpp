@@ -58,6 +58,9 @@ std::optional<std::vector<std::string>> PreviousRunFiles(const fs::path& folder)
     return files;
 }
 
+std::mutex active_mutex;
+RunFolder* active_folder = nullptr;  // guarded by active_mutex
+
 bool IsStaging(const fs::path& entry) {
     return entry.filename().string().rfind(kStagingPrefix, 0) == 0;
 }
@@ -162,6 +165,28 @@ void RunFolder::Abandon(RunStatus status, const std::string& message) noexcept {
     try {
         WriteManifest(status, {}, message);
     } catch (const std::exception&) {  // nothing left to tell: the folder holds no results
+    }
+}
+
+ActiveRun::ActiveRun(RunFolder& folder) {
+    const std::lock_guard<std::mutex> lock(active_mutex);
+    previous_ = active_folder;
+    active_folder = &folder;
+}
+
+ActiveRun::~ActiveRun() {
+    const std::lock_guard<std::mutex> lock(active_mutex);
+    active_folder = previous_;
+}
+
+fs::path AbandonActiveRun(RunStatus status, const std::string& message) noexcept {
+    const std::lock_guard<std::mutex> lock(active_mutex);
+    if (active_folder == nullptr) return {};
+    active_folder->Abandon(status, message);
+    try {
+        return active_folder->folder();
+    } catch (const std::exception&) {  // out of memory: the folder is abandoned all the same
+        return {};
     }
 }
 

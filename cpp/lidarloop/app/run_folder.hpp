@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace lidarloop::app {
@@ -63,5 +64,42 @@ private:
     std::mutex mutex_;
     bool finished_ = false;
 };
+
+/// While alive, `folder` is the process's running results folder, which AbandonActiveRun
+/// abandons (one at a time: a second ActiveRun replaces the first until it ends).
+class ActiveRun {
+public:
+    explicit ActiveRun(RunFolder& folder);
+    ~ActiveRun();
+    ActiveRun(const ActiveRun&) = delete;
+    ActiveRun& operator=(const ActiveRun&) = delete;
+
+private:
+    RunFolder* previous_;
+};
+
+/// Abandons the running results folder (see ActiveRun) with `status` and `message`, for a signal
+/// watcher thread about to end the process. Returns that folder, or an empty path when no run
+/// writes one. Thread-safe; never throws.
+std::filesystem::path AbandonActiveRun(RunStatus status, const std::string& message) noexcept;
+
+/// Runs `run(staging)` for the results folder `out` with RunFolder's guarantees: when `run`
+/// returns, its files move into place and run.json says complete; when it throws, only a
+/// run.json saying failed is left and the error propagates; meanwhile AbandonActiveRun can stop
+/// it as interrupted. What library callers, the CLI and Python use to write a results folder.
+/// Returns what `run` returns.
+template <typename Run>
+auto RunInFolder(const std::filesystem::path& out, RunInfo info, Run&& run) {
+    RunFolder folder(out, std::move(info));
+    const ActiveRun active(folder);
+    try {
+        auto result = std::forward<Run>(run)(folder.staging());
+        folder.Complete();
+        return result;
+    } catch (const std::exception& e) {
+        folder.Abandon(RunStatus::kFailed, e.what());
+        throw;
+    }
+}
 
 }  // namespace lidarloop::app

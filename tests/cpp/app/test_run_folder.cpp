@@ -122,6 +122,47 @@ TEST(RunFolder, AFolderInsideTheDatasetIsRefused) {
     EXPECT_FALSE(fs::exists(dir / "dataset" / "velodyne" / "out"));
 }
 
+TEST(RunInFolder, ReturnsWhatTheRunReturnsAndLeavesOnlyRunJsonWhenItThrows) {
+    test::TempDir dir;
+    const int answer = RunInFolder(dir / "ok", {}, [](const fs::path& staging) {
+        test::WriteFile(staging / "loops.csv", "1");
+        return 42;
+    });
+    EXPECT_EQ(answer, 42);
+    EXPECT_EQ(Entries(dir / "ok"), (std::vector<std::string>{"loops.csv", "run.json"}));
+    EXPECT_EQ(Manifest(dir / "ok")["status"], "complete");
+
+    EXPECT_THROW(RunInFolder(dir / "bad", {},
+                             [](const fs::path& staging) -> int {
+                                 test::WriteFile(staging / "loops.csv", "half");
+                                 throw io::ReadError("scan.bin", "truncated");
+                             }),
+                 io::ReadError);
+    EXPECT_EQ(Entries(dir / "bad"), std::vector<std::string>{"run.json"});
+    EXPECT_EQ(Manifest(dir / "bad")["status"], "failed");
+    EXPECT_EQ(Manifest(dir / "bad")["message"], "scan.bin: truncated");
+}
+
+// What the CLI's signal watcher does on Ctrl-C: the running folder is abandoned as interrupted,
+// and the run cannot complete afterwards.
+TEST(RunInFolder, AbandonActiveRunInterruptsTheRunningFolderOnly) {
+    test::TempDir dir;
+    EXPECT_EQ(AbandonActiveRun(RunStatus::kInterrupted, "no run"), fs::path());
+    fs::path abandoned;
+    EXPECT_THROW(RunInFolder(dir / "run", {},
+                             [&](const fs::path& staging) {
+                                 test::WriteFile(staging / "loops.csv", "1");
+                                 abandoned = AbandonActiveRun(RunStatus::kInterrupted, "signal 2");
+                                 return 0;
+                             }),
+                 io::WriteError);
+    EXPECT_EQ(abandoned, dir / "run");
+    EXPECT_EQ(Entries(dir / "run"), std::vector<std::string>{"run.json"});
+    EXPECT_EQ(Manifest(dir / "run")["status"], "interrupted");
+    EXPECT_EQ(Manifest(dir / "run")["message"], "signal 2");
+    EXPECT_EQ(AbandonActiveRun(RunStatus::kInterrupted, "after"), fs::path());  // ended
+}
+
 // /dev/full takes the open and fails every write with ENOSPC, as a full disk does; the
 // writers must say so instead of leaving a file that looks whole.
 TEST(ResultWriters, AFullDiskIsAnError) {
