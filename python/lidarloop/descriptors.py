@@ -1,0 +1,3 @@
+"""To come (describe, distances): part 1 of issue 17."""
+
+__all__: list = []

@@ -1,0 +1,3 @@
+"""To come (database, index, detector): part 1 of issue 17."""
+
+__all__: list = []

@@ -1,0 +1,8 @@
+// Part 2 of issue 17 owns this file (python/README.md).
+#include "bindings.hpp"
+
+namespace lidarloop::python {
+
+void BindEval(pybind11::module_& /*m*/) {}
+
+}  // namespace lidarloop::python
