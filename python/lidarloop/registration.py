@@ -1,3 +1,21 @@
-"""Part 2 of issue 17 owns this area (python/README.md): re-export its names from ._lidarloop."""
+"""Geometric verification of a scan pair: is the query a revisit of the match, and at what pose."""
 
-__all__: list = []
+from ._lidarloop import (
+    PairVerification,
+    PreparedScan,
+    Verification,
+    prepare_scan,
+    verify,
+    verify_pair,
+    verify_scan_files,
+)
+
+__all__ = [
+    "PairVerification",
+    "PreparedScan",
+    "Verification",
+    "prepare_scan",
+    "verify",
+    "verify_pair",
+    "verify_scan_files",
+]
