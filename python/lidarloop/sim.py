@@ -1,3 +1,13 @@
-"""Part 2 of issue 17 owns this area (python/README.md): re-export its names from ._lidarloop."""
+"""The simulator: synthetic LiDAR sequences with ground truth and drifting odometry."""
 
-__all__: list = []
+from ._lidarloop import (
+    SimulationSummary,
+    Simulator,
+    write_simulation,
+)
+
+__all__ = [
+    "SimulationSummary",
+    "Simulator",
+    "write_simulation",
+]
