@@ -1,3 +1,21 @@
-"""Part 2 of issue 17 owns this area (python/README.md): re-export its names from ._lidarloop."""
+"""The run layer: detect, evaluate and optimise a dataset into a results folder, as the CLI does."""
 
-__all__: list = []
+from ._lidarloop import (
+    DetectResult,
+    EvaluateResult,
+    MethodEvaluation,
+    OptimiseResult,
+    detect,
+    evaluate,
+    optimise,
+)
+
+__all__ = [
+    "DetectResult",
+    "EvaluateResult",
+    "MethodEvaluation",
+    "OptimiseResult",
+    "detect",
+    "evaluate",
+    "optimise",
+]
