@@ -12,6 +12,7 @@ PYBIND11_MODULE(_lidarloop, m) {
     python::BindErrors(m);
     python::BindIo(m);
     python::BindDescriptors(m);
+    python::BindPipeline(m);
     python::BindRegistration(m);
     python::BindPosegraph(m);
     python::BindEval(m);
