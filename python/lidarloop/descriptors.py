@@ -1,3 +1,21 @@
-"""To come (describe, distances): part 1 of issue 17."""
+"""Describing scans and comparing descriptors."""
 
-__all__: list = []
+from ._lidarloop import (
+    Descriptor,
+    default_threshold,
+    describe,
+    distance,
+    dump_config,
+    is_match,
+    method_names,
+)
+
+__all__ = [
+    "Descriptor",
+    "default_threshold",
+    "describe",
+    "distance",
+    "dump_config",
+    "is_match",
+    "method_names",
+]

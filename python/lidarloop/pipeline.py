@@ -1,3 +1,5 @@
-"""To come (database, index, detector): part 1 of issue 17."""
+"""The descriptor database, its nearest-neighbour index and the online loop detector."""
 
-__all__: list = []
+from ._lidarloop import DescriptorDatabase, LoopDetector, LoopQuery, Neighbor, NeighborIndex
+
+__all__ = ["DescriptorDatabase", "LoopDetector", "LoopQuery", "Neighbor", "NeighborIndex"]

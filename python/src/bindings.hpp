@@ -15,6 +15,12 @@ void BindErrors(pybind11::module_& m);
 /// Reading scans, poses and datasets.
 void BindIo(pybind11::module_& m);
 
+/// describe(), Descriptor, distances, method names, the effective config.
+void BindDescriptors(pybind11::module_& m);
+
+/// The descriptor database, its nearest-neighbour index, the online loop detector.
+void BindPipeline(pybind11::module_& m);
+
 /// Part 2 of issue 17 (registration, pose graph, evaluation, simulator, run layer).
 void BindRegistration(pybind11::module_& m);
 void BindPosegraph(pybind11::module_& m);

@@ -11,6 +11,8 @@ PYBIND11_MODULE(_lidarloop, m) {
     // Errors first: every later binding raises them.
     python::BindErrors(m);
     python::BindIo(m);
+    python::BindDescriptors(m);
+    python::BindPipeline(m);
     python::BindRegistration(m);
     python::BindPosegraph(m);
     python::BindEval(m);
