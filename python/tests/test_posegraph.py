@@ -6,9 +6,10 @@ import pytest
 
 import lidarloop
 
-# Quadratic in the loop's error: a Cauchy scale of 100 sigmas (the largest allowed) leaves the
-# answer within 1e-4 of the weighted mean.
-NEARLY_QUADRATIC = {"posegraph": {"robust": {"cauchy_scale": 100.0}}}
+# A loop sigma of 0.2 m (default 0.1), so that the answer shows the config was applied; a Cauchy
+# scale of 100 sigmas (the largest allowed) keeps the loop's error nearly quadratic.
+CONFIG = {"posegraph": {"information": {"loop_translation_sigma_m": 0.2},
+                        "robust": {"cauchy_scale": 100.0}}}
 
 
 def pose(x=0.0, y=0.0, yaw_deg=0.0, z=0.0):
@@ -29,16 +30,16 @@ def random_rotation(rng):
 
 
 def test_two_poses_settle_at_the_information_weighted_mean():
-    # Odometry says pose 1 is 1.0 m ahead, the loop says 1.2 m. Default informations: the
-    # odometry step of 1 m has sigma_t^2 = 0.01^2 + 0.1^2 * 1, the loop 0.1^2 (no RMSE known).
+    # Odometry says pose 1 is 1.0 m ahead, the loop says 1.2 m. The odometry step of 1 m has
+    # sigma_t^2 = 0.01^2 + 0.1^2 * 1 (defaults), the loop 0.2^2 (CONFIG; no RMSE known).
     odometry = np.stack([pose(), pose(1.0)])
     loop = lidarloop.LoopConstraint(query=1, match=0, T_match_query=pose(1.2))
-    graph = lidarloop.build_pose_graph(odometry, [loop], config=NEARLY_QUADRATIC)
+    graph = lidarloop.build_pose_graph(odometry, [loop], config=CONFIG)
     assert [e.kind for e in graph.edges] == ["odometry", "loop"]
-    w_odometry, w_loop = 1.0 / (0.01**2 + 0.1**2 * 1.0), 1.0 / 0.1**2
+    w_odometry, w_loop = 1.0 / (0.01**2 + 0.1**2 * 1.0), 1.0 / 0.2**2
     assert graph.edges[0].information[0, 0] == pytest.approx(w_odometry)
     assert graph.edges[1].information[0, 0] == pytest.approx(w_loop)
-    result = lidarloop.optimise_pose_graph(graph, config=NEARLY_QUADRATIC)
+    result = lidarloop.optimise_pose_graph(graph, config=CONFIG)
     expected_x = (w_odometry * 1.0 + w_loop * 1.2) / (w_odometry + w_loop)
     assert result.loops_used == 1 and result.loops[0].verdict == "used"
     np.testing.assert_allclose(result.poses[0], np.eye(4), atol=1e-12)  # pose 0 is fixed
