@@ -82,3 +82,28 @@ def test_bad_options_raise_typed_errors(tmp_path):
     lidarloop.write_simulation(lidarloop.Simulator(**SMALL), tmp_path / "seq")
     with pytest.raises(lidarloop.WriteError):  # holds scans, and no overwrite
         lidarloop.write_simulation(lidarloop.Simulator(**SMALL), tmp_path / "seq")
+
+
+def test_writing_releases_the_gil(tmp_path):
+    """Another Python thread runs while the C++ side writes (a held GIL would stall it)."""
+    import threading
+    import time
+
+    ticks, done = [], threading.Event()
+
+    def heartbeat():
+        while not done.is_set():
+            ticks.append(time.monotonic())
+            time.sleep(0.002)
+
+    simulator = lidarloop.Simulator(**{**SMALL, "scans": 40, "horizontal_steps": 1024})
+    thread = threading.Thread(target=heartbeat)
+    thread.start()
+    start = time.monotonic()
+    lidarloop.write_simulation(simulator, tmp_path / "seq", threads=1)
+    end = time.monotonic()
+    done.set()
+    thread.join()
+    during = [t for t in ticks if start < t < end]
+    assert end - start > 0.1  # long enough to tell
+    assert len(during) >= 10, f"{len(during)} heartbeats in {end - start:.2f} s"
