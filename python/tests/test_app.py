@@ -165,3 +165,24 @@ def test_a_failed_run_leaves_only_run_json(sequence, tmp_path):
         lidarloop.detect(sequence, out=tmp_path / "bad", method="no_such_method")
     with pytest.raises(lidarloop.ReadError):
         lidarloop.evaluate(tmp_path / "missing", out=tmp_path / "eval")
+
+
+@pytest.mark.parametrize("area", ["registration", "posegraph", "eval", "sim", "app"])
+def test_stubs_match_the_module(area):
+    """Every exported name has a stub, and every public member of a class a stub entry."""
+    import ast
+    import importlib
+    from pathlib import Path
+
+    module = importlib.import_module(f"lidarloop.{area}")
+    stub = Path(module.__file__).with_suffix(".pyi")
+    tree = ast.parse(stub.read_text())
+    stubbed = {n.name: n for n in tree.body if isinstance(n, (ast.ClassDef, ast.FunctionDef))}
+    assert set(module.__all__) == set(stubbed)
+    for name, node in stubbed.items():
+        if not isinstance(node, ast.ClassDef):
+            continue
+        members = {getattr(m, "name", None) or getattr(getattr(m, "target", None), "id", None)
+                   for m in node.body}
+        public = {a for a in dir(getattr(module, name)) if not a.startswith("_")}
+        assert public <= members, f"{name}: no stub for {public - members}"
