@@ -14,11 +14,14 @@ from .eval import (
     ThresholdTransfer,
     Confusion,
 )
+from .io import Dataset
 from .posegraph import LoopConstraint, OptimisationResult
 
 PathLike = Union[str, os.PathLike]
 Config = Union[None, Mapping[str, Any], PathLike]
 """None (the defaults), a dict nested like the YAML file, or a YAML file's path."""
+# `dataset`: a folder (opened with format, poses and calib, as the CLI's DATASET) or a Dataset
+# from open_dataset (then without those).
 Progress = Callable[[str, int, int], Any]
 """progress(stage, done, total), called from worker threads (with the GIL); if it raises, the
 run's folder is abandoned as failed and the exception raised when the run returns."""
@@ -52,7 +55,7 @@ class DetectResult:
         """candidates.csv's query, rank (1-based), match, distance."""
 
 def detect(
-    dataset: PathLike,
+    dataset: Union[PathLike, Dataset],
     *,
     out: PathLike,
     method: Optional[str] = None,
@@ -129,7 +132,7 @@ class EvaluateResult:
         """The whole metrics.json."""
 
 def evaluate(
-    dataset: PathLike,
+    dataset: Union[PathLike, Dataset],
     *,
     out: PathLike,
     methods: Optional[Sequence[str]] = None,
@@ -180,7 +183,7 @@ class OptimiseResult:
     def total_s(self) -> float: ...
 
 def optimise(
-    dataset: PathLike,
+    dataset: Union[PathLike, Dataset],
     *,
     odometry: PathLike,
     out: PathLike,

@@ -54,6 +54,25 @@ io::Dataset OpenDatasetOf(const fs::path& folder, const std::string& format,
     return io::OpenDataset(folder, options);
 }
 
+/// The dataset argument of a run: a lidarloop.Dataset (open_dataset) as it is, or a folder
+/// opened with the dataset keywords (which an opened Dataset does not take).
+io::Dataset DatasetOf(const py::object& dataset, const std::string& format,
+                      const std::optional<fs::path>& poses, const std::optional<fs::path>& calib) {
+    if (py::isinstance<io::Dataset>(dataset)) {
+        if (format != "auto" || poses || calib) {
+            throw core::ConfigError(
+                "format, poses and calib apply to a dataset folder; this Dataset is open "
+                "already (give them to open_dataset)");
+        }
+        return dataset.cast<io::Dataset>();
+    }
+    if (!py::isinstance<py::str>(dataset) && !py::hasattr(dataset, "__fspath__")) {
+        throw py::type_error(
+            "dataset must be a folder (str or os.PathLike) or a lidarloop.Dataset");
+    }
+    return OpenDatasetOf(dataset.cast<fs::path>(), format, poses, calib);
+}
+
 /// The detection keywords, as --threshold --min-gap --min-gap-unit --top-k --no-verify
 /// (cli/detection_options.cpp): each overrides its key when given.
 struct DetectionKeywords {
@@ -251,7 +270,7 @@ void BindDetect(py::module_& m) {
             request.skip_bad = skip_bad;
             request.progress = python_progress.Callback();
             request.out = out;
-            const io::Dataset data = OpenDatasetOf(dataset.cast<fs::path>(), format, poses, calib);
+            const io::Dataset data = DatasetOf(dataset, format, poses, calib);
             DetectResult result;
             result.outcome =
                 RunInFolder(out, data.root(), overwrite, CallText("detect", dataset, given),
@@ -270,7 +289,8 @@ void BindDetect(py::module_& m) {
         py::arg("min_gap") = py::none(), py::arg("min_gap_unit") = py::none(),
         py::arg("skip_bad") = false, py::arg("overwrite") = false, py::arg("progress") = py::none(),
         py::arg("format") = "auto", py::arg("poses") = py::none(), py::arg("calib") = py::none(),
-        "`lidarloop detect DATASET --out OUT`: describes every scan, finds each scan's "
+        "`lidarloop detect DATASET --out OUT` on a dataset folder (or a Dataset of "
+        "open_dataset): describes every scan, finds each scan's "
         "candidates, verifies them (unless verify=False or the config says so) and writes "
         "loops.csv, candidates.csv, the similarity matrix and images, database.lldb, "
         "config.yaml, timings.json and run.json into `out` (a results folder: refused inside "
@@ -394,7 +414,7 @@ void BindEvaluate(py::module_& m) {
             request.skip_bad = skip_bad;
             request.progress = python_progress.Callback();
             request.out = out;
-            const io::Dataset data = OpenDatasetOf(dataset.cast<fs::path>(), format, poses, calib);
+            const io::Dataset data = DatasetOf(dataset, format, poses, calib);
             EvaluateResult result;
             result.outcome =
                 RunInFolder(out, data.root(), overwrite, CallText("evaluate", dataset, given),
@@ -490,7 +510,7 @@ void BindOptimise(py::module_& m) {
             request.skip_bad = skip_bad;
             request.progress = python_progress.Callback();
             request.out = out;
-            const io::Dataset data = OpenDatasetOf(dataset.cast<fs::path>(), format, poses, calib);
+            const io::Dataset data = DatasetOf(dataset, format, poses, calib);
             OptimiseResult result;
             {
                 // As the CLI: RunOptimisation writes into `out` itself (no staging).

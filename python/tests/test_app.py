@@ -69,6 +69,19 @@ def test_detect_without_verification_matches_the_cli(cli, sequence, tmp_path):
     assert "loops.csv" in run["files"]
 
 
+def test_an_opened_dataset_runs_as_its_folder(sequence, tmp_path):
+    by_path = lidarloop.detect(sequence, out=tmp_path / "path", verify=False)
+    dataset = lidarloop.open_dataset(sequence)
+    by_dataset = lidarloop.detect(dataset, out=tmp_path / "dataset", verify=False)
+    assert (tmp_path / "path" / "loops.csv").read_bytes() == \
+        (tmp_path / "dataset" / "loops.csv").read_bytes()
+    assert by_dataset.accepted == by_path.accepted
+    with pytest.raises(lidarloop.ConfigError, match="open_dataset"):
+        lidarloop.detect(dataset, out=tmp_path / "x", format="kitti")
+    with pytest.raises(TypeError, match="lidarloop.Dataset"):
+        lidarloop.evaluate(42, out=tmp_path / "y")
+
+
 def test_verified_detect_matches_the_cli(cli_verified, sequence, tmp_path):
     calls = []
     result = lidarloop.detect(sequence, out=tmp_path / "py", method="range", top_k=1,
