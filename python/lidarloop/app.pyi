@@ -154,9 +154,11 @@ def evaluate(
     format: str = "auto",
     poses: Optional[PathLike] = None,
     calib: Optional[PathLike] = None,
+    train_on: Union[None, PathLike, Dataset] = None,
 ) -> EvaluateResult:
     """`lidarloop evaluate DATASET --out OUT`: every method (default all) on one ground truth
-    (distance_m default 10 m, max_heading_deg 0: any, the config's min gap)."""
+    (distance_m default 10 m, max_heading_deg 0: any, the config's min gap); train_on: learn
+    each method's threshold on that dataset (with poses) instead of the first part."""
 
 class OptimiseResult:
     @property

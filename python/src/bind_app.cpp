@@ -394,7 +394,8 @@ void BindEvaluate(py::module_& m) {
            std::optional<bool> verify, std::optional<double> threshold, std::optional<int> top_k,
            std::optional<double> min_gap, const std::optional<std::string>& min_gap_unit,
            bool skip_bad, bool overwrite, const py::object& progress, const std::string& format,
-           const std::optional<fs::path>& poses, const std::optional<fs::path>& calib) {
+           const std::optional<fs::path>& poses, const std::optional<fs::path>& calib,
+           const py::object& train_on) {
             const py::dict given(py::arg("out") = out.string(), py::arg("methods") = methods,
                                  py::arg("verify") = verify, py::arg("top_k") = top_k,
                                  py::arg("min_gap") = min_gap, py::arg("overwrite") = overwrite);
@@ -415,14 +416,18 @@ void BindEvaluate(py::module_& m) {
             request.progress = python_progress.Callback();
             request.out = out;
             const io::Dataset data = DatasetOf(dataset, format, poses, calib);
+            // --train-on: learn each method's threshold on another dataset (with poses).
+            std::optional<io::Dataset> train_data;
+            if (!train_on.is_none())
+                train_data = DatasetOf(train_on, "auto", std::nullopt, std::nullopt);
             EvaluateResult result;
-            result.outcome =
-                RunInFolder(out, data.root(), overwrite, CallText("evaluate", dataset, given),
-                            python_progress, [&](const fs::path& staging) {
-                                app::EvaluationRequest staged = request;
-                                staged.out = staging;
-                                return app::RunEvaluation(data, staged);
-                            });
+            result.outcome = RunInFolder(
+                out, data.root(), overwrite, CallText("evaluate", dataset, given), python_progress,
+                [&](const fs::path& staging) {
+                    app::EvaluationRequest staged = request;
+                    staged.out = staging;
+                    return app::RunEvaluation(data, staged, train_data ? &*train_data : nullptr);
+                });
             result.out = out;
             result.dataset = data.root().string();
             result.scans = data.size();
@@ -437,11 +442,14 @@ void BindEvaluate(py::module_& m) {
         py::arg("min_gap") = py::none(), py::arg("min_gap_unit") = py::none(),
         py::arg("skip_bad") = false, py::arg("overwrite") = false, py::arg("progress") = py::none(),
         py::arg("format") = "auto", py::arg("poses") = py::none(), py::arg("calib") = py::none(),
+        py::arg("train_on") = py::none(),
         "`lidarloop evaluate DATASET --out OUT`: scores every method (default all) and "
         "results file on one ground truth from the dataset's poses (distance_m, "
         "max_heading_deg, the config's min gap) and writes metrics.json, roc.csv, pr.csv, "
         "images, report.md, config.yaml and run.json into `out` (a results folder, as "
-        "detect's). None keeps the default of app::EvaluationRequest or the config.");
+        "detect's). train_on (a folder or Dataset with poses) learns each method's threshold "
+        "there instead of on the first part. None keeps the default of app::EvaluationRequest "
+        "or the config.");
 }
 
 // ---- optimise ----

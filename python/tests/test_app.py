@@ -131,6 +131,21 @@ def test_evaluate_matches_the_cli(cli, sequence, tmp_path):
         assert (tmp_path / "py" / name).is_file(), name
 
 
+def test_evaluate_learns_on_another_dataset_as_the_cli(cli, sequence, tmp_path):
+    other = tmp_path / "other"
+    lidarloop.write_simulation(lidarloop.Simulator(scene="urban", route="uturn", sensor="vlp16",
+                                                   scans=60, seed=2, horizontal_steps=256), other)
+    run_cli(cli, "evaluate", sequence, "--method", "range", "--no-verify", "--train-on", other,
+            "--out", tmp_path / "cli")
+    result = lidarloop.evaluate(sequence, out=tmp_path / "py", methods=["range"], verify=False,
+                                train_on=lidarloop.open_dataset(other))
+    cli_metrics = json.loads((tmp_path / "cli" / "metrics.json").read_text())
+    assert without_timings(result.metrics) == without_timings(cli_metrics)
+    learning = cli_metrics["methods"]["range"]["threshold_learning"]
+    assert learning["trained_on"] != "first part" and str(other) in learning["trained_on"]
+    assert result.methods["range"].learnt.threshold == pytest.approx(learning["tau"])
+
+
 def test_optimise_matches_the_cli(cli, cli_verified, sequence, tmp_path):
     loops = cli_verified / "loops.csv"
     odometry = sequence / "poses_odometry.txt"
