@@ -14,6 +14,7 @@
 #include "conversions.hpp"
 #include "lidarloop/app/simulation.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/sim/odometry_drift.hpp"
 #include "lidarloop/sim/simulator.hpp"
 #include "part2_helpers.hpp"
 
@@ -52,7 +53,7 @@ std::vector<Eigen::Vector3d> TrajectoryFrom(const py::handle& positions) {
 
 // The SimulationConfig the keywords name, as `lidarloop simulate` builds it from its flags
 // (cli/simulate.cpp): names parsed, the sensor's and route's own values unless given, the
-// odometry noise scaled by `drift`. Unknown keywords are an error.
+// odometry noise scaled by `drift` (sim::ScaledOdometry). Unknown keywords are an error.
 SimulationConfig ConfigFrom(const std::optional<std::string>& scene,
                             const std::optional<std::string>& route,
                             const std::optional<std::string>& sensor,
@@ -79,13 +80,8 @@ SimulationConfig ConfigFrom(const std::optional<std::string>& scene,
     r.spacing_min_m = Take<double>(options, "spacing_min_m").value_or(r.spacing_min_m);
     r.spacing_max_m = Take<double>(options, "spacing_max_m").value_or(r.spacing_max_m);
     r.uturn_blocks = Take<int>(options, "uturn_blocks").value_or(r.uturn_blocks);
-    // The same factor on the four odometry errors as `lidarloop simulate --drift`.
-    const double drift = Take<double>(options, "drift").value_or(1.0);
-    if (!(drift >= 0.0)) throw core::ConfigError("drift must be >= 0");
-    config.odometry.yaw_noise_deg *= drift;
-    config.odometry.translation_noise *= drift;
-    config.odometry.yaw_bias_deg_per_100m *= drift;
-    config.odometry.length_bias *= drift;
+    if (const auto drift = Take<double>(options, "drift"))
+        config.odometry = sim::ScaledOdometry(config.odometry, *drift);
     if (options.contains("trajectory")) {
         config.trajectory = TrajectoryFrom(options["trajectory"]);
         config.scans = config.trajectory.size();
