@@ -11,6 +11,7 @@
 #include "lidarloop/app/simulation.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/io/poses.hpp"
+#include "lidarloop/sim/odometry_drift.hpp"
 #include "progress.hpp"
 
 namespace lidarloop::cli {
@@ -49,9 +50,6 @@ sim::SimulationConfig ToConfig(const SimulateFlags& flags) {
         throw core::ConfigError("--scans must be in [1, 1000000], got " +
                                 std::to_string(flags.scans));
     }
-    if (!(flags.drift >= 0.0)) {
-        throw core::ConfigError("--drift must be >= 0 (a factor on the default odometry noise)");
-    }
     config.scans = static_cast<std::size_t>(flags.scans);
     if (!flags.trajectory.empty()) {
         for (const core::StampedPose& pose : io::ReadPoses(flags.trajectory)) {
@@ -69,10 +67,7 @@ sim::SimulationConfig ToConfig(const SimulateFlags& flags) {
     config.route.spacing_min_m = flags.spacing_min_m.value_or(config.route.spacing_min_m);
     config.route.spacing_max_m = flags.spacing_max_m.value_or(config.route.spacing_max_m);
     config.route.uturn_blocks = flags.uturn_blocks.value_or(config.route.uturn_blocks);
-    config.odometry.yaw_noise_deg *= flags.drift;
-    config.odometry.translation_noise *= flags.drift;
-    config.odometry.yaw_bias_deg_per_100m *= flags.drift;
-    config.odometry.length_bias *= flags.drift;
+    config.odometry = sim::ScaledOdometry(config.odometry, flags.drift);
     config.Validate();
     return config;
 }

@@ -48,12 +48,9 @@ nlohmann::json VerificationTimingsJson(const PreparedScans& prepared,
     return json;
 }
 
-PairVerification VerifyScanFiles(const std::filesystem::path& query_file,
-                                 const std::filesystem::path& match_file,
-                                 const registration::VerificationConfig& config) {
+PairVerification VerifyClouds(const core::PointCloud& query, const core::PointCloud& match,
+                              const registration::VerificationConfig& config) {
     config.Validate();
-    const core::PointCloud query = io::ReadScan(query_file);
-    const core::PointCloud match = io::ReadScan(match_file);
     PairVerification result;
     result.query_points = query.size();
     result.match_points = match.size();
@@ -72,6 +69,13 @@ PairVerification VerifyScanFiles(const std::filesystem::path& query_file,
     }
     result.verify_ms = 1e3 * verify_clock.Seconds();
     return result;
+}
+
+PairVerification VerifyScanFiles(const std::filesystem::path& query_file,
+                                 const std::filesystem::path& match_file,
+                                 const registration::VerificationConfig& config) {
+    config.Validate();
+    return VerifyClouds(io::ReadScan(query_file), io::ReadScan(match_file), config);
 }
 
 nlohmann::json VerificationJson(const registration::Verification& verdict) {

@@ -51,8 +51,14 @@ struct PairVerification {
     double verify_ms = 0.0;   ///< coarse search, ICP and acceptance
 };
 
+/// Prepares two scans (sensor frames, metres) and verifies the first as the query against the
+/// second (registration::Verify), timing both steps: what `lidarloop verify` and the Python
+/// lidarloop.verify_pair compute. Validates `config` (core::ConfigError).
+PairVerification VerifyClouds(const core::PointCloud& query, const core::PointCloud& match,
+                              const registration::VerificationConfig& config);
+
 /// Reads two scan files (io::ReadScan; errors name the file) and verifies the first as the
-/// query against the second (registration::Verify). Validates `config` (core::ConfigError).
+/// query against the second (VerifyClouds). Validates `config` (core::ConfigError).
 PairVerification VerifyScanFiles(const std::filesystem::path& query_file,
                                  const std::filesystem::path& match_file,
                                  const registration::VerificationConfig& config);

@@ -1,0 +1,216 @@
+import os
+from typing import Any, Callable, Mapping, Optional, Sequence, Union
+
+import numpy as np
+import numpy.typing as npt
+
+from .eval import (
+    DifferenceThreshold,
+    GroundTruth,
+    LoopRetrievalEvaluation,
+    PairwiseEvaluation,
+    PerScanEvaluation,
+    TaxonomyCounts,
+    ThresholdTransfer,
+    Confusion,
+)
+from .io import Dataset
+from .posegraph import LoopConstraint, OptimisationResult
+
+PathLike = Union[str, os.PathLike]
+Config = Union[None, Mapping[str, Any], PathLike]
+"""None (the defaults), a dict nested like the YAML file, or a YAML file's path."""
+# `dataset`: a folder (opened with format, poses and calib, as the CLI's DATASET) or a Dataset
+# from open_dataset (then without those).
+Progress = Callable[[str, int, int], Any]
+"""progress(stage, done, total), called from worker threads (with the GIL); if it raises, the
+run's folder is abandoned as failed and the exception raised when the run returns."""
+
+class DetectResult:
+    """What `lidarloop detect` found and wrote."""
+
+    @property
+    def out(self) -> os.PathLike: ...
+    @property
+    def method(self) -> str: ...
+    @property
+    def threshold(self) -> float: ...
+    @property
+    def accepted(self) -> int:
+        """Scans whose best match was accepted."""
+    @property
+    def skipped(self) -> list[str]: ...
+    @property
+    def total_s(self) -> float: ...
+    @property
+    def loops(self) -> dict[str, Any]:
+        """loops.csv's rows as columns: query, match, distance, second_ratio (NaN: none),
+        accepted (bool), rank (1-based verified candidate, 0: not verified), T_match_query
+        ((R, 4, 4), NaN when not verified), verification (list of Verification or None)."""
+    @property
+    def accepted_loops(self) -> list[LoopConstraint]:
+        """The accepted, verified loops, ready for build_pose_graph."""
+    @property
+    def candidates(self) -> dict[str, npt.NDArray[Any]]:
+        """candidates.csv's query, rank (1-based), match, distance."""
+
+def detect(
+    dataset: Union[PathLike, Dataset],
+    *,
+    out: PathLike,
+    method: Optional[str] = None,
+    config: Config = None,
+    verify: Optional[bool] = None,
+    threshold: Optional[float] = None,
+    top_k: Optional[int] = None,
+    min_gap: Optional[float] = None,
+    min_gap_unit: Optional[str] = None,
+    skip_bad: bool = False,
+    overwrite: bool = False,
+    progress: Optional[Progress] = None,
+    format: str = "auto",
+    poses: Optional[PathLike] = None,
+    calib: Optional[PathLike] = None,
+) -> DetectResult:
+    """`lidarloop detect DATASET --out OUT` (None keeps the config's value; verification is on
+    by default). `out` is a results folder with run.json (refused inside the dataset, or when it
+    holds other files unless overwrite=True; a failed run leaves only run.json)."""
+
+class MethodEvaluation:
+    """Everything `lidarloop evaluate` computed for one method."""
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def default_threshold(self) -> Optional[float]: ...
+    @property
+    def similarity(self) -> npt.NDArray[np.float32]:
+        """(n, n) descriptor distances (W or sigma'), diagonal 0."""
+    @property
+    def pairwise(self) -> PairwiseEvaluation: ...
+    @property
+    def learnt(self) -> Optional[ThresholdTransfer]: ...
+    @property
+    def learnt_on(self) -> str: ...
+    @property
+    def at_default(self) -> Optional[Confusion]: ...
+    @property
+    def fixed_thresholds(self) -> list[float]: ...
+    @property
+    def at_fixed(self) -> list[Confusion]: ...
+    @property
+    def per_scan(self) -> PerScanEvaluation: ...
+    @property
+    def per_scan_at_default(self) -> Optional[TaxonomyCounts]: ...
+    @property
+    def em(self) -> DifferenceThreshold: ...
+    @property
+    def retrieval(self) -> Optional[LoopRetrievalEvaluation]: ...
+    @property
+    def retrieval_verified(self) -> Optional[LoopRetrievalEvaluation]: ...
+    @property
+    def describe_ms_per_scan_median(self) -> float: ...
+    @property
+    def ns_per_comparison(self) -> float: ...
+    @property
+    def metrics(self) -> dict[str, Any]:
+        """This method's entry of metrics.json."""
+
+class EvaluateResult:
+    @property
+    def out(self) -> os.PathLike: ...
+    @property
+    def metrics_path(self) -> os.PathLike: ...
+    @property
+    def truth(self) -> GroundTruth: ...
+    @property
+    def methods(self) -> dict[str, MethodEvaluation]: ...
+    @property
+    def notes(self) -> list[str]: ...
+    @property
+    def metrics(self) -> dict[str, Any]:
+        """The whole metrics.json."""
+
+def evaluate(
+    dataset: Union[PathLike, Dataset],
+    *,
+    out: PathLike,
+    methods: Optional[Sequence[str]] = None,
+    config: Config = None,
+    results: Sequence[PathLike] = ...,
+    distance_m: Optional[float] = None,
+    max_heading_deg: Optional[float] = None,
+    train_fraction: Optional[float] = None,
+    criterion: Optional[str] = None,
+    fixed_thresholds: Sequence[float] = ...,
+    verify: Optional[bool] = None,
+    threshold: Optional[float] = None,
+    top_k: Optional[int] = None,
+    min_gap: Optional[float] = None,
+    min_gap_unit: Optional[str] = None,
+    skip_bad: bool = False,
+    overwrite: bool = False,
+    progress: Optional[Progress] = None,
+    format: str = "auto",
+    poses: Optional[PathLike] = None,
+    calib: Optional[PathLike] = None,
+    train_on: Union[None, PathLike, Dataset] = None,
+) -> EvaluateResult:
+    """`lidarloop evaluate DATASET --out OUT`: every method (default all) on one ground truth
+    (distance_m default 10 m, max_heading_deg 0: any, the config's min gap); train_on: learn
+    each method's threshold on that dataset (with poses) instead of the first part."""
+
+class OptimiseResult:
+    @property
+    def out(self) -> os.PathLike: ...
+    @property
+    def metrics_path(self) -> os.PathLike: ...
+    @property
+    def loops(self) -> list[LoopConstraint]: ...
+    @property
+    def result(self) -> OptimisationResult: ...
+    @property
+    def poses(self) -> npt.NDArray[np.float64]:
+        """(N, 4, 4) optimised T_world_sensor."""
+    @property
+    def loop_is_true(self) -> list[bool]: ...
+    @property
+    def odometry_metrics(self) -> Optional[dict[str, float]]:
+        """ate_rmse_m, rpe_translation_percent, rpe_rotation_deg_per_100m, rpe_segments."""
+    @property
+    def optimised_metrics(self) -> Optional[dict[str, float]]: ...
+    @property
+    def notes(self) -> list[str]: ...
+    @property
+    def total_s(self) -> float: ...
+
+def optimise(
+    dataset: Union[PathLike, Dataset],
+    *,
+    odometry: PathLike,
+    out: PathLike,
+    loops: Optional[PathLike] = None,
+    pose_format: str = "kitti",
+    method: Optional[str] = None,
+    config: Config = None,
+    threshold: Optional[float] = None,
+    top_k: Optional[int] = None,
+    min_gap: Optional[float] = None,
+    min_gap_unit: Optional[str] = None,
+    skip_bad: bool = False,
+    progress: Optional[Progress] = None,
+    format: str = "auto",
+    poses: Optional[PathLike] = None,
+    calib: Optional[PathLike] = None,
+) -> OptimiseResult:
+    """`lidarloop optimise DATASET --odometry FILE --out OUT [--loops loops.csv]`."""
+
+__all__ = [
+    "DetectResult",
+    "EvaluateResult",
+    "MethodEvaluation",
+    "OptimiseResult",
+    "detect",
+    "evaluate",
+    "optimise",
+]

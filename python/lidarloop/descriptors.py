@@ -1,0 +1,21 @@
+"""Describing scans and comparing descriptors."""
+
+from ._lidarloop import (
+    Descriptor,
+    default_threshold,
+    describe,
+    distance,
+    dump_config,
+    is_match,
+    method_names,
+)
+
+__all__ = [
+    "Descriptor",
+    "default_threshold",
+    "describe",
+    "distance",
+    "dump_config",
+    "is_match",
+    "method_names",
+]

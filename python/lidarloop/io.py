@@ -1,0 +1,5 @@
+"""Reading scans, poses and datasets."""
+
+from ._lidarloop import Dataset, is_scan_file, open_dataset, read_poses, read_scan
+
+__all__ = ["Dataset", "is_scan_file", "open_dataset", "read_poses", "read_scan"]

@@ -1,0 +1,554 @@
+// The run layer (lidarloop::app): detect, evaluate and optimise a dataset into a results folder,
+// as the CLI's commands do (cli/detect.cpp, cli/evaluate.cpp, cli/optimise.cpp), returning the
+// outcome as Python objects.
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include "bindings.hpp"
+#include "conversions.hpp"
+#include "lidarloop/app/detection.hpp"
+#include "lidarloop/app/evaluation.hpp"
+#include "lidarloop/app/metrics_json.hpp"
+#include "lidarloop/app/optimisation.hpp"
+#include "lidarloop/app/run_folder.hpp"
+#include "lidarloop/core/error.hpp"
+#include "lidarloop/core/min_gap.hpp"
+#include "lidarloop/io/dataset.hpp"
+#include "lidarloop/pipeline/descriptor_method.hpp"
+#include "part2_helpers.hpp"
+
+namespace lidarloop::python {
+namespace {
+
+namespace fs = std::filesystem;
+
+// ---- what the CLI's option classes do, for keywords ----
+
+/// The dataset keywords (cli/dataset_options.cpp): format auto | kitti | folder | osnabrueck,
+/// another poses file, a KITTI calib.txt.
+io::Dataset OpenDatasetOf(const fs::path& folder, const std::string& format,
+                          const std::optional<fs::path>& poses,
+                          const std::optional<fs::path>& calib) {
+    io::DatasetOptions options;
+    if (format == "kitti") {
+        options.format = io::DatasetFormat::kKitti;
+    } else if (format == "folder") {
+        options.format = io::DatasetFormat::kFolder;
+    } else if (format == "osnabrueck") {
+        options.format = io::DatasetFormat::kOsnabrueck;
+    } else if (format != "auto") {
+        throw core::ConfigError("format must be auto, kitti, folder or osnabrueck, got '" + format +
+                                "'");
+    }
+    options.poses_file = poses.value_or(fs::path());
+    options.calib_file = calib.value_or(fs::path());
+    return io::OpenDataset(folder, options);
+}
+
+/// The dataset argument of a run: a lidarloop.Dataset (open_dataset) as it is, or a folder
+/// opened with the dataset keywords (which an opened Dataset does not take).
+io::Dataset DatasetOf(const py::object& dataset, const std::string& format,
+                      const std::optional<fs::path>& poses, const std::optional<fs::path>& calib) {
+    if (py::isinstance<io::Dataset>(dataset)) {
+        if (format != "auto" || poses || calib) {
+            throw core::ConfigError(
+                "format, poses and calib apply to a dataset folder; this Dataset is open "
+                "already (give them to open_dataset)");
+        }
+        return dataset.cast<io::Dataset>();
+    }
+    if (!py::isinstance<py::str>(dataset) && !py::hasattr(dataset, "__fspath__")) {
+        throw py::type_error(
+            "dataset must be a folder (str or os.PathLike) or a lidarloop.Dataset");
+    }
+    return OpenDatasetOf(dataset.cast<fs::path>(), format, poses, calib);
+}
+
+/// The detection keywords, as --threshold --min-gap --min-gap-unit --top-k --no-verify
+/// (cli/detection_options.cpp): each overrides its key when given.
+struct DetectionKeywords {
+    std::optional<double> threshold;
+    std::optional<double> min_gap;
+    std::optional<std::string> min_gap_unit;
+    std::optional<int> top_k;
+    std::optional<bool> verify;
+
+    void ApplyTo(io::RunConfig& config) const {
+        if (threshold) config.detection.threshold = *threshold;
+        if (min_gap) config.detection.min_gap.value = *min_gap;
+        if (min_gap_unit) config.detection.min_gap.unit = core::ParseMinGapUnit(*min_gap_unit);
+        if (top_k) config.detection.top_k = *top_k;
+        if (verify) config.detection.verify = *verify;
+    }
+};
+
+/// defaults < config (dict or YAML) < method < detection keywords, validated: the order of
+/// DescriptorOptions::Resolve and DetectionOptions::ApplyTo.
+io::RunConfig ResolveConfig(const py::object& config, const std::optional<std::string>& method,
+                            const DetectionKeywords& detection) {
+    io::RunConfig run = RunConfigFrom(config);
+    if (method) run.descriptor.method = pipeline::ParseMethod(*method);
+    detection.ApplyTo(run);
+    run.Validate();
+    return run;
+}
+
+/// "lidarloop.detect('seq', out='res', verify=False)": the call as run.json's command line.
+std::string CallText(const std::string& function, const py::object& first, const py::dict& given) {
+    std::string text = "lidarloop." + function + "(" + py::repr(first).cast<std::string>();
+    for (const auto& [key, value] : given) {
+        if (value.is_none()) continue;
+        text += ", " + py::str(key).cast<std::string>() + "=" + py::repr(value).cast<std::string>();
+    }
+    return text + ")";
+}
+
+/// What cli/run_output.hpp's RunInFolder does, without signals (Python's KeyboardInterrupt
+/// waits until the run returns): app::RunFolder checks and stages `out`, `run(staging)` runs
+/// with the GIL released, and the folder is completed, or abandoned as failed with the error
+/// (then only run.json is left, saying so). A progress callback that raised fails the run too.
+template <typename Run>
+auto RunInFolder(const fs::path& out, const fs::path& dataset, bool overwrite,
+                 const std::string& command_line, const PythonProgress& progress, Run&& run) {
+    app::RunFolder folder(out, {command_line, dataset, overwrite});
+    try {
+        std::optional<decltype(run(folder.staging()))> result;
+        {
+            py::gil_scoped_release release;
+            result.emplace(run(folder.staging()));
+        }
+        if (progress.Failed()) {
+            folder.Abandon(app::RunStatus::kFailed, "the progress callback raised an exception");
+            progress.Rethrow();
+        }
+        folder.Complete();
+        return std::move(*result);
+    } catch (const py::error_already_set&) {
+        throw;  // the folder was abandoned above
+    } catch (const std::exception& e) {
+        folder.Abandon(app::RunStatus::kFailed, e.what());
+        throw;
+    }
+}
+
+py::object JsonToPython(const nlohmann::json& json) {
+    return py::module_::import("json").attr("loads")(json.dump());
+}
+
+// ---- detect ----
+
+/// A detection run's outcome with where it was written.
+struct DetectResult {
+    app::DetectOutcome outcome;
+    fs::path out;
+    std::string method;
+};
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// The rows of loops.csv (one per query with a candidate; app::WriteLoopsCsv) as column arrays.
+py::dict LoopsTable(const std::vector<pipeline::LoopQuery>& queries) {
+    std::vector<long long> query, match, rank;
+    std::vector<double> distance, second_ratio;
+    std::vector<bool> accepted;
+    std::vector<core::Transform> poses;
+    py::list verifications;
+    for (const pipeline::LoopQuery& q : queries) {
+        if (!q.has_match()) continue;
+        const std::size_t r = q.loop().value_or(0);
+        query.push_back(static_cast<long long>(q.query));
+        match.push_back(static_cast<long long>(q.candidates[r].index));
+        distance.push_back(q.candidates[r].distance);
+        second_ratio.push_back(q.second_ratio);
+        accepted.push_back(q.accepted);
+        rank.push_back(q.verified() ? static_cast<long long>(r + 1) : 0);
+        core::Transform T = core::Transform::Identity();
+        if (q.verified()) {
+            T = q.verifications[r].T_match_query;
+            verifications.append(py::cast(q.verifications[r]));
+        } else {
+            T.matrix().setConstant(kNaN);
+            verifications.append(py::none());
+        }
+        poses.push_back(T);
+    }
+    py::array_t<bool> accepted_array(static_cast<py::ssize_t>(accepted.size()));
+    for (std::size_t k = 0; k < accepted.size(); ++k) accepted_array.mutable_at(k) = accepted[k];
+    py::dict table;
+    table["query"] = ArrayOf(query);
+    table["match"] = ArrayOf(match);
+    table["distance"] = ArrayOf(distance);
+    table["second_ratio"] = ArrayOf(second_ratio);
+    table["accepted"] = accepted_array;
+    table["rank"] = ArrayOf(rank);
+    table["T_match_query"] = TransformsToArray(poses);
+    table["verification"] = verifications;
+    return table;
+}
+
+/// Accepted, verified loops as pose-graph constraints (what `optimise --loops` reads).
+std::vector<posegraph::LoopConstraint> AcceptedLoops(
+    const std::vector<pipeline::LoopQuery>& queries) {
+    std::vector<posegraph::LoopConstraint> loops;
+    for (const pipeline::LoopQuery& q : queries) {
+        const std::optional<std::size_t> r = q.loop();
+        if (!q.accepted || !r || !q.verified()) continue;
+        const registration::Verification& v = q.verifications[*r];
+        loops.push_back(
+            {q.query, q.candidates[*r].index, v.T_match_query, v.overlap.Min(), v.overlap.rmse_m});
+    }
+    return loops;
+}
+
+void BindDetect(py::module_& m) {
+    py::class_<DetectResult>(m, "DetectResult", "What `lidarloop detect` found and wrote")
+        .def_readonly("out", &DetectResult::out, "the results folder")
+        .def_readonly("method", &DetectResult::method)
+        .def_property_readonly("threshold",
+                               [](const DetectResult& r) { return r.outcome.threshold; })
+        .def_property_readonly(
+            "accepted", [](const DetectResult& r) { return r.outcome.accepted; },
+            "scans whose best match was accepted")
+        .def_property_readonly("skipped", [](const DetectResult& r) { return r.outcome.skipped; })
+        .def_property_readonly("total_s", [](const DetectResult& r) { return r.outcome.total_s; })
+        .def_property_readonly(
+            "loops", [](const DetectResult& r) { return LoopsTable(r.outcome.queries); },
+            "loops.csv's rows as columns: query, match, distance, second_ratio (NaN: none), "
+            "accepted (bool), rank (1-based verified candidate, 0: not verified), "
+            "T_match_query (R, 4, 4; NaN when not verified), verification (Verification or "
+            "None per row)")
+        .def_property_readonly(
+            "accepted_loops",
+            [](const DetectResult& r) { return AcceptedLoops(r.outcome.queries); },
+            "the accepted, verified loops as LoopConstraints (for build_pose_graph)")
+        .def_property_readonly(
+            "candidates",
+            [](const DetectResult& r) {
+                std::vector<long long> query, rank, match;
+                std::vector<double> distance;
+                for (const pipeline::LoopQuery& q : r.outcome.queries) {
+                    for (std::size_t k = 0; k < q.candidates.size(); ++k) {
+                        query.push_back(static_cast<long long>(q.query));
+                        rank.push_back(static_cast<long long>(k + 1));
+                        match.push_back(static_cast<long long>(q.candidates[k].index));
+                        distance.push_back(q.candidates[k].distance);
+                    }
+                }
+                py::dict table;
+                table["query"] = ArrayOf(query);
+                table["rank"] = ArrayOf(rank);
+                table["match"] = ArrayOf(match);
+                table["distance"] = ArrayOf(distance);
+                return table;
+            },
+            "candidates.csv's first columns: query, rank (1-based), match, distance");
+    m.def(
+        "detect",
+        [](const py::object& dataset, const fs::path& out, const std::optional<std::string>& method,
+           const py::object& config, std::optional<bool> verify, std::optional<double> threshold,
+           std::optional<int> top_k, std::optional<double> min_gap,
+           const std::optional<std::string>& min_gap_unit, bool skip_bad, bool overwrite,
+           const py::object& progress, const std::string& format,
+           const std::optional<fs::path>& poses, const std::optional<fs::path>& calib) {
+            const py::dict given(py::arg("out") = out.string(), py::arg("method") = method,
+                                 py::arg("verify") = verify, py::arg("threshold") = threshold,
+                                 py::arg("top_k") = top_k, py::arg("min_gap") = min_gap,
+                                 py::arg("overwrite") = overwrite);
+            const PythonProgress python_progress(progress);
+            app::DetectRequest request;
+            request.config =
+                ResolveConfig(config, method, {threshold, min_gap, min_gap_unit, top_k, verify});
+            request.skip_bad = skip_bad;
+            request.progress = python_progress.Callback();
+            request.out = out;
+            const io::Dataset data = DatasetOf(dataset, format, poses, calib);
+            DetectResult result;
+            result.outcome =
+                RunInFolder(out, data.root(), overwrite, CallText("detect", dataset, given),
+                            python_progress, [&](const fs::path& staging) {
+                                app::DetectRequest staged = request;
+                                staged.out = staging;
+                                return app::RunDetect(data, staged);
+                            });
+            result.out = out;
+            result.method = core::ToString(request.config.descriptor.method);
+            return result;
+        },
+        py::arg("dataset"), py::kw_only(), py::arg("out"), py::arg("method") = py::none(),
+        py::arg("config") = py::none(), py::arg("verify") = py::none(),
+        py::arg("threshold") = py::none(), py::arg("top_k") = py::none(),
+        py::arg("min_gap") = py::none(), py::arg("min_gap_unit") = py::none(),
+        py::arg("skip_bad") = false, py::arg("overwrite") = false, py::arg("progress") = py::none(),
+        py::arg("format") = "auto", py::arg("poses") = py::none(), py::arg("calib") = py::none(),
+        "`lidarloop detect DATASET --out OUT` on a dataset folder (or a Dataset of "
+        "open_dataset): describes every scan, finds each scan's "
+        "candidates, verifies them (unless verify=False or the config says so) and writes "
+        "loops.csv, candidates.csv, the similarity matrix and images, database.lldb, "
+        "config.yaml, timings.json and run.json into `out` (a results folder: refused inside "
+        "the dataset or when it holds other files, unless overwrite=True). None keeps the "
+        "config's value. progress(stage, done, total) is called from worker threads.");
+}
+
+// ---- evaluate ----
+
+struct EvaluateResult {
+    app::EvaluationOutcome outcome;
+    fs::path out;
+    std::string dataset;
+    std::size_t scans = 0;
+};
+
+/// The full (n, n) float32 distance matrix (diagonal 0) of a similarity matrix.
+py::array_t<float> FullMatrix(const pipeline::SimilarityMatrix& matrix) {
+    const auto n = static_cast<py::ssize_t>(matrix.size());
+    py::array_t<float> full({n, n});
+    auto out = full.mutable_unchecked<2>();
+    for (py::ssize_t i = 0; i < n; ++i) {
+        out(i, i) = 0.0f;
+        for (py::ssize_t j = i + 1; j < n; ++j) {
+            const float d = matrix.at(static_cast<std::size_t>(i), static_cast<std::size_t>(j));
+            out(i, j) = d;
+            out(j, i) = d;
+        }
+    }
+    return full;
+}
+
+void BindMethodEvaluation(py::module_& m) {
+    using app::MethodEvaluation;
+    py::class_<MethodEvaluation>(m, "MethodEvaluation",
+                                 "Everything `lidarloop evaluate` computed for one method")
+        .def_readonly("name", &MethodEvaluation::name, "height, range, ndt or results:<file>")
+        .def_readonly("default_threshold", &MethodEvaluation::default_threshold)
+        .def_property_readonly(
+            "similarity", [](const MethodEvaluation& e) { return FullMatrix(e.matrix); },
+            "(n, n) float32 descriptor distances (W or sigma'), diagonal 0")
+        .def_readonly("pairwise", &MethodEvaluation::pairwise, "Röhling IV-B/C")
+        .def_readonly("learnt", &MethodEvaluation::learnt, "Röhling table I, or None")
+        .def_readonly("learnt_on", &MethodEvaluation::learnt_on)
+        .def_readonly("at_default", &MethodEvaluation::at_default)
+        .def_readonly("fixed_thresholds", &MethodEvaluation::fixed_thresholds)
+        .def_readonly("at_fixed", &MethodEvaluation::at_fixed)
+        .def_readonly("per_scan", &MethodEvaluation::per_scan, "Magnusson table I, fig. 1")
+        .def_readonly("per_scan_at_default", &MethodEvaluation::per_scan_at_default)
+        .def_readonly("em", &MethodEvaluation::em, "Magnusson fig. 2")
+        .def_property_readonly(
+            "retrieval",
+            [](const MethodEvaluation& e) -> py::object {
+                if (!e.retrieval) return py::none();
+                return py::cast(e.retrieval->descriptor);
+            },
+            "the top-k candidates scored as the descriptor decides them (LoopRetrievalEvaluation)")
+        .def_property_readonly(
+            "retrieval_verified",
+            [](const MethodEvaluation& e) -> py::object {
+                if (!e.retrieval || !e.retrieval->verified) return py::none();
+                return py::cast(*e.retrieval->verified);
+            },
+            "the same after geometric verification; None when verification is off")
+        .def_readonly("describe_ms_per_scan_median", &MethodEvaluation::describe_ms_per_scan_median)
+        .def_readonly("ns_per_comparison", &MethodEvaluation::ns_per_comparison)
+        .def_property_readonly(
+            "metrics", [](const MethodEvaluation& e) { return JsonToPython(app::MetricsJson(e)); },
+            "this method's entry of metrics.json, as a dict");
+}
+
+void BindEvaluate(py::module_& m) {
+    py::class_<EvaluateResult>(m, "EvaluateResult", "What `lidarloop evaluate` computed and wrote")
+        .def_readonly("out", &EvaluateResult::out)
+        .def_property_readonly("metrics_path",
+                               [](const EvaluateResult& r) { return r.out / "metrics.json"; })
+        .def_property_readonly("truth", [](const EvaluateResult& r) { return r.outcome.truth; })
+        .def_property_readonly(
+            "methods",
+            [](const EvaluateResult& r) {
+                py::dict methods;
+                for (const app::MethodEvaluation& e : r.outcome.methods)
+                    methods[py::str(e.name)] = py::cast(e);
+                return methods;
+            },
+            "name -> MethodEvaluation, in the order evaluated")
+        .def_property_readonly("notes", [](const EvaluateResult& r) { return r.outcome.notes; })
+        .def_property_readonly(
+            "metrics",
+            [](const EvaluateResult& r) {
+                return JsonToPython(app::EvaluationMetricsJson(r.dataset, r.scans, r.outcome));
+            },
+            "the whole metrics.json as a dict");
+    m.def(
+        "evaluate",
+        [](const py::object& dataset, const fs::path& out,
+           const std::optional<std::vector<std::string>>& methods, const py::object& config,
+           const std::vector<fs::path>& results, std::optional<double> distance_m,
+           std::optional<double> max_heading_deg, std::optional<double> train_fraction,
+           const std::optional<std::string>& criterion, const std::vector<double>& fixed_thresholds,
+           std::optional<bool> verify, std::optional<double> threshold, std::optional<int> top_k,
+           std::optional<double> min_gap, const std::optional<std::string>& min_gap_unit,
+           bool skip_bad, bool overwrite, const py::object& progress, const std::string& format,
+           const std::optional<fs::path>& poses, const std::optional<fs::path>& calib,
+           const py::object& train_on) {
+            const py::dict given(py::arg("out") = out.string(), py::arg("methods") = methods,
+                                 py::arg("verify") = verify, py::arg("top_k") = top_k,
+                                 py::arg("min_gap") = min_gap, py::arg("overwrite") = overwrite);
+            const PythonProgress python_progress(progress);
+            app::EvaluationRequest request;
+            for (const std::string& name : methods.value_or(pipeline::MethodNames()))
+                request.methods.push_back(pipeline::ParseMethod(name));
+            request.config = ResolveConfig(config, std::nullopt,
+                                           {threshold, min_gap, min_gap_unit, top_k, verify});
+            for (const fs::path& file : results) request.results_files.push_back(file.string());
+            request.distance_m = distance_m.value_or(request.distance_m);
+            request.max_heading_deg = max_heading_deg.value_or(request.max_heading_deg);
+            request.learning.train_fraction =
+                train_fraction.value_or(request.learning.train_fraction);
+            if (criterion) request.learning.criterion = eval::ParseCriterion(*criterion);
+            request.fixed_thresholds = fixed_thresholds;
+            request.skip_bad = skip_bad;
+            request.progress = python_progress.Callback();
+            request.out = out;
+            const io::Dataset data = DatasetOf(dataset, format, poses, calib);
+            // --train-on: learn each method's threshold on another dataset (with poses).
+            std::optional<io::Dataset> train_data;
+            if (!train_on.is_none())
+                train_data = DatasetOf(train_on, "auto", std::nullopt, std::nullopt);
+            EvaluateResult result;
+            result.outcome = RunInFolder(
+                out, data.root(), overwrite, CallText("evaluate", dataset, given), python_progress,
+                [&](const fs::path& staging) {
+                    app::EvaluationRequest staged = request;
+                    staged.out = staging;
+                    return app::RunEvaluation(data, staged, train_data ? &*train_data : nullptr);
+                });
+            result.out = out;
+            result.dataset = data.root().string();
+            result.scans = data.size();
+            return result;
+        },
+        py::arg("dataset"), py::kw_only(), py::arg("out"), py::arg("methods") = py::none(),
+        py::arg("config") = py::none(), py::arg("results") = std::vector<fs::path>{},
+        py::arg("distance_m") = py::none(), py::arg("max_heading_deg") = py::none(),
+        py::arg("train_fraction") = py::none(), py::arg("criterion") = py::none(),
+        py::arg("fixed_thresholds") = std::vector<double>{}, py::arg("verify") = py::none(),
+        py::arg("threshold") = py::none(), py::arg("top_k") = py::none(),
+        py::arg("min_gap") = py::none(), py::arg("min_gap_unit") = py::none(),
+        py::arg("skip_bad") = false, py::arg("overwrite") = false, py::arg("progress") = py::none(),
+        py::arg("format") = "auto", py::arg("poses") = py::none(), py::arg("calib") = py::none(),
+        py::arg("train_on") = py::none(),
+        "`lidarloop evaluate DATASET --out OUT`: scores every method (default all) and "
+        "results file on one ground truth from the dataset's poses (distance_m, "
+        "max_heading_deg, the config's min gap) and writes metrics.json, roc.csv, pr.csv, "
+        "images, report.md, config.yaml and run.json into `out` (a results folder, as "
+        "detect's). train_on (a folder or Dataset with poses) learns each method's threshold "
+        "there instead of on the first part. None keeps the default of app::EvaluationRequest "
+        "or the config.");
+}
+
+// ---- optimise ----
+
+struct OptimiseResult {
+    app::OptimiseOutcome outcome;
+    fs::path out;
+};
+
+py::object TrajectoryMetricsOf(const std::optional<app::TrajectoryMetrics>& metrics) {
+    if (!metrics) return py::none();
+    py::dict d;
+    d["ate_rmse_m"] = metrics->ate_rmse_m;
+    d["rpe_translation_percent"] = metrics->rpe.translation_percent;
+    d["rpe_rotation_deg_per_100m"] = metrics->rpe.rotation_deg_per_100m;
+    d["rpe_segments"] = metrics->rpe.segments;
+    return d;
+}
+
+void BindOptimise(py::module_& m) {
+    py::class_<OptimiseResult>(m, "OptimiseResult", "What `lidarloop optimise` did and wrote")
+        .def_readonly("out", &OptimiseResult::out)
+        .def_property_readonly("metrics_path",
+                               [](const OptimiseResult& r) { return r.out / "metrics.json"; })
+        .def_property_readonly(
+            "loops", [](const OptimiseResult& r) { return r.outcome.loops; },
+            "the accepted loops, as read or detected")
+        .def_property_readonly(
+            "result", [](const OptimiseResult& r) { return r.outcome.result; },
+            "the OptimisationResult (optimised poses, per-loop verdicts)")
+        .def_property_readonly(
+            "poses",
+            [](const OptimiseResult& r) { return TransformsToArray(r.outcome.result.poses); },
+            "(N, 4, 4) optimised T_world_sensor")
+        .def_property_readonly("loop_is_true",
+                               [](const OptimiseResult& r) { return r.outcome.loop_is_true; })
+        .def_property_readonly(
+            "odometry_metrics",
+            [](const OptimiseResult& r) { return TrajectoryMetricsOf(r.outcome.odometry); },
+            "ATE RMSE and RPE of the odometry against the ground truth (None without it)")
+        .def_property_readonly(
+            "optimised_metrics",
+            [](const OptimiseResult& r) { return TrajectoryMetricsOf(r.outcome.optimised); })
+        .def_property_readonly("notes", [](const OptimiseResult& r) { return r.outcome.notes; })
+        .def_property_readonly("total_s",
+                               [](const OptimiseResult& r) { return r.outcome.total_s; });
+    m.def(
+        "optimise",
+        [](const py::object& dataset, const fs::path& odometry, const fs::path& out,
+           const std::optional<fs::path>& loops, const std::string& pose_format,
+           const std::optional<std::string>& method, const py::object& config,
+           std::optional<double> threshold, std::optional<int> top_k, std::optional<double> min_gap,
+           const std::optional<std::string>& min_gap_unit, bool skip_bad,
+           const py::object& progress, const std::string& format,
+           const std::optional<fs::path>& poses, const std::optional<fs::path>& calib) {
+            if (pose_format != "kitti" && pose_format != "tum")
+                throw core::ConfigError("pose_format must be kitti or tum, got '" + pose_format +
+                                        "'");
+            const PythonProgress python_progress(progress);
+            app::OptimiseRequest request;
+            request.config = ResolveConfig(config, method,
+                                           {threshold, min_gap, min_gap_unit, top_k, std::nullopt});
+            request.odometry_file = odometry;
+            request.loops_file = loops.value_or(fs::path());
+            request.format = pose_format == "tum" ? app::PoseFormat::kTum : app::PoseFormat::kKitti;
+            request.skip_bad = skip_bad;
+            request.progress = python_progress.Callback();
+            request.out = out;
+            const io::Dataset data = DatasetOf(dataset, format, poses, calib);
+            OptimiseResult result;
+            {
+                // As the CLI: RunOptimisation writes into `out` itself (no staging).
+                py::gil_scoped_release release;
+                result.outcome = app::RunOptimisation(data, request);
+            }
+            python_progress.Rethrow();
+            result.out = out;
+            return result;
+        },
+        py::arg("dataset"), py::kw_only(), py::arg("odometry"), py::arg("out"),
+        py::arg("loops") = py::none(), py::arg("pose_format") = "kitti",
+        py::arg("method") = py::none(), py::arg("config") = py::none(),
+        py::arg("threshold") = py::none(), py::arg("top_k") = py::none(),
+        py::arg("min_gap") = py::none(), py::arg("min_gap_unit") = py::none(),
+        py::arg("skip_bad") = false, py::arg("progress") = py::none(), py::arg("format") = "auto",
+        py::arg("poses") = py::none(), py::arg("calib") = py::none(),
+        "`lidarloop optimise DATASET --odometry FILE --out OUT`: reads the accepted loops "
+        "(loops.csv of a verified detect) or detects them first (into out/detection), builds "
+        "and optimises the pose graph and writes poses_optimised.txt (pose_format kitti | "
+        "tum), graph.g2o, loop_verdicts.csv, metrics.json, report.md and config.yaml.");
+}
+
+}  // namespace
+
+void BindApp(py::module_& m) {
+    BindDetect(m);
+    BindMethodEvaluation(m);
+    BindEvaluate(m);
+    BindOptimise(m);
+}
+
+}  // namespace lidarloop::python

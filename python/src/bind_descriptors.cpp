@@ -1,0 +1,215 @@
+// Describing scans and comparing descriptors (lidarloop.descriptors, docs/python.md).
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "bindings.hpp"
+#include "conversions.hpp"
+#include "lidarloop/app/describe_run.hpp"
+#include "lidarloop/app/descriptor_json.hpp"
+#include "lidarloop/core/descriptor.hpp"
+#include "lidarloop/pipeline/descriptor_method.hpp"
+#include "run_config.hpp"
+
+namespace lidarloop::python {
+namespace {
+
+using core::Descriptor;
+
+const core::Histogram& HistogramOf(const Descriptor& descriptor, const char* field) {
+    const auto* histogram = std::any_cast<core::Histogram>(&descriptor.value);
+    if (histogram == nullptr) {
+        throw py::attribute_error("a " + core::ToString(descriptor.method) + " descriptor has no " +
+                                  field + " (histograms have)");
+    }
+    return *histogram;
+}
+
+const core::NdtDescriptorSet& NdtOf(const Descriptor& descriptor, const char* field) {
+    const auto* set = std::any_cast<core::NdtDescriptorSet>(&descriptor.value);
+    if (set == nullptr) {
+        throw py::attribute_error("a " + core::ToString(descriptor.method) + " descriptor has no " +
+                                  field + " (NDT descriptor sets have)");
+    }
+    return *set;
+}
+
+// One rotation candidate F of an NDT set, as `lidarloop describe` prints it.
+py::dict NdtDescriptorDict(const core::NdtDescriptor& f) {
+    py::array_t<float> counts({f.rows, f.cols});
+    std::copy(f.counts.begin(), f.counts.end(), counts.mutable_data());
+    py::dict entry;
+    entry["R_aligned_sensor"] = MatrixToArray(f.R_aligned_sensor);
+    entry["cells"] = f.total;
+    entry["F"] = counts;
+    return entry;
+}
+
+// Points used: a histogram counts them in its buckets, an NDT set in its cells.
+std::size_t PointsUsed(const Descriptor& descriptor) {
+    if (const auto* set = std::any_cast<core::NdtDescriptorSet>(&descriptor.value)) {
+        return set->cell_stats.points_used;
+    }
+    return HistogramOf(descriptor, "points_used").points_used;
+}
+
+std::size_t PointsSkipped(const Descriptor& descriptor) {
+    if (const auto* set = std::any_cast<core::NdtDescriptorSet>(&descriptor.value)) {
+        return set->cell_stats.points_skipped;
+    }
+    return HistogramOf(descriptor, "points_skipped").points_skipped;
+}
+
+Descriptor Describe(const py::object& points, const std::optional<std::string>& method,
+                    const py::object& config, const HistogramKeywords& keywords,
+                    bool skip_non_finite) {
+    const io::RunConfig run = ResolveRunConfig(config, method, keywords);
+    if (py::isinstance<py::str>(points) || py::hasattr(points, "__fspath__")) {
+        const std::filesystem::path file = points.cast<std::filesystem::path>();
+        py::gil_scoped_release release;
+        return app::DescribeScanFile(file, run.descriptor);
+    }
+    const core::PointCloud cloud = PointsFromArray(points, skip_non_finite);
+    py::gil_scoped_release release;
+    return pipeline::ComputeDescriptor(cloud, run.descriptor);
+}
+
+void BindDescriptorClass(py::module_& m) {
+    py::class_<Descriptor>(m, "Descriptor",
+                           "The place descriptor of one scan, with the fields `lidarloop "
+                           "describe` prints (to_dict() gives exactly its JSON). Made by "
+                           "describe().")
+        .def_property_readonly("method",
+                               [](const Descriptor& d) { return core::ToString(d.method); })
+        .def_property_readonly(
+            "bins",
+            [](const py::object& self) {
+                return ViewOf(HistogramOf(self.cast<const Descriptor&>(), "bins").mass, self);
+            },
+            "Histograms: the masses h_k of the b buckets, float64, summing to 1 (a read-only "
+            "view of the C++ histogram, no copy).")
+        .def_property_readonly(
+            "min", [](const Descriptor& d) { return HistogramOf(d, "min").min_value; },
+            "Histograms: v_min, metres (height above the ground plane, or range).")
+        .def_property_readonly(
+            "max", [](const Descriptor& d) { return HistogramOf(d, "max").max_value; },
+            "Histograms: v_max, metres.")
+        .def_property_readonly(
+            "up",
+            [](const Descriptor& d) {
+                const core::Histogram& histogram = HistogramOf(d, "up");
+                if (histogram.projection != core::Projection::kHeight) {
+                    throw py::attribute_error("only a height histogram has an up vector");
+                }
+                return MatrixToArray(histogram.up);
+            },
+            "Height histograms: the unit up vector u of the projection, sensor frame, (3, 1).")
+        .def_property_readonly("points_used", &PointsUsed,
+                               "Points counted (histograms: in the buckets; NDT: in the cells).")
+        .def_property_readonly("points_skipped", &PointsSkipped, "Non-finite points skipped.")
+        .def_property_readonly(
+            "points_out_of_range",
+            [](const Descriptor& d) {
+                return HistogramOf(d, "points_out_of_range").points_out_of_range;
+            },
+            "Histograms: finite points outside [min, max] (clamped or dropped).")
+        .def_property_readonly(
+            "descriptors",
+            [](const Descriptor& d) {
+                py::list list;
+                for (const auto& f : NdtOf(d, "descriptors").descriptors) {
+                    list.append(NdtDescriptorDict(f));
+                }
+                return list;
+            },
+            "NDT: one dict per rotation candidate: 'F' (range intervals x classes float32 cell "
+            "counts), 'cells' (their sum) and 'R_aligned_sensor' (3x3 rotation applied). Copies.")
+        .def_property_readonly(
+            "sparse_cells",
+            [](const Descriptor& d) { return NdtOf(d, "sparse_cells").cell_stats.sparse_cells; },
+            "NDT: cells with too few points to classify.")
+        .def_property_readonly(
+            "degenerate_cells",
+            [](const Descriptor& d) { return NdtOf(d, "degenerate_cells").degenerate_cells; },
+            "NDT: cells whose covariance was degenerate.")
+        .def(
+            "to_dict",
+            [](const Descriptor& d) {
+                const std::string json = app::DescriptorJson(d).dump();
+                return py::module_::import("json").attr("loads")(json);
+            },
+            "Exactly the JSON object `lidarloop describe` prints, as plain Python values.")
+        .def("distance", &pipeline::DescriptorDistance, py::arg("other"),
+             "distance(self, other), see lidarloop.distance.")
+        .def("__repr__", [](const Descriptor& d) {
+            return "<lidarloop.Descriptor " + core::ToString(d.method) + ">";
+        });
+}
+
+}  // namespace
+
+void BindDescriptors(py::module_& m) {
+    BindDescriptorClass(m);
+    m.def(
+        "describe",
+        [](const py::object& points, const std::optional<std::string>& method,
+           const py::object& config, std::optional<int> bins, std::optional<double> min,
+           std::optional<double> max, std::optional<std::string> up,
+           std::optional<double> sensor_height, std::optional<std::string> out_of_range,
+           bool skip_non_finite) {
+            const HistogramKeywords keywords{bins, min, max, up, sensor_height, out_of_range};
+            return Describe(points, method, config, keywords, skip_non_finite);
+        },
+        py::arg("points"), py::arg("method") = py::none(), py::kw_only(),
+        py::arg("config") = py::none(), py::arg("bins") = py::none(), py::arg("min") = py::none(),
+        py::arg("max") = py::none(), py::arg("up") = py::none(),
+        py::arg("sensor_height") = py::none(), py::arg("out_of_range") = py::none(),
+        py::arg("skip_non_finite") = false,
+        R"doc(The descriptor of one scan, as `lidarloop describe` computes it.
+
+points: an (N, 3) or (N, 4) float32/float64 array (sensor frame, metres; a 4th column is
+    ignored; any memory layout; copied once into the C++ layout), or a scan file path (read as
+    `lidarloop describe SCAN` reads it).
+method: 'height', 'range', 'ndt' or any registered method (lidarloop.method_names());
+    default: the config's (height).
+config: None, a dict nested like the YAML config ({'ndt': {'cell_size_m': 1.0}}), or a YAML
+    file path; unknown keys raise lidarloop.ReadError.
+bins, min, max (metres, of the projection in use), up ('fixed' | 'pca'), sensor_height
+    (metres), out_of_range ('clamp' | 'drop'): as the flags of `lidarloop describe`.
+skip_non_finite: False raises lidarloop.NonFiniteError for a NaN/Inf point; True lets the
+    descriptor skip and count them (points_skipped), as it does for files.
+
+Raises DtypeError, ShapeError, NonFiniteError, ConfigError, EmptyInputError (nothing usable),
+ReadError (files). Releases the GIL while describing.)doc");
+    m.def("distance", &pipeline::DescriptorDistance, py::arg("a"), py::arg("b"),
+          "The method's distance between two descriptors of the same method and config: W "
+          "(Roehling eq. 6) for histograms, sigma' (Magnusson eq. 9) for NDT; 0 for equal "
+          "descriptors, symmetric. lidarloop.ConfigError for mixed methods.");
+    m.def("method_names", &pipeline::MethodNames,
+          "The registered descriptor methods: height, range, ndt, then any registered in C++.");
+    m.def(
+        "default_threshold",
+        [](const std::string& method) {
+            return pipeline::DefaultThreshold(pipeline::ParseMethod(method));
+        },
+        py::arg("method"), "The method's default decision threshold (tau or t_d).");
+    m.def(
+        "is_match",
+        [](const std::string& method, double distance, double threshold) {
+            return pipeline::IsMatch(pipeline::ParseMethod(method), distance, threshold);
+        },
+        py::arg("method"), py::arg("distance"), py::arg("threshold"),
+        "Whether `distance` says 'same place' under `threshold`: W <= tau (histograms), "
+        "sigma' < t_d (NDT).");
+    m.def(
+        "dump_config",
+        [](const py::object& config) { return io::DumpConfigYaml(ResolveRunConfig(config, {})); },
+        py::arg("config") = py::none(),
+        "The effective configuration (defaults overridden by `config`, a dict or YAML path) as "
+        "the YAML text `lidarloop dump-config` prints.");
+}
+
+}  // namespace lidarloop::python

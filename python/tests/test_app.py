@@ -1,0 +1,216 @@
+"""The run layer: detect, evaluate and optimise against the CLI on a small simulated sequence
+(80 VLP-16 scans out and back along a street: 27 scans revisit a place), and the guarantees of
+a results folder."""
+
+import json
+import subprocess
+
+import numpy as np
+import pytest
+
+import lidarloop
+
+
+@pytest.fixture(scope="module")
+def sequence(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("data") / "street"
+    simulator = lidarloop.Simulator(scene="urban", route="uturn", sensor="vlp16", scans=80,
+                                    horizontal_steps=512)
+    lidarloop.write_simulation(simulator, folder)
+    return folder
+
+
+@pytest.fixture(scope="module")
+def cli_verified(cli, sequence, tmp_path_factory):
+    """`lidarloop detect --top-k 1` (with verification) once for the tests that need it."""
+    out = tmp_path_factory.mktemp("cli") / "verified"
+    run_cli(cli, "detect", sequence, "--method", "range", "--top-k", "1", "--out", out)
+    return out
+
+
+def run_cli(cli, *args):
+    subprocess.run([str(cli), *map(str, args), "--quiet"], check=True, capture_output=True)
+
+
+def read_csv(path):
+    lines = path.read_text().splitlines()
+    header = lines[0].split(",")
+    return [dict(zip(header, line.split(","))) for line in lines[1:]]
+
+
+def without_timings(value):
+    """metrics.json without the figures that measure time (they differ run to run)."""
+    if isinstance(value, dict):
+        return {k: without_timings(v) for k, v in value.items()
+                if not (k.endswith("_ms") or k.endswith("_s") or "ms_per" in k or k in
+                        ("seconds", "ns_per_comparison", "verification_times"))}
+    if isinstance(value, list):
+        return [without_timings(v) for v in value]
+    return value
+
+
+def test_detect_without_verification_matches_the_cli(cli, sequence, tmp_path):
+    run_cli(cli, "detect", sequence, "--method", "range", "--no-verify", "--out", tmp_path / "cli")
+    result = lidarloop.detect(sequence, out=tmp_path / "py", method="range", verify=False)
+    for name in ("loops.csv", "candidates.csv", "config.yaml", "similarity.bin"):
+        assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), \
+            name
+    rows = read_csv(tmp_path / "cli" / "loops.csv")
+    loops = result.loops
+    assert len(rows) == len(loops["query"]) > 40
+    np.testing.assert_array_equal(loops["query"], [int(r["query"]) for r in rows])
+    np.testing.assert_array_equal(loops["match"], [int(r["match"]) for r in rows])
+    np.testing.assert_allclose(loops["distance"], [float(r["distance"]) for r in rows], rtol=1e-8)
+    np.testing.assert_array_equal(loops["accepted"], [r["accepted"] == "1" for r in rows])
+    assert result.accepted == sum(r["accepted"] == "1" for r in rows)
+    assert result.method == "range" and np.isnan(loops["T_match_query"]).all()
+    run = json.loads((tmp_path / "py" / "run.json").read_text())
+    assert run["status"] == "complete" and run["command_line"].startswith("lidarloop.detect(")
+    assert "loops.csv" in run["files"]
+
+
+def test_an_opened_dataset_runs_as_its_folder(sequence, tmp_path):
+    by_path = lidarloop.detect(sequence, out=tmp_path / "path", verify=False)
+    dataset = lidarloop.open_dataset(sequence)
+    by_dataset = lidarloop.detect(dataset, out=tmp_path / "dataset", verify=False)
+    assert (tmp_path / "path" / "loops.csv").read_bytes() == \
+        (tmp_path / "dataset" / "loops.csv").read_bytes()
+    assert by_dataset.accepted == by_path.accepted
+    with pytest.raises(lidarloop.ConfigError, match="open_dataset"):
+        lidarloop.detect(dataset, out=tmp_path / "x", format="kitti")
+    with pytest.raises(TypeError, match="lidarloop.Dataset"):
+        lidarloop.evaluate(42, out=tmp_path / "y")
+
+
+def test_verified_detect_matches_the_cli(cli_verified, sequence, tmp_path):
+    calls = []
+    result = lidarloop.detect(sequence, out=tmp_path / "py", method="range", top_k=1,
+                              progress=lambda stage, done, total: calls.append(stage))
+    assert (tmp_path / "py" / "loops.csv").read_bytes() == \
+        (cli_verified / "loops.csv").read_bytes()
+    assert "verifying" in calls
+    from_file = lidarloop.read_loops_csv(cli_verified / "loops.csv", 80)
+    assert len(result.accepted_loops) == len(from_file) > 10
+    for ours, theirs in zip(result.accepted_loops, from_file):
+        assert (ours.query, ours.match) == (theirs.query, theirs.match)
+        np.testing.assert_allclose(ours.T_match_query, theirs.T_match_query, atol=1e-6)
+    accepted = result.loops["accepted"]
+    verdicts = [v for v, a in zip(result.loops["verification"], accepted) if a]
+    assert all(v.accepted and v.reason == "none" for v in verdicts)
+    np.testing.assert_array_equal(result.loops["T_match_query"][accepted],
+                                  [v.T_match_query for v in verdicts])
+
+
+def test_evaluate_matches_the_cli(cli, sequence, tmp_path):
+    run_cli(cli, "evaluate", sequence, "--method", "range", "--method", "height", "--no-verify",
+            "--fixed-thresholds", "0.01,0.02", "--out", tmp_path / "cli")
+    result = lidarloop.evaluate(sequence, out=tmp_path / "py", methods=["range", "height"],
+                                verify=False, fixed_thresholds=[0.01, 0.02])
+    cli_metrics = json.loads((tmp_path / "cli" / "metrics.json").read_text())
+    py_metrics = json.loads(result.metrics_path.read_text())
+    assert without_timings(py_metrics) == without_timings(cli_metrics)
+    assert without_timings(result.metrics) == without_timings(cli_metrics)
+    assert list(result.methods) == ["range", "height"]
+    for name, evaluation in result.methods.items():
+        assert without_timings(evaluation.metrics) == \
+            without_timings(cli_metrics["methods"][name])
+        similarity = evaluation.similarity
+        assert similarity.shape == (80, 80)
+        np.testing.assert_array_equal(similarity, similarity.T)
+    range_eval = result.methods["range"]
+    # The attributes carry the same figures as the JSON.
+    cli_range = cli_metrics["methods"]["range"]
+    assert range_eval.pairwise.best_mcc.score == pytest.approx(cli_range["best_mcc"])
+    assert range_eval.pairwise.best_mcc.threshold == pytest.approx(cli_range["tau_best_mcc"])
+    assert range_eval.pairwise.roc_auc == pytest.approx(cli_range["roc_auc"])
+    assert range_eval.per_scan.zero_error.recall == pytest.approx(cli_range["recall_at_zero_fp"])
+    assert range_eval.retrieval.recall_at_1 == pytest.approx(0.625)  # the CLI printed 62.5 %
+    assert range_eval.retrieval_verified is None
+    assert result.truth.overlapping_count == 55
+    for name in ("metrics.json", "roc.csv", "pr.csv", "report.md", "config.yaml"):
+        assert (tmp_path / "py" / name).is_file(), name
+
+
+def test_evaluate_learns_on_another_dataset_as_the_cli(cli, sequence, tmp_path):
+    other = tmp_path / "other"
+    lidarloop.write_simulation(lidarloop.Simulator(scene="urban", route="uturn", sensor="vlp16",
+                                                   scans=60, seed=2, horizontal_steps=256), other)
+    run_cli(cli, "evaluate", sequence, "--method", "range", "--no-verify", "--train-on", other,
+            "--out", tmp_path / "cli")
+    result = lidarloop.evaluate(sequence, out=tmp_path / "py", methods=["range"], verify=False,
+                                train_on=lidarloop.open_dataset(other))
+    cli_metrics = json.loads((tmp_path / "cli" / "metrics.json").read_text())
+    assert without_timings(result.metrics) == without_timings(cli_metrics)
+    learning = cli_metrics["methods"]["range"]["threshold_learning"]
+    assert learning["trained_on"] != "first part" and str(other) in learning["trained_on"]
+    assert result.methods["range"].learnt.threshold == pytest.approx(learning["tau"])
+
+
+def test_optimise_matches_the_cli(cli, cli_verified, sequence, tmp_path):
+    loops = cli_verified / "loops.csv"
+    odometry = sequence / "poses_odometry.txt"
+    run_cli(cli, "optimise", sequence, "--odometry", odometry, "--loops", loops, "--out",
+            tmp_path / "cli")
+    result = lidarloop.optimise(sequence, odometry=odometry, loops=loops, out=tmp_path / "py")
+    assert (tmp_path / "py" / "poses_optimised.txt").read_bytes() == \
+        (tmp_path / "cli" / "poses_optimised.txt").read_bytes()
+    cli_metrics = json.loads((tmp_path / "cli" / "metrics.json").read_text())
+    py_metrics = json.loads(result.metrics_path.read_text())
+    assert without_timings(py_metrics) == without_timings(cli_metrics)
+    assert result.optimised_metrics["ate_rmse_m"] == cli_metrics["ate_rmse_m_optimised"]
+    assert result.optimised_metrics["ate_rmse_m"] < result.odometry_metrics["ate_rmse_m"]
+    assert result.result.loops_used == cli_metrics["loops"]["used"] > 10
+    assert all(result.loop_is_true)
+    kitti = np.loadtxt(tmp_path / "py" / "poses_optimised.txt").reshape(-1, 3, 4)
+    np.testing.assert_allclose(result.poses[:, :3, :], kitti, atol=1e-6)
+
+
+def test_results_folders_are_guarded(sequence, tmp_path):
+    with pytest.raises(lidarloop.WriteError):  # inside the dataset: its files would be scans
+        lidarloop.detect(sequence, out=sequence / "results", verify=False)
+    foreign = tmp_path / "foreign"
+    foreign.mkdir()
+    (foreign / "notes.txt").write_text("mine")
+    with pytest.raises(lidarloop.WriteError, match="overwrite"):
+        lidarloop.detect(sequence, out=foreign, verify=False)
+    lidarloop.detect(sequence, out=foreign, verify=False, overwrite=True)
+    assert (foreign / "notes.txt").read_text() == "mine" and (foreign / "loops.csv").is_file()
+    # A run again into its own folder replaces the run before.
+    lidarloop.detect(sequence, out=foreign, verify=False, method="height")
+    assert "method: height" in (foreign / "config.yaml").read_text()
+
+
+def test_a_failed_run_leaves_only_run_json(sequence, tmp_path):
+    def interrupt(stage, done, total):
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        lidarloop.detect(sequence, out=tmp_path / "out", verify=False, progress=interrupt)
+    assert [p.name for p in (tmp_path / "out").iterdir()] == ["run.json"]
+    run = json.loads((tmp_path / "out" / "run.json").read_text())
+    assert run["status"] == "failed" and "progress" in run["message"]
+    with pytest.raises(lidarloop.ConfigError, match="no_such_method"):
+        lidarloop.detect(sequence, out=tmp_path / "bad", method="no_such_method")
+    with pytest.raises(lidarloop.ReadError):
+        lidarloop.evaluate(tmp_path / "missing", out=tmp_path / "eval")
+
+
+@pytest.mark.parametrize("area", ["registration", "posegraph", "eval", "sim", "app"])
+def test_stubs_match_the_module(area):
+    """Every exported name has a stub, and every public member of a class a stub entry."""
+    import ast
+    import importlib
+    from pathlib import Path
+
+    module = importlib.import_module(f"lidarloop.{area}")
+    stub = Path(module.__file__).with_suffix(".pyi")
+    tree = ast.parse(stub.read_text())
+    stubbed = {n.name: n for n in tree.body if isinstance(n, (ast.ClassDef, ast.FunctionDef))}
+    assert set(module.__all__) == set(stubbed)
+    for name, node in stubbed.items():
+        if not isinstance(node, ast.ClassDef):
+            continue
+        members = {getattr(m, "name", None) or getattr(getattr(m, "target", None), "id", None)
+                   for m in node.body}
+        public = {a for a in dir(getattr(module, name)) if not a.startswith("_")}
+        assert public <= members, f"{name}: no stub for {public - members}"

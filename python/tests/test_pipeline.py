@@ -1,0 +1,177 @@
+"""The descriptor database, its index and the online detector: parity with `lidarloop detect`
+on a simulated sequence, brute force for the index, save/load round trips."""
+
+import csv
+import subprocess
+
+import numpy as np
+import pytest
+
+import lidarloop
+
+MIN_GAP = 10
+
+
+@pytest.fixture(scope="module")
+def sequence(cli, tmp_path_factory):
+    """60 small simulated VLP-16 scans (KITTI layout) with revisits, made by the CLI."""
+    folder = tmp_path_factory.mktemp("sequence")
+    subprocess.run(
+        [str(cli), "simulate", "--scans", "60", "--sensor", "vlp16", "--horizontal-steps", "450",
+         "--quiet", "--out", str(folder)],
+        check=True, capture_output=True)
+    return lidarloop.open_dataset(folder)
+
+
+@pytest.fixture(scope="module")
+def detected(cli, sequence, tmp_path_factory):
+    """`lidarloop detect --no-verify` on the sequence: its results folder."""
+    out = tmp_path_factory.mktemp("detect")
+    subprocess.run(
+        [str(cli), "detect", str(sequence.root), "--method", "range", "--no-verify",
+         "--min-gap", str(MIN_GAP), "--out", str(out)],
+        check=True, capture_output=True)
+    return out
+
+
+@pytest.fixture(scope="module")
+def descriptors(sequence):
+    return [lidarloop.describe(sequence[i], "range") for i in range(len(sequence))]
+
+
+@pytest.fixture(scope="module")
+def database(sequence, descriptors):
+    times, _ = sequence.poses
+    database = lidarloop.DescriptorDatabase(method="range")
+    for descriptor, time_s in zip(descriptors, times):
+        database.add(descriptor, time_s)
+    return database
+
+
+def test_database_distances_are_the_pairwise_distances(database, descriptors):
+    assert len(database) == len(descriptors) and database.method == "range"
+    for i, j in [(0, 1), (5, 40), (59, 3)]:
+        assert database.distance(i, j) == pytest.approx(lidarloop.distance(descriptors[i], descriptors[j]), rel=1e-6)
+    to_all = database.distances(descriptors[7])
+    assert to_all.shape == (len(descriptors),)
+    assert to_all[7] == pytest.approx(0.0, abs=1e-7)
+    np.testing.assert_allclose(to_all, [database.distance(7, j) for j in range(len(database))], rtol=1e-6)
+
+
+def test_database_matches_the_one_detect_saves(database, detected):
+    saved = lidarloop.DescriptorDatabase.load(detected / "database.lldb")
+    assert len(saved) == len(database)
+    np.testing.assert_array_equal(saved.times_s, database.times_s)
+    for i, j in [(0, 1), (5, 40), (59, 3)]:
+        assert saved.distance(i, j) == database.distance(i, j)
+
+
+def test_database_save_load_round_trip(descriptors, tmp_path):
+    database = lidarloop.DescriptorDatabase(method="range")
+    for descriptor in descriptors[:20]:
+        database.add(descriptor)
+    database.add_missing(1000.0)
+    database.save(tmp_path / "db.lldb")
+    loaded = lidarloop.DescriptorDatabase.load(tmp_path / "db.lldb")
+    assert len(loaded) == len(database)
+    assert not loaded.is_valid(len(loaded) - 1) and loaded.is_valid(0)
+    np.testing.assert_array_equal(loaded.times_s, database.times_s)
+    assert loaded.distance(0, len(loaded) - 1) == np.inf
+    n = len(loaded) - 1
+    expected = [[database.distance(i, j) for j in range(n)] for i in range(n)]
+    np.testing.assert_array_equal([[loaded.distance(i, j) for j in range(n)] for i in range(n)], expected)
+
+
+def test_loading_a_damaged_database_raises_read_error(database, tmp_path):
+    file = tmp_path / "db.lldb"
+    database.save(file)
+    file.write_bytes(file.read_bytes()[:-5])
+    with pytest.raises(lidarloop.ReadError) as error:
+        lidarloop.DescriptorDatabase.load(file)
+    assert error.value.file == str(file)
+    with pytest.raises(lidarloop.ReadError):
+        lidarloop.DescriptorDatabase.load(tmp_path / "missing.lldb")
+
+
+def test_adding_another_method_raises_config_error(database, sequence):
+    with pytest.raises(lidarloop.ConfigError):
+        database.add(lidarloop.describe(sequence[0], "height"))
+
+
+def test_index_search_is_the_brute_force_top_k(database, descriptors):
+    index = database.index()
+    index.insert_all()
+    eligible = np.arange(len(database)) < 30
+    for query in (descriptors[45], descriptors[50]):
+        distances = database.distances(query)
+        order = sorted(range(len(database)), key=lambda j: (distances[j], j))
+        found = index.search(query, 5)
+        assert [n.index for n in found] == order[:5]
+        np.testing.assert_allclose([n.distance for n in found], distances[order[:5]], rtol=1e-6)
+        restricted = index.search(query, 5, eligible=eligible)
+        assert [n.index for n in restricted] == [j for j in order if eligible[j]][:5]
+    with pytest.raises(lidarloop.ShapeError):
+        index.search(descriptors[0], 3, eligible=np.ones(3, bool))
+
+
+def test_ndt_has_no_index(sequence):
+    database = lidarloop.DescriptorDatabase(method="ndt")
+    database.add(lidarloop.describe(sequence[0], "ndt"))
+    assert database.index() is None
+
+
+def read_loops(results):
+    with open(results / "loops.csv") as file:
+        return {int(row["query"]): row for row in csv.DictReader(file)}
+
+
+def test_online_detector_finds_the_loops_detect_finds(sequence, detected):
+    detector = lidarloop.LoopDetector(method="range", min_gap=MIN_GAP, verify=False)
+    times, _ = sequence.poses
+    queries = [detector.process(sequence[i], times[i]) for i in range(len(sequence))]
+    expected = read_loops(detected)
+    assert len(detector) == len(sequence)
+    assert {q.query for q in queries if q.candidates} == set(expected)
+    for query in queries:
+        if not query.candidates:
+            continue
+        row = expected[query.query]
+        best = query.candidates[0]
+        assert best.index == int(row["match"])
+        assert best.distance == pytest.approx(float(row["distance"]), rel=1e-6)
+        assert query.accepted == (row["accepted"] == "1")
+        assert (query.match == best.index) == query.accepted
+
+
+def test_detector_save_load_continues_the_map(sequence, tmp_path):
+    detector = lidarloop.LoopDetector(method="range", min_gap=MIN_GAP, verify=False)
+    for i in range(40):
+        detector.process(sequence[i])
+    detector.save(tmp_path / "map.lldb")
+    loaded = lidarloop.LoopDetector.load(tmp_path / "map.lldb")
+    assert len(loaded) == 40 and loaded.threshold == detector.threshold and not loaded.verify
+    query = lidarloop.describe(sequence[45], "range")
+    assert [(n.index, n.distance) for n in loaded.query(query).candidates] == [
+        (n.index, n.distance) for n in detector.query(query).candidates
+    ]
+
+
+def test_verifying_detector_keeps_and_saves_its_scans(sequence, tmp_path):
+    detector = lidarloop.LoopDetector(method="range", min_gap=MIN_GAP, top_k=2)
+    results = [detector.process(sequence[i]) for i in range(15)]
+    assert detector.verify
+    assert all(r.verified == bool(r.candidates) for r in results)
+    detector.save(tmp_path / "map.lldb")
+    assert (tmp_path / "map.scans").is_file()
+    assert len(lidarloop.LoopDetector.load(tmp_path / "map.lldb")) == 15
+
+
+def test_detector_rejects_bad_points_and_config():
+    detector = lidarloop.LoopDetector(method="range", verify=False)
+    with pytest.raises(lidarloop.ShapeError):
+        detector.process(np.zeros((5, 2)))
+    with pytest.raises(lidarloop.NonFiniteError):
+        detector.process(np.full((5, 3), np.nan))
+    assert len(detector) == 0
+    with pytest.raises(lidarloop.ConfigError, match="top_k"):
+        lidarloop.LoopDetector(top_k=0)
