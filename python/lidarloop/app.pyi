@@ -198,6 +198,7 @@ def optimise(
     min_gap: Optional[float] = None,
     min_gap_unit: Optional[str] = None,
     skip_bad: bool = False,
+    overwrite: bool = False,
     progress: Optional[Progress] = None,
     format: str = "auto",
     poses: Optional[PathLike] = None,

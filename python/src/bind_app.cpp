@@ -112,30 +112,24 @@ std::string CallText(const std::string& function, const py::object& first, const
     return text + ")";
 }
 
-/// What cli/run_output.hpp's RunInFolder does, without signals (Python's KeyboardInterrupt
-/// waits until the run returns): app::RunFolder checks and stages `out`, `run(staging)` runs
-/// with the GIL released, and the folder is completed, or abandoned as failed with the error
-/// (then only run.json is left, saying so). A progress callback that raised fails the run too.
+/// app::RunInFolder with the GIL released: `out` is checked and staged, `run(staging)` runs, and
+/// the folder is completed, or abandoned as failed with the error (then only run.json is left,
+/// saying so). A progress callback that raised fails the run too, with its exception. Python's
+/// KeyboardInterrupt waits until the run returns.
 template <typename Run>
 auto RunInFolder(const fs::path& out, const fs::path& dataset, bool overwrite,
                  const std::string& command_line, const PythonProgress& progress, Run&& run) {
-    app::RunFolder folder(out, {command_line, dataset, overwrite});
     try {
-        std::optional<decltype(run(folder.staging()))> result;
-        {
-            py::gil_scoped_release release;
-            result.emplace(run(folder.staging()));
-        }
-        if (progress.Failed()) {
-            folder.Abandon(app::RunStatus::kFailed, "the progress callback raised an exception");
-            progress.Rethrow();
-        }
-        folder.Complete();
-        return std::move(*result);
-    } catch (const py::error_already_set&) {
-        throw;  // the folder was abandoned above
-    } catch (const std::exception& e) {
-        folder.Abandon(app::RunStatus::kFailed, e.what());
+        py::gil_scoped_release release;
+        return app::RunInFolder(
+            out, {command_line, dataset, overwrite}, [&](const fs::path& staging) {
+                auto result = run(staging);
+                if (progress.Failed())
+                    throw core::Error("the progress callback raised an exception");
+                return result;
+            });
+    } catch (const core::Error&) {
+        progress.Rethrow();  // the callback's own exception, when it raised one
         throw;
     }
 }
@@ -502,9 +496,13 @@ void BindOptimise(py::module_& m) {
            const std::optional<fs::path>& loops, const std::string& pose_format,
            const std::optional<std::string>& method, const py::object& config,
            std::optional<double> threshold, std::optional<int> top_k, std::optional<double> min_gap,
-           const std::optional<std::string>& min_gap_unit, bool skip_bad,
+           const std::optional<std::string>& min_gap_unit, bool skip_bad, bool overwrite,
            const py::object& progress, const std::string& format,
            const std::optional<fs::path>& poses, const std::optional<fs::path>& calib) {
+            const py::dict given(py::arg("odometry") = odometry.string(),
+                                 py::arg("out") = out.string(), py::arg("method") = method,
+                                 py::arg("threshold") = threshold, py::arg("top_k") = top_k,
+                                 py::arg("min_gap") = min_gap, py::arg("overwrite") = overwrite);
             if (pose_format != "kitti" && pose_format != "tum")
                 throw core::ConfigError("pose_format must be kitti or tum, got '" + pose_format +
                                         "'");
@@ -520,12 +518,13 @@ void BindOptimise(py::module_& m) {
             request.out = out;
             const io::Dataset data = DatasetOf(dataset, format, poses, calib);
             OptimiseResult result;
-            {
-                // As the CLI: RunOptimisation writes into `out` itself (no staging).
-                py::gil_scoped_release release;
-                result.outcome = app::RunOptimisation(data, request);
-            }
-            python_progress.Rethrow();
+            result.outcome =
+                RunInFolder(out, data.root(), overwrite, CallText("optimise", dataset, given),
+                            python_progress, [&](const fs::path& staging) {
+                                app::OptimiseRequest staged = request;
+                                staged.out = staging;
+                                return app::RunOptimisation(data, staged);
+                            });
             result.out = out;
             return result;
         },
@@ -534,12 +533,14 @@ void BindOptimise(py::module_& m) {
         py::arg("method") = py::none(), py::arg("config") = py::none(),
         py::arg("threshold") = py::none(), py::arg("top_k") = py::none(),
         py::arg("min_gap") = py::none(), py::arg("min_gap_unit") = py::none(),
-        py::arg("skip_bad") = false, py::arg("progress") = py::none(), py::arg("format") = "auto",
-        py::arg("poses") = py::none(), py::arg("calib") = py::none(),
+        py::arg("skip_bad") = false, py::arg("overwrite") = false, py::arg("progress") = py::none(),
+        py::arg("format") = "auto", py::arg("poses") = py::none(), py::arg("calib") = py::none(),
         "`lidarloop optimise DATASET --odometry FILE --out OUT`: reads the accepted loops "
         "(loops.csv of a verified detect) or detects them first (into out/detection), builds "
         "and optimises the pose graph and writes poses_optimised.txt (pose_format kitti | "
-        "tum), graph.g2o, loop_verdicts.csv, metrics.json, report.md and config.yaml.");
+        "tum), graph.g2o, loop_verdicts.csv, metrics.json, report.md and config.yaml into `out` "
+        "(a results folder, as detect's: staged, run.json last, refused inside the dataset or "
+        "when it holds other files unless overwrite).");
 }
 
 }  // namespace

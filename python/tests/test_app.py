@@ -163,6 +163,9 @@ def test_optimise_matches_the_cli(cli, cli_verified, sequence, tmp_path):
     assert all(result.loop_is_true)
     kitti = np.loadtxt(tmp_path / "py" / "poses_optimised.txt").reshape(-1, 3, 4)
     np.testing.assert_allclose(result.poses[:, :3, :], kitti, atol=1e-6)
+    assert json.loads((tmp_path / "py" / "run.json").read_text())["status"] == "complete"
+    with pytest.raises(lidarloop.WriteError):  # inside the dataset, as detect
+        lidarloop.optimise(sequence, odometry=odometry, loops=loops, out=sequence / "opt")
 
 
 def test_results_folders_are_guarded(sequence, tmp_path):
