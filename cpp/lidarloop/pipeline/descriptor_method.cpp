@@ -63,6 +63,11 @@ Registry& TheRegistry() {
 
 }  // namespace
 
+core::Descriptor DescriptorMethod::DescribeView(core::PointsView points,
+                                                const core::DescriptorConfig& config) const {
+    return Describe(core::PointCloud(points.begin(), points.end()), config);
+}
+
 void DescriptorMethod::ValidateThreshold(double threshold) const {
     if (!(std::isfinite(threshold) && threshold >= 0.0)) {
         throw core::ConfigError("detection.threshold must be a finite number >= 0, got " +
@@ -101,6 +106,11 @@ std::string MethodNamesText(std::string_view separator) {
 core::Descriptor ComputeDescriptor(const core::PointCloud& cloud,
                                    const core::DescriptorConfig& config) {
     return MethodOf(config.method).Describe(cloud, config);
+}
+
+core::Descriptor ComputeDescriptorView(core::PointsView points,
+                                       const core::DescriptorConfig& config) {
+    return MethodOf(config.method).DescribeView(points, config);
 }
 
 double DescriptorDistance(const core::Descriptor& a, const core::Descriptor& b) {
