@@ -63,6 +63,37 @@ std::size_t PointsSkipped(const Descriptor& descriptor) {
     return HistogramOf(descriptor, "points_skipped").points_skipped;
 }
 
+// The non-finite points a descriptor skipped, when its type counts them.
+std::optional<std::size_t> SkippedPoints(const Descriptor& descriptor) {
+    if (const auto* set = std::any_cast<core::NdtDescriptorSet>(&descriptor.value)) {
+        return set->cell_stats.points_skipped;
+    }
+    if (const auto* histogram = std::any_cast<core::Histogram>(&descriptor.value)) {
+        return histogram->points_skipped;
+    }
+    return std::nullopt;
+}
+
+// Describes points that C++ reads in place (no copy). Non-finite points are looked for only
+// when the descriptor counted some, or cannot tell, so the common case reads the points once.
+Descriptor DescribeView(core::PointsView points, const core::DescriptorConfig& config,
+                        bool skip_non_finite) {
+    py::gil_scoped_release release;
+    Descriptor descriptor;
+    try {
+        descriptor = pipeline::ComputeDescriptorView(points, config);
+    } catch (const core::EmptyInputError&) {
+        // All points non-finite: say so rather than "nothing usable".
+        const auto row = skip_non_finite ? std::nullopt : FirstNonFiniteRow(points);
+        if (row) ThrowNonFiniteRow(*row);
+        throw;
+    }
+    if (!skip_non_finite && SkippedPoints(descriptor).value_or(1) > 0) {
+        if (const auto row = FirstNonFiniteRow(points)) ThrowNonFiniteRow(*row);
+    }
+    return descriptor;
+}
+
 Descriptor Describe(const py::object& points, const std::optional<std::string>& method,
                     const py::object& config, const HistogramKeywords& keywords,
                     bool skip_non_finite) {
@@ -72,7 +103,10 @@ Descriptor Describe(const py::object& points, const std::optional<std::string>& 
         py::gil_scoped_release release;
         return app::DescribeScanFile(file, run.descriptor);
     }
-    const core::PointCloud cloud = PointsFromArray(points, skip_non_finite);
+    if (const auto view = ViewOfPoints(points)) {
+        return DescribeView(*view, run.descriptor, skip_non_finite);
+    }
+    const core::PointCloud& cloud = ScratchPointsFromArray(points, skip_non_finite);
     py::gil_scoped_release release;
     return pipeline::ComputeDescriptor(cloud, run.descriptor);
 }

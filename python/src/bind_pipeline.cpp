@@ -291,7 +291,7 @@ void BindDetector(py::module_& m) {
             "process",
             [](LoopDetector& detector, const py::object& points, std::optional<double> time_s,
                bool skip_non_finite) {
-                const core::PointCloud cloud = PointsFromArray(points, skip_non_finite);
+                const core::PointCloud& cloud = ScratchPointsFromArray(points, skip_non_finite);
                 const double t = time_s.value_or(static_cast<double>(detector.database().size()));
                 py::gil_scoped_release release;
                 return detector.Process(cloud, t);

@@ -21,6 +21,9 @@ void BindDescriptors(pybind11::module_& m);
 /// The descriptor database, its nearest-neighbour index, the online loop detector.
 void BindPipeline(pybind11::module_& m);
 
+/// Private C++ timings for bench/python_overhead.py.
+void BindTiming(pybind11::module_& m);
+
 /// Part 2 of issue 17 (registration, pose graph, evaluation, simulator, run layer).
 void BindRegistration(pybind11::module_& m);
 void BindPosegraph(pybind11::module_& m);

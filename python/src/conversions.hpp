@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -38,46 +39,94 @@ inline void CheckFloatArray(const py::handle& object, const std::string& what) {
     throw DtypeError(what + " must be a NumPy array of float32 or float64, got " + got);
 }
 
+/// NonFiniteError for points row `row`.
+[[noreturn]] inline void ThrowNonFiniteRow(std::size_t row) {
+    throw NonFiniteError("points row " + std::to_string(row) +
+                         " is not finite (NaN or infinite); drop such rows, or pass "
+                         "skip_non_finite=True to have lidarloop skip and count them");
+}
+
+/// The first row of `points` with a NaN or infinite coordinate, if any.
+inline std::optional<std::size_t> FirstNonFiniteRow(core::PointsView points) {
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        if (!points[i].allFinite()) return i;
+    }
+    return std::nullopt;
+}
+
+/// ShapeError unless `points` (a float array) has shape (N, 3) or (N, 4).
+inline void CheckPointsShape(const py::array& points) {
+    if (points.ndim() != 2 || (points.shape(1) != 3 && points.shape(1) != 4)) {
+        throw ShapeError("points must have shape (N, 3) or (N, 4), got " +
+                         py::str(points.attr("shape")).cast<std::string>());
+    }
+}
+
+/// The points of `points` without a copy when their memory is already core::PointsView's
+/// layout: a C-contiguous (N, 3) float32 array. The array must outlive the view (and not change
+/// while C++ reads it).
+inline std::optional<core::PointsView> ViewOfPoints(const py::handle& points) {
+    if (!IsArrayOf<float>(points)) return std::nullopt;
+    const auto array = py::reinterpret_borrow<py::array_t<float>>(points);
+    constexpr auto kRow = static_cast<py::ssize_t>(3 * sizeof(float));
+    const bool packed = array.ndim() == 2 && array.shape(1) == 3 &&
+                        (array.shape(0) <= 1 || array.strides(0) == kRow) &&
+                        array.strides(1) == static_cast<py::ssize_t>(sizeof(float));
+    if (!packed) return std::nullopt;
+    static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float));
+    return core::PointsView(reinterpret_cast<const Eigen::Vector3f*>(array.data()),
+                            static_cast<std::size_t>(array.shape(0)));
+}
+
 namespace detail {
 
 template <typename T>
-core::PointCloud CopyPoints(const py::array_t<T>& array, bool allow_non_finite) {
+void CopyPoints(const py::array_t<T>& array, bool allow_non_finite, core::PointCloud& cloud) {
     const auto view = array.template unchecked<2>();  // follows the strides: any layout
-    core::PointCloud cloud(static_cast<std::size_t>(view.shape(0)));
+    cloud.resize(static_cast<std::size_t>(view.shape(0)));
     for (py::ssize_t i = 0; i < view.shape(0); ++i) {
         Eigen::Vector3f& point = cloud[static_cast<std::size_t>(i)];
         point = {static_cast<float>(view(i, 0)), static_cast<float>(view(i, 1)),
                  static_cast<float>(view(i, 2))};
-        if (!allow_non_finite && !point.allFinite()) {
-            throw NonFiniteError("points row " + std::to_string(i) +
-                                 " is not finite (NaN or infinite); drop such rows, or pass "
-                                 "skip_non_finite=True to have lidarloop skip and count them");
-        }
+        if (!allow_non_finite && !point.allFinite()) ThrowNonFiniteRow(static_cast<std::size_t>(i));
     }
-    return cloud;
 }
 
 }  // namespace detail
 
-/// Points in the sensor frame, metres, from an (N, 3) or (N, 4) float32 or float64 array in any
-/// memory layout (the 4th column, e.g. intensity, is ignored). core::PointCloud is a
+/// Copies points in the sensor frame, metres, from an (N, 3) or (N, 4) float32 or float64 array in
+/// any memory layout (the 4th column, e.g. intensity, is ignored). core::PointCloud is a
 /// std::vector of Eigen::Vector3f, which cannot borrow NumPy's memory, so this is one copy
 /// (12 bytes a point; float64 is rounded to float32, as the readers of files do). DtypeError,
 /// ShapeError, and NonFiniteError for a NaN or infinite coordinate unless `allow_non_finite`
 /// (then the C++ side skips and counts them, as it does for files).
-inline core::PointCloud PointsFromArray(const py::handle& points, bool allow_non_finite) {
+inline void CopyPointsInto(const py::handle& points, bool allow_non_finite,
+                           core::PointCloud& cloud) {
     CheckFloatArray(points, "points");
-    const py::array array = py::reinterpret_borrow<py::array>(points);
-    if (array.ndim() != 2 || (array.shape(1) != 3 && array.shape(1) != 4)) {
-        throw ShapeError("points must have shape (N, 3) or (N, 4), got " +
-                         py::str(points.attr("shape")).cast<std::string>());
-    }
+    CheckPointsShape(py::reinterpret_borrow<py::array>(points));
     if (IsArrayOf<float>(points)) {
-        return detail::CopyPoints(py::reinterpret_borrow<py::array_t<float>>(points),
-                                  allow_non_finite);
+        detail::CopyPoints(py::reinterpret_borrow<py::array_t<float>>(points), allow_non_finite,
+                           cloud);
+    } else {
+        detail::CopyPoints(py::reinterpret_borrow<py::array_t<double>>(points), allow_non_finite,
+                           cloud);
     }
-    return detail::CopyPoints(py::reinterpret_borrow<py::array_t<double>>(points),
-                              allow_non_finite);
+}
+
+inline core::PointCloud PointsFromArray(const py::handle& points, bool allow_non_finite) {
+    core::PointCloud cloud;
+    CopyPointsInto(points, allow_non_finite, cloud);
+    return cloud;
+}
+
+/// PointsFromArray into a buffer of the calling thread, kept between calls, for calls that
+/// read the points only while they run: a fresh buffer for a large scan is mapped anew by malloc
+/// each time, and its page faults cost more than the copy. Valid until the thread's next call.
+inline const core::PointCloud& ScratchPointsFromArray(const py::handle& points,
+                                                      bool allow_non_finite) {
+    thread_local core::PointCloud scratch;
+    CopyPointsInto(points, allow_non_finite, scratch);
+    return scratch;
 }
 
 /// An (N, 3) float32 array that owns `cloud` and views its memory: no copy (Eigen::Vector3f is

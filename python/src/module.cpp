@@ -13,6 +13,7 @@ PYBIND11_MODULE(_lidarloop, m) {
     python::BindIo(m);
     python::BindDescriptors(m);
     python::BindPipeline(m);
+    python::BindTiming(m);
     python::BindRegistration(m);
     python::BindPosegraph(m);
     python::BindEval(m);

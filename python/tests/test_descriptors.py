@@ -177,3 +177,12 @@ def test_method_names_thresholds_and_config_dump(cli):
     assert lidarloop.method_names()[:3] == METHODS
     assert lidarloop.is_match("range", 0.001, lidarloop.default_threshold("range"))
     assert lidarloop.dump_config() == run_cli(cli, "dump-config")
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_a_scan_of_only_non_finite_points_raises_non_finite_error(dtype):
+    points = np.full((5, 3), np.nan, dtype)
+    with pytest.raises(lidarloop.NonFiniteError, match="row 0"):
+        lidarloop.describe(points, "range")
+    with pytest.raises(lidarloop.EmptyInputError):
+        lidarloop.describe(points, "range", skip_non_finite=True)

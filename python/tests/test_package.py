@@ -35,3 +35,25 @@ def test_every_error_is_a_lidarloop_error_and_its_builtin(name, builtin):
 def test_every_area_name_is_exported_at_the_top():
     for name in lidarloop.__all__:
         assert hasattr(lidarloop, name), name
+
+
+AREAS = ["app", "descriptors", "errors", "eval", "io", "pipeline", "posegraph", "registration", "sim"]
+
+
+@pytest.mark.parametrize("area", AREAS)
+def test_each_area_stub_declares_exactly_its_exports(area):
+    """The .pyi of an area declares the names its module exports, and its classes' methods
+    exist on the real classes, so that editors complete what is there."""
+    import ast
+    import importlib
+
+    module = importlib.import_module(f"lidarloop.{area}")
+    stub = ast.parse((Path(lidarloop.__file__).parent / f"{area}.pyi").read_text())
+    declared = {node.name for node in stub.body if isinstance(node, (ast.ClassDef, ast.FunctionDef))}
+    assert declared == set(module.__all__)
+    for node in stub.body:
+        if isinstance(node, ast.ClassDef):
+            cls = getattr(module, node.name)
+            for member in node.body:
+                if isinstance(member, ast.FunctionDef):
+                    assert hasattr(cls, member.name), f"{node.name}.{member.name}"

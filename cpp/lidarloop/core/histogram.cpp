@@ -89,7 +89,7 @@ struct BlockRanges {
 // Counts the values of `cloud` into buckets; `values` gives the projection v(p) of point j of
 // the block it prepared last.
 template <typename BlockValues>
-void CountValues(const PointCloud& cloud, BlockValues values, const HistogramConfig& config,
+void CountValues(PointsView cloud, BlockValues values, const HistogramConfig& config,
                  std::vector<std::size_t>& counts, Histogram& histogram) {
     const double min_value = histogram.min_value;
     const double max_value = histogram.max_value;
@@ -168,8 +168,7 @@ void HistogramConfig::Validate() const {
     if (range_min_m < 0.0) throw ConfigError("histogram.range_min_m must be >= 0 (a range)");
 }
 
-Histogram ComputeHistogram(const PointCloud& cloud, Projection projection,
-                           const HistogramConfig& config) {
+Histogram ComputeHistogram(PointsView cloud, Projection projection, const HistogramConfig& config) {
     config.Validate();
     if (cloud.empty()) throw EmptyInputError("the scan has no points");
     Histogram histogram;

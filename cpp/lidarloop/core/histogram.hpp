@@ -62,7 +62,11 @@ struct Histogram {
 /// [v_min + k*dI, v_min + (k+1)*dI), the last one also v_max. Non-finite points are skipped and
 /// counted. Throws EmptyInputError when no point is left to count and ConfigError for an invalid
 /// configuration. Thread-safe; O(|S| + b).
-Histogram ComputeHistogram(const PointCloud& cloud, Projection projection,
-                           const HistogramConfig& config);
+Histogram ComputeHistogram(PointsView cloud, Projection projection, const HistogramConfig& config);
+/// The same for a PointCloud (or a braced list of points).
+inline Histogram ComputeHistogram(const PointCloud& cloud, Projection projection,
+                                  const HistogramConfig& config) {
+    return ComputeHistogram(PointsView(cloud), projection, config);
+}
 
 }  // namespace lidarloop::core

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <span>
 #include <vector>
 
 #include <Eigen/Core>
@@ -10,6 +11,10 @@ namespace lidarloop::core {
 /// One LiDAR scan: points in the sensor frame (origin at the sensor), metres, x forward, y left,
 /// z up (right-handed). Points may be non-finite (no return); consumers skip and count them.
 using PointCloud = std::vector<Eigen::Vector3f>;
+
+/// Points in the same layout without owning them (a PointCloud converts implicitly), e.g. the
+/// memory of a NumPy array, so that a caller need not copy them into a PointCloud.
+using PointsView = std::span<const Eigen::Vector3f>;
 
 /// A rigid transform T_target_source: maps coordinates in the source frame into the target frame.
 using Transform = Eigen::Isometry3d;

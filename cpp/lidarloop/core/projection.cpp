@@ -38,7 +38,7 @@ UpVectorMode ParseUpVectorMode(std::string_view name) {
     return ParseEnum(kUpVectorModeNames, name, "up vector mode");
 }
 
-Eigen::Vector3d EstimateUpVectorPca(const PointCloud& cloud) {
+Eigen::Vector3d EstimateUpVectorPca(PointsView cloud) {
     // Two passes (mean, then centred second moments) keep the covariance accurate for scans far
     // from the origin, which a one-pass sum of squares would not.
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();

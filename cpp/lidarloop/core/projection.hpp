@@ -31,6 +31,10 @@ UpVectorMode ParseUpVectorMode(std::string_view name);
 /// of the finite points, the direction of least spread, which for a ground vehicle's scan is the
 /// normal of the ground. Sign chosen so that z >= 0 ("positive z values point upwards").
 /// Throws EmptyInputError with fewer than 3 finite points.
-Eigen::Vector3d EstimateUpVectorPca(const PointCloud& cloud);
+Eigen::Vector3d EstimateUpVectorPca(PointsView cloud);
+/// The same for a PointCloud (or a braced list of points).
+inline Eigen::Vector3d EstimateUpVectorPca(const PointCloud& cloud) {
+    return EstimateUpVectorPca(PointsView(cloud));
+}
 
 }  // namespace lidarloop::core

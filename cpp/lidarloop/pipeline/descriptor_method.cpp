@@ -63,6 +63,16 @@ Registry& TheRegistry() {
 
 }  // namespace
 
+core::Descriptor DescriptorMethod::DescribeView(core::PointsView points,
+                                                const core::DescriptorConfig& config) const {
+    // One buffer per thread, kept between calls: a fresh 1.4 MB copy of a 120k-point scan is
+    // mapped anew by malloc each time, and its page faults cost ~0.5 ms (docs/BENCHMARK.md,
+    // "Python bindings"). Describe does not keep a reference to its input.
+    thread_local core::PointCloud copy;
+    copy.assign(points.begin(), points.end());
+    return Describe(copy, config);
+}
+
 void DescriptorMethod::ValidateThreshold(double threshold) const {
     if (!(std::isfinite(threshold) && threshold >= 0.0)) {
         throw core::ConfigError("detection.threshold must be a finite number >= 0, got " +
@@ -101,6 +111,11 @@ std::string MethodNamesText(std::string_view separator) {
 core::Descriptor ComputeDescriptor(const core::PointCloud& cloud,
                                    const core::DescriptorConfig& config) {
     return MethodOf(config.method).Describe(cloud, config);
+}
+
+core::Descriptor ComputeDescriptorView(core::PointsView points,
+                                       const core::DescriptorConfig& config) {
+    return MethodOf(config.method).DescribeView(points, config);
 }
 
 double DescriptorDistance(const core::Descriptor& a, const core::Descriptor& b) {

@@ -106,6 +106,10 @@ public:
     /// The descriptor of `cloud`; core::EmptyInputError when nothing in it is usable.
     virtual core::Descriptor Describe(const core::PointCloud& cloud,
                                       const core::DescriptorConfig& config) const = 0;
+    /// Describe for points owned elsewhere (e.g. a NumPy array). By default they are copied
+    /// into a PointCloud for Describe; a method that reads a view directly overrides this.
+    virtual core::Descriptor DescribeView(core::PointsView points,
+                                          const core::DescriptorConfig& config) const;
     /// The distance between two descriptors of this method: smaller is more similar, 0 for
     /// equal descriptors, symmetric.
     virtual double Distance(const core::Descriptor& a, const core::Descriptor& b) const = 0;
@@ -146,6 +150,11 @@ std::string MethodNamesText(std::string_view separator);
 /// EmptyInputError for a scan with nothing usable. Thread-safe.
 core::Descriptor ComputeDescriptor(const core::PointCloud& cloud,
                                    const core::DescriptorConfig& config);
+
+/// ComputeDescriptor for points owned elsewhere: MethodOf(config.method).DescribeView, which
+/// copies them only for methods that cannot read a view. Thread-safe.
+core::Descriptor ComputeDescriptorView(core::PointsView points,
+                                       const core::DescriptorConfig& config);
 
 /// The distance between two descriptors of the same method (ConfigError on mixed methods).
 double DescriptorDistance(const core::Descriptor& a, const core::Descriptor& b);

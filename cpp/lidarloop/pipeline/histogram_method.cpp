@@ -84,8 +84,13 @@ HistogramMethod::HistogramMethod(core::Method method) : DescriptorMethod(method)
 
 core::Descriptor HistogramMethod::Describe(const core::PointCloud& cloud,
                                            const core::DescriptorConfig& config) const {
+    return DescribeView(cloud, config);
+}
+
+core::Descriptor HistogramMethod::DescribeView(core::PointsView points,
+                                               const core::DescriptorConfig& config) const {
     return {method(),
-            core::ComputeHistogram(cloud, core::ProjectionOf(method()), config.histogram)};
+            core::ComputeHistogram(points, core::ProjectionOf(method()), config.histogram)};
 }
 
 double HistogramMethod::Distance(const core::Descriptor& a, const core::Descriptor& b) const {

@@ -21,6 +21,9 @@ public:
 
     core::Descriptor Describe(const core::PointCloud& cloud,
                               const core::DescriptorConfig& config) const override;
+    /// No copy: the histogram reads the view.
+    core::Descriptor DescribeView(core::PointsView points,
+                                  const core::DescriptorConfig& config) const override;
     double Distance(const core::Descriptor& a, const core::Descriptor& b) const override;
     std::unique_ptr<DescriptorStore> MakeStore(const core::DescriptorConfig& config) const override;
     /// tau = 0.005: Röhling table II, MCC is best near 0.005 on every route. Their b and value

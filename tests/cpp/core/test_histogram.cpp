@@ -126,7 +126,8 @@ TEST(Histogram, RangesOfEveryPointLandInTheirBucketsWithNonFiniteOnesSkipped) {
 
 TEST(Histogram, EmptyOrUnusableScanIsAnError) {
     constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
-    EXPECT_THROW(ComputeHistogram({}, Projection::kHeight, SmallConfig()), EmptyInputError);
+    EXPECT_THROW(ComputeHistogram(PointCloud{}, Projection::kHeight, SmallConfig()),
+                 EmptyInputError);
     EXPECT_THROW(ComputeHistogram({{kNan, kNan, kNan}}, Projection::kRange, SmallConfig()),
                  EmptyInputError);
     HistogramConfig drop = SmallConfig();

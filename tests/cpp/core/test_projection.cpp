@@ -47,7 +47,7 @@ TEST(Projection, PcaUpVectorPointsUpEvenForUpsideDownInput) {
 
 TEST(Projection, PcaNeedsThreeFinitePoints) {
     const float nan = std::numeric_limits<float>::quiet_NaN();
-    EXPECT_THROW(EstimateUpVectorPca({}), EmptyInputError);
+    EXPECT_THROW(EstimateUpVectorPca(PointCloud{}), EmptyInputError);
     EXPECT_THROW(EstimateUpVectorPca({{1, 2, 3}, {4, 5, 6}, {nan, 0, 0}}), EmptyInputError);
 }
 

@@ -92,6 +92,41 @@ TEST(DescriptorMethod, DescriptorsOfTwoMethodsAreNotCompared) {
     EXPECT_THROW(a.ndt(), core::ConfigError);  // holds a histogram
 }
 
+// A ground plane and a wall, dense enough for NDT cells, with random points between them.
+core::PointCloud GroundAndWall() {
+    core::PointCloud cloud = test::RandomCloud(2000, 3);
+    for (int i = 0; i < 150; ++i) {
+        for (int j = 0; j < 150; ++j) {
+            const float u = -7.5f + 0.1f * static_cast<float>(i);
+            const float v = -7.5f + 0.1f * static_cast<float>(j);
+            cloud.emplace_back(u, v, -1.7f);
+            cloud.emplace_back(8.0f, u, 0.05f * static_cast<float>(j) - 1.7f);
+        }
+    }
+    return cloud;
+}
+
+TEST(DescriptorMethod, AViewOfPointsIsDescribedAsTheirCopy) {
+    const core::PointCloud cloud = GroundAndWall();
+    // A part of the cloud, so that a view reading past its end would differ.
+    const core::PointsView part(cloud.data() + 1000, cloud.size() - 2000);
+    const core::PointCloud copy(part.begin(), part.end());
+    for (const core::Method& method :
+         {core::Method::kHeight, core::Method::kRange, core::Method::kNdt}) {
+        core::DescriptorConfig config;
+        config.method = method;
+        const core::Descriptor viewed = ComputeDescriptorView(part, config);
+        const core::Descriptor copied = ComputeDescriptor(copy, config);
+        EXPECT_EQ(DescriptorDistance(viewed, copied), 0.0) << core::ToString(method);
+        if (core::IsHistogramMethod(method)) {
+            EXPECT_EQ(viewed.histogram().mass, copied.histogram().mass);
+            EXPECT_EQ(viewed.histogram().points_used, copy.size());
+        } else {
+            EXPECT_EQ(viewed.ndt().cell_stats.points_used, copied.ndt().cell_stats.points_used);
+        }
+    }
+}
+
 TEST(DescriptorDatabase, TypedViewsBelongToTheirMethodAndCopiesAreDeep) {
     core::DescriptorConfig config;
     DescriptorDatabase histograms(config);
