@@ -84,7 +84,7 @@ eval::StreamedResult StreamPairs(eval::StreamedPairwise& evaluation, std::size_t
                                               std::min(n, (b + 1) * kStreamRows), n, distance);
                               }
                           });
-        for (const eval::StreamedPairwise::Sink& sink : sinks) evaluation.Merge(sink);
+        for (eval::StreamedPairwise::Sink& sink : sinks) evaluation.Merge(sink);
         evaluation.EndPass();
     }
     return evaluation.Result();

@@ -1,6 +1,7 @@
 #include "lidarloop/eval/streamed_pairwise.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <bit>
 #include <cmath>
@@ -8,6 +9,7 @@
 #include <limits>
 #include <new>
 #include <string>
+#include <utility>
 
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/eval/detail/sweep.hpp"
@@ -34,7 +36,7 @@ constexpr int kFineBits = 12;
 constexpr std::size_t kCoarseBuckets = std::size_t{1} << (32 - kFineBits);
 constexpr std::size_t kFineKeys = std::size_t{1} << kFineBits;
 constexpr std::size_t kBitmapWords = (std::size_t{1} << 32) / 64;
-constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr std::size_t kPending = std::size_t{1} << 18;  // negatives a sink sorts at once
 
 // A key whose unsigned order is the float order (-0 and +0 are one value, as `<` sees them).
 std::uint32_t OrderKey(float distance) {
@@ -62,14 +64,56 @@ struct PositiveLevels {
     std::vector<float> distances;       // distinct finite, ascending
     std::vector<std::uint64_t> counts;  // positives at each
     std::uint64_t total = 0;            // unscored included
+    // The first distance whose key's coarse bucket is >= b: a slot is then searched among the
+    // few distances of one bucket, not all (a binary search over all cost most of the time).
+    std::vector<std::uint32_t> first_in_bucket;
+    std::vector<std::uint32_t> keys;  // OrderKey of each distance
 
-    std::size_t SlotCount() const { return 2 * distances.size() + 1; }
-    std::size_t Slot(float distance) const {
-        const auto at = std::lower_bound(distances.begin(), distances.end(), distance);
-        const auto k = static_cast<std::size_t>(at - distances.begin());
-        return 2 * k + (at != distances.end() && *at == distance ? 1 : 0);
+    void Index() {
+        keys.clear();
+        for (const float d : distances) keys.push_back(OrderKey(d));
+        first_in_bucket.assign(kCoarseBuckets + 1, 0);
+        std::size_t k = 0;
+        for (std::size_t b = 0; b <= kCoarseBuckets; ++b) {
+            while (k < distances.size() && (OrderKey(distances[k]) >> kFineBits) < b) ++k;
+            first_in_bucket[b] = static_cast<std::uint32_t>(k);
+        }
     }
+    std::size_t SlotCount() const { return 2 * distances.size() + 1; }
 };
+
+// Sorts keys ascending: LSD radix sort in three passes of 11 bits, O(n) and cache-friendly.
+void RadixSort(std::vector<std::uint32_t>& keys, std::vector<std::uint32_t>& scratch) {
+    constexpr std::uint32_t kDigits = 2048;
+    scratch.resize(keys.size());
+    for (unsigned shift = 0; shift < 32; shift += 11) {
+        std::array<std::size_t, kDigits> offsets{};
+        for (const std::uint32_t key : keys) ++offsets[(key >> shift) & (kDigits - 1)];
+        std::size_t sum = 0;
+        for (std::size_t& offset : offsets) sum += std::exchange(offset, sum);
+        for (const std::uint32_t key : keys)
+            scratch[offsets[(key >> shift) & (kDigits - 1)]++] = key;
+        keys.swap(scratch);
+    }
+}
+
+// Counts ascending keys of negatives into the slots between `levels` (below D_k: 2k, at D_k:
+// 2k + 1), walking both in order, and gives each distinct key and its count to `each_key`.
+template <class EachKey>
+void CountSortedKeys(const std::vector<std::uint32_t>& keys, const PositiveLevels& levels,
+                     std::vector<std::uint64_t>& slots, EachKey each_key) {
+    std::size_t k = 0;
+    for (std::size_t a = 0; a < keys.size();) {
+        const std::uint32_t key = keys[a];
+        std::size_t b = a + 1;
+        while (b < keys.size() && keys[b] == key) ++b;
+        k = std::max<std::size_t>(k, levels.first_in_bucket[key >> kFineBits]);
+        while (k < levels.keys.size() && levels.keys[k] < key) ++k;
+        slots[2 * k + (k < levels.keys.size() && levels.keys[k] == key ? 1 : 0)] += b - a;
+        each_key(key, static_cast<std::uint64_t>(b - a));
+        a = b;
+    }
+}
 
 template <class Keep>
 PositiveLevels LevelsOf(const std::vector<ScoredPair>& positives, Keep keep) {
@@ -88,6 +132,7 @@ PositiveLevels LevelsOf(const std::vector<ScoredPair>& positives, Keep keep) {
         }
         ++levels.counts.back();
     }
+    levels.Index();
     return levels;
 }
 
@@ -141,8 +186,7 @@ struct StreamedPairwise::Shared {
     bool Learning() const { return request.learning.has_value(); }
     bool InTest(std::size_t j) const { return j >= first_test_scan; }
     // True when no pair had this distance before: fetch_or tells exactly one thread.
-    bool MarkDistinct(float distance) const {
-        const std::uint32_t key = OrderKey(distance);
+    bool MarkDistinct(std::uint32_t key) const {
         std::atomic_ref<std::uint64_t> word(bitmap.get()[key >> 6]);
         const std::uint64_t bit = std::uint64_t{1} << (key & 63u);
         if ((word.load(std::memory_order_relaxed) & bit) != 0) return false;
@@ -208,6 +252,8 @@ StreamedPairwise::Sink::Sink(const Shared& shared) : shared_(&shared) {
         if (shared.Learning()) train_slots_.assign(shared.train.SlotCount(), 0);
         coarse_.assign(kCoarseBuckets, 0);
         best_.assign(n, BestMatch{});
+        pending_all_.reserve(kPending);
+        if (shared.Learning()) pending_train_.reserve(kPending);
     } else {
         std::size_t tables = 0;
         for (const std::int32_t t : shared.fine_of_bucket) tables += t >= 0 ? 1 : 0;
@@ -246,32 +292,47 @@ void StreamedPairwise::Sink::Add(std::size_t i, std::size_t j, float distance) {
     const Shared& s = *shared_;
     if (!s.truth->Comparable(i, j)) return;
     CheckNotNan(i, j, distance);
+    const bool loop = s.truth->IsLoop(i, j);
     if (s.pass == 1) {
         Offer(best_[i], j, distance);
         Offer(best_[j], i, distance);
-        if (detail::IsScored(distance) && s.MarkDistinct(distance)) ++distinct_;
+        // The negatives' distances are marked when their batch is counted (Flush).
+        if (loop && detail::IsScored(distance) && s.MarkDistinct(OrderKey(distance))) ++distinct_;
     }
-    if (!s.truth->IsLoop(i, j)) AddNegative(j, distance);
+    if (!loop) AddNegative(j, distance);
+}
+
+void StreamedPairwise::Sink::Flush() {
+    const Shared& s = *shared_;
+    RadixSort(pending_all_, scratch_);
+    CountSortedKeys(pending_all_, s.all, all_slots_, [&](std::uint32_t key, std::uint64_t count) {
+        coarse_[key >> kFineBits] += count;
+        if (s.MarkDistinct(key)) ++distinct_;
+    });
+    pending_all_.clear();
+    RadixSort(pending_train_, scratch_);
+    CountSortedKeys(pending_train_, s.train, train_slots_, [](std::uint32_t, std::uint64_t) {});
+    pending_train_.clear();
 }
 
 void StreamedPairwise::Sink::AddNegative(std::size_t j, float distance) {
     const Shared& s = *shared_;
     const bool scored = detail::IsScored(distance);
     const bool in_test = s.Learning() && s.InTest(j);
+    const std::uint32_t key = OrderKey(distance);
     if (s.pass == 1) {
+        // Counted in sorted batches: one random access a negative into the slots cost most of
+        // the time when they outgrow the cache.
         all_.Add(distance);
-        if (scored) {
-            ++all_slots_[s.all.Slot(distance)];
-            ++coarse_[OrderKey(distance) >> kFineBits];
-        }
+        if (scored) pending_all_.push_back(key);
         if (s.Learning()) {
             (in_test ? test_ : train_).Add(distance);
-            if (scored && !in_test) ++train_slots_[s.train.Slot(distance)];
+            if (scored && !in_test) pending_train_.push_back(key);
         }
+        if (pending_all_.size() >= kPending || pending_train_.size() >= kPending) Flush();
         return;
     }
     if (!scored) return;
-    const std::uint32_t key = OrderKey(distance);
     const std::int32_t table = s.fine_of_bucket[key >> kFineBits];
     if (table >= 0) ++fine_[static_cast<std::size_t>(table) * kFineKeys + (key & (kFineKeys - 1))];
     const auto first =
@@ -338,12 +399,13 @@ int StreamedPairwise::pass() const { return shared_->pass; }
 
 StreamedPairwise::Sink StreamedPairwise::NewSink() const { return Sink(*shared_); }
 
-void StreamedPairwise::Merge(const Sink& sink) {
+void StreamedPairwise::Merge(Sink& sink) {
     Sink& m = shared_->merged;
     const auto add = [](std::vector<std::uint64_t>& into, const std::vector<std::uint64_t>& from) {
         for (std::size_t k = 0; k < from.size(); ++k) into[k] += from[k];
     };
     if (shared_->pass == 1) {
+        sink.Flush();
         add(m.all_slots_, sink.all_slots_);
         add(m.train_slots_, sink.train_slots_);
         add(m.coarse_, sink.coarse_);

@@ -72,11 +72,15 @@ public:
     private:
         friend class StreamedPairwise;
         void AddNegative(std::size_t j, float distance);
+        void Flush();
         const Shared* shared_;
         std::vector<std::uint64_t> all_slots_;
         std::vector<std::uint64_t> train_slots_;
-        std::vector<std::uint64_t> coarse_;  ///< pass 1: negatives by the top bits of the key
-        std::vector<std::uint64_t> fine_;    ///< pass 2: negatives by key in the target buckets
+        std::vector<std::uint64_t> coarse_;       ///< pass 1: negatives by the top bits of the key
+        std::vector<std::uint32_t> pending_all_;  ///< pass 1: keys of negatives to count
+        std::vector<std::uint32_t> pending_train_;  ///< pass 1: of training negatives
+        std::vector<std::uint32_t> scratch_;
+        std::vector<std::uint64_t> fine_;  ///< pass 2: negatives by key in the target buckets
         std::vector<std::uint64_t> from_threshold_;  ///< pass 2: as in ConfusionsAt
         std::uint64_t test_at_learnt_ = 0;           ///< pass 2: test negatives <= learnt tau
         std::vector<BestMatch> best_;
@@ -109,7 +113,8 @@ public:
     /// 1 or 2 while pairs are streamed, 3 when Result() is ready.
     int pass() const;
     Sink NewSink() const;
-    void Merge(const Sink& sink);
+    /// Adds a sink's counts (after counting what it still holds).
+    void Merge(Sink& sink);
     /// Ends a pass. Throws core::EmptyInputError after the first when there is no pair.
     void EndPass();
     /// After the second pass.

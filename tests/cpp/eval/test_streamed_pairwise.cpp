@@ -162,7 +162,7 @@ TEST(StreamedPairwise, PairsSpreadOverSinksInAnyOrderGiveTheSameResult) {
             const auto [i, j] = order[k];
             sinks[k % 3].Add(i, j, s.condensed[CondensedIndex(n, i, j)]);
         }
-        for (const auto& sink : sinks) evaluation.Merge(sink);
+        for (auto& sink : sinks) evaluation.Merge(sink);
         evaluation.EndPass();
     }
     ExpectEqualToPairsInMemory(c, s, evaluation.Result());
