@@ -134,7 +134,8 @@ TEST(StreamedPairwise, EqualsPairsInMemoryOnRandomSequences) {
         {5, 100, 0, 0.0, 0.0, 3, Criterion::kMcc, 0.7},     // fewest points
         {6, 160, 50, 0.02, 0.0, 40, Criterion::kMcc, 0.9},
         {7, 110, 4, 0.3, 10.0, 7, Criterion::kF1, 0.2},
-        {8, 90, 0, 0.0, 0.0, 25, Criterion::kMcc, -0.5},  // a detector worse than chance
+        {8, 90, 0, 0.0, 0.0, 25, Criterion::kMcc, -0.5},     // a detector worse than chance
+        {9, 780, 30, 0.01, 0.0, 200, Criterion::kMcc, 0.6},  // > 2^18 pairs: several batches
     };
     for (const Case& c : cases) {
         SCOPED_TRACE("seed " + std::to_string(c.seed));
