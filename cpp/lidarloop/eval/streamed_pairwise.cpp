@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <mutex>
 #include <new>
 #include <string>
 #include <utility>
@@ -176,8 +177,11 @@ struct StreamedPairwise::Shared {
     std::vector<std::size_t> threshold_order;
     std::unique_ptr<std::uint64_t, FreeDeleter> bitmap = NewBitmap();
     int pass = 1;
-    // Merged counts.
-    Sink merged;
+    // Merged counts. In the first pass the sinks count their sorted batches straight into its
+    // slots and coarse histogram, under `counting`: one copy of the O(positives) slots, not one
+    // a thread.
+    mutable Sink merged;
+    mutable std::mutex counting;
     std::vector<std::int32_t> fine_of_bucket;  // pass 2: table of a coarse bucket, or -1
     std::vector<RankQuery> queries;
     std::optional<double> learnt_threshold;
@@ -248,9 +252,6 @@ void StreamedPairwise::Sink::Extremes::Merge(const Extremes& other) {
 StreamedPairwise::Sink::Sink(const Shared& shared) : shared_(&shared) {
     const std::size_t n = shared.truth->size();
     if (shared.pass == 1) {
-        all_slots_.assign(shared.all.SlotCount(), 0);
-        if (shared.Learning()) train_slots_.assign(shared.train.SlotCount(), 0);
-        coarse_.assign(kCoarseBuckets, 0);
         best_.assign(n, BestMatch{});
         pending_all_.reserve(kPending);
         if (shared.Learning()) pending_train_.reserve(kPending);
@@ -305,13 +306,19 @@ void StreamedPairwise::Sink::Add(std::size_t i, std::size_t j, float distance) {
 void StreamedPairwise::Sink::Flush() {
     const Shared& s = *shared_;
     RadixSort(pending_all_, scratch_);
-    CountSortedKeys(pending_all_, s.all, all_slots_, [&](std::uint32_t key, std::uint64_t count) {
-        coarse_[key >> kFineBits] += count;
-        if (s.MarkDistinct(key)) ++distinct_;
-    });
-    pending_all_.clear();
     RadixSort(pending_train_, scratch_);
-    CountSortedKeys(pending_train_, s.train, train_slots_, [](std::uint32_t, std::uint64_t) {});
+    {
+        const std::lock_guard<std::mutex> lock(s.counting);
+        Sink& merged = s.merged;
+        CountSortedKeys(pending_all_, s.all, merged.all_slots_,
+                        [&](std::uint32_t key, std::uint64_t count) {
+                            merged.coarse_[key >> kFineBits] += count;
+                            if (s.MarkDistinct(key)) ++distinct_;
+                        });
+        CountSortedKeys(pending_train_, s.train, merged.train_slots_,
+                        [](std::uint32_t, std::uint64_t) {});
+    }
+    pending_all_.clear();
     pending_train_.clear();
 }
 
@@ -390,6 +397,9 @@ StreamedPairwise::StreamedPairwise(const GroundTruth& truth, std::vector<ScoredP
               [&](std::size_t a, std::size_t b) { return thresholds[a] < thresholds[b]; });
     for (const std::size_t k : s.threshold_order) s.ascending_thresholds.push_back(thresholds[k]);
     s.merged = Sink(s);
+    s.merged.all_slots_.assign(s.all.SlotCount(), 0);
+    if (s.Learning()) s.merged.train_slots_.assign(s.train.SlotCount(), 0);
+    s.merged.coarse_.assign(kCoarseBuckets, 0);
     shared_ = std::move(shared);
 }
 
@@ -406,9 +416,6 @@ void StreamedPairwise::Merge(Sink& sink) {
     };
     if (shared_->pass == 1) {
         sink.Flush();
-        add(m.all_slots_, sink.all_slots_);
-        add(m.train_slots_, sink.train_slots_);
-        add(m.coarse_, sink.coarse_);
         for (std::size_t k = 0; k < m.best_.size(); ++k) MergeBest(m.best_[k], sink.best_[k]);
         m.all_.Merge(sink.all_);
         m.train_.Merge(sink.train_);

@@ -55,9 +55,12 @@ struct StreamedResult {
 /// each pass, give each thread a NewSink(), Add every pair to some sink, Merge every sink, then
 /// EndPass(). After the second pass, Result(). The exact curve needs the second pass: its
 /// thinned points between two positives' distances are order statistics of the negatives.
-/// Memory: the positives, 8 MiB + 24 bytes a scan per sink, 32 KiB per curve point, and a
-/// bitmap of the distinct distances (512 MiB of address space, of which only the pages of
-/// occurring distances become resident: 4 KiB per 32768 consecutive float values).
+/// Memory: the positives (16 bytes each) and, per distinct positive distance, about 40 bytes
+/// (its key, count, slots of the whole sequence and of the training part, and a bucket table of
+/// 8 MiB); per sink 24 bytes a scan and 3 MiB of batch; in the second pass 32 KiB per located
+/// curve point and sink; and a bitmap of the distinct distances (512 MiB of address space, of
+/// which only the pages of occurring distances become resident: 4 KiB per 32768 consecutive
+/// float values). Sinks count their batches into shared counters under a mutex.
 class StreamedPairwise {
 public:
     struct Shared;
