@@ -251,6 +251,14 @@ void WriteEvaluationResults(const std::filesystem::path& out_dir, const io::Data
               EvaluationMetricsJson(dataset.root().string(), dataset.size(), outcome));
     WriteCurveCsvs(out_dir, outcome.methods);
     outcome.notes = WriteFigures(out_dir, truth, outcome.methods);
+    for (const MethodEvaluation& e : outcome.methods) {
+        if (e.optimum_exact) continue;
+        outcome.notes.push_back(
+            e.name +
+            ": the MCC is negative at every positive pair's distance, and the streamed "
+            "evaluation does not visit the thresholds between them, where the best MCC could "
+            "be higher (docs/evaluation.md, evaluation in linear memory)");
+    }
     WriteReport(out_dir, {dataset.root().string(), dataset.size(), truth.Describe()},
                 outcome.methods, outcome.notes);
 }

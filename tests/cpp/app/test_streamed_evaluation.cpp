@@ -147,6 +147,10 @@ TEST(StreamedEvaluation, WithoutTheMatrixTheRunWritesTheSameFiguresAndNoImages) 
     EXPECT_FALSE(std::filesystem::exists(dir / "streamed" / "ground_truth.png"));
     EXPECT_NE(Contents(dir / "streamed" / "report.md").find("similarity_matrix_mib"),
               std::string::npos);
+    // Its few listed pairs are all wrong: the report says the best MCC may lie elsewhere.
+    EXPECT_FALSE(streamed.methods.back().optimum_exact);
+    EXPECT_NE(Contents(dir / "streamed" / "report.md").find("results:sparse: the MCC is negative"),
+              std::string::npos);
 }
 
 TEST(StreamedEvaluation, DistancesOfResultsEqualMatrixOfResults) {
