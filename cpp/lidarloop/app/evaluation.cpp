@@ -3,7 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <string>
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
 
 #include "lidarloop/app/describe_run.hpp"
 #include "lidarloop/app/evaluation_report.hpp"
@@ -13,9 +18,12 @@
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/io/read_error.hpp"
 #include "lidarloop/io/results_csv.hpp"
+#include "lidarloop/pipeline/loop_detector.hpp"
 
 namespace lidarloop::app {
 namespace {
+
+std::string FirstPartName(const eval::ThresholdLearningConfig& learning);
 
 void LearnThreshold(MethodEvaluation& e, const std::vector<eval::ScoredPair>& pairs,
                     std::size_t scans, const eval::ThresholdLearningConfig& learning,
@@ -26,21 +34,88 @@ void LearnThreshold(MethodEvaluation& e, const std::vector<eval::ScoredPair>& pa
             e.learnt_on = training->source;
         } else {
             e.learnt = eval::LearnOnFirstPart(pairs, scans, learning);
-            e.learnt_on = "the queries of the first " +
-                          std::to_string(std::lround(100.0 * learning.train_fraction)) +
-                          " % of the scans";
+            e.learnt_on = FirstPartName(learning);
         }
     } catch (const core::EmptyInputError&) {
         // Too short a sequence to split, or no pairs: the learnt row is left out of the report.
     }
 }
 
-void EvaluatePerScan(MethodEvaluation& e, const eval::GroundTruth& truth) {
-    e.best_matches = eval::BestMatchesFromCondensed(e.matrix.condensed(), truth);
+void EvaluatePerScan(MethodEvaluation& e, std::vector<eval::BestMatch> best_matches,
+                     const eval::GroundTruth& truth) {
+    e.best_matches = std::move(best_matches);
     e.per_scan = eval::EvaluatePerScan(e.best_matches, truth);
     for (const eval::BestMatch& m : e.best_matches) e.smallest_differences.push_back(m.distance);
     e.em = eval::EstimateDifferenceThreshold(e.smallest_differences);
     e.distinctiveness = eval::SummarizeDistinctiveness(e.best_matches);
+    if (e.default_threshold) {
+        e.per_scan_at_default =
+            eval::CountLabels(eval::LabelScans(e.best_matches, truth, *e.default_threshold));
+    }
+}
+
+constexpr std::size_t kStreamRows = 64;      // rows of a block, one task
+constexpr std::size_t kStreamColumns = 512;  // columns of a tile: the rows' descriptors stay cached
+
+void StreamBlock(eval::StreamedPairwise::Sink& sink, std::size_t row_begin, std::size_t row_end,
+                 std::size_t n, const eval::PairDistance& distance) {
+    for (std::size_t column = row_begin + 1; column < n; column += kStreamColumns) {
+        const std::size_t column_end = std::min(n, column + kStreamColumns);
+        for (std::size_t i = row_begin; i < row_end; ++i) {
+            for (std::size_t j = std::max(column, i + 1); j < column_end; ++j)
+                sink.Add(i, j, distance(i, j));
+        }
+    }
+}
+
+// Streams every pair i < j through `evaluation`, blocks of rows in parallel, one sink a thread,
+// pass after pass.
+eval::StreamedResult StreamPairs(eval::StreamedPairwise& evaluation, std::size_t n,
+                                 const eval::PairDistance& distance) {
+    const std::size_t blocks = (n + kStreamRows - 1) / kStreamRows;
+    while (evaluation.pass() < 3) {
+        tbb::enumerable_thread_specific<eval::StreamedPairwise::Sink> sinks(
+            [&] { return evaluation.NewSink(); });
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 1),
+                          [&](const tbb::blocked_range<std::size_t>& range) {
+                              eval::StreamedPairwise::Sink& sink = sinks.local();
+                              for (std::size_t b = range.begin(); b < range.end(); ++b) {
+                                  StreamBlock(sink, b * kStreamRows,
+                                              std::min(n, (b + 1) * kStreamRows), n, distance);
+                              }
+                          });
+        for (eval::StreamedPairwise::Sink& sink : sinks) evaluation.Merge(sink);
+        evaluation.EndPass();
+    }
+    return evaluation.Result();
+}
+
+eval::PairDistance MatrixDistance(const pipeline::SimilarityMatrix& matrix) {
+    return
+        [&matrix](std::size_t i, std::size_t j) { return matrix.condensed()[matrix.Index(i, j)]; };
+}
+
+eval::PairDistance DatabaseDistance(const pipeline::DescriptorDatabase& database) {
+    return [&database](std::size_t i, std::size_t j) {
+        return static_cast<float>(database.Distance(i, j));
+    };
+}
+
+eval::ThresholdTransfer TransferOf(const LearntThreshold& training, const eval::Confusion& test) {
+    eval::ThresholdTransfer transfer;
+    transfer.criterion = training.criterion;
+    transfer.threshold = training.best.threshold;
+    transfer.train_score = training.best.score;
+    transfer.train = training.best.confusion;
+    transfer.test = test;
+    transfer.test_f1 = eval::F1(test);
+    transfer.test_mcc = eval::Mcc(test);
+    return transfer;
+}
+
+std::string FirstPartName(const eval::ThresholdLearningConfig& learning) {
+    return "the queries of the first " +
+           std::to_string(std::lround(100.0 * learning.train_fraction)) + " % of the scans";
 }
 
 // A pair of a results file must name scans of the dataset, and a finite distance must stay
@@ -68,10 +143,12 @@ void RequirePoses(const io::Dataset& dataset, const std::string& role,
     }
 }
 
-// Every scored pair of the training dataset under the evaluation's ground-truth rule.
-TrainingPairs TrainingPairsOf(const EvaluationRequest& request,
-                              const core::DescriptorConfig& descriptor,
-                              const io::Dataset& train_dataset) {
+// The threshold learnt on every pair of the training dataset under the evaluation's
+// ground-truth rule (streamed); nullopt without a pair or a finite distance there, as
+// LearnAndTest's EmptyInputError leaves the learnt row out.
+std::optional<LearntThreshold> TrainingThresholdOf(const EvaluationRequest& request,
+                                                   const core::DescriptorConfig& descriptor,
+                                                   const io::Dataset& train_dataset) {
     const auto described =
         DescribeDataset(train_dataset, descriptor,
                         {"training set (" + core::ToString(descriptor.method) + ")",
@@ -79,11 +156,21 @@ TrainingPairs TrainingPairsOf(const EvaluationRequest& request,
                          pipeline::Execution::kParallel,
                          request.progress,
                          {}});
-    const pipeline::SimilarityMatrix matrix = pipeline::ComputeSimilarityMatrix(described.database);
     const eval::GroundTruth truth =
         eval::BuildGroundTruth(train_dataset.poses(), GroundTruthRule(request));
-    return {"all pairs of " + train_dataset.root().string(),
-            eval::CollectPairs(matrix.condensed(), truth)};
+    const eval::PairDistance distance = DatabaseDistance(described.database);
+    eval::StreamedPairwise evaluation(truth, eval::ScorePositives(truth, distance), {});
+    eval::StreamedResult result;
+    try {
+        result = StreamPairs(evaluation, truth.size(), distance);
+    } catch (const core::EmptyInputError&) {
+        return std::nullopt;
+    }
+    if (result.pairwise.distinct_thresholds == 0) return std::nullopt;
+    const eval::Criterion criterion = request.learning.criterion;
+    return LearntThreshold{
+        "all pairs of " + train_dataset.root().string(), criterion,
+        criterion == eval::Criterion::kMcc ? result.pairwise.best_mcc : result.pairwise.best_f1};
 }
 
 // Scans prepared for verification once per evaluation: while the first method describes them.
@@ -98,9 +185,9 @@ MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method m
                                 const io::Dataset* train_dataset, VerificationState& verification) {
     io::RunConfig config = request.config;
     config.descriptor.method = method;
-    std::optional<TrainingPairs> training;
+    std::optional<LearntThreshold> training;
     if (train_dataset != nullptr)
-        training = TrainingPairsOf(request, config.descriptor, *train_dataset);
+        training = TrainingThresholdOf(request, config.descriptor, *train_dataset);
     DescribeRun run{"describing (" + core::ToString(method) + ")",
                     request.skip_bad,
                     pipeline::Execution::kParallel,
@@ -111,19 +198,49 @@ MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method m
         verification.collected = true;
     }
     const auto described = DescribeDataset(dataset, config.descriptor, run);
+    const pipeline::DescriptorDatabase& database = described.database;
+    const bool keep_matrix = config.output.KeepsSimilarityMatrix(database.size());
+    pipeline::SimilarityMatrix matrix;
+    eval::PairDistance distance = DatabaseDistance(database);
     Stopwatch matrix_clock;
-    pipeline::SimilarityMatrix matrix = pipeline::ComputeSimilarityMatrix(described.database);
+    if (keep_matrix) {
+        matrix = pipeline::ComputeSimilarityMatrix(database);
+        distance = MatrixDistance(matrix);
+    }
     const double matrix_s = matrix_clock.Seconds();
-    const double pairs = static_cast<double>(matrix.condensed().size());
-    MethodEvaluation e = EvaluateMatrix(core::ToString(method), std::move(matrix), truth,
-                                        request.learning, config.detection.ThresholdFor(method),
-                                        request.fixed_thresholds, training ? &*training : nullptr);
+    Stopwatch streamed_clock;
+    MethodEvaluation e =
+        EvaluateStreamed(core::ToString(method), distance, truth, request.learning,
+                         config.detection.ThresholdFor(method), request.fixed_thresholds, training);
+    // Without the matrix each pass computes every distance once: two comparisons a pair.
+    const double comparisons_s = keep_matrix ? matrix_s : streamed_clock.Seconds() / 2.0;
+    const double pairs = static_cast<double>(eval::CondensedSize(database.size()));
     e.describe_ms_per_scan_median = 1e3 * Quantile(described.describe_seconds, 0.5);
-    e.ns_per_comparison = pairs > 0 ? 1e9 * matrix_s / pairs : 0.0;
+    e.ns_per_comparison = pairs > 0 ? 1e9 * comparisons_s / pairs : 0.0;
+    e.matrix = std::move(matrix);
+    const PreparedScans* prepared = verification.prepared ? &*verification.prepared : nullptr;
     e.retrieval =
-        CompareRetrieval(e.matrix, described.database.times_s(), config.detection, method, truth,
-                         dataset.poses(), verification.prepared ? &*verification.prepared : nullptr,
-                         &verification.cache, request.progress);
+        keep_matrix
+            ? CompareRetrieval(e.matrix, database.times_s(), config.detection, method, truth,
+                               dataset.poses(), prepared, &verification.cache, request.progress)
+            : CompareRetrieval(pipeline::DetectStreaming(database, config.detection),
+                               config.detection, method, truth, dataset.poses(), prepared,
+                               &verification.cache, request.progress);
+    return e;
+}
+
+// A results file's pairs, kept as a matrix for the images only when it fits the budget.
+MethodEvaluation EvaluateResults(const EvaluationRequest& request, const std::string& file,
+                                 std::size_t scans, const eval::GroundTruth& truth) {
+    const std::string name = "results:" + std::filesystem::path(file).stem().string();
+    if (!request.config.output.KeepsSimilarityMatrix(scans)) {
+        return EvaluateStreamed(name, DistancesOfResults(file, scans), truth, request.learning,
+                                std::nullopt, request.fixed_thresholds);
+    }
+    pipeline::SimilarityMatrix matrix = MatrixOfResults(file, scans);
+    MethodEvaluation e = EvaluateStreamed(name, MatrixDistance(matrix), truth, request.learning,
+                                          std::nullopt, request.fixed_thresholds);
+    e.matrix = std::move(matrix);
     return e;
 }
 
@@ -134,6 +251,14 @@ void WriteEvaluationResults(const std::filesystem::path& out_dir, const io::Data
               EvaluationMetricsJson(dataset.root().string(), dataset.size(), outcome));
     WriteCurveCsvs(out_dir, outcome.methods);
     outcome.notes = WriteFigures(out_dir, truth, outcome.methods);
+    for (const MethodEvaluation& e : outcome.methods) {
+        if (e.optimum_exact) continue;
+        outcome.notes.push_back(
+            e.name +
+            ": the MCC is negative at every positive pair's distance, and the streamed "
+            "evaluation does not visit the thresholds between them, where the best MCC could "
+            "be higher (docs/evaluation.md, evaluation in linear memory)");
+    }
     WriteReport(out_dir, {dataset.root().string(), dataset.size(), truth.Describe()},
                 outcome.methods, outcome.notes);
 }
@@ -156,11 +281,45 @@ MethodEvaluation EvaluateMatrix(std::string name, pipeline::SimilarityMatrix mat
     if (default_threshold) e.at_default = eval::ConfusionAt(pairs, *default_threshold);
     e.fixed_thresholds = fixed_thresholds;
     e.at_fixed = eval::ConfusionsAt(pairs, fixed_thresholds);
-    EvaluatePerScan(e, truth);
-    if (default_threshold) {
-        e.per_scan_at_default =
-            eval::CountLabels(eval::LabelScans(e.best_matches, truth, *default_threshold));
+    EvaluatePerScan(e, eval::BestMatchesFromCondensed(e.matrix.condensed(), truth), truth);
+    return e;
+}
+
+MethodEvaluation EvaluateStreamed(std::string name, const eval::PairDistance& distance,
+                                  const eval::GroundTruth& truth,
+                                  const eval::ThresholdLearningConfig& learning,
+                                  std::optional<double> default_threshold,
+                                  const std::vector<double>& fixed_thresholds,
+                                  const std::optional<LearntThreshold>& training) {
+    MethodEvaluation e;
+    e.name = std::move(name);
+    e.default_threshold = default_threshold;
+    e.fixed_thresholds = fixed_thresholds;
+    // The confusions wanted: the fixed thresholds, then the default, then the learnt one.
+    eval::StreamedRequest request;
+    request.thresholds = fixed_thresholds;
+    if (default_threshold) request.thresholds.push_back(*default_threshold);
+    if (training) {
+        request.thresholds.push_back(training->best.threshold);
+    } else {
+        request.learning = learning;
     }
+    eval::StreamedPairwise evaluation(truth, eval::ScorePositives(truth, distance), request);
+    eval::StreamedResult result = StreamPairs(evaluation, truth.size(), distance);
+    e.pairwise = std::move(result.pairwise);
+    e.optimum_exact = result.optimum_exact;
+    const auto& at = result.at_thresholds;
+    e.at_fixed.assign(at.begin(),
+                      at.begin() + static_cast<std::ptrdiff_t>(fixed_thresholds.size()));
+    if (default_threshold) e.at_default = at[fixed_thresholds.size()];
+    if (training) {
+        e.learnt = TransferOf(*training, at.back());
+        e.learnt_on = training->source;
+    } else if (result.learnt) {
+        e.learnt = result.learnt;
+        e.learnt_on = FirstPartName(learning);
+    }
+    EvaluatePerScan(e, std::move(result.best_matches), truth);
     return e;
 }
 
@@ -177,6 +336,51 @@ pipeline::SimilarityMatrix MatrixOfResults(const std::filesystem::path& file, st
         matrix.set(i, j, std::min(matrix.at(i, j), static_cast<float>(r.distance)));
     }
     return matrix;
+}
+
+eval::PairDistance DistancesOfResults(const std::filesystem::path& file, std::size_t scans) {
+    struct Listed {
+        std::size_t i;
+        std::size_t j;
+        float distance;
+    };
+    std::vector<Listed> listed;
+    for (const io::ExternalResult& r : io::ReadResultsCsv(file)) {
+        CheckResult(file, r, scans);
+        if (r.query == r.match) continue;
+        listed.push_back({std::min(r.query, r.match), std::max(r.query, r.match),
+                          static_cast<float>(r.distance)});
+    }
+    // Pairs listed twice keep the smallest distance, folded in file order as MatrixOfResults.
+    std::stable_sort(listed.begin(), listed.end(), [](const Listed& a, const Listed& b) {
+        return a.i != b.i ? a.i < b.i : a.j < b.j;
+    });
+    struct Rows {
+        std::vector<std::size_t> offsets;  // pairs of row i: [offsets[i], offsets[i + 1])
+        std::vector<std::size_t> columns;
+        std::vector<float> distances;
+    };
+    auto rows = std::make_shared<Rows>();
+    rows->offsets.assign(scans + 1, 0);
+    for (std::size_t k = 0; k < listed.size(); ++k) {
+        const Listed& p = listed[k];
+        if (k > 0 && listed[k - 1].i == p.i && listed[k - 1].j == p.j) {
+            rows->distances.back() = std::min(rows->distances.back(), p.distance);
+            continue;
+        }
+        rows->columns.push_back(p.j);
+        rows->distances.push_back(std::min(std::numeric_limits<float>::infinity(), p.distance));
+        ++rows->offsets[p.i + 1];
+    }
+    for (std::size_t i = 0; i < scans; ++i) rows->offsets[i + 1] += rows->offsets[i];
+    return [rows](std::size_t i, std::size_t j) {
+        const auto begin = rows->columns.begin() + static_cast<std::ptrdiff_t>(rows->offsets[i]);
+        const auto end = rows->columns.begin() + static_cast<std::ptrdiff_t>(rows->offsets[i + 1]);
+        const auto at = std::lower_bound(begin, end, j);
+        return at != end && *at == j
+                   ? rows->distances[static_cast<std::size_t>(at - rows->columns.begin())]
+                   : std::numeric_limits<float>::infinity();
+    };
 }
 
 eval::GroundTruthConfig GroundTruthRule(const EvaluationRequest& request) {
@@ -210,10 +414,7 @@ EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequ
             EvaluateMethod(request, method, dataset, outcome.truth, train_dataset, verification));
     }
     for (const std::string& file : request.results_files) {
-        outcome.methods.push_back(
-            EvaluateMatrix("results:" + std::filesystem::path(file).stem().string(),
-                           MatrixOfResults(file, dataset.size()), outcome.truth, request.learning,
-                           std::nullopt, request.fixed_thresholds));
+        outcome.methods.push_back(EvaluateResults(request, file, dataset.size(), outcome.truth));
     }
     WriteEvaluationResults(out_dir, dataset, outcome);
     return outcome;

@@ -11,6 +11,7 @@
 #include "lidarloop/eval/ground_truth.hpp"
 #include "lidarloop/eval/pairwise.hpp"
 #include "lidarloop/eval/per_scan.hpp"
+#include "lidarloop/eval/streamed_pairwise.hpp"
 #include "lidarloop/eval/summary.hpp"
 #include "lidarloop/eval/threshold_learning.hpp"
 #include "lidarloop/io/config_yaml.hpp"
@@ -24,7 +25,12 @@ namespace lidarloop::app {
 struct MethodEvaluation {
     std::string name;                         ///< height, range, ndt, or results:<file>
     std::optional<double> default_threshold;  ///< the method's default tau / t_d, when a method
+    /// The distances, kept only within output.similarity_matrix_mib (else size 0): the
+    /// evaluation itself streams the pairs (eval::StreamedPairwise).
     pipeline::SimilarityMatrix matrix;
+    /// False when the best MCC may miss a threshold between two positives' distances
+    /// (eval::StreamedResult::optimum_exact); always true for EvaluateMatrix.
+    bool optimum_exact = true;
     eval::PairwiseEvaluation pairwise;              ///< Röhling IV-B/C
     std::optional<eval::ThresholdTransfer> learnt;  ///< table I: learnt on training pairs
     std::string learnt_on;  ///< where they came from: the first part or another dataset
@@ -50,7 +56,8 @@ struct TrainingPairs {
     std::vector<eval::ScoredPair> pairs;
 };
 
-/// Evaluates a finished similarity matrix against `truth`. The threshold is learnt on
+/// Evaluates a finished similarity matrix against `truth` with every pair in memory (O(n^2)):
+/// the reference of EvaluateStreamed, which RunEvaluation uses. The threshold is learnt on
 /// `training` when given, else on the first part of this sequence (learning.train_fraction).
 MethodEvaluation EvaluateMatrix(std::string name, pipeline::SimilarityMatrix matrix,
                                 const eval::GroundTruth& truth,
@@ -58,6 +65,29 @@ MethodEvaluation EvaluateMatrix(std::string name, pipeline::SimilarityMatrix mat
                                 std::optional<double> default_threshold,
                                 const std::vector<double>& fixed_thresholds = {},
                                 const TrainingPairs* training = nullptr);
+
+/// A threshold learnt on all pairs of another dataset (Röhling table I), for EvaluateStreamed.
+struct LearntThreshold {
+    std::string source;  ///< e.g. "all pairs of <folder>"
+    eval::Criterion criterion = eval::Criterion::kMcc;
+    eval::BestThreshold best;  ///< the training optimum: tau, its score and confusion
+};
+
+/// EvaluateMatrix without the matrix, in memory O(n + positives): the pairs are streamed from
+/// `distance` twice in parallel (oneTBB), and every figure equals EvaluateMatrix's on the same
+/// distances, up to MethodEvaluation::optimum_exact. `matrix` is left empty; the threshold is
+/// learnt on `training` when given, else on the first part of this sequence.
+MethodEvaluation EvaluateStreamed(std::string name, const eval::PairDistance& distance,
+                                  const eval::GroundTruth& truth,
+                                  const eval::ThresholdLearningConfig& learning,
+                                  std::optional<double> default_threshold,
+                                  const std::vector<double>& fixed_thresholds = {},
+                                  const std::optional<LearntThreshold>& training = std::nullopt);
+
+/// The distances of an external detector's `query,match,distance` CSV as MatrixOfResults has
+/// them, in memory O(listed pairs): +inf for every pair the file leaves out. io::ReadError as
+/// MatrixOfResults.
+eval::PairDistance DistancesOfResults(const std::filesystem::path& file, std::size_t scans);
 
 /// The similarity matrix of an external detector's `query,match,distance` CSV: listed pairs get
 /// their distance (the smallest when listed twice), every other pair +inf, which the evaluation
@@ -88,7 +118,9 @@ struct EvaluationOutcome {
 /// The ground-truth rule of `request`: its distance, heading and the config's minimum gap.
 eval::GroundTruthConfig GroundTruthRule(const EvaluationRequest& request);
 
-/// Evaluates every method and results file on one ground truth from the dataset's poses and
+/// Evaluates every method and results file on one ground truth from the dataset's poses
+/// (EvaluateStreamed: memory linear in the scans; the matrices are kept for the images only
+/// within config.output.similarity_matrix_mib) and
 /// writes config.yaml, metrics.json, roc.csv, pr.csv, the images and figures and report.md into
 /// request.out. Every method's top-k candidates (config.detection) are also scored as the
 /// online detector reports them, and with config.detection.verify after geometric verification

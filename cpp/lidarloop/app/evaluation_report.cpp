@@ -273,7 +273,22 @@ void WriteRetrievalTable(std::ostream& out, const std::vector<MethodEvaluation>&
            "distance of the ground truth) is not one.";
 }
 
-void WriteFigureGallery(std::ostream& out, const std::vector<MethodEvaluation>& evaluations) {
+// The n x n images are drawn from the similarity matrices, which the evaluation keeps only
+// within output.similarity_matrix_mib.
+bool PairImagesDrawn(const std::vector<MethodEvaluation>& evaluations, std::size_t scans) {
+    return std::all_of(evaluations.begin(), evaluations.end(),
+                       [&](const MethodEvaluation& e) { return e.matrix.size() == scans; });
+}
+
+void WriteMethodFigures(std::ostream& out, const std::vector<MethodEvaluation>& evaluations);
+
+void WriteFigureGallery(std::ostream& out, const std::vector<MethodEvaluation>& evaluations,
+                        std::size_t scans) {
+    if (!PairImagesDrawn(evaluations, scans)) {
+        out << "\n\n## Curves\n\n![ROC](roc.png) ![precision-recall](pr.png)\n\n";
+        WriteMethodFigures(out, evaluations);
+        return;
+    }
     out << "\n\n## Similarity matrices (black: pairs under the best-MCC threshold; grey: inside "
            "the minimum gap, not evaluated)\n\n| ground truth |";
     for (const MethodEvaluation& e : evaluations) out << " " << e.name << " |";
@@ -284,9 +299,27 @@ void WriteFigureGallery(std::ostream& out, const std::vector<MethodEvaluation>& 
         out << " ![](similarity_" << FileSafe(e.name) << ".png) |";
     }
     out << "\n\n## Curves\n\n![ROC](roc.png) ![precision-recall](pr.png)\n\n";
+    WriteMethodFigures(out, evaluations);
+}
+
+void WriteMethodFigures(std::ostream& out, const std::vector<MethodEvaluation>& evaluations) {
     for (const MethodEvaluation& e : evaluations) {
         out << "![EM " << e.name << "](em_" << FileSafe(e.name) << ".png) ![counts " << e.name
             << "](counts_" << FileSafe(e.name) << ".png)\n\n";
+    }
+}
+
+void WritePairImages(const std::filesystem::path& folder, const eval::GroundTruth& truth,
+                     const std::vector<MethodEvaluation>& evaluations) {
+    io::WritePng(folder / "ground_truth.png", PairImage(truth, [&](std::size_t i, std::size_t j) {
+                     return truth.IsLoop(std::min(i, j), std::max(i, j));
+                 }));
+    for (const MethodEvaluation& e : evaluations) {
+        const double tau = e.pairwise.best_mcc.threshold;
+        io::WritePng(folder / ("similarity_" + FileSafe(e.name) + ".png"),
+                     PairImage(truth, [&](std::size_t i, std::size_t j) {
+                         return e.matrix.at(i, j) <= tau;
+                     }));
     }
 }
 
@@ -317,20 +350,20 @@ void WriteCurveCsvs(const std::filesystem::path& folder,
 std::vector<std::string> WriteFigures(const std::filesystem::path& folder,
                                       const eval::GroundTruth& truth,
                                       const std::vector<MethodEvaluation>& evaluations) {
-    io::WritePng(folder / "ground_truth.png", PairImage(truth, [&](std::size_t i, std::size_t j) {
-                     return truth.IsLoop(std::min(i, j), std::max(i, j));
-                 }));
-    for (const MethodEvaluation& e : evaluations) {
-        const double tau = e.pairwise.best_mcc.threshold;
-        io::WritePng(folder / ("similarity_" + FileSafe(e.name) + ".png"),
-                     PairImage(truth, [&](std::size_t i, std::size_t j) {
-                         return e.matrix.at(i, j) <= tau;
-                     }));
+    std::vector<std::string> notes;
+    if (PairImagesDrawn(evaluations, truth.size())) {
+        WritePairImages(folder, truth, evaluations);
+    } else {
+        notes.push_back(
+            "the " + std::to_string(truth.size()) + " x " + std::to_string(truth.size()) +
+            " images ground_truth.png and similarity_*.png are drawn only when the similarity "
+            "matrix fits output.similarity_matrix_mib; the evaluation streamed the pairs instead");
     }
     if (!io::GnuplotAvailable()) {
-        return {
+        notes.push_back(
             "gnuplot is not installed, so the curves are only in roc.csv and pr.csv "
-            "(apt-get install gnuplot-nox)"};
+            "(apt-get install gnuplot-nox)");
+        return notes;
     }
     io::RenderPlot(folder / "roc.png", RocPlot(evaluations, false));
     io::RenderPlot(folder / "pr.png", RocPlot(evaluations, true));
@@ -338,7 +371,7 @@ std::vector<std::string> WriteFigures(const std::filesystem::path& folder,
         io::RenderPlot(folder / ("em_" + FileSafe(e.name) + ".png"), EmPlot(e));
         io::RenderPlot(folder / ("counts_" + FileSafe(e.name) + ".png"), CountsPlot(e));
     }
-    return {};
+    return notes;
 }
 
 void WriteReport(const std::filesystem::path& folder, const ReportContext& context,
@@ -351,7 +384,7 @@ void WriteReport(const std::filesystem::path& folder, const ReportContext& conte
     WriteFixedThresholdTable(out, evaluations);
     WritePerScanTable(out, evaluations);
     WriteRetrievalTable(out, evaluations);
-    WriteFigureGallery(out, evaluations);
+    WriteFigureGallery(out, evaluations, context.scans);
     for (const std::string& note : notes) out << "Note: " << note << "\n\n";
     out.close();
     if (!out) throw io::WriteError(folder / "report.md", "writing failed");

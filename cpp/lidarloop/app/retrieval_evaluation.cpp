@@ -46,9 +46,19 @@ RetrievalComparison CompareRetrieval(const pipeline::SimilarityMatrix& matrix,
                                      std::span<const core::StampedPose> poses,
                                      const PreparedScans* prepared,
                                      pipeline::VerificationCache* cache, const Progress& progress) {
+    return CompareRetrieval(pipeline::DetectFromMatrix(matrix, times_s, detector, method), detector,
+                            method, truth, poses, prepared, cache, progress);
+}
+
+RetrievalComparison CompareRetrieval(std::vector<pipeline::LoopQuery> queries,
+                                     const pipeline::DetectorConfig& detector,
+                                     const core::Method& method, const eval::GroundTruth& truth,
+                                     std::span<const core::StampedPose> poses,
+                                     const PreparedScans* prepared,
+                                     pipeline::VerificationCache* cache, const Progress& progress) {
     RetrievalComparison comparison;
     comparison.top_k = static_cast<std::size_t>(detector.top_k);
-    comparison.queries = pipeline::DetectFromMatrix(matrix, times_s, detector, method);
+    comparison.queries = std::move(queries);
     const eval::LoopRetrievalConfig config{comparison.top_k};
     comparison.descriptor = eval::EvaluateLoopRetrieval(
         DescriptorCandidates(comparison.queries, method, detector.ThresholdFor(method)), truth,

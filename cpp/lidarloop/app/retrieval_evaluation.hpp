@@ -52,4 +52,13 @@ RetrievalComparison CompareRetrieval(const pipeline::SimilarityMatrix& matrix,
                                      const PreparedScans* prepared,
                                      pipeline::VerificationCache* cache, const Progress& progress);
 
+/// CompareRetrieval of queries already detected (e.g. pipeline::DetectStreaming, without the
+/// matrix).
+RetrievalComparison CompareRetrieval(std::vector<pipeline::LoopQuery> queries,
+                                     const pipeline::DetectorConfig& detector,
+                                     const core::Method& method, const eval::GroundTruth& truth,
+                                     std::span<const core::StampedPose> poses,
+                                     const PreparedScans* prepared,
+                                     pipeline::VerificationCache* cache, const Progress& progress);
+
 }  // namespace lidarloop::app

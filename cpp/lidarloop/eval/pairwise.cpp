@@ -7,9 +7,15 @@
 #include <string>
 
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/eval/detail/sweep.hpp"
 
 namespace lidarloop::eval {
 namespace {
+
+using detail::CurveThinner;
+using detail::IsScored;
+using detail::KeepBest;
+using detail::MakePoint;
 
 struct Scored {
     float distance;
@@ -31,46 +37,8 @@ void CheckThreshold(double threshold) {
     if (std::isnan(threshold)) throw core::Error("evaluation threshold must not be NaN");
 }
 
-// +inf marks a pair that was never scored: a scan that could not be read, or a pair a results
-// file leaves out. No threshold, not even +inf, detects it; otherwise the sweep would end at
-// +inf calling every pair a loop, and a learnt threshold could be +inf.
-bool IsScored(float distance) { return distance != std::numeric_limits<float>::infinity(); }
-
 bool DetectedAt(float distance, double threshold) {
     return IsScored(distance) && static_cast<double>(distance) <= threshold;
-}
-
-CurvePoint MakePoint(double threshold, const Confusion& c) {
-    return {threshold, c, Recall(c), FalsePositiveRate(c), Precision(c)};
-}
-
-// Keeps curve points evenly spaced along the ROC curve, measured by FPR + TPR (its L1 length,
-// since the curve is monotone), so the steep low-FPR part is not lost between the many points
-// of the flat part.
-class CurveThinner {
-public:
-    explicit CurveThinner(std::size_t max_points)
-        : step_(max_points == 0 ? 0.0 : 2.0 / static_cast<double>(max_points - 2)) {}
-
-    bool Keep(const CurvePoint& point) {
-        if (step_ == 0.0) return true;
-        const double bucket = std::floor((point.fpr + point.tpr) / step_);
-        if (bucket <= last_bucket_) return false;
-        last_bucket_ = bucket;
-        return true;
-    }
-
-private:
-    double step_;
-    double last_bucket_ = 0.0;
-};
-
-void KeepBest(BestThreshold& best, bool& have, double score, double threshold, const Confusion& c) {
-    // Strictly greater: ties keep the smaller threshold seen first.
-    if (!have || score > best.score) {
-        best = {threshold, score, c};
-        have = true;
-    }
 }
 
 // Distance and label of every pair, distance ascending; throws for a NaN distance.
@@ -96,7 +64,7 @@ void Sweep(std::span<const Scored> sorted, const PairwiseConfig& config,
     result.best_mcc = {previous.threshold, Mcc(c), c};
     result.best_f1 = {previous.threshold, F1(c), c};
     CurveThinner thinner(config.max_curve_points);
-    double area = 0.0;
+    detail::AreaSum area;
     bool have_mcc = false;
     bool have_f1 = false;
     for (std::size_t k = 0; k < sorted.size();) {
@@ -107,13 +75,14 @@ void Sweep(std::span<const Scored> sorted, const PairwiseConfig& config,
         }
         const CurvePoint point = MakePoint(distance, c);
         ++result.distinct_thresholds;
-        area += (point.fpr - previous.fpr) * 0.5 * (point.tpr + previous.tpr);
+        area.Step(c.fp - previous.confusion.fp, previous.confusion.tp, c.tp);
         KeepBest(result.best_mcc, have_mcc, Mcc(c), distance, c);
         KeepBest(result.best_f1, have_f1, F1(c), distance, c);
         if (k == sorted.size() || thinner.Keep(point)) result.curve.push_back(point);
         previous = point;
     }
-    if (result.positives > 0 && result.negatives > 0) result.roc_auc = area;
+    if (result.positives > 0 && result.negatives > 0)
+        result.roc_auc = area.Area(result.positives, result.negatives);
 }
 
 // Position of the first of the ascending thresholds >= distance (their count when none is).

@@ -1,0 +1,702 @@
+#include "lidarloop/eval/streamed_pairwise.hpp"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <mutex>
+#include <new>
+#include <string>
+#include <utility>
+
+#include "lidarloop/core/error.hpp"
+#include "lidarloop/eval/detail/sweep.hpp"
+
+// How the streamed sweep equals the sweep over sorted pairs (docs/evaluation.md):
+// - The positives are kept, sorted into their distinct finite distances D_0 < ... < D_{U-1}.
+//   Each negative is counted in a slot: below D_k (2k), at D_k (2k + 1), above all (2U). At
+//   every D_k the sweep's confusion is then known exactly, and so is the ROC area (only FP grows
+//   between two D_k, by the slot's count, at constant TP).
+// - Between D_{k-1} and D_k lie the negatives' distinct distances, which the sweep also visits.
+//   The thinned curve keeps, of those, the first point in each new FPR + TPR bucket: the point
+//   whose cumulative FP first reaches a count known after the first pass, i.e. an order
+//   statistic of the negatives. The first pass histograms the negatives by the top 20 bits of
+//   an order-preserving key of the float, the second counts each key in the few buckets that
+//   hold a wanted rank: its value and its cumulative count are then exact.
+// - MCC and F1 at a fixed TP fall as FP grows while they are positive, so their optimum is at a
+//   D_k, or (when no score is positive) at the first or the last point, whose distances are the
+//   negatives' extremes. StreamedResult::optimum_exact names the one case left open.
+
+namespace lidarloop::eval {
+namespace {
+
+constexpr int kFineBits = 12;
+constexpr std::size_t kCoarseBuckets = std::size_t{1} << (32 - kFineBits);
+constexpr std::size_t kFineKeys = std::size_t{1} << kFineBits;
+constexpr std::size_t kBitmapWords = (std::size_t{1} << 32) / 64;
+constexpr std::size_t kPending = std::size_t{1} << 18;  // negatives a sink sorts at once
+
+// A key whose unsigned order is the float order (-0 and +0 are one value, as `<` sees them).
+std::uint32_t OrderKey(float distance) {
+    const auto bits = std::bit_cast<std::uint32_t>(distance == 0.0f ? 0.0f : distance);
+    return (bits & 0x80000000u) != 0 ? ~bits : bits | 0x80000000u;
+}
+
+float FromKey(std::uint32_t key) {
+    const std::uint32_t bits = (key & 0x80000000u) != 0 ? key & 0x7fffffffu : ~key;
+    return std::bit_cast<float>(bits);
+}
+
+std::string PairName(std::size_t i, std::size_t j) {
+    return "(" + std::to_string(i) + ", " + std::to_string(j) + ")";
+}
+
+void CheckNotNan(std::size_t i, std::size_t j, float distance) {
+    if (std::isnan(distance)) {
+        throw core::Error("pair-wise evaluation: distance of pair " + PairName(i, j) + " is NaN");
+    }
+}
+
+// The positives of one population by distinct finite distance, and the slot of a negative.
+struct PositiveLevels {
+    std::vector<float> distances;       // distinct finite, ascending
+    std::vector<std::uint64_t> counts;  // positives at each
+    std::uint64_t total = 0;            // unscored included
+    // The first distance whose key's coarse bucket is >= b: a slot is then searched among the
+    // few distances of one bucket, not all (a binary search over all cost most of the time).
+    std::vector<std::uint32_t> first_in_bucket;
+    std::vector<std::uint32_t> keys;  // OrderKey of each distance
+
+    void Index() {
+        keys.clear();
+        for (const float d : distances) keys.push_back(OrderKey(d));
+        first_in_bucket.assign(kCoarseBuckets + 1, 0);
+        std::size_t k = 0;
+        for (std::size_t b = 0; b <= kCoarseBuckets; ++b) {
+            while (k < distances.size() && (OrderKey(distances[k]) >> kFineBits) < b) ++k;
+            first_in_bucket[b] = static_cast<std::uint32_t>(k);
+        }
+    }
+    std::size_t SlotCount() const { return 2 * distances.size() + 1; }
+};
+
+// Sorts keys ascending: LSD radix sort in three passes of 11 bits, O(n) and cache-friendly.
+void RadixSort(std::vector<std::uint32_t>& keys, std::vector<std::uint32_t>& scratch) {
+    constexpr std::uint32_t kDigits = 2048;
+    scratch.resize(keys.size());
+    for (unsigned shift = 0; shift < 32; shift += 11) {
+        std::array<std::size_t, kDigits> offsets{};
+        for (const std::uint32_t key : keys) ++offsets[(key >> shift) & (kDigits - 1)];
+        std::size_t sum = 0;
+        for (std::size_t& offset : offsets) sum += std::exchange(offset, sum);
+        for (const std::uint32_t key : keys)
+            scratch[offsets[(key >> shift) & (kDigits - 1)]++] = key;
+        keys.swap(scratch);
+    }
+}
+
+// Counts ascending keys of negatives into the slots between `levels` (below D_k: 2k, at D_k:
+// 2k + 1), walking both in order, and gives each distinct key and its count to `each_key`.
+template <class EachKey>
+void CountSortedKeys(const std::vector<std::uint32_t>& keys, const PositiveLevels& levels,
+                     std::vector<std::uint64_t>& slots, EachKey each_key) {
+    std::size_t k = 0;
+    for (std::size_t a = 0; a < keys.size();) {
+        const std::uint32_t key = keys[a];
+        std::size_t b = a + 1;
+        while (b < keys.size() && keys[b] == key) ++b;
+        k = std::max<std::size_t>(k, levels.first_in_bucket[key >> kFineBits]);
+        while (k < levels.keys.size() && levels.keys[k] < key) ++k;
+        slots[2 * k + (k < levels.keys.size() && levels.keys[k] == key ? 1 : 0)] += b - a;
+        each_key(key, static_cast<std::uint64_t>(b - a));
+        a = b;
+    }
+}
+
+template <class Keep>
+PositiveLevels LevelsOf(const std::vector<ScoredPair>& positives, Keep keep) {
+    std::vector<float> scored;
+    PositiveLevels levels;
+    for (const ScoredPair& p : positives) {
+        if (!keep(p)) continue;
+        ++levels.total;
+        if (detail::IsScored(p.distance)) scored.push_back(p.distance);
+    }
+    std::sort(scored.begin(), scored.end());
+    for (const float d : scored) {
+        if (levels.distances.empty() || levels.distances.back() != d) {
+            levels.distances.push_back(d);
+            levels.counts.push_back(0);
+        }
+        ++levels.counts.back();
+    }
+    levels.Index();
+    return levels;
+}
+
+struct FreeDeleter {
+    void operator()(std::uint64_t* p) const { std::free(p); }
+};
+
+// One bit per float key. calloc leaves untouched pages unmapped, so only the pages of keys
+// that occur become resident.
+std::unique_ptr<std::uint64_t, FreeDeleter> NewBitmap() {
+    auto* words = static_cast<std::uint64_t*>(std::calloc(kBitmapWords, sizeof(std::uint64_t)));
+    if (words == nullptr) throw std::bad_alloc();
+    return std::unique_ptr<std::uint64_t, FreeDeleter>(words);
+}
+
+// A wanted order statistic of the finite negatives: rank (1-based) and, after the first pass,
+// where it lies; after the second, its value and how many negatives are <= it.
+struct RankQuery {
+    std::uint64_t rank = 0;
+    std::uint32_t bucket = 0;
+    std::uint64_t rank_in_bucket = 0;
+    float value = 0.0f;
+    std::uint64_t at_most = 0;
+};
+
+Confusion ConfusionOf(std::uint64_t tp, std::uint64_t fp, std::uint64_t positives,
+                      std::uint64_t negatives) {
+    return {tp, fp, negatives - fp, positives - tp};
+}
+
+}  // namespace
+
+struct StreamedPairwise::Shared {
+    const GroundTruth* truth = nullptr;
+    StreamedRequest request;
+    std::vector<ScoredPair> positives;
+    std::size_t first_test_scan = 0;  // the test part: pairs with j >= it
+    PositiveLevels all;
+    PositiveLevels train;
+    std::vector<double> ascending_thresholds;
+    std::vector<std::size_t> threshold_order;
+    std::unique_ptr<std::uint64_t, FreeDeleter> bitmap = NewBitmap();
+    int pass = 1;
+    // Merged counts. In the first pass the sinks count their sorted batches straight into its
+    // slots and coarse histogram, under `counting`: one copy of the O(positives) slots, not one
+    // a thread.
+    mutable Sink merged;
+    mutable std::mutex counting;
+    std::vector<std::int32_t> fine_of_bucket;  // pass 2: table of a coarse bucket, or -1
+    std::vector<RankQuery> queries;
+    std::optional<double> learnt_threshold;
+
+    explicit Shared(const GroundTruth& t) : truth(&t), merged(*this) {}
+    bool Learning() const { return request.learning.has_value(); }
+    bool InTest(std::size_t j) const { return j >= first_test_scan; }
+    // True when no pair had this distance before: fetch_or tells exactly one thread.
+    bool MarkDistinct(std::uint32_t key) const {
+        std::atomic_ref<std::uint64_t> word(bitmap.get()[key >> 6]);
+        const std::uint64_t bit = std::uint64_t{1} << (key & 63u);
+        if ((word.load(std::memory_order_relaxed) & bit) != 0) return false;
+        return (word.fetch_or(bit, std::memory_order_relaxed) & bit) == 0;
+    }
+    struct Optima {
+        BestThreshold mcc;
+        BestThreshold f1;
+    };
+    Optima BestOf(const PositiveLevels& levels, const std::vector<std::uint64_t>& slots,
+                  const Sink::Extremes& negatives) const;
+    void PrepareSecondPass();
+    void ResolveQueries();
+    void SweepAll(StreamedResult& result) const;
+    std::optional<ThresholdTransfer> Transfer() const;
+};
+
+// ---- Sink -------------------------------------------------------------------------------------
+
+void StreamedPairwise::Sink::Extremes::Add(float distance) {
+    ++total;
+    if (!detail::IsScored(distance)) {
+        ++unscored;
+        return;
+    }
+    if (min_count == 0 || distance < min) {
+        min = distance;
+        min_count = 0;
+    }
+    if (max_count == 0 || distance > max) {
+        max = distance;
+        max_count = 0;
+    }
+    min_count += distance == min ? 1 : 0;
+    max_count += distance == max ? 1 : 0;
+}
+
+void StreamedPairwise::Sink::Extremes::Merge(const Extremes& other) {
+    total += other.total;
+    unscored += other.unscored;
+    if (other.min_count > 0) {
+        if (min_count == 0 || other.min < min) {
+            min = other.min;
+            min_count = other.min_count;
+        } else if (other.min == min) {
+            min_count += other.min_count;
+        }
+    }
+    if (other.max_count > 0) {
+        if (max_count == 0 || other.max > max) {
+            max = other.max;
+            max_count = other.max_count;
+        } else if (other.max == max) {
+            max_count += other.max_count;
+        }
+    }
+}
+
+StreamedPairwise::Sink::Sink(const Shared& shared) : shared_(&shared) {
+    const std::size_t n = shared.truth->size();
+    if (shared.pass == 1) {
+        best_.assign(n, BestMatch{});
+        pending_all_.reserve(kPending);
+        if (shared.Learning()) pending_train_.reserve(kPending);
+    } else {
+        std::size_t tables = 0;
+        for (const std::int32_t t : shared.fine_of_bucket) tables += t >= 0 ? 1 : 0;
+        fine_.assign(tables * kFineKeys, 0);
+        from_threshold_.assign(shared.ascending_thresholds.size() + 1, 0);
+    }
+}
+
+namespace {
+
+// Offers a candidate to a scan's best match as BestMatchesFromCondensed does, for candidates in
+// any order: the smallest distance wins, ties to the smaller scan.
+void Offer(BestMatch& m, std::size_t other, double distance) {
+    if (distance < m.distance || (distance == m.distance && other < m.match &&
+                                  distance != std::numeric_limits<double>::infinity())) {
+        m.second_distance = std::min(m.second_distance, m.distance);
+        m.distance = distance;
+        m.match = other;
+    } else {
+        m.second_distance = std::min(m.second_distance, distance);
+    }
+}
+
+void MergeBest(BestMatch& into, const BestMatch& from) {
+    if (from.match != kNoScan) {
+        Offer(into, from.match, from.distance);
+    } else {
+        into.second_distance = std::min(into.second_distance, from.distance);
+    }
+    into.second_distance = std::min(into.second_distance, from.second_distance);
+}
+
+}  // namespace
+
+void StreamedPairwise::Sink::Add(std::size_t i, std::size_t j, float distance) {
+    const Shared& s = *shared_;
+    if (!s.truth->Comparable(i, j)) return;
+    CheckNotNan(i, j, distance);
+    const bool loop = s.truth->IsLoop(i, j);
+    if (s.pass == 1) {
+        Offer(best_[i], j, distance);
+        Offer(best_[j], i, distance);
+        // The negatives' distances are marked when their batch is counted (Flush).
+        if (loop && detail::IsScored(distance) && s.MarkDistinct(OrderKey(distance))) ++distinct_;
+    }
+    if (!loop) AddNegative(j, distance);
+}
+
+void StreamedPairwise::Sink::Flush() {
+    const Shared& s = *shared_;
+    RadixSort(pending_all_, scratch_);
+    RadixSort(pending_train_, scratch_);
+    {
+        const std::lock_guard<std::mutex> lock(s.counting);
+        Sink& merged = s.merged;
+        CountSortedKeys(pending_all_, s.all, merged.all_slots_,
+                        [&](std::uint32_t key, std::uint64_t count) {
+                            merged.coarse_[key >> kFineBits] += count;
+                            if (s.MarkDistinct(key)) ++distinct_;
+                        });
+        CountSortedKeys(pending_train_, s.train, merged.train_slots_,
+                        [](std::uint32_t, std::uint64_t) {});
+    }
+    pending_all_.clear();
+    pending_train_.clear();
+}
+
+void StreamedPairwise::Sink::AddNegative(std::size_t j, float distance) {
+    const Shared& s = *shared_;
+    const bool scored = detail::IsScored(distance);
+    const bool in_test = s.Learning() && s.InTest(j);
+    const std::uint32_t key = OrderKey(distance);
+    if (s.pass == 1) {
+        // Counted in sorted batches: one random access a negative into the slots cost most of
+        // the time when they outgrow the cache.
+        all_.Add(distance);
+        if (scored) pending_all_.push_back(key);
+        if (s.Learning()) {
+            (in_test ? test_ : train_).Add(distance);
+            if (scored && !in_test) pending_train_.push_back(key);
+        }
+        if (pending_all_.size() >= kPending || pending_train_.size() >= kPending) Flush();
+        return;
+    }
+    if (!scored) return;
+    const std::int32_t table = s.fine_of_bucket[key >> kFineBits];
+    if (table >= 0) ++fine_[static_cast<std::size_t>(table) * kFineKeys + (key & (kFineKeys - 1))];
+    const auto first =
+        std::lower_bound(s.ascending_thresholds.begin(), s.ascending_thresholds.end(),
+                         static_cast<double>(distance));
+    ++from_threshold_[static_cast<std::size_t>(first - s.ascending_thresholds.begin())];
+    if (in_test && s.learnt_threshold && static_cast<double>(distance) <= *s.learnt_threshold)
+        ++test_at_learnt_;
+}
+
+// ---- StreamedPairwise -------------------------------------------------------------------------
+
+std::vector<ScoredPair> ScorePositives(const GroundTruth& truth, const PairDistance& distance) {
+    std::vector<ScoredPair> positives;
+    for (const LoopPair& loop : truth.loops) {
+        if (!truth.Comparable(loop.i, loop.j)) continue;
+        const float d = distance(loop.i, loop.j);
+        CheckNotNan(loop.i, loop.j, d);
+        positives.push_back(
+            {static_cast<std::uint32_t>(loop.i), static_cast<std::uint32_t>(loop.j), d, true});
+    }
+    return positives;
+}
+
+StreamedPairwise::StreamedPairwise(const GroundTruth& truth, std::vector<ScoredPair> positives,
+                                   StreamedRequest request)
+    : shared_(nullptr) {
+    request.pairwise.Validate();
+    if (request.pairwise.max_curve_points == 0) {
+        throw core::ConfigError(
+            "pairwise.max_curve_points must be >= 3 for the streamed evaluation: keeping every "
+            "point needs every distance in memory");
+    }
+    if (request.learning) request.learning->Validate();
+    for (const double t : request.thresholds) {
+        if (std::isnan(t)) throw core::Error("evaluation threshold must not be NaN");
+    }
+    if (truth.size() > std::numeric_limits<std::uint32_t>::max())
+        throw core::Error("pair-wise evaluation: more than 2^32 scans");
+    for (const ScoredPair& p : positives) CheckNotNan(p.i, p.j, p.distance);
+    auto shared = std::make_unique<Shared>(truth);
+    Shared& s = *shared;
+    s.request = std::move(request);
+    s.positives = std::move(positives);
+    if (s.request.learning) {
+        s.first_test_scan = static_cast<std::size_t>(
+            std::llround(s.request.learning->train_fraction * static_cast<double>(truth.size())));
+    }
+    s.all = LevelsOf(s.positives, [](const ScoredPair&) { return true; });
+    s.train = LevelsOf(s.positives, [&](const ScoredPair& p) { return !s.InTest(p.j); });
+    const std::vector<double>& thresholds = s.request.thresholds;
+    s.threshold_order.resize(thresholds.size());
+    for (std::size_t k = 0; k < thresholds.size(); ++k) s.threshold_order[k] = k;
+    std::sort(s.threshold_order.begin(), s.threshold_order.end(),
+              [&](std::size_t a, std::size_t b) { return thresholds[a] < thresholds[b]; });
+    for (const std::size_t k : s.threshold_order) s.ascending_thresholds.push_back(thresholds[k]);
+    s.merged = Sink(s);
+    s.merged.all_slots_.assign(s.all.SlotCount(), 0);
+    if (s.Learning()) s.merged.train_slots_.assign(s.train.SlotCount(), 0);
+    s.merged.coarse_.assign(kCoarseBuckets, 0);
+    shared_ = std::move(shared);
+}
+
+StreamedPairwise::~StreamedPairwise() = default;
+
+int StreamedPairwise::pass() const { return shared_->pass; }
+
+StreamedPairwise::Sink StreamedPairwise::NewSink() const { return Sink(*shared_); }
+
+void StreamedPairwise::Merge(Sink& sink) {
+    Sink& m = shared_->merged;
+    const auto add = [](std::vector<std::uint64_t>& into, const std::vector<std::uint64_t>& from) {
+        for (std::size_t k = 0; k < from.size(); ++k) into[k] += from[k];
+    };
+    if (shared_->pass == 1) {
+        sink.Flush();
+        for (std::size_t k = 0; k < m.best_.size(); ++k) MergeBest(m.best_[k], sink.best_[k]);
+        m.all_.Merge(sink.all_);
+        m.train_.Merge(sink.train_);
+        m.test_.Merge(sink.test_);
+        m.distinct_ += sink.distinct_;
+    } else {
+        add(m.fine_, sink.fine_);
+        add(m.from_threshold_, sink.from_threshold_);
+        m.test_at_learnt_ += sink.test_at_learnt_;
+    }
+}
+
+void StreamedPairwise::EndPass() {
+    Shared& s = *shared_;
+    if (s.pass == 1) {
+        if (s.positives.size() + s.merged.all_.total == 0)
+            throw core::EmptyInputError("pair-wise evaluation: no pairs to evaluate");
+        s.PrepareSecondPass();
+        // The second pass's sink keeps the first pass's merged counts.
+        Sink first = std::move(s.merged);
+        s.pass = 2;
+        s.merged = Sink(s);
+        s.merged.all_slots_ = std::move(first.all_slots_);
+        s.merged.train_slots_ = std::move(first.train_slots_);
+        s.merged.coarse_ = std::move(first.coarse_);
+        s.merged.best_ = std::move(first.best_);
+        s.merged.all_ = first.all_;
+        s.merged.train_ = first.train_;
+        s.merged.test_ = first.test_;
+        s.merged.distinct_ = first.distinct_;
+    } else if (s.pass == 2) {
+        s.ResolveQueries();
+        s.pass = 3;
+    }
+}
+
+StreamedResult StreamedPairwise::Result() const {
+    const Shared& s = *shared_;
+    if (s.pass != 3) throw core::Error("streamed evaluation: Result() before both passes ended");
+    StreamedResult result;
+    s.SweepAll(result);
+    result.learnt = s.Transfer();
+    result.best_matches = s.merged.best_;
+    // ConfusionsAt: positives directly, negatives from the second pass's slots.
+    const std::uint64_t negatives = s.merged.all_.total;
+    const std::uint64_t positives = s.positives.size();
+    result.at_thresholds.resize(s.ascending_thresholds.size());
+    std::uint64_t fp = 0;
+    for (std::size_t r = 0; r < s.ascending_thresholds.size(); ++r) {
+        fp += s.merged.from_threshold_[r];
+        std::uint64_t tp = 0;
+        for (const ScoredPair& p : s.positives) {
+            tp += detail::IsScored(p.distance) &&
+                          static_cast<double>(p.distance) <= s.ascending_thresholds[r]
+                      ? 1
+                      : 0;
+        }
+        result.at_thresholds[s.threshold_order[r]] = ConfusionOf(tp, fp, positives, negatives);
+    }
+    return result;
+}
+
+// ---- Between the passes -----------------------------------------------------------------------
+
+namespace {
+
+// Walks the sweep's steps: for each D_k the run of negatives below it (slot 2k), then the
+// positives and negatives at it (slot 2k + 1); finally the run above all (slot 2U).
+template <class Run, class AtLevel>
+void ForEachStep(const PositiveLevels& levels, const std::vector<std::uint64_t>& slots, Run run,
+                 AtLevel at_level) {
+    std::uint64_t tp = 0;
+    std::uint64_t fp = 0;
+    for (std::size_t k = 0; k <= levels.distances.size(); ++k) {
+        run(k, tp, fp, slots[2 * k]);
+        fp += slots[2 * k];
+        if (k == levels.distances.size()) break;
+        at_level(k, tp, fp, levels.counts[k], slots[2 * k + 1]);
+        tp += levels.counts[k];
+        fp += slots[2 * k + 1];
+    }
+}
+
+// The smallest fp in [low, high] whose curve point lies in a bucket >= `bucket`; high when none.
+std::uint64_t FirstFpInBucket(const detail::CurveThinner& thinner, double bucket, std::uint64_t tp,
+                              std::uint64_t low, std::uint64_t high, std::uint64_t positives,
+                              std::uint64_t negatives) {
+    while (low < high) {
+        const std::uint64_t mid = low + (high - low) / 2;
+        const CurvePoint p = detail::MakePoint(0.0, ConfusionOf(tp, mid, positives, negatives));
+        if (thinner.Bucket(p) >= bucket) {
+            high = mid;
+        } else {
+            low = mid + 1;
+        }
+    }
+    return low;
+}
+
+}  // namespace
+
+void StreamedPairwise::Shared::PrepareSecondPass() {
+    const std::uint64_t positives_n = positives.size();
+    const std::uint64_t negatives_n = merged.all_.total;
+    const detail::CurveThinner thinner(request.pairwise.max_curve_points);
+    std::vector<std::uint64_t> ranks;
+    // Every rank that can start a new bucket inside a run (see SweepAll).
+    ForEachStep(
+        all, merged.all_slots_,
+        [&](std::size_t, std::uint64_t tp, std::uint64_t fp, std::uint64_t count) {
+            if (count == 0) return;
+            const auto bucket_at = [&](std::uint64_t f) {
+                return thinner.Bucket(
+                    detail::MakePoint(0.0, ConfusionOf(tp, f, positives_n, negatives_n)));
+            };
+            for (double b = bucket_at(fp) + 1; b <= bucket_at(fp + count); ++b) {
+                ranks.push_back(
+                    FirstFpInBucket(thinner, b, tp, fp + 1, fp + count, positives_n, negatives_n));
+            }
+        },
+        [](std::size_t, std::uint64_t, std::uint64_t, std::uint64_t, std::uint64_t) {});
+    ranks.erase(std::unique(ranks.begin(), ranks.end()), ranks.end());
+    // Locate each rank's coarse bucket.
+    fine_of_bucket.assign(kCoarseBuckets, -1);
+    std::int32_t tables = 0;
+    std::uint64_t before = 0;
+    std::size_t next = 0;
+    for (std::size_t bucket = 0; bucket < kCoarseBuckets && next < ranks.size(); ++bucket) {
+        const std::uint64_t count = merged.coarse_[bucket];
+        for (; next < ranks.size() && ranks[next] <= before + count; ++next) {
+            if (fine_of_bucket[bucket] < 0) fine_of_bucket[bucket] = tables++;
+            queries.push_back(
+                {ranks[next], static_cast<std::uint32_t>(bucket), ranks[next] - before, 0.0f, 0});
+        }
+        before += count;
+    }
+    learnt_threshold.reset();
+    if (const auto t = Transfer()) learnt_threshold = t->threshold;
+}
+
+void StreamedPairwise::Shared::ResolveQueries() {
+    std::uint64_t before = 0;
+    std::uint32_t summed_to = 0;  // coarse buckets [0, summed_to) are in `before`
+    for (RankQuery& q : queries) {
+        for (; summed_to < q.bucket; ++summed_to) before += merged.coarse_[summed_to];
+        const std::uint64_t* table =
+            merged.fine_.data() + static_cast<std::size_t>(fine_of_bucket[q.bucket]) * kFineKeys;
+        std::uint64_t cumulative = 0;
+        std::size_t key = 0;
+        for (; key < kFineKeys; ++key) {
+            cumulative += table[key];
+            if (cumulative >= q.rank_in_bucket) break;
+        }
+        q.value = FromKey((q.bucket << kFineBits) | static_cast<std::uint32_t>(key));
+        q.at_most = before + cumulative;
+    }
+}
+
+// ---- After the passes ---------------------------------------------------------------------
+
+// The optima over the sweep's points at the positives' distances and its first and last points:
+// see the top of this file for why the points between two positives' distances cannot win.
+StreamedPairwise::Shared::Optima StreamedPairwise::Shared::BestOf(
+    const PositiveLevels& levels, const std::vector<std::uint64_t>& slots,
+    const Sink::Extremes& negatives) const {
+    const std::uint64_t positives_n = levels.total;
+    const std::uint64_t negatives_n = negatives.total;
+    const Confusion start = ConfusionOf(0, 0, positives_n, negatives_n);
+    const double minus_inf = -std::numeric_limits<double>::infinity();
+    Optima best{{minus_inf, Mcc(start), start}, {minus_inf, F1(start), start}};
+    bool have_mcc = false;
+    bool have_f1 = false;
+    const auto consider = [&](double threshold, std::uint64_t tp, std::uint64_t fp) {
+        const Confusion c = ConfusionOf(tp, fp, positives_n, negatives_n);
+        detail::KeepBest(best.mcc, have_mcc, Mcc(c), threshold, c);
+        detail::KeepBest(best.f1, have_f1, F1(c), threshold, c);
+    };
+    if (slots.front() > 0) consider(negatives.min, 0, negatives.min_count);
+    std::uint64_t scored_positives = 0;
+    ForEachStep(
+        levels, slots, [](std::size_t, std::uint64_t, std::uint64_t, std::uint64_t) {},
+        [&](std::size_t k, std::uint64_t tp, std::uint64_t fp, std::uint64_t pos,
+            std::uint64_t neg) {
+            consider(levels.distances[k], tp + pos, fp + neg);
+            scored_positives = tp + pos;
+        });
+    if (slots.back() > 0)
+        consider(negatives.max, scored_positives, negatives_n - negatives.unscored);
+    return best;
+}
+
+void StreamedPairwise::Shared::SweepAll(StreamedResult& result) const {
+    PairwiseEvaluation& e = result.pairwise;
+    const std::uint64_t positives_n = positives.size();
+    const std::uint64_t negatives_n = merged.all_.total;
+    e.pairs = positives_n + negatives_n;
+    e.positives = positives_n;
+    e.negatives = negatives_n;
+    e.distinct_thresholds = merged.distinct_;
+    const auto point_at = [&](double threshold, std::uint64_t tp, std::uint64_t fp) {
+        return detail::MakePoint(threshold, ConfusionOf(tp, fp, positives_n, negatives_n));
+    };
+    e.curve.push_back(point_at(-std::numeric_limits<double>::infinity(), 0, 0));
+    detail::CurveThinner thinner(request.pairwise.max_curve_points);
+    detail::AreaSum area;
+    const std::size_t levels = all.distances.size();
+    const bool ends_in_run = merged.all_slots_.back() > 0;
+    std::size_t next_query = 0;
+    const auto run = [&](std::size_t k, std::uint64_t tp, std::uint64_t fp, std::uint64_t count) {
+        if (count == 0) return;
+        area.Step(count, tp, tp);
+        const std::uint64_t end = fp + count;
+        while (thinner.Bucket(point_at(0.0, tp, end)) > thinner.last_bucket()) {
+            const std::uint64_t rank = FirstFpInBucket(thinner, thinner.last_bucket() + 1, tp,
+                                                       fp + 1, end, positives_n, negatives_n);
+            while (next_query < queries.size() && queries[next_query].rank < rank) ++next_query;
+            if (next_query == queries.size() || queries[next_query].rank != rank)
+                throw core::Error("streamed evaluation: a curve point was not located");
+            const RankQuery& q = queries[next_query];
+            if (k == levels && q.at_most == end) break;  // the last point, kept below
+            const CurvePoint point = point_at(q.value, tp, q.at_most);
+            thinner.Keep(point);
+            e.curve.push_back(point);
+            fp = q.at_most;
+        }
+        if (k == levels) e.curve.push_back(point_at(merged.all_.max, tp, end));
+    };
+    const auto at_level = [&](std::size_t k, std::uint64_t tp, std::uint64_t fp, std::uint64_t pos,
+                              std::uint64_t neg) {
+        area.Step(neg, tp, tp + pos);
+        const CurvePoint point = point_at(all.distances[k], tp + pos, fp + neg);
+        const bool last = k + 1 == levels && !ends_in_run;
+        if (last || thinner.Keep(point)) e.curve.push_back(point);
+    };
+    ForEachStep(all, merged.all_slots_, run, at_level);
+    if (positives_n > 0 && negatives_n > 0) e.roc_auc = area.Area(positives_n, negatives_n);
+    const Optima best = BestOf(all, merged.all_slots_, merged.all_);
+    e.best_mcc = best.mcc;
+    e.best_f1 = best.f1;
+    result.optimum_exact = !(best.mcc.score < 0.0);
+}
+
+std::optional<ThresholdTransfer> StreamedPairwise::Shared::Transfer() const {
+    if (!Learning()) return std::nullopt;
+    const std::uint64_t test_positives = positives.size() - train.total;
+    const std::uint64_t train_pairs = train.total + merged.train_.total;
+    const std::uint64_t test_pairs = test_positives + merged.test_.total;
+    if (train_pairs == 0 || test_pairs == 0) return std::nullopt;
+    if (train.distances.empty() && merged.train_.min_count == 0) return std::nullopt;
+    const Optima best = BestOf(train, merged.train_slots_, merged.train_);
+    const Criterion criterion = request.learning->criterion;
+    const BestThreshold& chosen = criterion == Criterion::kMcc ? best.mcc : best.f1;
+    ThresholdTransfer result;
+    result.criterion = criterion;
+    result.threshold = chosen.threshold;
+    result.train_score = chosen.score;
+    result.train = chosen.confusion;
+    std::uint64_t tp = 0;
+    for (const ScoredPair& p : positives) {
+        tp += InTest(p.j) && detail::IsScored(p.distance) &&
+                      static_cast<double>(p.distance) <= result.threshold
+                  ? 1
+                  : 0;
+    }
+    result.test = ConfusionOf(tp, merged.test_at_learnt_, test_positives, merged.test_.total);
+    result.test_f1 = F1(result.test);
+    result.test_mcc = Mcc(result.test);
+    return result;
+}
+
+StreamedResult StreamSerially(StreamedPairwise& evaluation, std::size_t n,
+                              const PairDistance& distance) {
+    while (evaluation.pass() < 3) {
+        StreamedPairwise::Sink sink = evaluation.NewSink();
+        for (std::size_t i = 0; i < n; ++i) {
+            for (std::size_t j = i + 1; j < n; ++j) sink.Add(i, j, distance(i, j));
+        }
+        evaluation.Merge(sink);
+        evaluation.EndPass();
+    }
+    return evaluation.Result();
+}
+
+}  // namespace lidarloop::eval

@@ -1,0 +1,135 @@
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "lidarloop/eval/ground_truth.hpp"
+#include "lidarloop/eval/pairwise.hpp"
+#include "lidarloop/eval/per_scan.hpp"
+#include "lidarloop/eval/threshold_learning.hpp"
+
+namespace lidarloop::eval {
+
+/// Distance of scans i < j as the evaluation stores it (float; +inf: never scored). May be
+/// called concurrently.
+using PairDistance = std::function<float(std::size_t i, std::size_t j)>;
+
+/// The comparable loop pairs of `truth` (the positives of the pair-wise protocol), in the order
+/// of truth.loops, with their distances: O(P) calls of `distance`. Throws core::Error for a NaN
+/// distance. Thread-safe.
+std::vector<ScoredPair> ScorePositives(const GroundTruth& truth, const PairDistance& distance);
+
+/// What StreamedPairwise computes besides the sweep over all pairs.
+struct StreamedRequest {
+    /// Must keep at most max_curve_points (0, every point, would need every distance).
+    PairwiseConfig pairwise;
+    std::vector<double> thresholds;  ///< the confusion of all pairs at each (table II, defaults)
+    std::optional<ThresholdLearningConfig> learning;  ///< learn on the first part, when given
+};
+
+/// The figures of the pair-wise and per-scan protocols, equal to those of the pairs in memory.
+struct StreamedResult {
+    PairwiseEvaluation pairwise;           ///< EvaluatePairs(pairs, request.pairwise)
+    std::vector<Confusion> at_thresholds;  ///< ConfusionsAt(pairs, request.thresholds)
+    /// LearnOnFirstPart(pairs, n, *request.learning); nullopt without learning or where that
+    /// throws core::EmptyInputError (a part without pairs or without a finite distance).
+    std::optional<ThresholdTransfer> learnt;
+    std::vector<BestMatch> best_matches;  ///< BestMatchesFromCondensed
+    /// False only when the best MCC is <= 0 at every threshold of a positive pair's distance, on
+    /// both sides: then a threshold between two positives' distances, which the streamed sweep
+    /// does not visit, could score higher (docs/evaluation.md, "Evaluation in linear memory").
+    bool optimum_exact = true;
+};
+
+/// The pair-wise evaluation (Röhling IV-B/C), threshold learning on the first part, fixed
+/// thresholds and the per-scan best matches of every comparable pair of a sequence, in memory
+/// O(n + positives) instead of the O(n^2) pairs: the positives are kept, the negatives are
+/// counted as they stream past. Results equal EvaluatePairs(CollectPairs(...)) and friends
+/// exactly (same doubles), with the caveat of StreamedResult::optimum_exact.
+///
+/// Use: construct with the positives (ScorePositives), then stream every pair i < j twice: for
+/// each pass, give each thread a NewSink(), Add every pair to some sink, Merge every sink, then
+/// EndPass(). After the second pass, Result(). The exact curve needs the second pass: its
+/// thinned points between two positives' distances are order statistics of the negatives.
+/// Memory: the positives (16 bytes each) and, per distinct positive distance, about 40 bytes
+/// (its key, count, slots of the whole sequence and of the training part, and a bucket table of
+/// 8 MiB); per sink 24 bytes a scan and 3 MiB of batch; in the second pass 32 KiB per located
+/// curve point and sink; and a bitmap of the distinct distances (512 MiB of address space, of
+/// which only the pages of occurring distances become resident: 4 KiB per 32768 consecutive
+/// float values). Sinks count their batches into shared counters under a mutex.
+class StreamedPairwise {
+public:
+    struct Shared;
+    /// Per-thread accumulator of one pass; cheap to Add to, not thread-safe itself.
+    class Sink {
+    public:
+        explicit Sink(const Shared& shared);
+        /// One pair i < j and its distance; pairs the ground truth does not compare are
+        /// ignored. Throws core::Error for a NaN distance.
+        void Add(std::size_t i, std::size_t j, float distance);
+
+    private:
+        friend class StreamedPairwise;
+        void AddNegative(std::size_t j, float distance);
+        void Flush();
+        const Shared* shared_;
+        std::vector<std::uint64_t> all_slots_;
+        std::vector<std::uint64_t> train_slots_;
+        std::vector<std::uint64_t> coarse_;       ///< pass 1: negatives by the top bits of the key
+        std::vector<std::uint32_t> pending_all_;  ///< pass 1: keys of negatives to count
+        std::vector<std::uint32_t> pending_train_;  ///< pass 1: of training negatives
+        std::vector<std::uint32_t> scratch_;
+        std::vector<std::uint64_t> fine_;  ///< pass 2: negatives by key in the target buckets
+        std::vector<std::uint64_t> from_threshold_;  ///< pass 2: as in ConfusionsAt
+        std::uint64_t test_at_learnt_ = 0;           ///< pass 2: test negatives <= learnt tau
+        std::vector<BestMatch> best_;
+        std::size_t distinct_ = 0;  ///< pass 1: distances this sink saw first
+        struct Extremes {
+            float min = 0.0f;
+            float max = 0.0f;
+            std::uint64_t min_count = 0;
+            std::uint64_t max_count = 0;
+            std::uint64_t unscored = 0;
+            std::uint64_t total = 0;
+            void Add(float distance);
+            void Merge(const Extremes& other);
+        };
+        Extremes all_;
+        Extremes train_;
+        Extremes test_;
+        friend struct Shared;
+    };
+
+    /// `positives`: ScorePositives(truth, distance). Throws core::ConfigError for an invalid
+    /// request, core::Error for a NaN threshold or positive distance, more than 2^32 scans, or
+    /// fewer than 2 scans (no pair).
+    StreamedPairwise(const GroundTruth& truth, std::vector<ScoredPair> positives,
+                     StreamedRequest request);
+    ~StreamedPairwise();
+    StreamedPairwise(const StreamedPairwise&) = delete;
+    StreamedPairwise& operator=(const StreamedPairwise&) = delete;
+
+    /// 1 or 2 while pairs are streamed, 3 when Result() is ready.
+    int pass() const;
+    Sink NewSink() const;
+    /// Adds a sink's counts (after counting what it still holds).
+    void Merge(Sink& sink);
+    /// Ends a pass. Throws core::EmptyInputError after the first when there is no pair.
+    void EndPass();
+    /// After the second pass.
+    StreamedResult Result() const;
+
+private:
+    std::unique_ptr<Shared> shared_;
+};
+
+/// Streams every pair i < j of `n` scans through `evaluation` serially, both passes, and returns
+/// the result: the reference for parallel drivers and for tests.
+StreamedResult StreamSerially(StreamedPairwise& evaluation, std::size_t n,
+                              const PairDistance& distance);
+
+}  // namespace lidarloop::eval
