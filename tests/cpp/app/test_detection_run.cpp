@@ -213,9 +213,9 @@ void ExpectRowIsTheVerdict(const std::map<std::string, std::string>& row,
     }
 }
 
-// candidates.csv holds every candidate's verdict, loops.csv each query's loop (the first accepted
-// candidate, else the best), and timings.json counts the pairs registered and the bytes of the
-// prepared scans (those saved in database.scans).
+// candidates.csv holds every candidate's verdict, loops.csv each query's loop (the accepted
+// candidate that overlaps best, else the first), and timings.json counts the pairs registered and
+// the bytes of the prepared scans (those saved in database.scans).
 void ExpectFilesStateTheVerdicts(const app::DetectRequest& request,
                                  const app::DetectOutcome& outcome, const io::Dataset& dataset) {
     const auto candidates = ReadCsv(request.out / "candidates.csv");
@@ -237,9 +237,17 @@ void ExpectFilesStateTheVerdicts(const app::DetectRequest& request,
         if (!q.has_match()) continue;
         ASSERT_LT(loop_row, loops.size());
         const auto& loop = loops[loop_row++];
+        // The loop: the accepted candidate that overlaps best (the first of equals), else rank 1.
         std::size_t rank = 0;
-        while (rank + 1 < q.candidates.size() && !q.verifications[rank].accepted) ++rank;
-        if (!q.verifications[rank].accepted) rank = 0;
+        double best_overlap = -1.0;
+        for (std::size_t r = 0; r < q.candidates.size(); ++r) {
+            const registration::Verification& v = q.verifications[r];
+            if (v.accepted &&
+                std::min(v.overlap.query_fraction, v.overlap.match_fraction) > best_overlap) {
+                rank = r;
+                best_overlap = std::min(v.overlap.query_fraction, v.overlap.match_fraction);
+            }
+        }
         EXPECT_EQ(std::stoul(loop.at("query")), q.query);
         EXPECT_EQ(std::stoul(loop.at("rank")), rank + 1) << q.query;
         EXPECT_EQ(std::stoul(loop.at("match")), q.candidates[rank].index) << q.query;
