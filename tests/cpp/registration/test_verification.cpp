@@ -2,6 +2,7 @@
 // bad input, and simulated scans with exact ground truth.
 #include <cmath>
 #include <limits>
+#include <random>
 
 #include <gtest/gtest.h>
 
@@ -71,6 +72,34 @@ INSTANTIATE_TEST_SUITE_P(Motions, KnownMotion,
                          ::testing::Values(Motion{0.0, 0.0, 0.0}, Motion{3.0, -1.0, 12.0},
                                            Motion{-6.0, 4.0, 180.0}, Motion{8.0, 2.5, -150.0},
                                            Motion{1.0, 7.0, 91.0}));
+
+// The cheap check that abandons a hypothesis decides as the full measure does, at poses from
+// right to far off and at thresholds around the overlaps they reach.
+TEST(Verification, OverlapReachesAgreesWithMeasureOverlap) {
+    const core::PointCloud match = test::SyntheticPlace();
+    const core::Transform truth = test::PlanarTransform(3.0, -1.0, 12.0);
+    const VerificationConfig config;
+    const PreparedScan q = PrepareScan(QueryOf(match, truth), config.reduction);
+    const PreparedScan t = PrepareScan(match, config.reduction);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> offset_m(-4.0, 4.0), yaw_deg(-30.0, 30.0);
+    int reached = 0, missed = 0;
+    for (int trial = 0; trial < 40; ++trial) {
+        const double scale = trial / 40.0;  // from the truth to 4 m and 30 degrees off
+        const core::Transform pose =
+            test::PlanarTransform(scale * offset_m(rng), scale * offset_m(rng),
+                                  scale * yaw_deg(rng)) *
+            truth;
+        const double overlap = MeasureOverlap(q, t, pose, config.acceptance).Min();
+        for (const double threshold : {0.05, 0.15, 0.3, 0.5, 0.7, overlap}) {
+            const bool reaches = OverlapReaches(q, t, pose, config.acceptance, threshold);
+            EXPECT_EQ(reaches, overlap >= threshold) << trial << " " << threshold;
+            (reaches ? reached : missed)++;
+        }
+    }
+    EXPECT_GT(reached, 20);  // both answers occur
+    EXPECT_GT(missed, 20);
+}
 
 TEST(Verification, MirroredPlaceIsRejected) {
     const core::PointCloud match = test::SyntheticPlace();
