@@ -26,8 +26,8 @@ sequences=(
     "indoor hdl64 300 0.4 0.8"
     "indoor vlp16 300 0.4 0.8"
 )
-printf "| sequence | method | revisiting | recall@1 | recall@%s | descriptor true/false | verified true/false | verified recall@100%%P | pose error m med/max | yaw deg med/max | ms/pair med |\n" "$top_k"
-printf "|---|---|---|---|---|---|---|---|---|---|---|\n"
+printf "| sequence | method | revisiting | recall@1 | recall@%s (ceiling) | descriptor true/false | verified true/false/wrong pose | verified recall | verified recall@100%%P | pose error m med/max | yaw deg med/max | ms/pair med |\n" "$top_k"
+printf "|---|---|---|---|---|---|---|---|---|---|---|---|\n"
 for row in "${sequences[@]}"; do
     read -r scene sensor scans smin smax <<<"$row"
     name="${scene}_${sensor}_s${seed}"
@@ -40,7 +40,7 @@ for row in "${sequences[@]}"; do
     out="$work/eval_${name}_k${top_k}"
     rm -rf "$out"
     "$lidarloop" evaluate "$data" --top-k "$top_k" --out "$out" --quiet "$@" >/dev/null
-    python3 - "$out/metrics.json" "$name" <<'PY'
+    "${PYTHON:-python3}" - "$out/metrics.json" "$name" <<'PY'
 import json, sys
 m = json.load(open(sys.argv[1]))
 def pct(x): return "–" if x is None else f"{100 * x:.1f} %"
@@ -54,7 +54,8 @@ for method, e in m["methods"].items():
     ms = r.get("verify_ms_per_pair", {}).get("median")
     print(f"| {sys.argv[2]} | {method} | {d['revisiting_scans']} | {pct(d['recall_at_1'])} | "
           f"{pct(d['recall_at_k'])} | {d['true_loops']}/{d['false_loops']} | "
-          f"{v.get('true_loops', '–')}/{v.get('false_loops', '–')} | "
+          f"{v.get('true_loops', '–')}/{v.get('false_loops', '–')}/"
+          f"{v.get('wrong_pose_loops', '–')} | {pct(v.get('recall'))} | "
           f"{pct(v.get('recall_at_full_precision'))} | {mm(v, 'translation_m') if v else '–'} | "
           f"{mm(v, 'yaw_deg') if v else '–'} | {'–' if ms is None else f'{ms:.2f}'} |")
 PY

@@ -27,12 +27,15 @@ std::vector<eval::QueryCandidates> VerifiedCandidates(
     for (const pipeline::LoopQuery& query : queries) {
         if (!query.has_match()) continue;
         eval::QueryCandidates ranked{query.query, {}};
+        // The evaluation scores each query's first accepted candidate: only the loop the
+        // pipeline takes counts as accepted, whatever its rank.
+        const std::optional<std::size_t> loop = query.loop();
         for (std::size_t i = 0; i < query.candidates.size(); ++i) {
             const registration::Verification& v = query.verifications.at(i);
             std::optional<core::Transform> pose;
             if (v.accepted) pose = v.T_match_query;
             ranked.ranked.push_back({query.candidates[i].index, query.candidates[i].distance,
-                                     v.accepted, v.score(), pose});
+                                     loop == i, v.score(), pose});
         }
         result.push_back(std::move(ranked));
     }

@@ -24,7 +24,8 @@ struct RetrievalComparison {
     /// -distance. recall_at_k is the ceiling of verification: it cannot find a loop that is
     /// not among the candidates.
     eval::LoopRetrievalEvaluation descriptor;
-    /// Accepted: the candidate passed registration::Verify; score: its overlap. Empty when
+    /// Accepted: the query's loop (LoopQuery::loop: of the candidates that passed
+    /// registration::Verify, the one that overlaps best); score: its overlap. Empty when
     /// verification is off.
     std::optional<eval::LoopRetrievalEvaluation> verified;
     pipeline::VerificationTimes verification_times;  ///< pairs registered by this method's run
@@ -36,9 +37,10 @@ struct RetrievalComparison {
 std::vector<eval::QueryCandidates> DescriptorCandidates(
     std::span<const pipeline::LoopQuery> queries, const core::Method& method, double threshold);
 
-/// The candidates of verified `queries`: accepted as verification decided, score the
-/// verification's overlap (Verification::score), with the registered T_match_query of every
-/// candidate that was registered.
+/// The candidates of verified `queries` in descriptor order: accepted only the query's loop
+/// (LoopQuery::loop: of the candidates verification accepted, the one that overlaps best), score
+/// the verification's overlap (Verification::score), with the registered T_match_query of every
+/// accepted candidate.
 std::vector<eval::QueryCandidates> VerifiedCandidates(std::span<const pipeline::LoopQuery> queries);
 
 /// Detects the top-k candidates of every scan from `matrix` (pipeline::DetectFromMatrix with

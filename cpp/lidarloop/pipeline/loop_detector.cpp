@@ -106,10 +106,14 @@ void DetectorConfig::Validate() const {
 
 std::optional<std::size_t> LoopQuery::loop() const {
     if (!verified()) return accepted && has_match() ? std::optional<std::size_t>(0) : std::nullopt;
+    // Of the accepted candidates the one that shares most of the view: the nearest, most
+    // reliable constraint (docs/verification.md, "Which candidate is the loop").
+    std::optional<std::size_t> best;
     for (std::size_t i = 0; i < verifications.size(); ++i) {
-        if (verifications[i].accepted) return i;
+        if (!verifications[i].accepted) continue;
+        if (!best || verifications[i].score() > verifications[*best].score()) best = i;
     }
-    return std::nullopt;
+    return best;
 }
 
 std::vector<Neighbor> NearestCandidates(std::size_t count, std::size_t k,

@@ -58,8 +58,9 @@ struct LoopQuery {
 
     bool has_match() const { return !candidates.empty(); }
     bool verified() const { return !verifications.empty(); }
-    /// The index in `candidates` of the loop: the first candidate verification accepted, or
-    /// without verification the best candidate when accepted; nullopt when there is no loop.
+    /// The index in `candidates` of the loop: of the candidates verification accepted, the one
+    /// that overlaps best (Verification::score; the earlier on a tie), or without verification
+    /// the best candidate when accepted; nullopt when there is no loop.
     std::optional<std::size_t> loop() const;
 };
 

@@ -178,8 +178,8 @@ IcpResult Refine(const PreparedScan& query, const PreparedScan& match,
                  const core::Transform& initial, const VerificationConfig& config) {
     return RefinePointToPlane(
         query, match, initial, config.icp, [&](const core::Transform& T_match_query) {
-            return MeasureOverlap(query, match, T_match_query, config.acceptance).Min() >=
-                   config.icp.abandon_below_overlap;
+            return OverlapReaches(query, match, T_match_query, config.acceptance,
+                                  config.icp.abandon_below_overlap);
         });
 }
 
@@ -273,6 +273,18 @@ Overlap MeasureOverlap(const PreparedScan& query, const PreparedScan& match,
                                            static_cast<double>(both));
     MeasureDegeneracy(*query.structure, *match.structure, T, forward, config, overlap);
     return overlap;
+}
+
+bool OverlapReaches(const PreparedScan& query, const PreparedScan& match,
+                    const core::Transform& T_match_query, const AcceptanceConfig& config,
+                    double min_overlap) {
+    const Eigen::Isometry3f T = T_match_query.cast<float>();
+    const OneWay forward = OverlapOneWay(*query.structure, query.structure_distinctive,
+                                         *match.structure, T, config, false);
+    if (Fraction(forward.overlapping, forward.in_view) < min_overlap) return false;
+    const OneWay backward = OverlapOneWay(*match.structure, match.structure_distinctive,
+                                          *query.structure, T.inverse(), config, false);
+    return Fraction(backward.overlapping, backward.in_view) >= min_overlap;
 }
 
 Verification Verify(const PreparedScan& query, const CoarseQuery& coarse, const PreparedScan& match,

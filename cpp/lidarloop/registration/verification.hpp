@@ -71,6 +71,13 @@ struct Verification {
 Overlap MeasureOverlap(const PreparedScan& query, const PreparedScan& match,
                        const core::Transform& T_match_query, const AcceptanceConfig& config);
 
+/// MeasureOverlap(query, match, T_match_query, config).Min() >= min_overlap, computed without
+/// the degeneracy test and without the match side when the query side already falls short (the
+/// check that abandons an ICP hypothesis). Thread-safe.
+bool OverlapReaches(const PreparedScan& query, const PreparedScan& match,
+                    const core::Transform& T_match_query, const AcceptanceConfig& config,
+                    double min_overlap);
+
 /// The largest RMSE a pair may have: max_rmse_ratio times the scans' combined roughness
 /// (PreparedScan::structure_roughness_m), within [min_allowed_rmse_m, max_rmse_m].
 double AllowedRmse(const PreparedScan& query, const PreparedScan& match,

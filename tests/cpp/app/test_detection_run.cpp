@@ -1,17 +1,23 @@
 // The detect and localise runs: what they return equals what the pipeline gives for the same
 // descriptors, and the results folder holds what the outcome says.
+#include <algorithm>
+#include <cmath>
 #include <fstream>
+#include <map>
 #include <mutex>
 #include <set>
 
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
 #include "app_test_utils.hpp"
 #include "lidarloop/app/describe_run.hpp"
 #include "lidarloop/app/detection.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/io/kitti_bin.hpp"
+#include "lidarloop/io/prepared_scans_file.hpp"
 #include "lidarloop/io/results_csv.hpp"
+#include "lidarloop/registration/verification.hpp"
 #include "test_utils.hpp"
 
 namespace lidarloop {
@@ -151,6 +157,121 @@ TEST_F(DetectionRun, AMapDescribedOtherwiseIsAClearError) {
     EXPECT_FALSE(std::filesystem::exists(localise.out));
 }
 
+// A CSV file as rows of fields by column name.
+std::vector<std::map<std::string, std::string>> ReadCsv(const std::filesystem::path& file) {
+    std::ifstream in(file);
+    const auto split = [](const std::string& line) {
+        std::vector<std::string> fields(1);
+        for (const char c : line) {
+            if (c == ',') {
+                fields.emplace_back();
+            } else {
+                fields.back() += c;
+            }
+        }
+        return fields;
+    };
+    std::string line;
+    std::getline(in, line);
+    const auto header = split(line);
+    std::vector<std::map<std::string, std::string>> rows;
+    while (std::getline(in, line)) {
+        const auto fields = split(line);
+        EXPECT_EQ(fields.size(), header.size()) << line;
+        auto& row = rows.emplace_back();
+        for (std::size_t i = 0; i < std::min(fields.size(), header.size()); ++i)
+            row[header[i]] = fields[i];
+    }
+    return rows;
+}
+
+// A verified row of loops.csv or candidates.csv states the verdict of its candidate: the pose,
+// the fit and the reason, as printed to 9 digits.
+void ExpectRowIsTheVerdict(const std::map<std::string, std::string>& row,
+                           const registration::Verification& v) {
+    const auto number = [&](const char* column) { return std::stod(row.at(column)); };
+    EXPECT_EQ(row.at("reason"), registration::ToString(v.reason));
+    if (row.at("tx").empty()) {
+        EXPECT_TRUE(v.reason == registration::RejectReason::kTooFewPoints ||
+                    v.reason == registration::RejectReason::kNoAlignment ||
+                    v.reason == registration::RejectReason::kPruned)
+            << row.at("reason");
+        return;
+    }
+    const Eigen::Quaterniond q(number("qw"), number("qx"), number("qy"), number("qz"));
+    core::Transform T = core::Transform::Identity();
+    T.linear() = q.toRotationMatrix();
+    T.translation() << number("tx"), number("ty"), number("tz");
+    EXPECT_LT((T.matrix() - v.T_match_query.matrix()).cwiseAbs().maxCoeff(), 1e-6);
+    EXPECT_NEAR(number("overlap_query"), v.overlap.query_fraction, 1e-8);
+    EXPECT_NEAR(number("overlap_match"), v.overlap.match_fraction, 1e-8);
+    EXPECT_NEAR(number("distinctive_query"), v.overlap.query_distinctive_fraction, 1e-8);
+    EXPECT_NEAR(number("distinctive_match"), v.overlap.match_distinctive_fraction, 1e-8);
+    EXPECT_NEAR(number("rmse_m"), v.overlap.rmse_m, 1e-8);
+    if (!std::isnan(v.shifted_overlap_ratio)) {
+        EXPECT_NEAR(number("shifted_overlap"), v.shifted_overlap_ratio, 1e-8);
+    }
+}
+
+// candidates.csv holds every candidate's verdict, loops.csv each query's loop (the accepted
+// candidate that overlaps best, else the first), and timings.json counts the pairs registered and
+// the bytes of the prepared scans (those saved in database.scans).
+void ExpectFilesStateTheVerdicts(const app::DetectRequest& request,
+                                 const app::DetectOutcome& outcome, const io::Dataset& dataset) {
+    const auto candidates = ReadCsv(request.out / "candidates.csv");
+    std::size_t row = 0, registered = 0;
+    for (const pipeline::LoopQuery& q : outcome.queries) {
+        for (std::size_t r = 0; r < q.candidates.size(); ++r, ++row) {
+            ASSERT_LT(row, candidates.size());
+            EXPECT_EQ(std::stoul(candidates[row].at("query")), q.query);
+            EXPECT_EQ(std::stoul(candidates[row].at("match")), q.candidates[r].index);
+            EXPECT_EQ(candidates[row].at("accepted"), q.verifications[r].accepted ? "1" : "0");
+            ExpectRowIsTheVerdict(candidates[row], q.verifications[r]);
+            registered += q.verifications[r].reason != registration::RejectReason::kPruned;
+        }
+    }
+    EXPECT_EQ(row, candidates.size());
+    const auto loops = ReadCsv(request.out / "loops.csv");
+    std::size_t loop_row = 0;
+    for (const pipeline::LoopQuery& q : outcome.queries) {
+        if (!q.has_match()) continue;
+        ASSERT_LT(loop_row, loops.size());
+        const auto& loop = loops[loop_row++];
+        // The loop: the accepted candidate that overlaps best (the first of equals), else rank 1.
+        std::size_t rank = 0;
+        double best_overlap = -1.0;
+        for (std::size_t r = 0; r < q.candidates.size(); ++r) {
+            const registration::Verification& v = q.verifications[r];
+            if (v.accepted &&
+                std::min(v.overlap.query_fraction, v.overlap.match_fraction) > best_overlap) {
+                rank = r;
+                best_overlap = std::min(v.overlap.query_fraction, v.overlap.match_fraction);
+            }
+        }
+        EXPECT_EQ(std::stoul(loop.at("query")), q.query);
+        EXPECT_EQ(std::stoul(loop.at("rank")), rank + 1) << q.query;
+        EXPECT_EQ(std::stoul(loop.at("match")), q.candidates[rank].index) << q.query;
+        EXPECT_EQ(loop.at("accepted"), q.accepted ? "1" : "0") << q.query;
+        ExpectRowIsTheVerdict(loop, q.verifications[rank]);
+    }
+    EXPECT_EQ(loop_row, loops.size());
+
+    std::ifstream timings_file(request.out / "timings.json");
+    const nlohmann::json timings = nlohmann::json::parse(timings_file)["verification"];
+    EXPECT_EQ(timings["pairs_verified"].get<std::size_t>(), registered);
+    // The bytes of the scans detect prepared, as it saved them in database.scans.
+    std::vector<double> bytes;
+    for (const auto& scan : io::LoadPreparedScans(request.out / "database.scans").scans) {
+        if (scan.structure) bytes.push_back(static_cast<double>(scan.MemoryBytes()));
+    }
+    ASSERT_EQ(bytes.size(), dataset.size());
+    std::sort(bytes.begin(), bytes.end());
+    EXPECT_EQ(timings["bytes_per_prepared_scan"]["max"].get<double>(), bytes.back());
+    for (const char* step : {"prepare_ms_per_scan", "verify_ms_per_pair"}) {
+        EXPECT_GT(timings[step]["median"].get<double>(), 0.0) << step;
+    }
+}
+
 // Verification inside detect gives what registering each candidate on its own gives.
 TEST_F(DetectionRun, VerifiesEveryCandidateAsRegisteringThePairAlone) {
     const app::DetectRequest request = Request("verified", core::Method::kRange);
@@ -181,6 +302,7 @@ TEST_F(DetectionRun, VerifiesEveryCandidateAsRegisteringThePairAlone) {
         for (const auto& q : outcome.queries) rows += q.candidates.size();
         return rows;
     }());
+    ExpectFilesStateTheVerdicts(request, outcome, *dataset_);
 }
 
 // A scan file emptied to zero bytes reads as a scan without points; the skip message names the

@@ -203,6 +203,32 @@ TEST(LoopDetector, NdtUsesTheSameRules) {
 
 // The bounded heap against sorting every eligible scan, with ties, missing (+inf) scans and k
 // from 0 to beyond the count.
+// A verified query's loop is the accepted candidate that overlaps best, not the first accepted
+// in descriptor order: it shares most of the view (docs/verification.md).
+TEST(LoopQuery, TheLoopIsTheAcceptedCandidateThatOverlapsBest) {
+    const auto verdict = [](bool accepted, double overlap) {
+        registration::Verification v;
+        v.accepted = accepted;
+        v.overlap.query_fraction = overlap;
+        v.overlap.match_fraction = overlap + 0.1;  // the score is the smaller fraction
+        return v;
+    };
+    LoopQuery q;
+    q.candidates = {{7, 0.1}, {3, 0.2}, {5, 0.3}, {1, 0.4}};
+    q.verifications = {verdict(false, 0.9), verdict(true, 0.4), verdict(true, 0.7),
+                       verdict(true, 0.7)};
+    EXPECT_EQ(q.loop(), std::optional<std::size_t>(2));  // the first of two equal overlaps
+    q.verifications[2].accepted = false;
+    EXPECT_EQ(q.loop(), std::optional<std::size_t>(3));
+    for (auto& v : q.verifications) v.accepted = false;
+    EXPECT_EQ(q.loop(), std::nullopt);
+    q.verifications.clear();  // descriptor only: the best candidate when accepted
+    q.accepted = true;
+    EXPECT_EQ(q.loop(), std::optional<std::size_t>(0));
+    q.accepted = false;
+    EXPECT_EQ(q.loop(), std::nullopt);
+}
+
 TEST(NearestCandidates, EqualsSortingEveryEligibleScan) {
     std::mt19937 rng(7);
     std::uniform_int_distribution<int> level(0, 6);  // few levels: many ties

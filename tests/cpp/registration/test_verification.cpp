@@ -2,6 +2,7 @@
 // bad input, and simulated scans with exact ground truth.
 #include <cmath>
 #include <limits>
+#include <random>
 
 #include <gtest/gtest.h>
 
@@ -72,6 +73,34 @@ INSTANTIATE_TEST_SUITE_P(Motions, KnownMotion,
                                            Motion{-6.0, 4.0, 180.0}, Motion{8.0, 2.5, -150.0},
                                            Motion{1.0, 7.0, 91.0}));
 
+// The cheap check that abandons a hypothesis decides as the full measure does, at poses from
+// right to far off and at thresholds around the overlaps they reach.
+TEST(Verification, OverlapReachesAgreesWithMeasureOverlap) {
+    const core::PointCloud match = test::SyntheticPlace();
+    const core::Transform truth = test::PlanarTransform(3.0, -1.0, 12.0);
+    const VerificationConfig config;
+    const PreparedScan q = PrepareScan(QueryOf(match, truth), config.reduction);
+    const PreparedScan t = PrepareScan(match, config.reduction);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> offset_m(-4.0, 4.0), yaw_deg(-30.0, 30.0);
+    int reached = 0, missed = 0;
+    for (int trial = 0; trial < 40; ++trial) {
+        const double scale = trial / 40.0;  // from the truth to 4 m and 30 degrees off
+        const core::Transform pose =
+            test::PlanarTransform(scale * offset_m(rng), scale * offset_m(rng),
+                                  scale * yaw_deg(rng)) *
+            truth;
+        const double overlap = MeasureOverlap(q, t, pose, config.acceptance).Min();
+        for (const double threshold : {0.05, 0.15, 0.3, 0.5, 0.7, overlap}) {
+            const bool reaches = OverlapReaches(q, t, pose, config.acceptance, threshold);
+            EXPECT_EQ(reaches, overlap >= threshold) << trial << " " << threshold;
+            (reaches ? reached : missed)++;
+        }
+    }
+    EXPECT_GT(reached, 20);  // both answers occur
+    EXPECT_GT(missed, 20);
+}
+
 TEST(Verification, MirroredPlaceIsRejected) {
     const core::PointCloud match = test::SyntheticPlace();
     core::PointCloud mirrored = match;
@@ -103,6 +132,52 @@ TEST(Verification, CorridorIsDegenerate) {
     EXPECT_EQ(v.reason, RejectReason::kDegenerate);
     // Nothing pins the position along the corridor but its far ends.
     EXPECT_LT(v.overlap.constraining_points, 20u);
+}
+
+// A corridor whose every 10 m repeat the same bay exactly (a door recess, a pillar, a box, a
+// side opening), longer than the sensor's range: a shift by the period fits as well as the truth.
+core::PointCloud PeriodicCorridor(double period_m = 10.0) {
+    core::PointCloud cloud;
+    const auto add = [&](double x, double y, double z) {
+        cloud.emplace_back(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
+    };
+    for (double x = -90; x <= 90; x += 0.2) {
+        const double phase = x - period_m * std::floor(x / period_m);  // [0, period)
+        const bool opening = phase < 3.0;                // a side corridor to the left
+        const bool recess = phase > 5.0 && phase < 6.0;  // a door set back into the right wall
+        for (double z = -1.5; z <= 1.2; z += 0.2) {
+            if (!opening) add(x, 1.5, z);
+            add(x, recess ? -2.0 : -1.5, z);
+        }
+        for (double y = -1.5; y <= 1.5; y += 0.3) {
+            add(x, y, -1.5);
+            add(x, y, 1.2);
+        }
+    }
+    for (double k = -9; k <= 9; ++k) {
+        const double x0 = k * period_m;
+        for (double a = 0; a < 2 * M_PI; a += 0.4)  // a pillar
+            for (double z = -1.5; z <= 1.2; z += 0.2)
+                add(x0 + 7.5 + 0.2 * std::cos(a), 1.1 + 0.2 * std::sin(a), z);
+        for (double x = x0 + 8.0; x <= x0 + 9.0; x += 0.2)  // a box by the right wall
+            for (double z = -1.5; z <= -0.7; z += 0.2) add(x, -1.0, z);
+        for (double x = x0; x <= x0 + 3.0; x += 0.2)  // the side corridor's walls
+            for (double y = 1.5; y <= 6.0; y += 0.2)
+                for (double z = -1.5; z <= 1.2; z += 0.3) {
+                    if (std::abs(x - x0) < 0.1 || std::abs(x - x0 - 3.0) < 0.1) add(x, y, z);
+                }
+    }
+    return cloud;
+}
+
+TEST(Verification, PeriodicCorridorIsAmbiguous) {
+    // The query 4 m along: the pose 10 m back (x = -6) fits as well as the truth (x = 4). Without
+    // the ambiguity test that alias is accepted.
+    const core::PointCloud match = PeriodicCorridor();
+    const core::PointCloud query = QueryOf(match, test::PlanarTransform(4.0, 0.0, 0.0));
+    const Verification v = VerifyPair(query, match, VerificationConfig{});
+    EXPECT_FALSE(v.accepted) << "accepted at x " << v.T_match_query.translation().x();
+    EXPECT_EQ(v.reason, RejectReason::kAmbiguous) << ToString(v.reason);
 }
 
 TEST(Verification, BadScansAreRejectedWithTheReason) {

@@ -1,0 +1,121 @@
+// The verification figures of `lidarloop bench`: the counts recounted by registering the same
+// pairs alone, the bytes per prepared scan recomputed from freshly prepared scans, the times
+// positive and consistent (thread CPU time cannot exceed the wall time of the same step).
+#include <algorithm>
+
+#include <gtest/gtest.h>
+
+#include "lidarloop/app/bench.hpp"
+#include "lidarloop/app/describe_run.hpp"
+#include "lidarloop/io/kitti_bin.hpp"
+#include "lidarloop/pipeline/similarity_matrix.hpp"
+#include "lidarloop/registration/verification.hpp"
+#include "lidarloop/sim/simulator.hpp"
+#include "test_utils.hpp"
+
+namespace lidarloop {
+namespace {
+
+// 12 simulated scans (thinned VLP-16) driven twice: scan 12 + i revisits scan i exactly, so
+// verification has loops to accept, in a sequence small enough for the sanitizers.
+io::Dataset TinyRevisit(const std::filesystem::path& folder) {
+    sim::SimulationConfig config = sim::DemoConfig();
+    config.scans = 12;
+    config.sensor.horizontal_steps = 360;
+    const sim::Simulator simulator(config);
+    std::filesystem::create_directories(folder);
+    for (std::size_t i = 0; i < 2 * config.scans; ++i) {
+        const std::string name = (i < 10 ? "scan0" : "scan") + std::to_string(i) + ".bin";
+        io::WriteKittiBin(folder / name, simulator.Scan(i % config.scans));
+    }
+    return io::OpenDataset(folder);
+}
+
+// The pairs bench verifies: the candidates of `queries` evenly spaced scans that have any, as
+// docs/cli.md describes --verify-queries.
+std::vector<pipeline::LoopQuery> BenchedQueries(const io::Dataset& dataset,
+                                                const io::RunConfig& config, std::size_t queries) {
+    const auto described = pipeline::DescribeSequence(app::SourceOf(dataset), config.descriptor);
+    std::vector<pipeline::LoopQuery> all = pipeline::DetectFromMatrix(
+        pipeline::ComputeSimilarityMatrix(described.database), described.database.times_s(),
+        config.detection, config.descriptor.method);
+    std::erase_if(all, [](const pipeline::LoopQuery& q) { return !q.has_match(); });
+    std::vector<pipeline::LoopQuery> chosen;
+    const std::size_t step = std::max<std::size_t>(1, all.size() / queries);
+    for (std::size_t q = 0; q < all.size() && chosen.size() < queries; q += step) {
+        chosen.push_back(all[q]);
+    }
+    return chosen;
+}
+
+// The median as the mean of the two middle values of an even count.
+double Median(std::vector<double> values) {
+    std::sort(values.begin(), values.end());
+    const std::size_t n = values.size();
+    return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+void ExpectTimes(const nlohmann::json& step, const std::string& name) {
+    for (const char* clock : {"wall", "thread_cpu"}) {
+        for (const char* statistic : {"median", "p95", "max"}) {
+            EXPECT_GT(step[clock][statistic].get<double>(), 0.0) << name << " " << clock;
+        }
+    }
+    // Per sample, a thread's CPU time is at most the wall time of the same step, so each order
+    // statistic is too (0.05 ms: the two clocks' resolution).
+    for (const char* statistic : {"median", "p95", "max"}) {
+        EXPECT_LE(step["thread_cpu"][statistic].get<double>(),
+                  step["wall"][statistic].get<double>() + 0.05)
+            << name << " " << statistic;
+    }
+}
+
+TEST(BenchRun, VerificationFiguresAreRecountedIndependently) {
+    test::TempDir dir;
+    const io::Dataset dataset = TinyRevisit(dir / "sequence");
+    app::BenchRequest request;
+    request.config.descriptor.method = core::Method::kRange;
+    request.config.detection.min_gap.value = 10;
+    request.config.detection.top_k = 2;  // registration is the slow part under the sanitizers
+    request.queries = 3;
+    request.verify_queries = 3;
+    const nlohmann::json json = app::RunBench(dataset, request);
+    ASSERT_TRUE(json.contains("verification"));
+    const nlohmann::json& v = json["verification"];
+
+    const auto queries = BenchedQueries(dataset, request.config, request.verify_queries);
+    const registration::VerificationConfig& config = request.config.detection.verification;
+    std::size_t pairs = 0, accepted = 0;
+    for (const pipeline::LoopQuery& q : queries) {
+        for (const pipeline::Neighbor& candidate : q.candidates) {
+            ++pairs;
+            accepted += registration::VerifyPair(dataset.LoadScan(q.query),
+                                                 dataset.LoadScan(candidate.index), config)
+                            .accepted;
+        }
+    }
+    ASSERT_EQ(queries.size(), 3U);
+    EXPECT_EQ(v["queries"].get<std::size_t>(), queries.size());
+    EXPECT_EQ(v["pairs"].get<std::size_t>(), pairs);
+    EXPECT_EQ(v["pairs_accepted"].get<std::size_t>(), accepted);
+    EXPECT_GT(accepted, 0U);  // the sequence revisits: the count is not trivially zero
+    EXPECT_EQ(v["top_k"].get<int>(), 2);
+
+    std::vector<double> bytes;
+    for (std::size_t i = 0; i < dataset.size(); ++i) {
+        bytes.push_back(static_cast<double>(
+            registration::PrepareScan(dataset.LoadScan(i), config.reduction).MemoryBytes()));
+    }
+    EXPECT_DOUBLE_EQ(v["bytes_per_prepared_scan"]["median"].get<double>(), Median(bytes));
+    EXPECT_EQ(v["bytes_per_prepared_scan"]["max"].get<double>(),
+              *std::max_element(bytes.begin(), bytes.end()));
+
+    for (const char* statistic : {"median", "p95", "max"}) {
+        EXPECT_GT(v["prepare_ms_per_scan"][statistic].get<double>(), 0.0) << statistic;
+    }
+    ExpectTimes(v["coarse_images_ms_per_query"], "coarse images");
+    ExpectTimes(v["verify_ms_per_pair"], "pairs");
+}
+
+}  // namespace
+}  // namespace lidarloop
