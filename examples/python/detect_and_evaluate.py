@@ -83,7 +83,8 @@ def main():
                                     methods=[args.method], verify=False)
     method = evaluation.methods[args.method]
     _, T_world_sensor = lidarloop.open_dataset(args.dataset).poses
-    plot_similarity(method, detection.loops, args.out / "similarity.png")
+    if method.similarity is not None:  # None past output.similarity_matrix_mib
+        plot_similarity(method, detection.loops, args.out / "similarity.png")
     plot_trajectory(T_world_sensor, detection.loops, args.out / "trajectory.png")
     print(f"{len(T_world_sensor)} scans, {evaluation.truth.describe()}")
     print(f"detect ({args.method}): {detection.accepted} scans with an accepted loop")

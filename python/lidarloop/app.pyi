@@ -84,8 +84,9 @@ class MethodEvaluation:
     @property
     def default_threshold(self) -> Optional[float]: ...
     @property
-    def similarity(self) -> npt.NDArray[np.float32]:
-        """(n, n) descriptor distances (W or sigma'), diagonal 0."""
+    def similarity(self) -> Optional[npt.NDArray[np.float32]]:
+        """(n, n) descriptor distances (W or sigma'), diagonal 0; None beyond
+        output.similarity_matrix_mib."""
     @property
     def pairwise(self) -> PairwiseEvaluation: ...
     @property

@@ -324,8 +324,13 @@ void BindMethodEvaluation(py::module_& m) {
         .def_readonly("name", &MethodEvaluation::name, "height, range, ndt or results:<file>")
         .def_readonly("default_threshold", &MethodEvaluation::default_threshold)
         .def_property_readonly(
-            "similarity", [](const MethodEvaluation& e) { return FullMatrix(e.matrix); },
-            "(n, n) float32 descriptor distances (W or sigma'), diagonal 0")
+            "similarity",
+            [](const MethodEvaluation& e) -> std::optional<py::array_t<float>> {
+                if (e.matrix.size() == 0) return std::nullopt;  // beyond the memory budget
+                return FullMatrix(e.matrix);
+            },
+            "(n, n) float32 descriptor distances (W or sigma'), diagonal 0; None when the "
+            "matrix would exceed output.similarity_matrix_mib (the evaluation streams the pairs)")
         .def_readonly("pairwise", &MethodEvaluation::pairwise, "Röhling IV-B/C")
         .def_readonly("learnt", &MethodEvaluation::learnt, "Röhling table I, or None")
         .def_readonly("learnt_on", &MethodEvaluation::learnt_on)
