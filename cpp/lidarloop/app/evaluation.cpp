@@ -73,7 +73,7 @@ void StreamBlock(eval::StreamedPairwise::Sink& sink, std::size_t row_begin, std:
 eval::StreamedResult StreamPairs(eval::StreamedPairwise& evaluation, std::size_t n,
                                  const eval::PairDistance& distance) {
     const std::size_t blocks = (n + kStreamRows - 1) / kStreamRows;
-    while (evaluation.pass() < 3) {
+    while (!evaluation.finished()) {
         tbb::enumerable_thread_specific<eval::StreamedPairwise::Sink> sinks(
             [&] { return evaluation.NewSink(); });
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 1),
@@ -99,18 +99,6 @@ eval::PairDistance DatabaseDistance(const pipeline::DescriptorDatabase& database
     return [&database](std::size_t i, std::size_t j) {
         return static_cast<float>(database.Distance(i, j));
     };
-}
-
-eval::ThresholdTransfer TransferOf(const LearntThreshold& training, const eval::Confusion& test) {
-    eval::ThresholdTransfer transfer;
-    transfer.criterion = training.criterion;
-    transfer.threshold = training.best.threshold;
-    transfer.train_score = training.best.score;
-    transfer.train = training.best.confusion;
-    transfer.test = test;
-    transfer.test_f1 = eval::F1(test);
-    transfer.test_mcc = eval::Mcc(test);
-    return transfer;
 }
 
 std::string FirstPartName(const eval::ThresholdLearningConfig& learning) {
@@ -313,7 +301,7 @@ MethodEvaluation EvaluateStreamed(std::string name, const eval::PairDistance& di
                       at.begin() + static_cast<std::ptrdiff_t>(fixed_thresholds.size()));
     if (default_threshold) e.at_default = at[fixed_thresholds.size()];
     if (training) {
-        e.learnt = TransferOf(*training, at.back());
+        e.learnt = eval::TransferOf(training->criterion, training->best, at.back());
         e.learnt_on = training->source;
     } else if (result.learnt) {
         e.learnt = result.learnt;

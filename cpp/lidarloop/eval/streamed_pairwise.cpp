@@ -668,27 +668,20 @@ std::optional<ThresholdTransfer> StreamedPairwise::Shared::Transfer() const {
     const Optima best = BestOf(train, merged.train_slots_, merged.train_);
     const Criterion criterion = request.learning->criterion;
     const BestThreshold& chosen = criterion == Criterion::kMcc ? best.mcc : best.f1;
-    ThresholdTransfer result;
-    result.criterion = criterion;
-    result.threshold = chosen.threshold;
-    result.train_score = chosen.score;
-    result.train = chosen.confusion;
     std::uint64_t tp = 0;
     for (const ScoredPair& p : positives) {
         tp += InTest(p.j) && detail::IsScored(p.distance) &&
-                      static_cast<double>(p.distance) <= result.threshold
+                      static_cast<double>(p.distance) <= chosen.threshold
                   ? 1
                   : 0;
     }
-    result.test = ConfusionOf(tp, merged.test_at_learnt_, test_positives, merged.test_.total);
-    result.test_f1 = F1(result.test);
-    result.test_mcc = Mcc(result.test);
-    return result;
+    return TransferOf(criterion, chosen,
+                      ConfusionOf(tp, merged.test_at_learnt_, test_positives, merged.test_.total));
 }
 
 StreamedResult StreamSerially(StreamedPairwise& evaluation, std::size_t n,
                               const PairDistance& distance) {
-    while (evaluation.pass() < 3) {
+    while (!evaluation.finished()) {
         StreamedPairwise::Sink sink = evaluation.NewSink();
         for (std::size_t i = 0; i < n; ++i) {
             for (std::size_t j = i + 1; j < n; ++j) sink.Add(i, j, distance(i, j));

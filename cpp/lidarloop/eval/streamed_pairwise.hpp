@@ -115,6 +115,8 @@ public:
 
     /// 1 or 2 while pairs are streamed, 3 when Result() is ready.
     int pass() const;
+    /// Both passes are done: Result() is ready (stream while this is false).
+    bool finished() const { return pass() > 2; }
     Sink NewSink() const;
     /// Adds a sink's counts (after counting what it still holds).
     void Merge(Sink& sink);

@@ -38,14 +38,19 @@ ThresholdTransfer LearnAndTest(std::span<const ScoredPair> train, std::span<cons
         throw core::EmptyInputError("threshold learning: no training pair has a finite distance");
     }
     const BestThreshold& best = criterion == Criterion::kMcc ? learnt.best_mcc : learnt.best_f1;
+    return TransferOf(criterion, best, ConfusionAt(test, best.threshold));
+}
+
+ThresholdTransfer TransferOf(Criterion criterion, const BestThreshold& learnt,
+                             const Confusion& test) {
     ThresholdTransfer result;
     result.criterion = criterion;
-    result.threshold = best.threshold;
-    result.train_score = best.score;
-    result.train = best.confusion;
-    result.test = ConfusionAt(test, best.threshold);
-    result.test_f1 = F1(result.test);
-    result.test_mcc = Mcc(result.test);
+    result.threshold = learnt.threshold;
+    result.train_score = learnt.score;
+    result.train = learnt.confusion;
+    result.test = test;
+    result.test_f1 = F1(test);
+    result.test_mcc = Mcc(test);
     return result;
 }
 

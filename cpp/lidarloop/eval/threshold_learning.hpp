@@ -31,6 +31,11 @@ struct ThresholdTransfer {
     double test_mcc = 0.0;     ///< Röhling eq. (10) on the test pairs
 };
 
+/// The row of a threshold learnt by `criterion` (`learnt`: its tau, score and training
+/// confusion) with its confusion `test` on the test pairs.
+ThresholdTransfer TransferOf(Criterion criterion, const BestThreshold& learnt,
+                             const Confusion& test);
+
 /// Learns tau on `train` (exact optimum of `criterion` over every distinct finite distance, ties
 /// to the smallest tau, see EvaluatePairs) and evaluates it on `test`; tau is always finite. The
 /// two sets may come from the same sequence (SplitByQuery) or from different data sets. Throws

@@ -155,7 +155,7 @@ TEST(StreamedPairwise, PairsSpreadOverSinksInAnyOrderGiveTheSameResult) {
     }
     StreamedPairwise evaluation(s.truth, ScorePositives(s.truth, DistanceOf(s)), RequestOf(c));
     std::mt19937 rng(5);
-    while (evaluation.pass() < 3) {
+    while (!evaluation.finished()) {
         std::shuffle(order.begin(), order.end(), rng);
         std::vector<StreamedPairwise::Sink> sinks;
         for (int k = 0; k < 3; ++k) sinks.push_back(evaluation.NewSink());
