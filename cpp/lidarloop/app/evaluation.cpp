@@ -123,6 +123,26 @@ void CheckResult(const std::filesystem::path& file, const io::ExternalResult& r,
     }
 }
 
+// A pair of a results file, scans ordered i < j.
+struct ListedPair {
+    std::size_t i;
+    std::size_t j;
+    float distance;
+};
+
+// The pairs `file` lists, in file order, each checked (CheckResult); a scan paired with itself
+// is left out.
+std::vector<ListedPair> ListedPairs(const std::filesystem::path& file, std::size_t scans) {
+    std::vector<ListedPair> listed;
+    for (const io::ExternalResult& r : io::ReadResultsCsv(file)) {
+        CheckResult(file, r, scans);
+        if (r.query == r.match) continue;
+        listed.push_back({std::min(r.query, r.match), std::max(r.query, r.match),
+                          static_cast<float>(r.distance)});
+    }
+    return listed;
+}
+
 void RequirePoses(const io::Dataset& dataset, const std::string& role,
                   const std::string& poses_flag) {
     if (!dataset.HasPoses()) {
@@ -316,31 +336,15 @@ pipeline::SimilarityMatrix MatrixOfResults(const std::filesystem::path& file, st
     pipeline::SimilarityMatrix matrix(scans);
     std::fill(matrix.condensed().begin(), matrix.condensed().end(),
               std::numeric_limits<float>::infinity());
-    for (const io::ExternalResult& r : io::ReadResultsCsv(file)) {
-        CheckResult(file, r, scans);
-        if (r.query == r.match) continue;
-        const std::size_t i = std::min(r.query, r.match);
-        const std::size_t j = std::max(r.query, r.match);
-        matrix.set(i, j, std::min(matrix.at(i, j), static_cast<float>(r.distance)));
-    }
+    for (const ListedPair& p : ListedPairs(file, scans))
+        matrix.set(p.i, p.j, std::min(matrix.at(p.i, p.j), p.distance));
     return matrix;
 }
 
 eval::PairDistance DistancesOfResults(const std::filesystem::path& file, std::size_t scans) {
-    struct Listed {
-        std::size_t i;
-        std::size_t j;
-        float distance;
-    };
-    std::vector<Listed> listed;
-    for (const io::ExternalResult& r : io::ReadResultsCsv(file)) {
-        CheckResult(file, r, scans);
-        if (r.query == r.match) continue;
-        listed.push_back({std::min(r.query, r.match), std::max(r.query, r.match),
-                          static_cast<float>(r.distance)});
-    }
+    std::vector<ListedPair> listed = ListedPairs(file, scans);
     // Pairs listed twice keep the smallest distance, folded in file order as MatrixOfResults.
-    std::stable_sort(listed.begin(), listed.end(), [](const Listed& a, const Listed& b) {
+    std::stable_sort(listed.begin(), listed.end(), [](const ListedPair& a, const ListedPair& b) {
         return a.i != b.i ? a.i < b.i : a.j < b.j;
     });
     struct Rows {
@@ -351,7 +355,7 @@ eval::PairDistance DistancesOfResults(const std::filesystem::path& file, std::si
     auto rows = std::make_shared<Rows>();
     rows->offsets.assign(scans + 1, 0);
     for (std::size_t k = 0; k < listed.size(); ++k) {
-        const Listed& p = listed[k];
+        const ListedPair& p = listed[k];
         if (k > 0 && listed[k - 1].i == p.i && listed[k - 1].j == p.j) {
             rows->distances.back() = std::min(rows->distances.back(), p.distance);
             continue;
