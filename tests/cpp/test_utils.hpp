@@ -1,5 +1,6 @@
 #pragma once
 
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -10,6 +11,8 @@
 #include <string>
 #include <string_view>
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
 
@@ -18,7 +21,9 @@
 
 namespace lidarloop::test {
 
-/// A fresh temporary folder per test, removed at the end of the test.
+/// A fresh temporary folder per test, removed at the end of the test. Named after the test, the
+/// process and a count, so that the same test running in two build trees at once, or two
+/// folders of one test, never share a folder.
 class TempDir {
 public:
     TempDir() {
@@ -29,6 +34,8 @@ public:
         for (char& c : name) {
             if (c == '/') c = '_';
         }
+        static std::atomic<int> count{0};
+        name += "_" + std::to_string(::getpid()) + "_" + std::to_string(count++);
         path_ = std::filesystem::temp_directory_path() / name;
         std::filesystem::remove_all(path_);
         std::filesystem::create_directories(path_);
