@@ -42,7 +42,8 @@ void BindVerification(py::module_& m) {
         .def_property_readonly(
             "reason", [](const Verification& v) { return registration::ToString(v.reason); },
             "why it was not accepted: 'none' (accepted), 'too_few_points', 'no_alignment', "
-            "'not_converged', 'low_overlap', 'high_rmse', 'degenerate', 'ambiguous', 'pruned'")
+            "'not_converged', 'low_overlap', 'high_rmse', 'degenerate', 'ambiguous', 'too_far', "
+            "'pruned'")
         .def_property_readonly(
             "T_match_query",
             [](const Verification& v) { return TransformToArray(v.T_match_query); },

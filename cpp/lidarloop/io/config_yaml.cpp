@@ -138,6 +138,8 @@ void VisitFields(registration::AcceptanceConfig& c, Visitor& v) {
             "share of the points pinning that direction still overlapping there, at most");
     v.Field("max_rival_overlap_ratio", c.max_rival_overlap_ratio,
             "another pose may reach at most this share of the accepted overlap");
+    v.Field("max_loop_distance_m", c.max_loop_distance_m,
+            "the registered sensors of a loop are at most this far apart");
 }
 
 template <typename Visitor>

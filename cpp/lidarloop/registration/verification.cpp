@@ -245,6 +245,8 @@ std::string ToString(RejectReason reason) {
             return "degenerate";
         case RejectReason::kAmbiguous:
             return "ambiguous";
+        case RejectReason::kTooFar:
+            return "too_far";
         case RejectReason::kPruned:
             return "pruned";
     }
@@ -306,7 +308,10 @@ Verification Verify(const PreparedScan& query, const CoarseQuery& coarse, const 
     for (std::size_t i = 0; i < tried; ++i) {
         Verification trial = RegisterFrom(query, match, hypotheses[i], config);
         if (trial.accepted) {
-            if (HasRivalPose(query, match, hypotheses, i, trial, config)) {
+            if (trial.T_match_query.translation().norm() > config.acceptance.max_loop_distance_m) {
+                trial.accepted = false;
+                trial.reason = RejectReason::kTooFar;
+            } else if (HasRivalPose(query, match, hypotheses, i, trial, config)) {
                 trial.accepted = false;
                 trial.reason = RejectReason::kAmbiguous;
             }

@@ -21,11 +21,13 @@ enum class RejectReason {
     kHighRmse,      ///< the overlapping points sit too far from the other scan's planes
     kDegenerate,    ///< sliding along the weakest direction fits as well (street, corridor)
     kAmbiguous,     ///< another, distinct pose fits about as well (periodic structure)
+    kTooFar,        ///< registered, but the sensors are farther apart than one place
     kPruned,        ///< not registered: the descriptor distance failed the threshold set
 };
 
 /// "none", "too_few_points", "no_alignment", "not_converged", "low_overlap", "high_rmse",
-/// "degenerate", "ambiguous", "pruned": the spelling of loops.csv and `lidarloop verify`.
+/// "degenerate", "ambiguous", "too_far", "pruned": the spelling of loops.csv and `lidarloop
+/// verify`.
 std::string ToString(RejectReason reason);
 
 /// How well a query sits on a match at a pose (registration::MeasureOverlap).

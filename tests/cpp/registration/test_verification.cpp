@@ -217,6 +217,24 @@ TEST(Verification, InvalidConfigIsAConfigError) {
     expect_error([](auto& c) { c.acceptance.min_overlap = 1.5; });
     expect_error([](auto& c) { c.acceptance.max_rmse_m = -1.0; });
     expect_error([](auto& c) { c.acceptance.overlap_plane_m = 2 * c.acceptance.overlap_radius_m; });
+    expect_error([](auto& c) { c.acceptance.max_loop_distance_m = 0.0; });
+}
+
+// One place seen from 11.6 m away registers at the right pose, but a loop is a revisit of one
+// place (max_loop_distance_m, 10 m): too far. Allowing 15 m accepts the same pair.
+TEST(Verification, PlaceSeenFromTooFarIsNotALoop) {
+    const core::PointCloud match = test::SyntheticPlace();
+    const core::Transform truth = test::PlanarTransform(11.5, 1.5, 20.0);
+    const core::PointCloud query = QueryOf(match, truth);
+    VerificationConfig config;
+    const Verification far = VerifyPair(query, match, config);
+    EXPECT_FALSE(far.accepted);
+    EXPECT_EQ(far.reason, RejectReason::kTooFar);
+    EXPECT_LT((far.T_match_query.translation() - truth.translation()).norm(), 0.1);
+    config.acceptance.max_loop_distance_m = 15.0;
+    const Verification allowed = VerifyPair(query, match, config);
+    EXPECT_TRUE(allowed.accepted) << ToString(allowed.reason);
+    EXPECT_LT((allowed.T_match_query.translation() - truth.translation()).norm(), 0.1);
 }
 
 TEST(Verification, ReasonsHaveStableNames) {
@@ -228,6 +246,7 @@ TEST(Verification, ReasonsHaveStableNames) {
     EXPECT_EQ(ToString(RejectReason::kHighRmse), "high_rmse");
     EXPECT_EQ(ToString(RejectReason::kDegenerate), "degenerate");
     EXPECT_EQ(ToString(RejectReason::kAmbiguous), "ambiguous");
+    EXPECT_EQ(ToString(RejectReason::kTooFar), "too_far");
     EXPECT_EQ(ToString(RejectReason::kPruned), "pruned");
 }
 
