@@ -125,33 +125,41 @@ double Median(std::vector<double> values) {
     return values[values.size() / 2];
 }
 
-// lidarloop: prepare both scans, the query's coarse images, then Verify (VerifyPair's steps,
-// timed apart); the median of `repeat` runs.
-reg::Verification RunLidarloop(const ScanPair& pair, int repeat, Timed& prepare, Timed& verify) {
+// lidarloop, default config: the median of `repeat` runs of each stage.
+// The stages of VerifyPair: preparing both scans, the query's coarse images (once per query
+// when it has several candidates), and Verify (once per candidate).
+struct LidarloopTimes {
+    Timed prepare, coarse, verify;
+};
+
+reg::Verification RunLidarloop(const ScanPair& pair, int repeat, LidarloopTimes& times) {
     const reg::VerificationConfig config;
     reg::Verification result;
-    std::vector<double> prepare_cpu, prepare_wall, verify_cpu, verify_wall;
+    std::vector<double> samples[6];  // cpu and wall of each stage
+    const auto lap = [&](int stage, double& cpu, double& wall) {
+        samples[2 * stage].push_back(Clock::Cpu() - cpu);
+        samples[2 * stage + 1].push_back(Clock::Wall() - wall);
+        cpu = Clock::Cpu();
+        wall = Clock::Wall();
+    };
     for (int run = 0; run < repeat; ++run) {
         double cpu = Clock::Cpu(), wall = Clock::Wall();
         const reg::PreparedScan query = reg::PrepareScan(pair.query, config.reduction);
         const reg::PreparedScan match = reg::PrepareScan(pair.match, config.reduction);
-        prepare_cpu.push_back(Clock::Cpu() - cpu);
-        prepare_wall.push_back(Clock::Wall() - wall);
-        cpu = Clock::Cpu();
-        wall = Clock::Wall();
+        lap(0, cpu, wall);
         const reg::CoarseQuery coarse(*query.structure, config.coarse);
+        lap(1, cpu, wall);
         result = reg::Verify(query, coarse, match, config);
-        verify_cpu.push_back(Clock::Cpu() - cpu);
-        verify_wall.push_back(Clock::Wall() - wall);
+        lap(2, cpu, wall);
     }
-    prepare = {1e3 * Median(prepare_cpu), 1e3 * Median(prepare_wall)};
-    verify = {1e3 * Median(verify_cpu), 1e3 * Median(verify_wall)};
+    Timed* stages[3] = {&times.prepare, &times.coarse, &times.verify};
+    for (int stage = 0; stage < 3; ++stage)
+        *stages[stage] = {1e3 * Median(samples[2 * stage]), 1e3 * Median(samples[2 * stage + 1])};
     return result;
 }
 
-void PrintRow(const ScanPair& pair, const reg::Verification& mine, const Timed& prepare,
-              const Timed& verify, const lidarloop::test::Open3dRegistration& theirs,
-              const Timed& open3d) {
+void PrintRow(const ScanPair& pair, const reg::Verification& mine, const LidarloopTimes& times,
+              const lidarloop::test::Open3dRegistration& theirs, const Timed& open3d) {
     using lidarloop::test::Difference;
     const auto error = [&](const lidarloop::core::Transform& T) {
         const auto d = Difference(T, pair.T_match_query_truth);
@@ -162,13 +170,14 @@ void PrintRow(const ScanPair& pair, const reg::Verification& mine, const Timed& 
     };
     const auto between = Difference(mine.T_match_query, theirs.T_match_query);
     std::printf(
-        "| %s | %s | %s | %.1f + %.1f ms (%.1f + %.1f) | %s | %.0f ms (%.0f) | %.3f | %s | "
-        "%.3f m, %.2f° |\n",
-        pair.name.c_str(), ToString(pair.kind),
+        "| %s | %s, %.0f m | %s | %.1f + %.1f + %.1f ms (%.0f + %.0f + %.0f) | %s | %.0f ms (%.0f) "
+        "| %.3f | %s | %.3f m, %.2f° |\n",
+        pair.name.c_str(), ToString(pair.kind), pair.T_match_query_truth.translation().norm(),
         mine.accepted ? "accept" : ("reject: " + reg::ToString(mine.reason)).c_str(),
-        prepare.cpu_ms, verify.cpu_ms, prepare.wall_ms, verify.wall_ms,
-        error(mine.T_match_query).c_str(), open3d.cpu_ms, open3d.wall_ms, theirs.fitness,
-        error(theirs.T_match_query).c_str(), between.translation_m, between.rotation_deg);
+        times.prepare.cpu_ms, times.coarse.cpu_ms, times.verify.cpu_ms, times.prepare.wall_ms,
+        times.coarse.wall_ms, times.verify.wall_ms, error(mine.T_match_query).c_str(),
+        open3d.cpu_ms, open3d.wall_ms, theirs.fitness, error(theirs.T_match_query).c_str(),
+        between.translation_m, between.rotation_deg);
     std::fflush(stdout);
 }
 
@@ -196,17 +205,19 @@ int main(int argc, char** argv) {
         const Options options = ParseFlags(argc, argv);
         const std::vector<ScanPair> pairs = Pairs(options);
         std::printf(
-            "| pair (query->match) | kind | lidarloop | lidarloop CPU prepare + verify (wall) | "
+            "| pair (query->match) | kind, apart | lidarloop | lidarloop CPU: prepare 2 scans + "
+            "coarse images + Verify (wall) | "
             "lidarloop vs truth: planar / vertical, yaw | Open3D CPU (wall) | Open3D fitness | "
             "Open3D vs truth | lidarloop vs Open3D |\n|---|---|---|---|---|---|---|---|---|\n");
         for (const ScanPair& pair : pairs) {
-            Timed prepare, verify, open3d;
-            const reg::Verification mine = RunLidarloop(pair, options.repeat, prepare, verify);
+            LidarloopTimes times;
+            Timed open3d;
+            const reg::Verification mine = RunLidarloop(pair, options.repeat, times);
             const double cpu = Clock::Cpu(), wall = Clock::Wall();
             const auto theirs =
                 lidarloop::test::RegisterWithOpen3d(pair.query, pair.match, options.open3d);
             open3d = {1e3 * (Clock::Cpu() - cpu), 1e3 * (Clock::Wall() - wall)};
-            PrintRow(pair, mine, prepare, verify, theirs, open3d);
+            PrintRow(pair, mine, times, theirs, open3d);
         }
     } catch (const std::exception& error) {
         std::fprintf(stderr, "verify_vs_open3d: %s\n%s", error.what(), kUsage);
