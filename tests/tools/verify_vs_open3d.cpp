@@ -170,7 +170,7 @@ void PrintRow(const ScanPair& pair, const reg::Verification& mine, const Lidarlo
     };
     const auto between = Difference(mine.T_match_query, theirs.T_match_query);
     std::printf(
-        "| %s | %s, %.0f m | %s | %.1f + %.1f + %.1f ms (%.0f + %.0f + %.0f) | %s | %.0f ms (%.0f) "
+        "| %s | %s, %.1f m | %s | %.1f + %.1f + %.1f ms (%.0f + %.0f + %.0f) | %s | %.0f ms (%.0f) "
         "| %.3f | %s | %.3f m, %.2f° |\n",
         pair.name.c_str(), ToString(pair.kind), pair.T_match_query_truth.translation().norm(),
         mine.accepted ? "accept" : ("reject: " + reg::ToString(mine.reason)).c_str(),
