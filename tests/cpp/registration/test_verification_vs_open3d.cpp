@@ -10,7 +10,7 @@
 // 0.06 m and 0.65 degrees on the simulated ones (VLP-16: Open3D's GICP on 16 rings tilts by up to
 // 0.6 degrees in roll and pitch). Real pairs: 0.05 m and 0.3 degrees; simulated: 0.1 m and 1 degree
 // (the pose target is 0.35 m and 1 degree). Against exact ground truth lidarloop is within
-// 0.016 m and 0.05 degrees: 0.05 m and 0.2 degrees.
+// 0.017 m and 0.15 degrees (VLP-16 in the mine): 0.05 m and 0.3 degrees.
 #include <gtest/gtest-spi.h>
 #include <gtest/gtest.h>
 
@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <numbers>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -40,7 +41,7 @@ struct Tolerance {
 
 constexpr Tolerance kRealAgreement{0.05, 0.3};
 constexpr Tolerance kSimulatedAgreement{0.1, 1.0};
-constexpr Tolerance kSimulatedTruth{0.05, 0.2};
+constexpr Tolerance kSimulatedTruth{0.05, 0.3};
 
 bool Within(const PoseDifference& d, Tolerance tolerance) {
     return d.translation_m < tolerance.translation_m && d.rotation_deg < tolerance.rotation_deg;
@@ -125,6 +126,11 @@ struct Drive {
     sim::SceneType scene;
     sim::SensorModel sensor;
 };
+
+// GoogleTest's name of a parameter (else it prints the struct's bytes).
+void PrintTo(const Drive& drive, std::ostream* out) {
+    *out << sim::ToString(drive.scene) << " " << sim::ToString(drive.sensor);
+}
 
 class SimulatedVsOpen3d : public ::testing::TestWithParam<Drive> {};
 
