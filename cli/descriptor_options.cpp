@@ -9,6 +9,7 @@ namespace lidarloop::cli {
 void DescriptorOptions::AddTo(CLI::App& command, bool with_method) {
     command.add_option("--config", config_file_, "YAML file overriding the defaults it names")
         ->check(CLI::ExistingFile);
+    with_method_ = with_method;
     if (with_method) {
         command.add_option("--method", method_, "descriptor: " + pipeline::MethodNamesText(" | "));
     }
@@ -46,6 +47,12 @@ void DescriptorOptions::ApplyHistogramFlags(core::DescriptorConfig& descriptor) 
             throw core::ConfigError(flag->get_name() +
                                     " applies to the height and range methods; set NDT "
                                     "parameters in the ndt section of --config");
+        }
+    }
+    for (const CLI::Option* flag : {up_option_, sensor_height_option_}) {
+        if (*flag && with_method_ && descriptor.method != core::Method::kHeight) {
+            throw core::ConfigError(flag->get_name() +
+                                    " applies to the height method only: add --method height");
         }
     }
     core::HistogramConfig& histogram = descriptor.histogram;

@@ -35,6 +35,7 @@ private:
 
     std::string config_file_;
     std::string method_;
+    bool with_method_ = true;  // false: the command runs several methods (evaluate)
     int bins_ = 0;
     double min_m_ = 0.0;
     double max_m_ = 0.0;

@@ -75,12 +75,14 @@ section_describe() {
             fail "describe $scan differs from the .bin of the same scan"
         fi
     done
-    expect_ok "describe osnabrueck" '"method":"height"' "$cli" describe "$samples/scan000.3d"
+    expect_ok "describe osnabrueck" '"method":"range"' "$cli" describe "$samples/scan000.3d"
     expect_ok "describe json keys" '"points_used":6000' "$cli" describe "$samples/corner_a.bin"
     expect_ok "describe skipped" '"points_skipped":0' "$cli" describe "$samples/corner_a.bin"
     expect_ok "describe range" '"method":"range"' "$cli" describe --method range --bins 10 \
         --min 0 --max 50 "$samples/corner_a.bin"
-    expect_ok "describe pca" '"up":[' "$cli" describe --up pca "$samples/corner_b.ply"
+    expect_ok "describe pca" '"up":[' "$cli" describe --method height --up pca "$samples/corner_b.ply"
+    expect_error "up with range" "applies to the height method only" "$cli" describe --up pca \
+        "$samples/corner_b.ply"
     bins="$("$cli" describe --bins 7 "$samples/corner_a.bin" | grep -o '"bins":\[[^]]*\]' |
         tr -cd , | wc -c)"
     if [ "$bins" -eq 6 ]; then pass; else fail "--bins 7 gave $((bins + 1)) buckets"; fi
@@ -439,7 +441,7 @@ section_bad_input() {
         "$samples/corner_a.bin"
     expect_error "negative range" "range_min_m must be >= 0" "$cli" describe --method range \
         --min -1 "$samples/corner_a.bin"
-    expect_error "bad up" "unknown up vector mode" "$cli" describe --up sideways \
+    expect_error "bad up" "unknown up vector mode" "$cli" describe --method height --up sideways \
         "$samples/corner_a.bin"
     expect_error "non-number flag" "--bins" "$cli" describe --bins many "$samples/corner_a.bin"
     expect_error "distance needs two" "SCAN_A SCAN_B" "$cli" distance "$samples/corner_a.bin"

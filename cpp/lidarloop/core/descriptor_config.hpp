@@ -56,7 +56,9 @@ Projection ProjectionOf(const Method& method);
 /// Everything that decides how a scan becomes a descriptor, and nothing else: two equal configs
 /// give comparable descriptors. The single home of the descriptor defaults.
 struct DescriptorConfig {
-    Method method = Method::kHeight;
+    /// Range: its top-k candidates hold a true loop most often, which is what verification
+    /// needs (docs/verification.md, "Evidence for the defaults").
+    Method method = Method::kRange;
     HistogramConfig histogram;
     NdtConfig ndt;
 

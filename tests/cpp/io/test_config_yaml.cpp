@@ -41,7 +41,7 @@ TEST(ConfigYaml, DumpThenLoadGivesTheSameConfig) {
 TEST(ConfigYaml, DumpNamesEveryKeyWithItsDefault) {
     const std::string dump = DumpConfigYaml({});
     for (const char* key :
-         {"method: height", "bins: 100", "up_vector: fixed", "sensor_height_m: 0",
+         {"method: range", "bins: 100", "up_vector: fixed", "sensor_height_m: 0",
           "height_min_m: -3", "height_max_m: 7", "range_min_m: 0", "range_max_m: 80",
           "out_of_range: clamp", "cell_size_m: 0.5", "planar_classes: 9",
           "eigen_ratio_threshold: 0.1", "ambiguity_ratio: 0.6", "range_limits_m: [3, 6, 9, 15]",
@@ -57,7 +57,7 @@ TEST(ConfigYaml, OverridesOnlyTheNamedKeys) {
     ApplyConfigYaml("histogram:\n  bins: 64\n", "x.yaml", config);
     EXPECT_EQ(config.descriptor.histogram.bins, 64);
     EXPECT_EQ(config.descriptor.histogram.range_max_m, 42.0);
-    EXPECT_EQ(config.descriptor.method, core::Method::kHeight);
+    EXPECT_EQ(config.descriptor.method, core::Method::kRange);
 }
 
 TEST(ConfigYaml, EmptyDocumentChangesNothing) {
@@ -151,8 +151,10 @@ TEST(ConfigYaml, TheThresholdIsUnsetByDefaultOrNull) {
 // the key went.
 TEST(ConfigYaml, AConfigOfVersion01LoadsWithItsDefaultThresholds) {
     const std::filesystem::path legacy = std::filesystem::path(LIDARLOOP_TEST_DATA_DIR) / "legacy";
-    // 0.1 dumped every key; its top_k of 5 is the file's own value now that the default is 10.
+    // 0.1 dumped every key; its method (height) and top_k of 5 are the file's own values now
+    // that the defaults are range and 10.
     RunConfig expected;
+    expected.descriptor.method = core::Method::kHeight;
     expected.detection.top_k = 5;
     EXPECT_EQ(DumpConfigYaml(LoadConfigYaml(legacy / "config_v0.1.yaml")),
               DumpConfigYaml(expected));

@@ -65,6 +65,7 @@ TEST(DescriptorMethod, AThresholdMustBeAbleToDecide) {
     DetectorConfig detection;
     detection.threshold = 1.5;
     core::DescriptorConfig height;
+    height.method = core::Method::kHeight;
     EXPECT_THROW(LoopDetector(height, detection), core::ConfigError);
     EXPECT_THROW(
         DetectFromMatrix(SimilarityMatrix(2), {0.0, 1.0}, detection, core::Method::kHeight),
@@ -81,6 +82,7 @@ TEST(DescriptorMethod, ANameIsRegisteredOnce) {
 
 TEST(DescriptorMethod, DescriptorsOfTwoMethodsAreNotCompared) {
     core::DescriptorConfig height;
+    height.method = core::Method::kHeight;
     core::DescriptorConfig range;
     range.method = core::Method::kRange;
     const core::PointCloud cloud = test::RandomCloud(500, 1);

@@ -15,6 +15,7 @@ namespace {
 
 core::DescriptorConfig HeightConfig(int bins) {
     core::DescriptorConfig config;
+    config.method = core::Method::kHeight;
     config.histogram.bins = bins;
     return config;
 }

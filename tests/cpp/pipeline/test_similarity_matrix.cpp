@@ -29,6 +29,7 @@ TEST(SimilarityMatrix, CondensedIndexingIsSymmetricWithZeroDiagonal) {
 
 TEST(SimilarityMatrix, ParallelEqualsSerialForHistograms) {
     core::DescriptorConfig config;
+    config.method = core::Method::kHeight;  // test::HistogramDescriptor's
     config.histogram.bins = 30;
     DescriptorDatabase database(config);
     for (const auto& h : test::ClusteredHistograms(700, 30, 20, 4)) {
