@@ -16,7 +16,7 @@ int main(int argc, char** argv) {
     try {
         // [readme-snippet]
         const ll::io::Dataset dataset = ll::io::OpenDataset(argv[1]);  // KITTI, scan files, .3d
-        ll::core::DescriptorConfig descriptor;                         // height histograms
+        ll::core::DescriptorConfig descriptor;                         // range histograms
         if (argc > 2) descriptor.method = ll::pipeline::ParseMethod(argv[2]);
         ll::pipeline::DetectorConfig detection;  // candidates > 30 scans back, default threshold
         ll::pipeline::LoopDetector detector(descriptor, detection);
