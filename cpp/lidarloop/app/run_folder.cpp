@@ -65,8 +65,9 @@ bool IsStaging(const fs::path& entry) {
     return entry.filename().string().rfind(kStagingPrefix, 0) == 0;
 }
 
-// Removes what an earlier run left: the files its run.json lists, run.json, and staging
-// folders of runs that were killed. Refuses a non-empty folder of other files unless told to.
+// Removes what an earlier run left: the files and folders its run.json lists (optimise's
+// detection/), run.json, and staging folders of runs that were killed. Refuses a non-empty folder
+// of other files unless told to.
 void ClearPreviousRun(const fs::path& folder, bool overwrite) {
     std::error_code ec;
     const auto previous = PreviousRunFiles(folder);
@@ -74,7 +75,7 @@ void ClearPreviousRun(const fs::path& folder, bool overwrite) {
         if (IsStaging(entry.path())) fs::remove_all(entry.path(), ec);
     }
     if (previous) {
-        for (const std::string& file : *previous) fs::remove(folder / file, ec);
+        for (const std::string& file : *previous) fs::remove_all(folder / file, ec);
         fs::remove(folder / kManifest, ec);
         return;
     }

@@ -110,6 +110,23 @@ TEST(RunFolder, TheFilesOfTheRunBeforeAreRemovedOthersRefused) {
     EXPECT_TRUE(fs::exists(foreign / "thesis.tex"));
 }
 
+// optimise writes a whole detect run into detection/: running it again into the same folder
+// must replace that folder too, not fail after removing the rest.
+TEST(RunFolder, AFolderOfTheRunBeforeIsReplaced) {
+    test::TempDir dir;
+    const fs::path out = dir / "results";
+    for (const std::string run : {"1", "2"}) {
+        RunFolder folder(out, {});
+        fs::create_directories(folder.staging() / "detection");
+        test::WriteFile(folder.staging() / "detection" / "loops.csv", run);
+        test::WriteFile(folder.staging() / "metrics.json", run);
+        EXPECT_NO_THROW(folder.Complete());
+    }
+    EXPECT_EQ(Entries(out), (std::vector<std::string>{"detection", "metrics.json", "run.json"}));
+    EXPECT_EQ(test::ReadFile(out / "detection" / "loops.csv"), "2");
+    EXPECT_EQ(Manifest(out)["status"], "complete");
+}
+
 TEST(RunFolder, AFolderInsideTheDatasetIsRefused) {
     test::TempDir dir;
     fs::create_directories(dir / "dataset" / "velodyne");
