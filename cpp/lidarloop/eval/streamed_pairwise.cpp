@@ -188,6 +188,12 @@ PositiveLevels LevelsOf(std::vector<float>& distances) {
                                    [](float d) { return !detail::IsScored(d); }),
                     distances.end());
     std::sort(distances.begin(), distances.end());
+    // Exactly as many levels as distinct distances: growing by doubling would need twice that.
+    std::size_t distinct = 0;
+    for (std::size_t a = 0; a < distances.size(); ++a)
+        distinct += a == 0 || distances[a] != distances[a - 1] ? 1 : 0;
+    levels.keys.reserve(distinct);
+    levels.small_counts.reserve(distinct);
     for (std::size_t a = 0; a < distances.size();) {
         std::size_t b = a + 1;
         while (b < distances.size() && distances[b] == distances[a]) ++b;
