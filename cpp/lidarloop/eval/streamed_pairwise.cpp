@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/eval/detail/slot_counts.hpp"
 #include "lidarloop/eval/detail/sweep.hpp"
 
 // How the streamed sweep equals the sweep over sorted pairs (docs/evaluation.md):
@@ -63,34 +64,7 @@ void CheckNotNan(std::size_t i, std::size_t j, float distance) {
 
 constexpr std::uint32_t kZeroKey = 0x80000000u;  // OrderKey of -0 and +0
 
-// Counts of negatives in slots, 4 bytes a slot instead of 8 (there are as many slots as twice
-// the positives' distinct distances, ~88 M at 100,000 scans): the rare slot past 2^32 keeps
-// its carries aside.
-class SlotCounts {
-public:
-    void Assign(std::size_t size) {
-        low_.assign(size, 0);
-        carries_.clear();
-    }
-    /// Adds count < 2^32 to slot k.
-    void Add(std::size_t k, std::uint64_t count) {
-        const std::uint32_t before = low_[k];
-        low_[k] = before + static_cast<std::uint32_t>(count);
-        if (low_[k] < before) ++carries_[k];
-    }
-    std::uint64_t operator[](std::size_t k) const {
-        const auto carry = carries_.find(k);
-        const std::uint64_t high = carry == carries_.end() ? 0 : carry->second;
-        return (high << 32) | low_[k];
-    }
-    std::size_t size() const { return low_.size(); }
-    std::uint64_t front() const { return (*this)[0]; }
-    std::uint64_t back() const { return (*this)[size() - 1]; }
-
-private:
-    std::vector<std::uint32_t> low_;
-    std::unordered_map<std::size_t, std::uint64_t> carries_;
-};
+using detail::SlotCounts;
 
 // The positives of one population by distinct finite distance, and the slot of a negative.
 // 5 bytes a distinct distance: its order key and a count that is almost always small.
