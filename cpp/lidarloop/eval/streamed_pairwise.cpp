@@ -135,21 +135,35 @@ std::size_t FirstNotBelow(const PositiveLevels& levels, std::uint32_t key, std::
     return static_cast<std::size_t>(std::lower_bound(first, last, key) - levels.keys.begin());
 }
 
-// Counts ascending keys of negatives into the slots between `levels` (below D_k: 2k, at D_k:
-// 2k + 1), walking both in order, and gives each distinct key and its count to `each_key`.
+// A located batch entry: (slot or coarse bucket << kCountBits) | count, where a count is at
+// most a batch (kPending).
+constexpr unsigned kCountBits = 20;
+constexpr std::uint64_t kCountMask = (std::uint64_t{1} << kCountBits) - 1;
+static_assert(kPending <= kCountMask);
+
+// Locates ascending keys of negatives in the slots between `levels` (below D_k: 2k, at D_k:
+// 2k + 1), walking both in order: one located entry per distinct key, also given to `each_key`
+// with its count. Reads only what is fixed during the pass, so it runs outside the lock.
 template <class EachKey>
-void CountSortedKeys(const std::vector<std::uint32_t>& keys, const PositiveLevels& levels,
-                     SlotCounts& slots, EachKey each_key) {
+void LocateSortedKeys(const std::vector<std::uint32_t>& keys, const PositiveLevels& levels,
+                      std::vector<std::uint64_t>& located, EachKey each_key) {
+    located.clear();
     std::size_t k = 0;
     for (std::size_t a = 0; a < keys.size();) {
         const std::uint32_t key = keys[a];
         std::size_t b = a + 1;
         while (b < keys.size() && keys[b] == key) ++b;
         k = FirstNotBelow(levels, key, k);
-        slots.Add(2 * k + (k < levels.keys.size() && levels.keys[k] == key ? 1 : 0), b - a);
+        const std::uint64_t slot =
+            2 * k + (k < levels.keys.size() && levels.keys[k] == key ? 1 : 0);
+        located.push_back((slot << kCountBits) | (b - a));
         each_key(key, static_cast<std::uint64_t>(b - a));
         a = b;
     }
+}
+
+void AddLocated(const std::vector<std::uint64_t>& located, SlotCounts& slots) {
+    for (const std::uint64_t entry : located) slots.Add(entry >> kCountBits, entry & kCountMask);
 }
 
 // The levels of `distances` (all of one population, unscored included), which it sorts. The
@@ -218,9 +232,9 @@ struct StreamedPairwise::Shared {
     std::vector<std::size_t> threshold_order;
     std::unique_ptr<std::uint64_t, FreeDeleter> bitmap = NewBitmap();
     int pass = 1;
-    // Merged counts. In the first pass the sinks count their sorted batches straight into its
-    // slots and coarse histogram, under `counting`: one copy of the O(positives) slots, not one
-    // a thread.
+    // Merged counts. In the first pass the sinks add their located batches straight into the
+    // slots and the coarse histogram, under `counting`: one copy of the O(positives) slots, not
+    // one a thread.
     mutable Sink merged;
     mutable SlotCounts all_slots;    // negatives in the slots between all.keys
     mutable SlotCounts train_slots;  // training negatives between train.keys
@@ -350,16 +364,25 @@ void StreamedPairwise::Sink::Flush() {
     const Shared& s = *shared_;
     RadixSort(pending_all_, scratch_);
     RadixSort(pending_train_, scratch_);
+    // Sorting and locating outside the lock; under it only the additions, in ascending order.
+    located_coarse_.clear();
+    LocateSortedKeys(
+        pending_all_, s.all, located_all_, [&](std::uint32_t key, std::uint64_t count) {
+            const std::uint64_t bucket = key >> kFineBits;
+            if (!located_coarse_.empty() && (located_coarse_.back() >> kCountBits) == bucket) {
+                located_coarse_.back() += count;
+            } else {
+                located_coarse_.push_back((bucket << kCountBits) | count);
+            }
+            if (s.MarkDistinct(key)) ++distinct_;
+        });
+    LocateSortedKeys(pending_train_, s.train, located_train_, [](std::uint32_t, std::uint64_t) {});
     {
         const std::lock_guard<std::mutex> lock(s.counting);
-        Sink& merged = s.merged;
-        CountSortedKeys(pending_all_, s.all, s.all_slots,
-                        [&](std::uint32_t key, std::uint64_t count) {
-                            merged.coarse_[key >> kFineBits] += count;
-                            if (s.MarkDistinct(key)) ++distinct_;
-                        });
-        CountSortedKeys(pending_train_, s.train, s.train_slots,
-                        [](std::uint32_t, std::uint64_t) {});
+        AddLocated(located_all_, s.all_slots);
+        AddLocated(located_train_, s.train_slots);
+        for (const std::uint64_t entry : located_coarse_)
+            s.merged.coarse_[entry >> kCountBits] += entry & kCountMask;
     }
     pending_all_.clear();
     pending_train_.clear();

@@ -58,10 +58,10 @@ struct StreamedResult {
 /// Memory: per distinct finite positive distance 13 bytes (its key, a one-byte count, two 4-byte
 /// slots of negatives), again for the training part's, and two bucket tables of 4 MiB; while
 /// constructing, the positives' distances (4 bytes each, sorted in place); per sink 24 bytes a scan
-/// and 3 MiB of batch; in the second pass 32 KiB per located curve point and sink; and a bitmap of
-/// the distinct distances (512 MiB of address space, of which only the pages of occurring distances
-/// become resident: 4 KiB per 32768 consecutive float values). Sinks count their batches into
-/// shared counters under a mutex.
+/// and up to 7 MiB of batch; in the second pass 32 KiB per located curve point and sink; and a
+/// bitmap of the distinct distances (512 MiB of address space, of which only the pages of occurring
+/// distances become resident: 4 KiB per 32768 consecutive float values). Sinks sort their batches
+/// and locate them among the slots on their own, and add them to shared counters under a mutex.
 class StreamedPairwise {
 public:
     struct Shared;
@@ -82,6 +82,10 @@ public:
         std::vector<std::uint32_t> pending_all_;  ///< pass 1: keys of negatives to count
         std::vector<std::uint32_t> pending_train_;  ///< pass 1: of training negatives
         std::vector<std::uint32_t> scratch_;
+        /// pass 1: a sorted batch located outside the lock, (slot or bucket << 20) | count
+        std::vector<std::uint64_t> located_all_;
+        std::vector<std::uint64_t> located_train_;
+        std::vector<std::uint64_t> located_coarse_;
         std::vector<std::uint64_t> fine_;  ///< pass 2: negatives by key in the target buckets
         std::vector<std::uint64_t> from_threshold_;  ///< pass 2: as in ConfusionsAt
         std::uint64_t test_at_learnt_ = 0;           ///< pass 2: test negatives <= learnt tau
