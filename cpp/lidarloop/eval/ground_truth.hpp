@@ -61,8 +61,8 @@ struct LoopPair {
 /// The ground truth of one sequence under one GroundTruthConfig. The positive pairs are not
 /// stored: they are a pure function of the poses, so IsLoop applies the rule to two scans (O(1))
 /// and ForEachLoop enumerates them through a k-d tree. Memory is O(n) whatever the number of
-/// positives (a list of them cost 40 bytes a pair: 88 M pairs at 100,000 scans). Copies share
-/// the tree. Build with BuildGroundTruth.
+/// positives (a list of them cost 40 bytes a pair: 92 M pairs at 100,000 simulated scans). Copies
+/// share the tree. Build with BuildGroundTruth.
 struct GroundTruth {
     GroundTruthConfig config;
     std::vector<double> times_s;               ///< per scan, the pose times (for a gap in seconds)

@@ -11,8 +11,9 @@
 namespace lidarloop::eval::detail {
 
 // 64-bit counters in 4 bytes each: there are twice as many slots as distinct positive distances
-// (~88 M at 100,000 scans and the 10 m rule), and almost every slot stays far below 2^32. The
-// few that pass it keep their carries aside. Not thread-safe.
+// (of which there are at most as many as positives: 92 M at 100,000 simulated scans and the
+// 10 m rule), and almost every slot stays far below 2^32. The few that pass it keep their
+// carries aside. Not thread-safe.
 class SlotCounts {
 public:
     // `size` counters, all 0.
