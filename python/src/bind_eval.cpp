@@ -110,23 +110,27 @@ void BindGroundTruth(py::module_& m) {
             "loops",
             [](const GroundTruth& t) {
                 py::array_t<long long> pairs(
-                    {static_cast<py::ssize_t>(t.loops.size()), py::ssize_t{2}});
+                    {static_cast<py::ssize_t>(t.loop_count), py::ssize_t{2}});
                 auto out = pairs.mutable_unchecked<2>();
-                for (std::size_t k = 0; k < t.loops.size(); ++k) {
-                    out(k, 0) = static_cast<long long>(t.loops[k].i);
-                    out(k, 1) = static_cast<long long>(t.loops[k].j);
-                }
+                py::ssize_t k = 0;
+                t.ForEachLoop([&](const LoopPair& loop) {
+                    out(k, 0) = static_cast<long long>(loop.i);
+                    out(k, 1) = static_cast<long long>(loop.j);
+                    ++k;
+                });
                 return pairs;
             },
-            "(P, 2) int64: every positive pair i < j, sorted")
+            "(P, 2) int64: every positive pair i < j, sorted (computed on each access)")
         .def_property_readonly(
             "loop_distances_m",
             [](const GroundTruth& t) {
                 std::vector<double> d;
-                for (const LoopPair& p : t.loops) d.push_back(p.distance_m);
+                d.reserve(t.loop_count);
+                t.ForEachLoop([&](const LoopPair& loop) { d.push_back(loop.distance_m); });
                 return ArrayOf(d);
             },
-            "(P,) distance between the sensor positions of each positive pair, metres")
+            "(P,) distance between the sensor positions of each positive pair, metres (computed "
+            "on each access)")
         .def_property_readonly(
             "nearest",
             [](const GroundTruth& t) {

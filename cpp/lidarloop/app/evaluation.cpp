@@ -1,6 +1,7 @@
 #include "lidarloop/app/evaluation.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -68,20 +69,32 @@ void StreamBlock(eval::StreamedPairwise::Sink& sink, std::size_t row_begin, std:
     }
 }
 
+// Pairs i < j of n scans with i < row: rows of n - 1, n - 2, ... pairs.
+std::size_t PairsBeforeRow(std::size_t row, std::size_t n) { return row * (2 * n - row - 1) / 2; }
+
 // Streams every pair i < j through `evaluation`, blocks of rows in parallel, one sink a thread,
-// pass after pass.
+// pass after pass, telling `progress` the pairs done (stage "pairs (<name>), pass p of 2").
 eval::StreamedResult StreamPairs(eval::StreamedPairwise& evaluation, std::size_t n,
-                                 const eval::PairDistance& distance) {
+                                 const eval::PairDistance& distance, const std::string& name,
+                                 const Progress& progress) {
     const std::size_t blocks = (n + kStreamRows - 1) / kStreamRows;
+    const std::size_t total = PairsBeforeRow(n, n);
     while (!evaluation.finished()) {
+        const std::string stage =
+            "pairs (" + name + "), pass " + std::to_string(evaluation.pass()) + " of 2";
+        std::atomic<std::size_t> done{0};
         tbb::enumerable_thread_specific<eval::StreamedPairwise::Sink> sinks(
             [&] { return evaluation.NewSink(); });
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 1),
                           [&](const tbb::blocked_range<std::size_t>& range) {
                               eval::StreamedPairwise::Sink& sink = sinks.local();
                               for (std::size_t b = range.begin(); b < range.end(); ++b) {
-                                  StreamBlock(sink, b * kStreamRows,
-                                              std::min(n, (b + 1) * kStreamRows), n, distance);
+                                  const std::size_t begin = b * kStreamRows;
+                                  const std::size_t end = std::min(n, begin + kStreamRows);
+                                  StreamBlock(sink, begin, end, n, distance);
+                                  const std::size_t pairs =
+                                      PairsBeforeRow(end, n) - PairsBeforeRow(begin, n);
+                                  if (progress) progress(stage, done += pairs, total);
                               }
                           });
         for (eval::StreamedPairwise::Sink& sink : sinks) evaluation.Merge(sink);
@@ -170,7 +183,9 @@ std::optional<LearntThreshold> TrainingThresholdOf(const EvaluationRequest& requ
     eval::StreamedPairwise evaluation(truth, eval::ScorePositives(truth, distance), {});
     eval::StreamedResult result;
     try {
-        result = StreamPairs(evaluation, truth.size(), distance);
+        result =
+            StreamPairs(evaluation, truth.size(), distance,
+                        "training set, " + core::ToString(descriptor.method), request.progress);
     } catch (const core::EmptyInputError&) {
         return std::nullopt;
     }
@@ -217,9 +232,9 @@ MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method m
     }
     const double matrix_s = matrix_clock.Seconds();
     Stopwatch streamed_clock;
-    MethodEvaluation e =
-        EvaluateStreamed(core::ToString(method), distance, truth, request.learning,
-                         config.detection.ThresholdFor(method), request.fixed_thresholds, training);
+    MethodEvaluation e = EvaluateStreamed(core::ToString(method), distance, truth, request.learning,
+                                          config.detection.ThresholdFor(method),
+                                          request.fixed_thresholds, training, request.progress);
     // Without the matrix each pass computes every distance once: two comparisons a pair.
     const double comparisons_s = keep_matrix ? matrix_s : streamed_clock.Seconds() / 2.0;
     const double pairs = static_cast<double>(eval::CondensedSize(database.size()));
@@ -243,11 +258,13 @@ MethodEvaluation EvaluateResults(const EvaluationRequest& request, const std::st
     const std::string name = "results:" + std::filesystem::path(file).stem().string();
     if (!request.config.output.KeepsSimilarityMatrix(scans)) {
         return EvaluateStreamed(name, DistancesOfResults(file, scans), truth, request.learning,
-                                std::nullopt, request.fixed_thresholds);
+                                std::nullopt, request.fixed_thresholds, std::nullopt,
+                                request.progress);
     }
     pipeline::SimilarityMatrix matrix = MatrixOfResults(file, scans);
-    MethodEvaluation e = EvaluateStreamed(name, MatrixDistance(matrix), truth, request.learning,
-                                          std::nullopt, request.fixed_thresholds);
+    MethodEvaluation e =
+        EvaluateStreamed(name, MatrixDistance(matrix), truth, request.learning, std::nullopt,
+                         request.fixed_thresholds, std::nullopt, request.progress);
     e.matrix = std::move(matrix);
     return e;
 }
@@ -298,7 +315,8 @@ MethodEvaluation EvaluateStreamed(std::string name, const eval::PairDistance& di
                                   const eval::ThresholdLearningConfig& learning,
                                   std::optional<double> default_threshold,
                                   const std::vector<double>& fixed_thresholds,
-                                  const std::optional<LearntThreshold>& training) {
+                                  const std::optional<LearntThreshold>& training,
+                                  const Progress& progress) {
     MethodEvaluation e;
     e.name = std::move(name);
     e.default_threshold = default_threshold;
@@ -313,7 +331,7 @@ MethodEvaluation EvaluateStreamed(std::string name, const eval::PairDistance& di
         request.learning = learning;
     }
     eval::StreamedPairwise evaluation(truth, eval::ScorePositives(truth, distance), request);
-    eval::StreamedResult result = StreamPairs(evaluation, truth.size(), distance);
+    eval::StreamedResult result = StreamPairs(evaluation, truth.size(), distance, e.name, progress);
     e.pairwise = std::move(result.pairwise);
     e.optimum_exact = result.optimum_exact;
     const auto& at = result.at_thresholds;

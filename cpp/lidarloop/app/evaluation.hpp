@@ -76,13 +76,15 @@ struct LearntThreshold {
 /// EvaluateMatrix without the matrix, in memory O(n + positives): the pairs are streamed from
 /// `distance` twice in parallel (oneTBB), and every figure equals EvaluateMatrix's on the same
 /// distances, up to MethodEvaluation::optimum_exact. `matrix` is left empty; the threshold is
-/// learnt on `training` when given, else on the first part of this sequence.
+/// learnt on `training` when given, else on the first part of this sequence. `progress` is told
+/// the pairs done of each pass (stage "pairs (<name>), pass p of 2"), from worker threads.
 MethodEvaluation EvaluateStreamed(std::string name, const eval::PairDistance& distance,
                                   const eval::GroundTruth& truth,
                                   const eval::ThresholdLearningConfig& learning,
                                   std::optional<double> default_threshold,
                                   const std::vector<double>& fixed_thresholds = {},
-                                  const std::optional<LearntThreshold>& training = std::nullopt);
+                                  const std::optional<LearntThreshold>& training = std::nullopt,
+                                  const Progress& progress = {});
 
 /// The distances of an external detector's `query,match,distance` CSV as MatrixOfResults has
 /// them, in memory O(listed pairs): +inf for every pair the file leaves out. io::ReadError as

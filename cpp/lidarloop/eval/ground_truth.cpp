@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 #include <sstream>
+#include <utility>
 
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/core/kd_tree.hpp"
@@ -43,20 +44,31 @@ void CheckPoses(const std::vector<core::StampedPose>& poses) {
     }
 }
 
-// Partners per scan in CSR form; `loops` is sorted by (i, j), so every list comes out sorted.
+// Per scan its first partner, and the number of pairs: one radius search a scan, whose sorted
+// answer puts the first partner first.
 void FillPartners(GroundTruth& truth) {
-    const std::size_t n = truth.size();
-    truth.partner_offsets.assign(n + 1, 0);
-    for (const auto& loop : truth.loops) {
-        ++truth.partner_offsets[loop.i + 1];
-        ++truth.partner_offsets[loop.j + 1];
+    truth.first_partner.assign(truth.size(), kNoScan);
+    for (std::size_t i = 0; i < truth.size(); ++i) {
+        for (const std::size_t j :
+             truth.tree->RadiusSearch(truth.positions_m[i], truth.config.distance_m)) {
+            if (!truth.IsLoop(i, j)) continue;
+            if (truth.first_partner[i] == kNoScan) truth.first_partner[i] = j;
+            truth.loop_count += j > i ? 1 : 0;
+        }
     }
-    for (std::size_t k = 0; k < n; ++k) truth.partner_offsets[k + 1] += truth.partner_offsets[k];
-    truth.partners.assign(truth.partner_offsets[n], 0);
-    std::vector<std::size_t> next(truth.partner_offsets.begin(), truth.partner_offsets.end() - 1);
-    for (const auto& loop : truth.loops) {
-        truth.partners[next[loop.i]++] = loop.j;
-        truth.partners[next[loop.j]++] = loop.i;
+}
+
+void FillNearest(GroundTruth& truth) {
+    const std::size_t n = truth.size();
+    truth.nearest.assign(n, kNoScan);
+    truth.nearest_distance_m.assign(n, std::numeric_limits<double>::infinity());
+    for (std::size_t i = 0; i < n; ++i) {
+        const auto found = truth.tree->NearestIf(
+            truth.positions_m[i], [&](std::size_t j) { return truth.SamePlaceRules(i, j); });
+        if (found) {
+            truth.nearest[i] = found->index;
+            truth.nearest_distance_m[i] = found->distance_m;
+        }
     }
 }
 
@@ -98,10 +110,35 @@ double HeadingDifferenceDeg(const core::Transform& T_world_a, const core::Transf
     return AngleDeg(GroundHeading(T_world_a), GroundHeading(T_world_b));
 }
 
+bool GroundTruth::SamePlaceRules(std::size_t i, std::size_t j) const {
+    return Comparable(i, j) &&
+           (ground_headings.empty() ||
+            AngleDeg(ground_headings[i], ground_headings[j]) < config.max_heading_deg);
+}
+
 bool GroundTruth::IsLoop(std::size_t i, std::size_t j) const {
-    const auto first = partners.begin() + static_cast<std::ptrdiff_t>(partner_offsets[i]);
-    const auto last = partners.begin() + static_cast<std::ptrdiff_t>(partner_offsets[i + 1]);
-    return std::binary_search(first, last, j);
+    if (i > j) std::swap(i, j);
+    // KdTree3::RadiusSearch's predicate, with the query i and the found point j, as in
+    // ForEachLoop: the same doubles decide, so both agree even exactly at the boundary.
+    return (positions_m[j] - positions_m[i]).squaredNorm() <
+               config.distance_m * config.distance_m &&
+           SamePlaceRules(i, j);
+}
+
+void GroundTruth::ForEachLoop(const std::function<void(const LoopPair&)>& each) const {
+    for (std::size_t i = 0; i < size(); ++i) {
+        for (const std::size_t j : tree->RadiusSearch(positions_m[i], config.distance_m)) {
+            if (j > i && SamePlaceRules(i, j))
+                each({i, j, (positions_m[i] - positions_m[j]).norm()});
+        }
+    }
+}
+
+std::vector<LoopPair> GroundTruth::Loops() const {
+    std::vector<LoopPair> loops;
+    loops.reserve(loop_count);
+    ForEachLoop([&](const LoopPair& loop) { loops.push_back(loop); });
+    return loops;
 }
 
 std::size_t GroundTruth::OverlappingCount() const {
@@ -135,7 +172,7 @@ std::size_t GroundTruth::ComparablePairCount() const {
 
 std::string GroundTruth::Describe() const {
     return config.Describe() + " (" + std::to_string(size()) + " scans, " +
-           std::to_string(loops.size()) + " positive pairs, " + std::to_string(OverlappingCount()) +
+           std::to_string(loop_count) + " positive pairs, " + std::to_string(OverlappingCount()) +
            " overlapping scans)";
 }
 
@@ -147,37 +184,18 @@ GroundTruth BuildGroundTruth(const std::vector<core::StampedPose>& poses,
     GroundTruth truth;
     truth.config = config;
     truth.times_s.resize(n);
-    std::vector<Eigen::Vector3d> positions(n);
-    std::vector<Eigen::Vector2d> headings(n);
+    truth.positions_m.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
         truth.times_s[i] = poses[i].time_s;
-        positions[i] = poses[i].T_world_sensor.translation();
-        headings[i] = GroundHeading(poses[i].T_world_sensor);
+        truth.positions_m[i] = poses[i].T_world_sensor.translation();
     }
-    const bool use_heading = config.max_heading_deg > 0.0;
-    const auto same_place_rules = [&](std::size_t i, std::size_t j) {
-        return truth.Comparable(i, j) &&
-               (!use_heading || AngleDeg(headings[i], headings[j]) < config.max_heading_deg);
-    };
-    const core::KdTree3 tree(positions);
-    for (std::size_t i = 0; i < n; ++i) {
-        for (const std::size_t j : tree.RadiusSearch(positions[i], config.distance_m)) {
-            if (j > i && same_place_rules(i, j)) {
-                truth.loops.push_back({i, j, (positions[i] - positions[j]).norm()});
-            }
-        }
+    if (config.max_heading_deg > 0.0) {
+        for (const auto& pose : poses)
+            truth.ground_headings.push_back(GroundHeading(pose.T_world_sensor));
     }
+    truth.tree = std::make_shared<const core::KdTree3>(truth.positions_m);
     FillPartners(truth);
-    truth.nearest.assign(n, kNoScan);
-    truth.nearest_distance_m.assign(n, std::numeric_limits<double>::infinity());
-    for (std::size_t i = 0; i < n; ++i) {
-        const auto found =
-            tree.NearestIf(positions[i], [&](std::size_t j) { return same_place_rules(i, j); });
-        if (found) {
-            truth.nearest[i] = found->index;
-            truth.nearest_distance_m[i] = found->distance_m;
-        }
-    }
+    FillNearest(truth);
     return truth;
 }
 

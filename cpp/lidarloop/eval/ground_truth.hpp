@@ -1,10 +1,15 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
+#include "lidarloop/core/kd_tree.hpp"
 #include "lidarloop/core/min_gap.hpp"
 #include "lidarloop/core/point_cloud.hpp"
 
@@ -53,32 +58,48 @@ struct LoopPair {
     double distance_m = 0.0;
 };
 
-/// The ground truth of one sequence under one GroundTruthConfig. Plain data; the member
-/// functions are O(1) or O(log degree) queries. Build with BuildGroundTruth.
+/// The ground truth of one sequence under one GroundTruthConfig. The positive pairs are not
+/// stored: they are a pure function of the poses, so IsLoop applies the rule to two scans (O(1))
+/// and ForEachLoop enumerates them through a k-d tree. Memory is O(n) whatever the number of
+/// positives (a list of them cost 40 bytes a pair: 92 M pairs at 100,000 simulated scans). Copies
+/// share the tree. Build with BuildGroundTruth.
 struct GroundTruth {
     GroundTruthConfig config;
-    std::vector<double> times_s;  ///< per scan, the pose times (used by a gap in seconds)
-    std::vector<LoopPair> loops;  ///< all positive pairs, i < j, sorted by (i, j)
+    std::vector<double> times_s;               ///< per scan, the pose times (for a gap in seconds)
+    std::vector<Eigen::Vector3d> positions_m;  ///< per scan, the sensor position, world frame
+    /// Per scan, the sensor's forward axis projected on the world ground plane (not
+    /// normalised); empty when the heading rule is off.
+    std::vector<Eigen::Vector2d> ground_headings;
     /// Per scan, the nearest scan outside the gap that also passes the heading rule (Magnusson
     /// table I: Ŝ), or kNoScan when there is none.
     std::vector<std::size_t> nearest;
     /// Per scan, the distance to `nearest`, metres (+inf when there is none).
     std::vector<double> nearest_distance_m;
-    /// CSR adjacency of `loops`: the partners of scan i are
-    /// partners[partner_offsets[i] .. partner_offsets[i + 1]), sorted ascending.
-    std::vector<std::size_t> partner_offsets;
-    std::vector<std::size_t> partners;
+    /// Per scan, its smallest positive partner (earlier or later), or kNoScan when it has none.
+    std::vector<std::size_t> first_partner;
+    std::size_t loop_count = 0;                 ///< number of positive pairs i < j
+    std::shared_ptr<const core::KdTree3> tree;  ///< over positions_m, for ForEachLoop
 
     std::size_t size() const { return times_s.size(); }
     /// True when scans i and j are far enough apart in the sequence to be evaluated.
     bool Comparable(std::size_t i, std::size_t j) const {
         return i != j && config.min_gap.Allows(i, j, times_s[i], times_s[j]);
     }
-    /// True when (i, j), in either order, is a positive pair.
+    /// The rules besides the distance: Comparable, and headings closer than max_heading_deg
+    /// when the heading rule is on.
+    bool SamePlaceRules(std::size_t i, std::size_t j) const;
+    /// True when (i, j), in either order, is a positive pair: the rule itself, decided by the
+    /// same expressions as the k-d tree's radius search, so it agrees with ForEachLoop exactly
+    /// (also at a distance of exactly distance_m, which is negative). O(1), thread-safe.
     bool IsLoop(std::size_t i, std::size_t j) const;
+    /// Calls each(pair) for every positive pair, i < j, in ascending (i, j) order. O(n log n + P)
+    /// time, O(largest neighbourhood) memory.
+    void ForEachLoop(const std::function<void(const LoopPair&)>& each) const;
+    /// All positive pairs, sorted by (i, j): O(P) memory, for tests and small sequences.
+    std::vector<LoopPair> Loops() const;
     /// True when scan i has at least one positive partner (Magnusson: an "overlapping" scan;
     /// nearest_distance_m[i] < distance_m, up to rounding exactly at the boundary).
-    bool Overlapping(std::size_t i) const { return partner_offsets[i + 1] > partner_offsets[i]; }
+    bool Overlapping(std::size_t i) const { return first_partner[i] != kNoScan; }
     /// Number of overlapping scans.
     std::size_t OverlappingCount() const;
     /// Number of pairs i < j that are Comparable (positives + negatives of the pair-wise
@@ -89,7 +110,7 @@ struct GroundTruth {
 };
 
 /// Builds the ground truth from the scans' poses with a k-d tree radius search (not all pairs):
-/// O(n log n + P) for P positive pairs, plus the nearest-partner search. Throws
+/// O(n log n + P) time for P positive pairs, plus the nearest-partner search; O(n) memory. Throws
 /// core::ConfigError for an invalid config and core::Error when a pose or time is not finite.
 /// Thread-safe.
 GroundTruth BuildGroundTruth(const std::vector<core::StampedPose>& poses,

@@ -182,8 +182,8 @@ bool Revisiting(const GroundTruth& truth, std::size_t scan) {
                           " is out of range: the ground truth has " + std::to_string(truth.size()) +
                           " scans");
     }
-    // Partners are sorted ascending and all outside the gap: the first one decides.
-    return truth.Overlapping(scan) && truth.partners[truth.partner_offsets[scan]] < scan;
+    // The first partner decides (kNoScan, none, is never smaller).
+    return truth.first_partner[scan] < scan;
 }
 
 LoopRetrievalEvaluation EvaluateLoopRetrieval(std::span<const QueryCandidates> queries,

@@ -10,9 +10,11 @@
 #include <mutex>
 #include <new>
 #include <string>
+#include <unordered_map>
 #include <utility>
 
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/eval/detail/slot_counts.hpp"
 #include "lidarloop/eval/detail/sweep.hpp"
 
 // How the streamed sweep equals the sweep over sorted pairs (docs/evaluation.md):
@@ -60,27 +62,50 @@ void CheckNotNan(std::size_t i, std::size_t j, float distance) {
     }
 }
 
+constexpr std::uint32_t kZeroKey = 0x80000000u;  // OrderKey of -0 and +0
+
+using detail::SlotCounts;
+
 // The positives of one population by distinct finite distance, and the slot of a negative.
+// 5 bytes a distinct distance: its order key and a count that is almost always small.
 struct PositiveLevels {
-    std::vector<float> distances;       // distinct finite, ascending
-    std::vector<std::uint64_t> counts;  // positives at each
-    std::uint64_t total = 0;            // unscored included
+    std::vector<std::uint32_t> keys;         // OrderKey of each distinct finite distance, ascending
+    std::vector<std::uint8_t> small_counts;  // positives at each; kLarge: see large_counts
+    std::unordered_map<std::size_t, std::uint64_t> large_counts;
+    float zero = 0.0f;        // the distance at kZeroKey: -0 or +0, as it came first
+    std::uint64_t total = 0;  // unscored included
     // The first distance whose key's coarse bucket is >= b: a slot is then searched among the
     // few distances of one bucket, not all (a binary search over all cost most of the time).
     std::vector<std::uint32_t> first_in_bucket;
-    std::vector<std::uint32_t> keys;  // OrderKey of each distance
+    static constexpr std::uint8_t kLarge = 255;
 
+    std::size_t size() const { return keys.size(); }
+    float Distance(std::size_t k) const { return keys[k] == kZeroKey ? zero : FromKey(keys[k]); }
+    std::uint64_t Count(std::size_t k) const {
+        return small_counts[k] < kLarge ? small_counts[k] : large_counts.at(k);
+    }
+    void Append(float distance, std::uint64_t count) {
+        if (OrderKey(distance) == kZeroKey) zero = distance;
+        keys.push_back(OrderKey(distance));
+        small_counts.push_back(count < kLarge ? static_cast<std::uint8_t>(count) : kLarge);
+        if (count >= kLarge) large_counts[keys.size() - 1] = count;
+    }
     void Index() {
-        keys.clear();
-        for (const float d : distances) keys.push_back(OrderKey(d));
         first_in_bucket.assign(kCoarseBuckets + 1, 0);
         std::size_t k = 0;
         for (std::size_t b = 0; b <= kCoarseBuckets; ++b) {
-            while (k < distances.size() && (OrderKey(distances[k]) >> kFineBits) < b) ++k;
+            while (k < keys.size() && (keys[k] >> kFineBits) < b) ++k;
             first_in_bucket[b] = static_cast<std::uint32_t>(k);
         }
     }
-    std::size_t SlotCount() const { return 2 * distances.size() + 1; }
+    std::size_t SlotCount() const { return 2 * keys.size() + 1; }
+    // Positives with a finite distance <= threshold.
+    std::uint64_t AtMost(double threshold) const {
+        std::uint64_t count = 0;
+        for (std::size_t k = 0; k < size() && static_cast<double>(Distance(k)) <= threshold; ++k)
+            count += Count(k);
+        return count;
+    }
 };
 
 // Sorts keys ascending: LSD radix sort in three passes of 11 bits, O(n) and cache-friendly.
@@ -98,40 +123,70 @@ void RadixSort(std::vector<std::uint32_t>& keys, std::vector<std::uint32_t>& scr
     }
 }
 
-// Counts ascending keys of negatives into the slots between `levels` (below D_k: 2k, at D_k:
-// 2k + 1), walking both in order, and gives each distinct key and its count to `each_key`.
+// The first level whose key is >= key, given that none before `from` is: a binary search among
+// the distances of key's coarse bucket, which can hold thousands when the positives are many,
+// instead of a walk through them one by one under the counting lock.
+std::size_t FirstNotBelow(const PositiveLevels& levels, std::uint32_t key, std::size_t from) {
+    const std::size_t bucket = key >> kFineBits;
+    const auto first = levels.keys.begin() + static_cast<std::ptrdiff_t>(std::max<std::size_t>(
+                                                 from, levels.first_in_bucket[bucket]));
+    const auto last =
+        levels.keys.begin() + static_cast<std::ptrdiff_t>(levels.first_in_bucket[bucket + 1]);
+    return static_cast<std::size_t>(std::lower_bound(first, last, key) - levels.keys.begin());
+}
+
+// A located batch entry: (slot or coarse bucket << kCountBits) | count, where a count is at
+// most a batch (kPending).
+constexpr unsigned kCountBits = 20;
+constexpr std::uint64_t kCountMask = (std::uint64_t{1} << kCountBits) - 1;
+static_assert(kPending <= kCountMask);
+
+// Locates ascending keys of negatives in the slots between `levels` (below D_k: 2k, at D_k:
+// 2k + 1), walking both in order: one located entry per distinct key, also given to `each_key`
+// with its count. Reads only what is fixed during the pass, so it runs outside the lock.
 template <class EachKey>
-void CountSortedKeys(const std::vector<std::uint32_t>& keys, const PositiveLevels& levels,
-                     std::vector<std::uint64_t>& slots, EachKey each_key) {
+void LocateSortedKeys(const std::vector<std::uint32_t>& keys, const PositiveLevels& levels,
+                      std::vector<std::uint64_t>& located, EachKey each_key) {
+    located.clear();
     std::size_t k = 0;
     for (std::size_t a = 0; a < keys.size();) {
         const std::uint32_t key = keys[a];
         std::size_t b = a + 1;
         while (b < keys.size() && keys[b] == key) ++b;
-        k = std::max<std::size_t>(k, levels.first_in_bucket[key >> kFineBits]);
-        while (k < levels.keys.size() && levels.keys[k] < key) ++k;
-        slots[2 * k + (k < levels.keys.size() && levels.keys[k] == key ? 1 : 0)] += b - a;
+        k = FirstNotBelow(levels, key, k);
+        const std::uint64_t slot =
+            2 * k + (k < levels.keys.size() && levels.keys[k] == key ? 1 : 0);
+        located.push_back((slot << kCountBits) | (b - a));
         each_key(key, static_cast<std::uint64_t>(b - a));
         a = b;
     }
 }
 
-template <class Keep>
-PositiveLevels LevelsOf(const std::vector<ScoredPair>& positives, Keep keep) {
-    std::vector<float> scored;
+void AddLocated(const std::vector<std::uint64_t>& located, SlotCounts& slots) {
+    for (const std::uint64_t entry : located) slots.Add(entry >> kCountBits, entry & kCountMask);
+}
+
+// The levels of `distances` (all of one population, unscored included), which it sorts. The
+// same sort of the same sequence as before these levels were compact, so that of -0 and +0 the
+// same one comes first.
+PositiveLevels LevelsOf(std::vector<float>& distances) {
     PositiveLevels levels;
-    for (const ScoredPair& p : positives) {
-        if (!keep(p)) continue;
-        ++levels.total;
-        if (detail::IsScored(p.distance)) scored.push_back(p.distance);
-    }
-    std::sort(scored.begin(), scored.end());
-    for (const float d : scored) {
-        if (levels.distances.empty() || levels.distances.back() != d) {
-            levels.distances.push_back(d);
-            levels.counts.push_back(0);
-        }
-        ++levels.counts.back();
+    levels.total = distances.size();
+    distances.erase(std::remove_if(distances.begin(), distances.end(),
+                                   [](float d) { return !detail::IsScored(d); }),
+                    distances.end());
+    std::sort(distances.begin(), distances.end());
+    // Exactly as many levels as distinct distances: growing by doubling would need twice that.
+    std::size_t distinct = 0;
+    for (std::size_t a = 0; a < distances.size(); ++a)
+        distinct += a == 0 || distances[a] != distances[a - 1] ? 1 : 0;
+    levels.keys.reserve(distinct);
+    levels.small_counts.reserve(distinct);
+    for (std::size_t a = 0; a < distances.size();) {
+        std::size_t b = a + 1;
+        while (b < distances.size() && distances[b] == distances[a]) ++b;
+        levels.Append(distances[a], b - a);
+        a = b;
     }
     levels.Index();
     return levels;
@@ -169,7 +224,7 @@ Confusion ConfusionOf(std::uint64_t tp, std::uint64_t fp, std::uint64_t positive
 struct StreamedPairwise::Shared {
     const GroundTruth* truth = nullptr;
     StreamedRequest request;
-    std::vector<ScoredPair> positives;
+    std::uint64_t positive_count = 0;
     std::size_t first_test_scan = 0;  // the test part: pairs with j >= it
     PositiveLevels all;
     PositiveLevels train;
@@ -177,10 +232,12 @@ struct StreamedPairwise::Shared {
     std::vector<std::size_t> threshold_order;
     std::unique_ptr<std::uint64_t, FreeDeleter> bitmap = NewBitmap();
     int pass = 1;
-    // Merged counts. In the first pass the sinks count their sorted batches straight into its
-    // slots and coarse histogram, under `counting`: one copy of the O(positives) slots, not one
-    // a thread.
+    // Merged counts. In the first pass the sinks add their located batches straight into the
+    // slots and the coarse histogram, under `counting`: one copy of the O(positives) slots, not
+    // one a thread.
     mutable Sink merged;
+    mutable SlotCounts all_slots;    // negatives in the slots between all.keys
+    mutable SlotCounts train_slots;  // training negatives between train.keys
     mutable std::mutex counting;
     std::vector<std::int32_t> fine_of_bucket;  // pass 2: table of a coarse bucket, or -1
     std::vector<RankQuery> queries;
@@ -200,7 +257,7 @@ struct StreamedPairwise::Shared {
         BestThreshold mcc;
         BestThreshold f1;
     };
-    Optima BestOf(const PositiveLevels& levels, const std::vector<std::uint64_t>& slots,
+    Optima BestOf(const PositiveLevels& levels, const SlotCounts& slots,
                   const Sink::Extremes& negatives) const;
     void PrepareSecondPass();
     void ResolveQueries();
@@ -307,16 +364,25 @@ void StreamedPairwise::Sink::Flush() {
     const Shared& s = *shared_;
     RadixSort(pending_all_, scratch_);
     RadixSort(pending_train_, scratch_);
+    // Sorting and locating outside the lock; under it only the additions, in ascending order.
+    located_coarse_.clear();
+    LocateSortedKeys(
+        pending_all_, s.all, located_all_, [&](std::uint32_t key, std::uint64_t count) {
+            const std::uint64_t bucket = key >> kFineBits;
+            if (!located_coarse_.empty() && (located_coarse_.back() >> kCountBits) == bucket) {
+                located_coarse_.back() += count;
+            } else {
+                located_coarse_.push_back((bucket << kCountBits) | count);
+            }
+            if (s.MarkDistinct(key)) ++distinct_;
+        });
+    LocateSortedKeys(pending_train_, s.train, located_train_, [](std::uint32_t, std::uint64_t) {});
     {
         const std::lock_guard<std::mutex> lock(s.counting);
-        Sink& merged = s.merged;
-        CountSortedKeys(pending_all_, s.all, merged.all_slots_,
-                        [&](std::uint32_t key, std::uint64_t count) {
-                            merged.coarse_[key >> kFineBits] += count;
-                            if (s.MarkDistinct(key)) ++distinct_;
-                        });
-        CountSortedKeys(pending_train_, s.train, merged.train_slots_,
-                        [](std::uint32_t, std::uint64_t) {});
+        AddLocated(located_all_, s.all_slots);
+        AddLocated(located_train_, s.train_slots);
+        for (const std::uint64_t entry : located_coarse_)
+            s.merged.coarse_[entry >> kCountBits] += entry & kCountMask;
     }
     pending_all_.clear();
     pending_train_.clear();
@@ -352,19 +418,48 @@ void StreamedPairwise::Sink::AddNegative(std::size_t j, float distance) {
 
 // ---- StreamedPairwise -------------------------------------------------------------------------
 
-std::vector<ScoredPair> ScorePositives(const GroundTruth& truth, const PairDistance& distance) {
-    std::vector<ScoredPair> positives;
-    for (const LoopPair& loop : truth.loops) {
-        if (!truth.Comparable(loop.i, loop.j)) continue;
+std::vector<float> ScorePositives(const GroundTruth& truth, const PairDistance& distance) {
+    std::vector<float> positives;
+    positives.reserve(truth.loop_count);
+    truth.ForEachLoop([&](const LoopPair& loop) {
         const float d = distance(loop.i, loop.j);
         CheckNotNan(loop.i, loop.j, d);
-        positives.push_back(
-            {static_cast<std::uint32_t>(loop.i), static_cast<std::uint32_t>(loop.j), d, true});
-    }
+        positives.push_back(d);
+    });
     return positives;
 }
 
-StreamedPairwise::StreamedPairwise(const GroundTruth& truth, std::vector<ScoredPair> positives,
+namespace {
+
+// Throws for a NaN among the positives, naming its pair (found by enumerating them again).
+void CheckPositives(const GroundTruth& truth, const std::vector<float>& positives) {
+    if (positives.size() != truth.loop_count) {
+        throw core::Error("pair-wise evaluation: " + std::to_string(positives.size()) +
+                          " positive distances for " + std::to_string(truth.loop_count) +
+                          " positive pairs");
+    }
+    if (std::none_of(positives.begin(), positives.end(), [](float d) { return std::isnan(d); }))
+        return;
+    std::size_t k = 0;
+    truth.ForEachLoop([&](const LoopPair& loop) { CheckNotNan(loop.i, loop.j, positives[k++]); });
+}
+
+// The distances of the positives of the training part (j before first_test_scan), in the
+// order of `positives` (GroundTruth::ForEachLoop's).
+std::vector<float> TrainingPositives(const GroundTruth& truth, const std::vector<float>& positives,
+                                     std::size_t first_test_scan) {
+    std::vector<float> train;
+    std::size_t k = 0;
+    truth.ForEachLoop([&](const LoopPair& loop) {
+        if (loop.j < first_test_scan) train.push_back(positives[k]);
+        ++k;
+    });
+    return train;
+}
+
+}  // namespace
+
+StreamedPairwise::StreamedPairwise(const GroundTruth& truth, std::vector<float> positives,
                                    StreamedRequest request)
     : shared_(nullptr) {
     request.pairwise.Validate();
@@ -379,17 +474,19 @@ StreamedPairwise::StreamedPairwise(const GroundTruth& truth, std::vector<ScoredP
     }
     if (truth.size() > std::numeric_limits<std::uint32_t>::max())
         throw core::Error("pair-wise evaluation: more than 2^32 scans");
-    for (const ScoredPair& p : positives) CheckNotNan(p.i, p.j, p.distance);
+    CheckPositives(truth, positives);
     auto shared = std::make_unique<Shared>(truth);
     Shared& s = *shared;
     s.request = std::move(request);
-    s.positives = std::move(positives);
+    s.positive_count = positives.size();
     if (s.request.learning) {
         s.first_test_scan = static_cast<std::size_t>(
             std::llround(s.request.learning->train_fraction * static_cast<double>(truth.size())));
+        std::vector<float> train = TrainingPositives(truth, positives, s.first_test_scan);
+        s.train = LevelsOf(train);
     }
-    s.all = LevelsOf(s.positives, [](const ScoredPair&) { return true; });
-    s.train = LevelsOf(s.positives, [&](const ScoredPair& p) { return !s.InTest(p.j); });
+    s.all = LevelsOf(positives);
+    positives = std::vector<float>();  // the levels hold what is needed of them
     const std::vector<double>& thresholds = s.request.thresholds;
     s.threshold_order.resize(thresholds.size());
     for (std::size_t k = 0; k < thresholds.size(); ++k) s.threshold_order[k] = k;
@@ -397,8 +494,8 @@ StreamedPairwise::StreamedPairwise(const GroundTruth& truth, std::vector<ScoredP
               [&](std::size_t a, std::size_t b) { return thresholds[a] < thresholds[b]; });
     for (const std::size_t k : s.threshold_order) s.ascending_thresholds.push_back(thresholds[k]);
     s.merged = Sink(s);
-    s.merged.all_slots_.assign(s.all.SlotCount(), 0);
-    if (s.Learning()) s.merged.train_slots_.assign(s.train.SlotCount(), 0);
+    s.all_slots.Assign(s.all.SlotCount());
+    if (s.Learning()) s.train_slots.Assign(s.train.SlotCount());
     s.merged.coarse_.assign(kCoarseBuckets, 0);
     shared_ = std::move(shared);
 }
@@ -431,15 +528,13 @@ void StreamedPairwise::Merge(Sink& sink) {
 void StreamedPairwise::EndPass() {
     Shared& s = *shared_;
     if (s.pass == 1) {
-        if (s.positives.size() + s.merged.all_.total == 0)
+        if (s.positive_count + s.merged.all_.total == 0)
             throw core::EmptyInputError("pair-wise evaluation: no pairs to evaluate");
         s.PrepareSecondPass();
         // The second pass's sink keeps the first pass's merged counts.
         Sink first = std::move(s.merged);
         s.pass = 2;
         s.merged = Sink(s);
-        s.merged.all_slots_ = std::move(first.all_slots_);
-        s.merged.train_slots_ = std::move(first.train_slots_);
         s.merged.coarse_ = std::move(first.coarse_);
         s.merged.best_ = std::move(first.best_);
         s.merged.all_ = first.all_;
@@ -461,18 +556,12 @@ StreamedResult StreamedPairwise::Result() const {
     result.best_matches = s.merged.best_;
     // ConfusionsAt: positives directly, negatives from the second pass's slots.
     const std::uint64_t negatives = s.merged.all_.total;
-    const std::uint64_t positives = s.positives.size();
+    const std::uint64_t positives = s.positive_count;
     result.at_thresholds.resize(s.ascending_thresholds.size());
     std::uint64_t fp = 0;
     for (std::size_t r = 0; r < s.ascending_thresholds.size(); ++r) {
         fp += s.merged.from_threshold_[r];
-        std::uint64_t tp = 0;
-        for (const ScoredPair& p : s.positives) {
-            tp += detail::IsScored(p.distance) &&
-                          static_cast<double>(p.distance) <= s.ascending_thresholds[r]
-                      ? 1
-                      : 0;
-        }
+        const std::uint64_t tp = s.all.AtMost(s.ascending_thresholds[r]);
         result.at_thresholds[s.threshold_order[r]] = ConfusionOf(tp, fp, positives, negatives);
     }
     return result;
@@ -485,17 +574,19 @@ namespace {
 // Walks the sweep's steps: for each D_k the run of negatives below it (slot 2k), then the
 // positives and negatives at it (slot 2k + 1); finally the run above all (slot 2U).
 template <class Run, class AtLevel>
-void ForEachStep(const PositiveLevels& levels, const std::vector<std::uint64_t>& slots, Run run,
-                 AtLevel at_level) {
+void ForEachStep(const PositiveLevels& levels, const SlotCounts& slots, Run run, AtLevel at_level) {
     std::uint64_t tp = 0;
     std::uint64_t fp = 0;
-    for (std::size_t k = 0; k <= levels.distances.size(); ++k) {
-        run(k, tp, fp, slots[2 * k]);
-        fp += slots[2 * k];
-        if (k == levels.distances.size()) break;
-        at_level(k, tp, fp, levels.counts[k], slots[2 * k + 1]);
-        tp += levels.counts[k];
-        fp += slots[2 * k + 1];
+    for (std::size_t k = 0; k <= levels.size(); ++k) {
+        const std::uint64_t below = slots[2 * k];
+        run(k, tp, fp, below);
+        fp += below;
+        if (k == levels.size()) break;
+        const std::uint64_t positives = levels.Count(k);
+        const std::uint64_t at = slots[2 * k + 1];
+        at_level(k, tp, fp, positives, at);
+        tp += positives;
+        fp += at;
     }
 }
 
@@ -518,13 +609,13 @@ std::uint64_t FirstFpInBucket(const detail::CurveThinner& thinner, double bucket
 }  // namespace
 
 void StreamedPairwise::Shared::PrepareSecondPass() {
-    const std::uint64_t positives_n = positives.size();
+    const std::uint64_t positives_n = positive_count;
     const std::uint64_t negatives_n = merged.all_.total;
     const detail::CurveThinner thinner(request.pairwise.max_curve_points);
     std::vector<std::uint64_t> ranks;
     // Every rank that can start a new bucket inside a run (see SweepAll).
     ForEachStep(
-        all, merged.all_slots_,
+        all, all_slots,
         [&](std::size_t, std::uint64_t tp, std::uint64_t fp, std::uint64_t count) {
             if (count == 0) return;
             const auto bucket_at = [&](std::uint64_t f) {
@@ -579,8 +670,7 @@ void StreamedPairwise::Shared::ResolveQueries() {
 // The optima over the sweep's points at the positives' distances and its first and last points:
 // see the top of this file for why the points between two positives' distances cannot win.
 StreamedPairwise::Shared::Optima StreamedPairwise::Shared::BestOf(
-    const PositiveLevels& levels, const std::vector<std::uint64_t>& slots,
-    const Sink::Extremes& negatives) const {
+    const PositiveLevels& levels, const SlotCounts& slots, const Sink::Extremes& negatives) const {
     const std::uint64_t positives_n = levels.total;
     const std::uint64_t negatives_n = negatives.total;
     const Confusion start = ConfusionOf(0, 0, positives_n, negatives_n);
@@ -599,7 +689,7 @@ StreamedPairwise::Shared::Optima StreamedPairwise::Shared::BestOf(
         levels, slots, [](std::size_t, std::uint64_t, std::uint64_t, std::uint64_t) {},
         [&](std::size_t k, std::uint64_t tp, std::uint64_t fp, std::uint64_t pos,
             std::uint64_t neg) {
-            consider(levels.distances[k], tp + pos, fp + neg);
+            consider(levels.Distance(k), tp + pos, fp + neg);
             scored_positives = tp + pos;
         });
     if (slots.back() > 0)
@@ -609,7 +699,7 @@ StreamedPairwise::Shared::Optima StreamedPairwise::Shared::BestOf(
 
 void StreamedPairwise::Shared::SweepAll(StreamedResult& result) const {
     PairwiseEvaluation& e = result.pairwise;
-    const std::uint64_t positives_n = positives.size();
+    const std::uint64_t positives_n = positive_count;
     const std::uint64_t negatives_n = merged.all_.total;
     e.pairs = positives_n + negatives_n;
     e.positives = positives_n;
@@ -621,8 +711,8 @@ void StreamedPairwise::Shared::SweepAll(StreamedResult& result) const {
     e.curve.push_back(point_at(-std::numeric_limits<double>::infinity(), 0, 0));
     detail::CurveThinner thinner(request.pairwise.max_curve_points);
     detail::AreaSum area;
-    const std::size_t levels = all.distances.size();
-    const bool ends_in_run = merged.all_slots_.back() > 0;
+    const std::size_t levels = all.size();
+    const bool ends_in_run = all_slots.back() > 0;
     std::size_t next_query = 0;
     const auto run = [&](std::size_t k, std::uint64_t tp, std::uint64_t fp, std::uint64_t count) {
         if (count == 0) return;
@@ -646,13 +736,13 @@ void StreamedPairwise::Shared::SweepAll(StreamedResult& result) const {
     const auto at_level = [&](std::size_t k, std::uint64_t tp, std::uint64_t fp, std::uint64_t pos,
                               std::uint64_t neg) {
         area.Step(neg, tp, tp + pos);
-        const CurvePoint point = point_at(all.distances[k], tp + pos, fp + neg);
+        const CurvePoint point = point_at(all.Distance(k), tp + pos, fp + neg);
         const bool last = k + 1 == levels && !ends_in_run;
         if (last || thinner.Keep(point)) e.curve.push_back(point);
     };
-    ForEachStep(all, merged.all_slots_, run, at_level);
+    ForEachStep(all, all_slots, run, at_level);
     if (positives_n > 0 && negatives_n > 0) e.roc_auc = area.Area(positives_n, negatives_n);
-    const Optima best = BestOf(all, merged.all_slots_, merged.all_);
+    const Optima best = BestOf(all, all_slots, merged.all_);
     e.best_mcc = best.mcc;
     e.best_f1 = best.f1;
     result.optimum_exact = !(best.mcc.score < 0.0);
@@ -660,21 +750,16 @@ void StreamedPairwise::Shared::SweepAll(StreamedResult& result) const {
 
 std::optional<ThresholdTransfer> StreamedPairwise::Shared::Transfer() const {
     if (!Learning()) return std::nullopt;
-    const std::uint64_t test_positives = positives.size() - train.total;
+    const std::uint64_t test_positives = positive_count - train.total;
     const std::uint64_t train_pairs = train.total + merged.train_.total;
     const std::uint64_t test_pairs = test_positives + merged.test_.total;
     if (train_pairs == 0 || test_pairs == 0) return std::nullopt;
-    if (train.distances.empty() && merged.train_.min_count == 0) return std::nullopt;
-    const Optima best = BestOf(train, merged.train_slots_, merged.train_);
+    if (train.size() == 0 && merged.train_.min_count == 0) return std::nullopt;
+    const Optima best = BestOf(train, train_slots, merged.train_);
     const Criterion criterion = request.learning->criterion;
     const BestThreshold& chosen = criterion == Criterion::kMcc ? best.mcc : best.f1;
-    std::uint64_t tp = 0;
-    for (const ScoredPair& p : positives) {
-        tp += InTest(p.j) && detail::IsScored(p.distance) &&
-                      static_cast<double>(p.distance) <= chosen.threshold
-                  ? 1
-                  : 0;
-    }
+    // The test part's positives are those of the whole sequence minus the training part's.
+    const std::uint64_t tp = all.AtMost(chosen.threshold) - train.AtMost(chosen.threshold);
     return TransferOf(criterion, chosen,
                       ConfusionOf(tp, merged.test_at_learnt_, test_positives, merged.test_.total));
 }

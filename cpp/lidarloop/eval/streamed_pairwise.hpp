@@ -18,10 +18,10 @@ namespace lidarloop::eval {
 /// called concurrently.
 using PairDistance = std::function<float(std::size_t i, std::size_t j)>;
 
-/// The comparable loop pairs of `truth` (the positives of the pair-wise protocol), in the order
-/// of truth.loops, with their distances: O(P) calls of `distance`. Throws core::Error for a NaN
-/// distance. Thread-safe.
-std::vector<ScoredPair> ScorePositives(const GroundTruth& truth, const PairDistance& distance);
+/// The distances of the loop pairs of `truth` (the positives of the pair-wise protocol), in the
+/// order of GroundTruth::ForEachLoop: O(P) calls of `distance`, 4 bytes a pair. Throws
+/// core::Error for a NaN distance. Thread-safe.
+std::vector<float> ScorePositives(const GroundTruth& truth, const PairDistance& distance);
 
 /// What StreamedPairwise computes besides the sweep over all pairs.
 struct StreamedRequest {
@@ -55,12 +55,13 @@ struct StreamedResult {
 /// each pass, give each thread a NewSink(), Add every pair to some sink, Merge every sink, then
 /// EndPass(). After the second pass, Result(). The exact curve needs the second pass: its
 /// thinned points between two positives' distances are order statistics of the negatives.
-/// Memory: the positives (16 bytes each) and, per distinct positive distance, about 40 bytes
-/// (its key, count, slots of the whole sequence and of the training part, and a bucket table of
-/// 8 MiB); per sink 24 bytes a scan and 3 MiB of batch; in the second pass 32 KiB per located
-/// curve point and sink; and a bitmap of the distinct distances (512 MiB of address space, of
-/// which only the pages of occurring distances become resident: 4 KiB per 32768 consecutive
-/// float values). Sinks count their batches into shared counters under a mutex.
+/// Memory: per distinct finite positive distance 13 bytes (its key, a one-byte count, two 4-byte
+/// slots of negatives), again for the training part's, and two bucket tables of 4 MiB; while
+/// constructing, the positives' distances (4 bytes each, sorted in place); per sink 24 bytes a scan
+/// and up to 7 MiB of batch; in the second pass 32 KiB per located curve point and sink; and a
+/// bitmap of the distinct distances (512 MiB of address space, of which only the pages of occurring
+/// distances become resident: 4 KiB per 32768 consecutive float values). Sinks sort their batches
+/// and locate them among the slots on their own, and add them to shared counters under a mutex.
 class StreamedPairwise {
 public:
     struct Shared;
@@ -77,12 +78,14 @@ public:
         void AddNegative(std::size_t j, float distance);
         void Flush();
         const Shared* shared_;
-        std::vector<std::uint64_t> all_slots_;
-        std::vector<std::uint64_t> train_slots_;
         std::vector<std::uint64_t> coarse_;       ///< pass 1: negatives by the top bits of the key
         std::vector<std::uint32_t> pending_all_;  ///< pass 1: keys of negatives to count
         std::vector<std::uint32_t> pending_train_;  ///< pass 1: of training negatives
         std::vector<std::uint32_t> scratch_;
+        /// pass 1: a sorted batch located outside the lock, (slot or bucket << 20) | count
+        std::vector<std::uint64_t> located_all_;
+        std::vector<std::uint64_t> located_train_;
+        std::vector<std::uint64_t> located_coarse_;
         std::vector<std::uint64_t> fine_;  ///< pass 2: negatives by key in the target buckets
         std::vector<std::uint64_t> from_threshold_;  ///< pass 2: as in ConfusionsAt
         std::uint64_t test_at_learnt_ = 0;           ///< pass 2: test negatives <= learnt tau
@@ -104,10 +107,11 @@ public:
         friend struct Shared;
     };
 
-    /// `positives`: ScorePositives(truth, distance). Throws core::ConfigError for an invalid
-    /// request, core::Error for a NaN threshold or positive distance, more than 2^32 scans, or
-    /// fewer than 2 scans (no pair).
-    StreamedPairwise(const GroundTruth& truth, std::vector<ScoredPair> positives,
+    /// `positives`: ScorePositives(truth, distance), one per truth.loop_count. Throws
+    /// core::ConfigError for an invalid request, core::Error for a NaN threshold or positive
+    /// distance, a count of positives other than truth.loop_count, more than 2^32 scans, or
+    /// fewer than 2 scans (no pair). `truth` must outlive this.
+    StreamedPairwise(const GroundTruth& truth, std::vector<float> positives,
                      StreamedRequest request);
     ~StreamedPairwise();
     StreamedPairwise(const StreamedPairwise&) = delete;

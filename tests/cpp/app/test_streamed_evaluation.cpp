@@ -1,8 +1,13 @@
 // The evaluation run streams the pairs (EvaluateStreamed): its figures must equal those of every
 // pair in memory (EvaluateMatrix), and a run without the matrix must write the same files.
+#include <algorithm>
 #include <fstream>
 #include <limits>
+#include <map>
+#include <mutex>
 #include <sstream>
+#include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -103,6 +108,30 @@ TEST(StreamedEvaluation, ThresholdLearntOnAnotherDatasetEqualsEveryPairInMemory)
         app::EvaluateMatrix(e.name, e.matrix, trained.truth, request.learning, e.default_threshold,
                             request.fixed_thresholds, &training);
     ExpectSameEvaluation(e, want);
+}
+
+// Both passes over the pairs report their progress in pairs, up to all n(n-1)/2 of them.
+TEST(StreamedEvaluation, TellsTheProgressOfBothPasses) {
+    const test::TempDir dir;
+    const io::Dataset dataset = test::SmallSequence(dir / "sequence");
+    app::EvaluationRequest request = Request(dir / "run");
+    request.methods = {core::Method::kRange};
+    std::mutex mutex;
+    std::map<std::string, std::pair<std::size_t, std::size_t>> reached;  // stage: done, total
+    request.progress = [&](const std::string& stage, std::size_t done, std::size_t total) {
+        const std::lock_guard<std::mutex> lock(mutex);
+        auto& [most, of] = reached[stage];
+        most = std::max(most, done);
+        of = total;
+    };
+    app::RunEvaluation(dataset, request);
+    const std::size_t pairs = dataset.size() * (dataset.size() - 1) / 2;
+    for (const std::string pass : {"1", "2"}) {
+        const std::string stage = "pairs (range), pass " + pass + " of 2";
+        ASSERT_EQ(reached.count(stage), 1u) << stage;
+        EXPECT_EQ(reached[stage].first, pairs) << stage;
+        EXPECT_EQ(reached[stage].second, pairs) << stage;
+    }
 }
 
 std::string Contents(const std::filesystem::path& file) {

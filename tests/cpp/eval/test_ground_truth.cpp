@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -62,15 +63,36 @@ BruteTruth BruteForce(const std::vector<core::StampedPose>& poses, const GroundT
     return truth;
 }
 
+// IsLoop, on every ordered pair (i == j included), answers exactly as the list of loops, and
+// each scan's first partner is its smallest one in the list.
+void ExpectIsLoopAsListed(const GroundTruth& truth, const std::vector<LoopPair>& loops) {
+    const std::size_t n = truth.size();
+    std::vector<bool> listed(n * n, false);
+    std::vector<std::size_t> first(n, kNoScan);
+    for (const LoopPair& loop : loops) {
+        listed[loop.i * n + loop.j] = listed[loop.j * n + loop.i] = true;
+        first[loop.i] = std::min(first[loop.i], loop.j);
+        first[loop.j] = std::min(first[loop.j], loop.i);
+    }
+    std::size_t wrong = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        for (std::size_t j = 0; j < n; ++j) wrong += truth.IsLoop(i, j) != listed[i * n + j];
+    }
+    EXPECT_EQ(wrong, 0u) << "pairs where IsLoop disagrees with the list";
+    EXPECT_EQ(truth.first_partner, first);
+}
+
 void ExpectSameAsBruteForce(const std::vector<core::StampedPose>& poses,
                             const GroundTruthConfig& config) {
     const GroundTruth truth = BuildGroundTruth(poses, config);
     const BruteTruth expected = BruteForce(poses, config);
-    ASSERT_EQ(truth.loops.size(), expected.loops.size()) << config.Describe();
-    for (std::size_t k = 0; k < truth.loops.size(); ++k) {
-        EXPECT_EQ(truth.loops[k].i, expected.loops[k].i);
-        EXPECT_EQ(truth.loops[k].j, expected.loops[k].j);
-        EXPECT_EQ(truth.loops[k].distance_m, expected.loops[k].distance_m);
+    const std::vector<LoopPair> loops = truth.Loops();
+    ASSERT_EQ(loops.size(), expected.loops.size()) << config.Describe();
+    EXPECT_EQ(truth.loop_count, expected.loops.size());
+    for (std::size_t k = 0; k < loops.size(); ++k) {
+        EXPECT_EQ(loops[k].i, expected.loops[k].i);
+        EXPECT_EQ(loops[k].j, expected.loops[k].j);
+        EXPECT_EQ(loops[k].distance_m, expected.loops[k].distance_m);
     }
     EXPECT_EQ(truth.nearest, expected.nearest) << config.Describe();
     EXPECT_EQ(truth.nearest_distance_m, expected.nearest_distance_m);
@@ -82,11 +104,7 @@ void ExpectSameAsBruteForce(const std::vector<core::StampedPose>& poses,
         overlapping += truth.Overlapping(i) ? 1 : 0;
     }
     EXPECT_EQ(truth.OverlappingCount(), overlapping);
-    for (const auto& loop : expected.loops) {
-        EXPECT_TRUE(truth.IsLoop(loop.i, loop.j));
-        EXPECT_TRUE(truth.IsLoop(loop.j, loop.i));
-    }
-    EXPECT_EQ(truth.partners.size(), 2 * expected.loops.size());
+    ExpectIsLoopAsListed(truth, expected.loops);
 }
 
 TEST(GroundTruth, KdTreeEqualsBruteForceOnRandomTrajectories) {
@@ -119,11 +137,14 @@ TEST(GroundTruth, HandMadeSequence) {
     config.distance_m = 5.0;
     config.min_gap = {2.0, MinGap::Unit::kScans};
     const GroundTruth truth = BuildGroundTruth(poses, config);
-    ASSERT_EQ(truth.loops.size(), 3u);  // (0,6) 4.12 m, (1,6) 1 m, (2,6) 4.12 m
-    EXPECT_EQ(truth.loops[0].i, 0u);
-    EXPECT_EQ(truth.loops[1].i, 1u);
-    EXPECT_DOUBLE_EQ(truth.loops[1].distance_m, 1.0);
-    EXPECT_EQ(truth.loops[2].i, 2u);
+    const std::vector<LoopPair> loops = truth.Loops();
+    ASSERT_EQ(loops.size(), 3u);  // (0,6) 4.12 m, (1,6) 1 m, (2,6) 4.12 m
+    EXPECT_EQ(loops[0].i, 0u);
+    EXPECT_EQ(loops[1].i, 1u);
+    EXPECT_DOUBLE_EQ(loops[1].distance_m, 1.0);
+    EXPECT_EQ(loops[2].i, 2u);
+    EXPECT_EQ(truth.first_partner[6], 0u);
+    EXPECT_EQ(truth.first_partner[0], 6u);
     EXPECT_EQ(truth.nearest[6], 1u);
     EXPECT_EQ(truth.nearest[3], 6u);  // 3 is 2 scans from 1 and 5: only 0 and 6 are outside
     EXPECT_DOUBLE_EQ(truth.nearest_distance_m[3], std::sqrt(64.0 + 1.0));
@@ -133,10 +154,58 @@ TEST(GroundTruth, HandMadeSequence) {
     // The heading rule removes them all: scan 6 faces the other way.
     config.max_heading_deg = 20.0;
     const GroundTruth directed = BuildGroundTruth(poses, config);
-    EXPECT_TRUE(directed.loops.empty());
+    EXPECT_EQ(directed.loop_count, 0u);
+    EXPECT_FALSE(directed.IsLoop(1, 6));
     EXPECT_EQ(directed.nearest[6], kNoScan);
     EXPECT_EQ(directed.nearest_distance_m[6], std::numeric_limits<double>::infinity());
     EXPECT_EQ(directed.nearest[0], 3u);
+}
+
+// Scans on a grid of whole metres (exact in double): many pairs lie exactly at the distance
+// limit, exactly the gap apart in scans, or with times exactly the gap apart in seconds; such a
+// pair is never positive, since every rule is a strict inequality.
+TEST(GroundTruth, BoundariesAreExclusiveAndIsLoopAgreesWithBruteForce) {
+    std::vector<core::StampedPose> poses;
+    for (int k = 0; k < 60; ++k) {
+        const double yaw = (k % 4) * 15.0 * kDeg;  // headings 0, 15, 30, 45 degrees
+        poses.push_back(MakePose(0.5 * (k / 2), (k * 7) % 11, (k * 3) % 5, yaw));
+    }
+    std::vector<GroundTruthConfig> configs(5);
+    configs[0].distance_m = 5.0;  // 3-4-5 triangles: exactly 5 m apart
+    configs[1].distance_m = 4.0;
+    configs[1].min_gap = {3.0, MinGap::Unit::kScans};  // |i - j| == 3 is not evaluated
+    configs[2].distance_m = 5.0;
+    configs[2].min_gap = {1.0, MinGap::Unit::kSeconds};  // times 1.0 s apart are not
+    configs[3].distance_m = 6.0;
+    configs[3].max_heading_deg = 30.0;  // 0 vs 30 degrees: not positive
+    configs[4].distance_m = 2.0;
+    configs[4].max_heading_deg = 16.0;
+    configs[4].min_gap = {2.0, MinGap::Unit::kScans};
+    for (const GroundTruthConfig& config : configs) {
+        SCOPED_TRACE(config.Describe());
+        ExpectSameAsBruteForce(poses, config);
+        // The grid does put pairs on each boundary.
+        const GroundTruth truth = BuildGroundTruth(poses, config);
+        std::size_t at_distance = 0;
+        for (std::size_t i = 0; i < poses.size(); ++i) {
+            for (std::size_t j = i + 1; j < poses.size(); ++j) {
+                const double d = (truth.positions_m[i] - truth.positions_m[j]).norm();
+                at_distance += d == config.distance_m && truth.Comparable(i, j);
+                if (d == config.distance_m) {
+                    EXPECT_FALSE(truth.IsLoop(i, j));
+                }
+            }
+        }
+        EXPECT_GT(at_distance, 0u);
+    }
+}
+
+TEST(GroundTruth, CopiesShareTheTreeAndAnswerTheSame) {
+    const GroundTruth truth = BuildGroundTruth(RandomTrajectory(5, 200), GroundTruthConfig{});
+    const GroundTruth copy = truth;
+    EXPECT_EQ(copy.tree, truth.tree);
+    EXPECT_EQ(copy.Loops().size(), truth.loop_count);
+    EXPECT_GT(truth.loop_count, 0u);
 }
 
 TEST(GroundTruth, HeadingDifferenceUsesTheGroundPlane) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <limits>
 #include <optional>
 #include <random>
@@ -12,6 +13,7 @@
 
 #include "eval_test_utils.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/eval/detail/slot_counts.hpp"
 #include "lidarloop/eval/pairwise.hpp"
 #include "lidarloop/eval/streamed_pairwise.hpp"
 
@@ -195,6 +197,26 @@ TEST(StreamedPairwise, BadInputGivesTypedErrors) {
     EXPECT_THROW(StreamAll(c, s), core::Error);
     const Sequence one = MakeSequence({32, 1});
     EXPECT_THROW(StreamAll(c, one), core::EmptyInputError);
+}
+
+// The 4-byte slots carry past 2^32 (a slot of more than 4.3e9 negatives: the pairs above every
+// positive's distance at 100,000 scans come near), and a carry stays with its slot.
+TEST(SlotCounts, CountPast32BitsExactly) {
+    detail::SlotCounts slots;
+    slots.Assign(3);
+    constexpr std::uint64_t kStep = (std::uint64_t{1} << 31) + 12345;  // below 2^32, as Add wants
+    std::uint64_t want = 0;
+    for (int k = 0; k < 5; ++k) {
+        slots.Add(1, kStep);
+        want += kStep;
+        EXPECT_EQ(slots[1], want) << "after " << k + 1 << " adds";
+    }
+    slots.Add(2, 7);
+    EXPECT_EQ(slots.front(), 0u);
+    EXPECT_EQ(slots.back(), 7u);
+    EXPECT_GT(want, std::uint64_t{1} << 33);
+    slots.Assign(3);
+    EXPECT_EQ(slots[1], 0u);
 }
 
 }  // namespace
