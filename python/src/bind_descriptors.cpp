@@ -211,8 +211,9 @@ method: 'height', 'range', 'ndt' or any registered method (lidarloop.method_name
     default: the config's (height).
 config: None, a dict nested like the YAML config ({'ndt': {'cell_size_m': 1.0}}), or a YAML
     file path; unknown keys raise lidarloop.ReadError.
-bins, min, max (metres, of the projection in use), up ('fixed' | 'pca'), sensor_height
-    (metres), out_of_range ('clamp' | 'drop'): as the flags of `lidarloop describe`.
+bins, min, max (metres, of the projection in use), up ('fixed' | 'pca') and sensor_height
+    (metres; both height only), out_of_range ('clamp' | 'drop'): as the flags of
+    `lidarloop describe`.
 skip_non_finite: False raises lidarloop.NonFiniteError for a NaN/Inf point; True lets the
     descriptor skip and count them (points_skipped), as it does for files.
 

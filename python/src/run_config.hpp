@@ -37,6 +37,10 @@ inline void ApplyHistogramKeywords(const HistogramKeywords& keywords,
             "bins, min, max, up, sensor_height and out_of_range apply to the height and range "
             "methods; give NDT parameters in config={'ndt': {...}}");
     }
+    if ((keywords.up || keywords.sensor_height_m) && descriptor.method != core::Method::kHeight) {
+        throw core::ConfigError(
+            "up and sensor_height apply to the height method only: pass method='height'");
+    }
     core::HistogramConfig& histogram = descriptor.histogram;
     if (keywords.bins) histogram.bins = *keywords.bins;
     if (keywords.up) histogram.up_vector = core::ParseUpVectorMode(*keywords.up);

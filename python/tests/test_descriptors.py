@@ -145,6 +145,12 @@ def test_config_errors_name_the_field(points):
         lidarloop.describe(points, "range", bins=0)
     with pytest.raises(lidarloop.ConfigError, match="ndt"):
         lidarloop.describe(points, "ndt", bins=10)
+    # As `lidarloop describe --up pca` without --method height: the default is range.
+    with pytest.raises(lidarloop.ConfigError, match="height method only"):
+        lidarloop.describe(points, up="pca")
+    with pytest.raises(lidarloop.ConfigError, match="height method only"):
+        lidarloop.describe(points, "range", sensor_height=1.7)
+    assert lidarloop.describe(points, "height", up="pca").method == "height"
     with pytest.raises(lidarloop.ConfigError, match="height"):
         lidarloop.describe(points, "no-such-method")
     with pytest.raises(lidarloop.ReadError, match="no_such_key"):
