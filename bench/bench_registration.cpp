@@ -1,10 +1,13 @@
 // Google Benchmark kernels of geometric verification (docs/verification.md). Run:
 //   taskset -c 1 ./build/bench/bench_registration
 // The scans are simulated (urban U-turn route, exact ground truth): a revisit driven in the
-// opposite direction (a true loop) and two places 60+ m apart (a pair that must be rejected),
-// for the HDL-64E and the VLP-16. `lidarloop bench --verify-queries N` measures a whole dataset.
+// opposite direction (a true loop) and the place farthest from it (a pair that must be
+// rejected), for the HDL-64E and the VLP-16, as in the Open3D comparison. `lidarloop bench
+// --verify-queries N` measures a whole dataset.
+#include <algorithm>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <benchmark/benchmark.h>
 
@@ -13,6 +16,7 @@
 #include "lidarloop/registration/prepared_scan.hpp"
 #include "lidarloop/registration/verification.hpp"
 #include "lidarloop/sim/simulator.hpp"
+#include "registration/comparison_pairs.hpp"
 
 namespace lidarloop::bench {
 namespace {
@@ -25,47 +29,31 @@ struct PairScans {
     core::PointCloud query_raw;
     PreparedScan query;
     PreparedScan revisit;    // the same place, driven the other way
-    PreparedScan elsewhere;  // a place at least 60 m away
+    PreparedScan elsewhere;  // the place farthest from the query
     core::Transform T_revisit_query = core::Transform::Identity();  // ground truth
 };
 
-double Distance(const sim::Simulator& simulator, std::size_t a, std::size_t b) {
-    return (simulator.GroundTruthPose(a).T_world_sensor.translation() -
-            simulator.GroundTruthPose(b).T_world_sensor.translation())
-        .norm();
-}
-
-bool Opposite(const sim::Simulator& simulator, std::size_t a, std::size_t b) {
-    return simulator.GroundTruthPose(a).T_world_sensor.linear().col(0).dot(
-               simulator.GroundTruthPose(b).T_world_sensor.linear().col(0)) < -0.9;
-}
-
+// The pairs of the Open3D comparison (tests/cpp/registration/comparison_pairs.hpp): its
+// opposite-direction revisit and its farthest other place on the urban U-turn drive.
 PairScans MakePairScans(sim::SensorModel sensor) {
-    sim::SimulationConfig config;
-    config.scene = sim::SceneType::kUrban;
-    config.route.type = sim::RouteType::kUTurn;
-    config.sensor.model = sensor;
-    config.scans = 200;
-    const sim::Simulator simulator(config);
-    for (std::size_t query = 60; query < simulator.size(); ++query) {
-        for (std::size_t revisit = 0; revisit + 30 < query; ++revisit) {
-            if (!Opposite(simulator, query, revisit) || Distance(simulator, query, revisit) >= 5)
-                continue;
-            std::size_t elsewhere = 0;
-            while (Distance(simulator, query, elsewhere) < 60) ++elsewhere;
-            const VerificationConfig defaults;
-            PairScans scans;
-            scans.query_raw = simulator.Scan(query);
-            scans.query = registration::PrepareScan(scans.query_raw, defaults.reduction);
-            scans.revisit = registration::PrepareScan(simulator.Scan(revisit), defaults.reduction);
-            scans.elsewhere =
-                registration::PrepareScan(simulator.Scan(elsewhere), defaults.reduction);
-            scans.T_revisit_query = simulator.GroundTruthPose(revisit).T_world_sensor.inverse() *
-                                    simulator.GroundTruthPose(query).T_world_sensor;
-            return scans;
-        }
-    }
-    throw std::runtime_error("no opposite-direction revisit in the simulated route");
+    const sim::Simulator simulator(test::UTurnDrive(sim::SceneType::kUrban, sensor));
+    std::vector<test::ScanPair> pairs = test::SimulatedPairs(simulator, "urban");
+    const auto find = [&](test::PairKind kind) -> test::ScanPair& {
+        const auto it = std::find_if(pairs.begin(), pairs.end(),
+                                     [&](const test::ScanPair& p) { return p.kind == kind; });
+        if (it == pairs.end()) throw std::runtime_error("the simulated drive lacks a pair");
+        return *it;
+    };
+    test::ScanPair& revisit = find(test::PairKind::kLoop);  // the opposite-direction one, first
+    const test::ScanPair& elsewhere = find(test::PairKind::kDifferentPlace);
+    const VerificationConfig defaults;
+    PairScans scans;
+    scans.query_raw = std::move(revisit.query);
+    scans.query = registration::PrepareScan(scans.query_raw, defaults.reduction);
+    scans.revisit = registration::PrepareScan(revisit.match, defaults.reduction);
+    scans.elsewhere = registration::PrepareScan(elsewhere.match, defaults.reduction);
+    scans.T_revisit_query = revisit.T_match_query_truth;
+    return scans;
 }
 
 const PairScans& Scans(sim::SensorModel sensor) {
