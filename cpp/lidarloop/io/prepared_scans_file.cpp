@@ -2,10 +2,12 @@
 
 #include <cmath>
 #include <cstdint>
+#include <fstream>
 #include <memory>
 
 #include "lidarloop/io/config_yaml.hpp"
 #include "lidarloop/io/detail/byte_stream.hpp"
+#include "lidarloop/io/detail/text_parsing.hpp"
 #include "lidarloop/io/read_error.hpp"
 
 namespace lidarloop::io {
@@ -72,19 +74,32 @@ registration::PreparedScan GetScan(core::ByteReader& in) {
     return scan;
 }
 
+void Append(std::ofstream& out, const core::ByteWriter& bytes) {
+    out.write(bytes.data().data(), static_cast<std::streamsize>(bytes.data().size()));
+}
+
 }  // namespace
 
+// Written scan by scan: encoding the whole file first held a second copy of every prepared scan
+// at the end of a long run, the peak of its memory.
 void SavePreparedScans(const std::filesystem::path& file,
                        const std::vector<registration::PreparedScan>& scans,
                        const registration::ScanReductionConfig& reduction) {
-    core::ByteWriter out;
-    out.PutMagic(kMagic);
+    std::ofstream out = detail::OpenForWriting(file, /*binary=*/true);
+    core::ByteWriter header;
+    header.PutMagic(kMagic);
     RunConfig config;
     config.detection.verification.reduction = reduction;
-    out.PutString(DumpConfigYaml(config));
-    out.Put<std::uint64_t>(scans.size());
-    for (const registration::PreparedScan& scan : scans) PutScan(out, scan);
-    detail::WriteWholeFile(file, out.data());
+    header.PutString(DumpConfigYaml(config));
+    header.Put<std::uint64_t>(scans.size());
+    Append(out, header);
+    for (const registration::PreparedScan& scan : scans) {
+        core::ByteWriter bytes;
+        PutScan(bytes, scan);
+        Append(out, bytes);
+    }
+    out.close();
+    if (!out) throw WriteError(file, "writing the prepared scans failed (disk full?)");
 }
 
 StoredPreparedScans LoadPreparedScans(const std::filesystem::path& file) {

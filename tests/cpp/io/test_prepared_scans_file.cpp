@@ -1,6 +1,7 @@
 // database.scans: a round trip keeps every point, normal, flag and figure; damaged files are read
 // errors naming the file, never a crash.
 #include <cmath>
+#include <filesystem>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -42,6 +43,12 @@ TEST(PreparedScansFile, RoundTripKeepsEverything) {
         EXPECT_EQ(a.input_points, b.input_points);
     }
     EXPECT_EQ(PreparedScansPathOf(dir / "database.lldb"), dir / "database.scans");
+}
+
+// Written as it goes: a failed write must still be an error, not a file that looks whole.
+TEST(PreparedScansFile, AFullDiskIsAnError) {
+    if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+    EXPECT_THROW(SavePreparedScans("/dev/full", TwoScansAndAGap(), {}), WriteError);
 }
 
 TEST(PreparedScansFile, DamagedFilesAreReadErrors) {
