@@ -9,6 +9,7 @@
 #include "detection_options.hpp"
 #include "lidarloop/app/bench.hpp"
 #include "lidarloop/app/results_folder.hpp"
+#include "lidarloop/app/run_folder.hpp"
 #include "progress.hpp"
 
 namespace lidarloop::cli {
@@ -20,6 +21,7 @@ struct BenchFlags {
     DetectionOptions detection;
     app::BenchRequest request;
     std::string json;
+    bool overwrite = false;
     bool quiet = false;
 };
 
@@ -28,9 +30,13 @@ void RunBench(BenchFlags& flags) {
     flags.request.config = flags.descriptor.Resolve();
     flags.detection.ApplyTo(flags.request.config);
     flags.request.progress = progress.Callback();
+    // The file is checked before the run, so that a refused --json costs no measurement.
+    if (!flags.json.empty())
+        app::CheckOutputFile(flags.json, flags.dataset.Inputs(), flags.overwrite);
     const nlohmann::json figures = app::RunBench(flags.dataset.Open(), flags.request);
     std::cout << figures.dump(2) << "\n";
-    if (!flags.json.empty()) app::WriteJson(flags.json, figures);
+    if (!flags.json.empty())
+        app::WriteOutputJson(flags.json, figures, flags.dataset.Inputs(), flags.overwrite);
 }
 
 }  // namespace
@@ -49,7 +55,11 @@ void AddBenchCommand(CLI::App& app) {
                         "0: none)");
     flags->detection.AddTo(*command, /*decides_loops=*/true,
                            "S: candidates at least this far back");
-    command->add_option("--json", flags->json, "also write the figures to this file");
+    command->add_option("--json", flags->json,
+                        "also write the figures to this file (replaced only when lidarloop wrote "
+                        "it, or with --overwrite)");
+    command->add_flag("--overwrite", flags->overwrite,
+                      "let --json replace a file that lidarloop did not write");
     command->add_flag("--quiet", flags->quiet, "no progress bar");
     command->callback([flags] { RunBench(*flags); });
 }

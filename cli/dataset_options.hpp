@@ -1,6 +1,8 @@
 #pragma once
 
+#include <filesystem>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -15,6 +17,8 @@ public:
     /// --format for a command whose --format means something else (optimise's pose format).
     void AddTo(CLI::App& command, const std::string& format_flag = "--format");
     io::Dataset Open() const;
+    /// The folder and the files given for it, which no output may lie inside or replace.
+    std::vector<std::filesystem::path> Inputs() const { return {path_, poses_, calib_}; }
     const std::string& path() const { return path_; }
 
 private:

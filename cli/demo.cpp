@@ -20,6 +20,7 @@ namespace {
 
 struct DemoFlags {
     std::string out = "lidarloop_demo";
+    bool overwrite = false;
     bool quiet = false;
 };
 
@@ -58,21 +59,23 @@ void PrintMethod(const app::MethodEvaluation& e) {
 }
 
 // A results folder of the demo (evaluation, optimised) with the guarantees of every results
-// folder; the demo owns its layout, so it replaces what an earlier demo left there.
+// folder: it replaces what an earlier demo left there, and nothing else without --overwrite.
 template <typename Run>
-auto RunDemoStage(const std::filesystem::path& out, const io::Dataset& dataset, Run&& run) {
-    return RunInFolder(out, dataset.root(), /*overwrite=*/true, std::forward<Run>(run));
+auto RunDemoStage(const std::filesystem::path& out, const io::Dataset& dataset, bool overwrite,
+                  Run&& run) {
+    return RunInFolder(out, {dataset.root()}, overwrite, std::forward<Run>(run));
 }
 
 // The loops closed: detect with verification, then the pose graph on the simulated odometry.
-void RunDemoOptimisation(const io::Dataset& dataset, const std::filesystem::path& out,
+void RunDemoOptimisation(const io::Dataset& dataset, const DemoFlags& flags,
                          ProgressPrinter& progress) {
+    const std::filesystem::path out(flags.out);
     app::OptimiseRequest request;
     request.odometry_file = dataset.root() / "poses_odometry.txt";
     request.progress = progress.Callback();
     request.out = out / "optimised";
     const app::OptimiseOutcome outcome =
-        RunDemoStage(request.out, dataset, [&](const auto& staging) {
+        RunDemoStage(request.out, dataset, flags.overwrite, [&](const auto& staging) {
             app::OptimiseRequest staged = request;
             staged.out = staging;
             return app::RunOptimisation(dataset, staged);
@@ -86,7 +89,8 @@ void RunDemoOptimisation(const io::Dataset& dataset, const std::filesystem::path
 void RunDemo(const DemoFlags& flags) {
     const std::filesystem::path out(flags.out);
     ProgressPrinter progress(flags.quiet);
-    const app::DemoSequence demo = app::PrepareDemoSequence(out / "sequence", progress.Callback());
+    const app::DemoSequence demo = app::PrepareDemoSequence(
+        out / "sequence", {CommandLine(), {}, flags.overwrite}, progress.Callback());
     const io::Dataset dataset = io::OpenDataset(demo.folder);
     PrintSequence(demo, dataset.size());
     app::EvaluationRequest request;
@@ -95,7 +99,7 @@ void RunDemo(const DemoFlags& flags) {
     request.progress = progress.Callback();
     request.out = out / "evaluation";
     const app::EvaluationOutcome outcome =
-        RunDemoStage(request.out, dataset, [&](const auto& staging) {
+        RunDemoStage(request.out, dataset, flags.overwrite, [&](const auto& staging) {
             app::EvaluationRequest staged = request;
             staged.out = staging;
             return app::RunEvaluation(dataset, staged);
@@ -105,7 +109,7 @@ void RunDemo(const DemoFlags& flags) {
     for (const std::string& note : outcome.notes) std::cout << "  note: " << note << "\n";
     std::cout << "figures and tables: " << (request.out / "report.md").string()
               << " (similarity matrices, ROC, precision-recall, EM fit, counts against t_d)\n";
-    RunDemoOptimisation(dataset, out, progress);
+    RunDemoOptimisation(dataset, flags, progress);
 }
 
 }  // namespace
@@ -116,6 +120,9 @@ void AddDemoCommand(CLI::App& app) {
     auto flags = std::make_shared<DemoFlags>();
     command->add_option("--out", flags->out, "folder for the sequence and the results")
         ->capture_default_str();
+    command->add_flag("--overwrite", flags->overwrite,
+                      "write into folders (sequence, evaluation, optimised) that hold no "
+                      "lidarloop run.json, replacing their files of the same names");
     command->add_flag("--quiet", flags->quiet, "no progress bars");
     command->callback([flags] { RunDemo(*flags); });
 }

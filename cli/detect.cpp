@@ -1,5 +1,7 @@
+#include <filesystem>
 #include <iostream>
 #include <memory>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -65,6 +67,13 @@ void PrintOutcome(const io::Dataset& dataset, const app::DetectRequest& request,
                                  "output.similarity_matrix_mib)\n");
 }
 
+// The map and its database.scans beside it are inputs too.
+std::vector<std::filesystem::path> Inputs(const DetectFlags& flags) {
+    std::vector<std::filesystem::path> inputs = flags.dataset.Inputs();
+    inputs.emplace_back(flags.map);
+    return inputs;
+}
+
 void RunDetect(const DetectFlags& flags) {
     ProgressPrinter progress(flags.quiet);
     app::DetectRequest request;
@@ -76,7 +85,7 @@ void RunDetect(const DetectFlags& flags) {
         request.config = ResolveAgainstMap(flags, map);
         const io::Dataset dataset = flags.dataset.Open();
         const app::DetectOutcome outcome = RunInFolder(
-            flags.out, dataset.root(), flags.overwrite, [&](const std::filesystem::path& staging) {
+            flags.out, Inputs(flags), flags.overwrite, [&](const std::filesystem::path& staging) {
                 app::DetectRequest staged = request;
                 staged.out = staging;
                 return app::RunLocalise(dataset, std::move(map), staged);
@@ -87,7 +96,7 @@ void RunDetect(const DetectFlags& flags) {
     request.config = flags.descriptor.Resolve();
     flags.detection.ApplyTo(request.config);
     const io::Dataset dataset = flags.dataset.Open();
-    const app::DetectOutcome outcome = RunInFolder(flags.out, dataset.root(), flags.overwrite,
+    const app::DetectOutcome outcome = RunInFolder(flags.out, Inputs(flags), flags.overwrite,
                                                    [&](const std::filesystem::path& staging) {
                                                        app::DetectRequest staged = request;
                                                        staged.out = staging;

@@ -1,7 +1,9 @@
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -115,6 +117,14 @@ void PrintOutcome(const io::Dataset& dataset, const app::EvaluationOutcome& outc
     std::cout << "  report: " << (out / "report.md").string() << "\n";
 }
 
+std::vector<std::filesystem::path> Inputs(const EvaluateFlags& flags) {
+    std::vector<std::filesystem::path> inputs = flags.dataset.Inputs();
+    inputs.insert(inputs.end(), flags.results.begin(), flags.results.end());
+    inputs.emplace_back(flags.train_on);
+    inputs.emplace_back(flags.train_poses);
+    return inputs;
+}
+
 void RunEvaluate(const EvaluateFlags& flags) {
     ProgressPrinter progress(flags.quiet);
     app::EvaluationRequest request = RequestOf(flags);
@@ -122,7 +132,7 @@ void RunEvaluate(const EvaluateFlags& flags) {
     const io::Dataset dataset = flags.dataset.Open();
     const std::optional<io::Dataset> train_dataset = TrainingDataset(flags);
     const app::EvaluationOutcome outcome = RunInFolder(
-        flags.out, dataset.root(), flags.overwrite, [&](const std::filesystem::path& staging) {
+        flags.out, Inputs(flags), flags.overwrite, [&](const std::filesystem::path& staging) {
             app::EvaluationRequest staged = request;
             staged.out = staging;
             return app::RunEvaluation(dataset, staged, train_dataset ? &*train_dataset : nullptr);

@@ -1,7 +1,9 @@
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -55,6 +57,13 @@ void PrintOutcome(const app::OptimiseRequest& request, const app::OptimiseOutcom
                  "trajectory.png, config.yaml)\n";
 }
 
+std::vector<std::filesystem::path> Inputs(const OptimiseFlags& flags) {
+    std::vector<std::filesystem::path> inputs = flags.dataset.Inputs();
+    inputs.emplace_back(flags.odometry);
+    inputs.emplace_back(flags.loops);
+    return inputs;
+}
+
 void RunOptimise(const OptimiseFlags& flags) {
     ProgressPrinter progress(flags.quiet);
     app::OptimiseRequest request;
@@ -68,7 +77,7 @@ void RunOptimise(const OptimiseFlags& flags) {
     request.out = flags.out;
     const io::Dataset dataset = flags.dataset.Open();
     const app::OptimiseOutcome outcome =
-        RunInFolder(flags.out, dataset.root(), flags.overwrite, [&](const auto& staging) {
+        RunInFolder(flags.out, Inputs(flags), flags.overwrite, [&](const auto& staging) {
             app::OptimiseRequest staged = request;
             staged.out = staging;
             return app::RunOptimisation(dataset, staged);

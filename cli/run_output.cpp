@@ -27,7 +27,9 @@ sigset_t InterruptSignals() {
     const std::filesystem::path folder = app::AbandonActiveRun(
         app::RunStatus::kInterrupted, "interrupted by signal " + std::to_string(signal));
     if (!folder.empty()) {
-        std::fprintf(stderr, "\nlidarloop: interrupted; %s/run.json says so, no result was kept\n",
+        std::fprintf(stderr,
+                     "\nlidarloop: interrupted; nothing of this run was kept in %s (earlier "
+                     "results there stay as they were)\n",
                      folder.c_str());
     } else {
         std::fprintf(stderr, "\nlidarloop: interrupted\n");

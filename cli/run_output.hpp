@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "lidarloop/app/run_folder.hpp"
 
@@ -17,12 +18,13 @@ void InstallInterruptHandler(int argc, char** argv);
 /// The command line as typed (arguments joined by spaces), for run.json.
 const std::string& CommandLine();
 
-/// app::RunInFolder for a command: `dataset` is the folder it reads, which `out` must lie
-/// outside; `overwrite` allows a non-empty folder of other files.
+/// app::RunInFolder for a command: `inputs` are the files and folders it reads, which `out` may
+/// neither lie inside nor hold; `overwrite` allows a non-empty folder of other files.
 template <typename Run>
-auto RunInFolder(const std::filesystem::path& out, const std::filesystem::path& dataset,
-                 bool overwrite, Run&& run) {
-    return app::RunInFolder(out, {CommandLine(), dataset, overwrite}, std::forward<Run>(run));
+auto RunInFolder(const std::filesystem::path& out, std::vector<std::filesystem::path> inputs,
+                 bool overwrite, Run&& run, io::RunKind kind = io::RunKind::kResults) {
+    return app::RunInFolder(out, {CommandLine(), std::move(inputs), overwrite, kind},
+                            std::forward<Run>(run));
 }
 
 }  // namespace lidarloop::cli

@@ -13,6 +13,7 @@
 #include "lidarloop/io/poses.hpp"
 #include "lidarloop/sim/odometry_drift.hpp"
 #include "progress.hpp"
+#include "run_output.hpp"
 
 namespace lidarloop::cli {
 namespace {
@@ -82,7 +83,8 @@ void RunSimulate(const SimulateFlags& flags) {
     const sim::Simulator simulator(ToConfig(flags));
     ProgressPrinter progress(flags.quiet);
     const app::SimulationSummary summary = app::WriteSimulation(
-        simulator, flags.out, flags.overwrite, flags.threads, progress.Callback());
+        simulator, flags.out, {CommandLine(), {flags.trajectory}, flags.overwrite}, flags.threads,
+        progress.Callback());
     const sim::SimulationConfig& c = simulator.config();
     char timing[32];
     std::snprintf(timing, sizeof(timing), "%.2f s", summary.seconds);
@@ -140,7 +142,9 @@ void AddSimulateCommand(CLI::App& app) {
         ->capture_default_str();
     command->add_option("--threads", flags->threads, "worker threads; 0: all cores")
         ->capture_default_str();
-    command->add_flag("--overwrite", flags->overwrite, "replace the scans of an earlier run");
+    command->add_flag("--overwrite", flags->overwrite,
+                      "write into a non-empty folder that holds no lidarloop sequence, replacing "
+                      "its files of the same names");
     command->add_flag("--quiet", flags->quiet, "no progress bar");
     command->callback([flags] { RunSimulate(*flags); });
 }

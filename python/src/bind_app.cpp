@@ -102,6 +102,17 @@ io::RunConfig ResolveConfig(const py::object& config, const std::optional<std::s
     return run;
 }
 
+/// What a run reads besides its scans' folder, which its results may neither lie inside nor
+/// replace.
+std::vector<fs::path> InputsOf(const io::Dataset& data, const std::optional<fs::path>& poses,
+                               const std::optional<fs::path>& calib,
+                               std::vector<fs::path> files = {}) {
+    files.push_back(data.root());
+    files.push_back(poses.value_or(fs::path()));
+    files.push_back(calib.value_or(fs::path()));
+    return files;
+}
+
 /// "lidarloop.detect('seq', out='res', verify=False)": the call as run.json's command line.
 std::string CallText(const std::string& function, const py::object& first, const py::dict& given) {
     std::string text = "lidarloop." + function + "(" + py::repr(first).cast<std::string>();
@@ -112,17 +123,17 @@ std::string CallText(const std::string& function, const py::object& first, const
     return text + ")";
 }
 
-/// app::RunInFolder with the GIL released: `out` is checked and staged, `run(staging)` runs, and
-/// the folder is completed, or abandoned as failed with the error (then only run.json is left,
-/// saying so). A progress callback that raised fails the run too, with its exception. Python's
-/// KeyboardInterrupt waits until the run returns.
+/// app::RunInFolder with the GIL released: `out` is checked against `inputs` and staged,
+/// `run(staging)` runs, and the folder is completed, or abandoned as failed with the error (then
+/// the earlier results stay, or a run.json says so). A progress callback that raised fails the run
+/// too, with its exception. Python's KeyboardInterrupt waits until the run returns.
 template <typename Run>
-auto RunInFolder(const fs::path& out, const fs::path& dataset, bool overwrite,
+auto RunInFolder(const fs::path& out, std::vector<fs::path> inputs, bool overwrite,
                  const std::string& command_line, const PythonProgress& progress, Run&& run) {
     try {
         py::gil_scoped_release release;
         return app::RunInFolder(
-            out, {command_line, dataset, overwrite}, [&](const fs::path& staging) {
+            out, {command_line, std::move(inputs), overwrite}, [&](const fs::path& staging) {
                 auto result = run(staging);
                 if (progress.Failed())
                     throw core::Error("the progress callback raised an exception");
@@ -266,13 +277,13 @@ void BindDetect(py::module_& m) {
             request.out = out;
             const io::Dataset data = DatasetOf(dataset, format, poses, calib);
             DetectResult result;
-            result.outcome =
-                RunInFolder(out, data.root(), overwrite, CallText("detect", dataset, given),
-                            python_progress, [&](const fs::path& staging) {
-                                app::DetectRequest staged = request;
-                                staged.out = staging;
-                                return app::RunDetect(data, staged);
-                            });
+            result.outcome = RunInFolder(out, InputsOf(data, poses, calib), overwrite,
+                                         CallText("detect", dataset, given), python_progress,
+                                         [&](const fs::path& staging) {
+                                             app::DetectRequest staged = request;
+                                             staged.out = staging;
+                                             return app::RunDetect(data, staged);
+                                         });
             result.out = out;
             result.method = core::ToString(request.config.descriptor.method);
             return result;
@@ -420,9 +431,12 @@ void BindEvaluate(py::module_& m) {
             if (!train_on.is_none())
                 train_data = DatasetOf(train_on, "auto", std::nullopt, std::nullopt);
             EvaluateResult result;
+            std::vector<fs::path> inputs = InputsOf(data, poses, calib);
+            inputs.insert(inputs.end(), results.begin(), results.end());
+            if (train_data) inputs.push_back(train_data->root());
             result.outcome = RunInFolder(
-                out, data.root(), overwrite, CallText("evaluate", dataset, given), python_progress,
-                [&](const fs::path& staging) {
+                out, std::move(inputs), overwrite, CallText("evaluate", dataset, given),
+                python_progress, [&](const fs::path& staging) {
                     app::EvaluationRequest staged = request;
                     staged.out = staging;
                     return app::RunEvaluation(data, staged, train_data ? &*train_data : nullptr);
@@ -524,8 +538,9 @@ void BindOptimise(py::module_& m) {
             const io::Dataset data = DatasetOf(dataset, format, poses, calib);
             OptimiseResult result;
             result.outcome =
-                RunInFolder(out, data.root(), overwrite, CallText("optimise", dataset, given),
-                            python_progress, [&](const fs::path& staging) {
+                RunInFolder(out, InputsOf(data, poses, calib, {odometry, request.loops_file}),
+                            overwrite, CallText("optimise", dataset, given), python_progress,
+                            [&](const fs::path& staging) {
                                 app::OptimiseRequest staged = request;
                                 staged.out = staging;
                                 return app::RunOptimisation(data, staged);

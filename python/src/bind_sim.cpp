@@ -171,6 +171,20 @@ void BindSimulator(py::module_& m) {
             "ground truth at scan 0");
 }
 
+// A callback that raised stops the writing (the sequence is then not finished, and readers
+// refuse it) instead of letting it run on unobserved.
+app::Progress StopOnFailure(const PythonProgress& python_progress) {
+    const app::Progress forward = python_progress.Callback();
+    if (!forward) return {};
+    return
+        [forward, &python_progress](const std::string& stage, std::size_t done, std::size_t total) {
+            forward(stage, done, total);
+            const py::gil_scoped_acquire gil;
+            if (python_progress.Failed())
+                throw core::Error("the progress callback raised an exception");
+        };
+}
+
 void BindWriteSimulation(py::module_& m) {
     py::class_<app::SimulationSummary>(m, "SimulationSummary")
         .def_readonly("mean_points", &app::SimulationSummary::mean_points)
@@ -185,10 +199,14 @@ void BindWriteSimulation(py::module_& m) {
            int threads, const py::object& progress) {
             const PythonProgress python_progress(progress);
             app::SimulationSummary summary;
-            {
+            try {
                 py::gil_scoped_release release;
-                summary = app::WriteSimulation(simulator, out, overwrite, threads,
-                                               python_progress.Callback());
+                summary = app::WriteSimulation(simulator, out,
+                                               {"lidarloop.write_simulation", {}, overwrite},
+                                               threads, StopOnFailure(python_progress));
+            } catch (const core::Error&) {
+                python_progress.Rethrow();  // the callback's own exception, when it raised one
+                throw;
             }
             python_progress.Rethrow();
             return summary;
@@ -196,7 +214,9 @@ void BindWriteSimulation(py::module_& m) {
         py::arg("simulator"), py::arg("out"), py::arg("overwrite") = false, py::arg("threads") = 0,
         py::arg("progress") = py::none(),
         "Writes the whole sequence into `out` in the KITTI layout (velodyne/*.bin, poses.txt, "
-        "times.txt, poses_odometry.txt, simulation.yaml), as `lidarloop simulate`. "
+        "times.txt, poses_odometry.txt, simulation.yaml), as `lidarloop simulate`, by the "
+        "results-folder rule (docs/cli.md): a folder that lidarloop did not write is replaced "
+        "only with overwrite=True, an interrupted run leaves the earlier sequence. "
         "progress(stage, done, total) is called from worker threads.");
 }
 

@@ -183,6 +183,25 @@ def test_results_folders_are_guarded(sequence, tmp_path):
     assert "method: height" in (foreign / "config.yaml").read_text()
 
 
+def test_no_run_replaces_its_own_input_or_an_earlier_result(sequence, tmp_path):
+    """Issue 25 (2, 3): inputs inside `out` are refused; a failed rerun keeps the results."""
+    res = tmp_path / "res"
+    lidarloop.detect(sequence, out=res, top_k=1)
+    before = {p.name: p.read_bytes() for p in res.iterdir()}
+    odometry = sequence / "poses_odometry.txt"
+    with pytest.raises(lidarloop.WriteError, match="holds the input"):
+        lidarloop.optimise(sequence, odometry=odometry, loops=res / "loops.csv", out=res)
+    with pytest.raises(lidarloop.WriteError, match="holds the input"):
+        lidarloop.evaluate(sequence, out=res, results=[res / "loops.csv"], methods=["range"])
+
+    def interrupt(stage, done, total):
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        lidarloop.detect(sequence, out=res, verify=False, progress=interrupt)
+    assert {p.name: p.read_bytes() for p in res.iterdir()} == before
+
+
 def test_a_failed_run_leaves_only_run_json(sequence, tmp_path):
     def interrupt(stage, done, total):
         raise KeyboardInterrupt

@@ -8,7 +8,7 @@
 # output; the last line is "cli <sections>: N passed, N failed".
 set -u
 sections=(describe distance ndt verify detect bench demo evaluate dump-config bad-input simulate
-    optimise)
+    optimise results-folders)
 if [ "${1-}" = "--list" ]; then
     printf '%s\n' "${sections[@]}"
     exit 0
@@ -248,10 +248,11 @@ section_detect() {
     fi
     expect_error "detect failing into a results folder" "detection.top_k" "$cli" detect "$seq" \
         --top-k 0 --quiet --out "$work/det3"
+    if [ -s "$work/det3/loops.csv" ]; then pass; else fail "a failed rerun removed loops.csv"; fi
     mkdir -p "$work/foreign" && touch "$work/foreign/thesis.tex"
     expect_error "detect into a folder of other files" "holds no lidarloop run.json" "$cli" \
         detect "$seq" --quiet --out "$work/foreign"
-    expect_error "detect into the dataset" "lies inside the dataset" "$cli" detect "$seq" \
+    expect_error "detect into the dataset" "lies inside the input" "$cli" detect "$seq" \
         --quiet --out "$seq/results"
     if [ -e "$seq/results" ]; then fail "a results folder was made inside the dataset"; else pass; fi
     expect_error "detect seconds without times" "needs scan times" "$cli" detect "$seq" \
@@ -470,8 +471,13 @@ section_simulate() {
         --out "$work/sim_bad"
     expect_error "simulate bad dropout" "sensor.dropout must be in [0, 1)" "$cli" simulate \
         --dropout 1.5 --out "$work/sim_bad"
-    expect_error "simulate into old scans" "already holds 5 .bin scans" "$cli" simulate \
+    expect_error "simulate into old scans" "holds a lidarloop dataset" "$cli" simulate \
         --sensor vlp16 --scans 2 --out "$work/sim"
+    expect_ok "simulate --overwrite" "simulated 2 scans" "$cli" simulate --sensor vlp16 --scans 2 \
+        --horizontal-steps 360 --quiet --overwrite --out "$work/sim"
+    if [ "$(find "$work/sim/velodyne" -name '*.bin' | wc -l)" -eq 2 ]; then pass; else
+        fail "simulate --overwrite left scans of the longer sequence before"
+    fi
 }
 
 # --- optimise: a pose graph of a tiny simulated sequence, and its bad input -----------------------
@@ -489,7 +495,7 @@ section_optimise() {
     if grep -q '"status": "complete"' "$work/opt/run.json"; then pass; else
         fail "optimise's run.json does not say complete"
     fi
-    expect_error "optimise into the dataset" "lies inside the dataset" "$cli" optimise "$work/seq" \
+    expect_error "optimise into the dataset" "lies inside the input" "$cli" optimise "$work/seq" \
         --odometry "$work/seq/poses_odometry.txt" --loops "$work/loops.csv" --out "$work/seq/opt"
     printf '%s\n%s\n' "$header" "35,2,0.001,,0,1,0,0,0,0,0,0,1" >"$work/none.csv"
     expect_ok "optimise without loops" "no loop: the odometry is returned unchanged" "$cli" \
@@ -506,6 +512,90 @@ section_optimise() {
     expect_error "optimise non-finite odometry" "line 3: 'nan' is not a finite number" "$cli" \
         optimise "$work/seq" --odometry "$work/inf.txt" --loops "$work/loops.csv" \
         --out "$work/opt_bad"
+}
+
+# expect_intact NAME FILE...: each file still exists and is not empty.
+expect_intact() {
+    local name="$1" file
+    shift
+    for file in "$@"; do
+        if [ -s "$file" ]; then pass; else fail "$name: $file was removed or emptied"; fi
+    done
+}
+
+# --- results folders: no command removes or replaces what it did not write (issue 25) --------
+section_results_folders() {
+    local seq="$work/seq" res="$work/res"
+    make_sequence "$seq"
+    expect_ok "detect" "8 scans" "$cli" detect "$seq" --min-gap 2 --quiet --out "$res"
+    local detected=("$res/loops.csv" "$res/database.lldb" "$res/database.scans" "$res/run.json")
+    printf '%s\n' 0 0 0 0 0 0 0 0 | awk '{ print "1 0 0 " NR " 0 1 0 0 0 0 1 0" }' \
+        >"$work/odometry.txt"
+    expect_error "optimise into its loops' folder" "holds the input $res/loops.csv" "$cli" \
+        optimise "$seq" --odometry "$work/odometry.txt" --loops "$res/loops.csv" --out "$res"
+    expect_error "evaluate into its results' folder" "holds the input" "$cli" evaluate "$seq" \
+        --poses "$work/odometry.txt" --results "$res/loops.csv" --method range --quiet \
+        --out "$res"
+    expect_error "detect into its map's folder" "holds the input $res/database.lldb" "$cli" \
+        detect "$seq" --map "$res/database.lldb" --quiet --out "$res"
+    expect_intact "inputs inside --out" "${detected[@]}"
+    # A rerun that fails on a truncated scan leaves the earlier results.
+    head -c 100 "$samples/corner_a.bin" >"$seq/scan3.bin"
+    expect_error "detect rerun on a truncated scan" "scan3.bin" "$cli" detect "$seq" --quiet \
+        --out "$res"
+    expect_intact "failed rerun" "${detected[@]}"
+    if grep -q '"status": "complete"' "$res/run.json"; then pass; else
+        fail "a failed rerun changed the earlier run.json"
+    fi
+    cp "$samples/corner_a.bin" "$seq/scan3.bin"
+    # bench --json: never into the dataset, never over a file that lidarloop did not write.
+    cp "$seq/scan0.bin" "$work/scan0.copy"
+    expect_error "bench --json onto a scan" "lies inside the input" "$cli" bench "$seq" \
+        --queries 2 --verify-queries 0 --quiet --json "$seq/scan0.bin"
+    if cmp -s "$seq/scan0.bin" "$work/scan0.copy"; then pass; else fail "bench replaced a scan"; fi
+    echo "my figures" >"$work/mine.json"
+    expect_error "bench --json onto a foreign file" "give --overwrite" "$cli" bench "$seq" \
+        --queries 2 --verify-queries 0 --quiet --json "$work/mine.json"
+    if grep -q "my figures" "$work/mine.json"; then pass; else fail "bench replaced mine.json"; fi
+    expect_ok "bench --json" "ns_per_comparison" "$cli" bench "$seq" --queries 2 \
+        --verify-queries 0 --quiet --json "$work/bench.json"
+    expect_ok "bench --json again" "ns_per_comparison" "$cli" bench "$seq" --queries 2 \
+        --verify-queries 0 --quiet --json "$work/bench.json"
+    expect_ok "bench --json --overwrite" "ns_per_comparison" "$cli" bench "$seq" --queries 2 \
+        --verify-queries 0 --quiet --json "$work/mine.json" --overwrite
+    # simulate into a foreign sequence folder, and a Ctrl-C halfway.
+    mkdir -p "$work/foreign" && echo "my poses" >"$work/foreign/poses.txt"
+    expect_error "simulate into a foreign folder" "holds no lidarloop run.json" "$cli" simulate \
+        --sensor vlp16 --scans 3 --horizontal-steps 90 --quiet --out "$work/foreign"
+    if grep -q "my poses" "$work/foreign/poses.txt"; then pass; else
+        fail "simulate replaced a foreign poses.txt"
+    fi
+    "$cli" simulate --sensor vlp16 --scans 100000 --horizontal-steps 90 --threads 1 --quiet \
+        --out "$work/cut" >/dev/null 2>"$work/cut.err" &
+    local pid=$! waited=0
+    until compgen -G "$work/cut/.lidarloop-staging-*/velodyne/000002.bin" >/dev/null ||
+        [ "$waited" -ge 600 ]; do
+        sleep 0.1
+        waited=$((waited + 1))
+    done
+    kill -INT "$pid"
+    wait "$pid"
+    local code=$?
+    if [ "$code" -eq 130 ] && [ ! -e "$work/cut/velodyne" ] &&
+        grep -q '"status": "interrupted"' "$work/cut/run.json"; then pass; else
+        fail "interrupted simulate: exit $code, $(ls -A "$work/cut"), $(cat "$work/cut.err")"
+    fi
+    expect_error "detect on an interrupted sequence" "not finished" "$cli" detect "$work/cut" \
+        --quiet --out "$work/cut_res"
+    # demo never replaces a foreign report (a small sequence stands in for the demo's).
+    "$cli" simulate --sensor vlp16 --scans 40 --horizontal-steps 90 --quiet \
+        --out "$work/demo/sequence" >/dev/null
+    mkdir -p "$work/demo/evaluation" && echo "my report" >"$work/demo/evaluation/report.md"
+    expect_error "demo into a foreign evaluation folder" "holds no lidarloop run.json" "$cli" demo \
+        --quiet --out "$work/demo"
+    if grep -q "my report" "$work/demo/evaluation/report.md"; then pass; else
+        fail "demo replaced a foreign report.md"
+    fi
 }
 
 # --- run the sections named on the command line -------------------------------------------------

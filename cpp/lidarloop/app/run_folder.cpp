@@ -1,8 +1,11 @@
 #include "lidarloop/app/run_folder.hpp"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cerrno>
 #include <ctime>
 #include <fstream>
 #include <optional>
@@ -15,8 +18,8 @@ namespace lidarloop::app {
 namespace fs = std::filesystem;
 namespace {
 
-constexpr char kManifest[] = "run.json";
 constexpr char kStagingPrefix[] = ".lidarloop-staging-";
+constexpr char kEarlierPrefix[] = ".lidarloop-earlier-";
 
 std::string UtcNow() {
     const std::time_t now = std::time(nullptr);
@@ -37,53 +40,191 @@ bool IsInside(const fs::path& inner, const fs::path& outer) {
     return end_b == b.end() || (std::next(end_b) == b.end() && end_b->empty());
 }
 
-// A name run.json may list: a plain file name in the folder, nothing that leads elsewhere.
-bool IsPlainName(const std::string& name) {
-    return !name.empty() && name != "." && name != ".." && fs::path(name).filename() == name;
-}
-
-// The files the earlier run's run.json lists; nullopt when there is no lidarloop run.json.
-std::optional<std::vector<std::string>> PreviousRunFiles(const fs::path& folder) {
-    std::ifstream in(folder / kManifest);
-    if (!in) return std::nullopt;
-    const nlohmann::json json = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-    if (!json.is_object() || json.value("tool", "") != "lidarloop") return std::nullopt;
-    std::vector<std::string> files;
-    if (json.contains("files") && json["files"].is_array()) {
-        for (const auto& file : json["files"]) {
-            if (file.is_string() && IsPlainName(file.get<std::string>()))
-                files.push_back(file.get<std::string>());
+// An output inside an input would be read as input (scans) or replace it; an input inside the
+// output would be replaced by the results. Both are refused before anything is written.
+void RefuseInputOverlap(const fs::path& output, const std::vector<fs::path>& inputs) {
+    for (const fs::path& input : inputs) {
+        if (input.empty()) continue;
+        std::error_code ec;
+        if (fs::equivalent(output, input, ec)) {
+            throw io::WriteError(output, "is an input of this run; write the results elsewhere");
+        }
+        if (IsInside(output, input)) {
+            throw io::WriteError(output, "lies inside the input " + input.string() +
+                                             ", which the results would mix with or replace; "
+                                             "write the results elsewhere");
+        }
+        if (IsInside(input, output)) {
+            throw io::WriteError(output, "holds the input " + input.string() +
+                                             ", which the results would replace; write the "
+                                             "results elsewhere");
         }
     }
-    return files;
+}
+
+// A hidden folder of a run in progress or of one that was killed: ".lidarloop-staging-PID-N".
+bool IsWorkFolder(const fs::path& entry) {
+    const std::string name = entry.filename().string();
+    return name.rfind(kStagingPrefix, 0) == 0 || name.rfind(kEarlierPrefix, 0) == 0;
+}
+
+// A killed process leaves its work folders; a live one (another run into the same folder) is
+// still using them.
+bool BelongsToLiveProcess(const fs::path& entry) {
+    const std::string name = entry.filename().string();
+    const std::size_t prefix = name.rfind(kStagingPrefix, 0) == 0 ? sizeof(kStagingPrefix) - 1
+                                                                  : sizeof(kEarlierPrefix) - 1;
+    long pid = 0;
+    try {
+        pid = std::stol(name.substr(prefix));
+    } catch (const std::exception&) {
+        return false;
+    }
+    return pid > 0 && (::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM);
+}
+
+// Removes what killed runs left: their staging folders (half-written results) and folders of
+// earlier files they had moved aside but not yet deleted.
+void RemoveLeftovers(const fs::path& folder) {
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(folder, ec)) {
+        if (IsWorkFolder(entry.path()) && !BelongsToLiveProcess(entry.path()))
+            fs::remove_all(entry.path(), ec);
+    }
+}
+
+bool HoldsOnlyLeftovers(const fs::path& folder) {
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(folder, ec)) {
+        if (!IsWorkFolder(entry.path())) return false;
+    }
+    return true;
+}
+
+// What may be replaced without being told to overwrite: nothing in a new or empty folder, the
+// files of an earlier run of results. A dataset is input to other runs: replacing it would
+// leave their results describing scans that no longer exist.
+void RefuseForeignFolder(const fs::path& folder, const std::optional<io::RunRecord>& earlier,
+                         const RunInfo& info) {
+    if (info.overwrite) return;
+    const bool holds_files = earlier && !earlier->files.empty();
+    if (holds_files && (earlier->kind != info.kind || earlier->kind == io::RunKind::kDataset)) {
+        throw io::WriteError(
+            folder,
+            "holds a lidarloop " + io::ToString(earlier->kind) +
+                (earlier->kind == io::RunKind::kDataset ? " (a sequence of scans)" : " folder") +
+                "; choose another folder, or give --overwrite to "
+                "replace it");
+    }
+    if (!earlier && !HoldsOnlyLeftovers(folder)) {
+        throw io::WriteError(folder,
+                             "is not empty and holds no lidarloop run.json; choose an empty or new "
+                             "folder, or give --overwrite to write into it anyway");
+    }
+}
+
+std::string UniqueSuffix() {
+    static std::atomic<unsigned> count{0};
+    return std::to_string(::getpid()) + "-" + std::to_string(count++);
+}
+
+std::vector<std::string> ListNames(const fs::path& folder) {
+    std::vector<std::string> names;
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(folder, ec))
+        names.push_back(entry.path().filename().string());
+    if (ec) throw io::WriteError(folder, "cannot list the staged files (" + ec.message() + ")");
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+bool Contains(const std::vector<std::string>& names, const std::string& name) {
+    return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+void Rename(const fs::path& from, const fs::path& to) {
+    std::error_code ec;
+    fs::rename(from, to, ec);
+    if (ec) throw io::WriteError(to, "cannot move into place (" + ec.message() + ")");
+}
+
+// The proof that replacing `file` loses nothing of the user's: lidarloop wrote it.
+bool IsLidarloopJson(const fs::path& file) {
+    std::ifstream in(file);
+    const nlohmann::json json = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+    return json.is_object() && json.value("tool", "") == "lidarloop";
 }
 
 std::mutex active_mutex;
 RunFolder* active_folder = nullptr;  // guarded by active_mutex
 
-bool IsStaging(const fs::path& entry) {
-    return entry.filename().string().rfind(kStagingPrefix, 0) == 0;
-}
+// The moves of Complete(), undone in reverse when one fails: the earlier files go aside, the
+// staged ones into place.
+class FolderSwap {
+public:
+    FolderSwap(fs::path folder, fs::path staging, fs::path aside)
+        : folder_(std::move(folder)), staging_(std::move(staging)), aside_(std::move(aside)) {}
 
-// Removes what an earlier run left: the files and folders its run.json lists (optimise's
-// detection/), run.json, and staging folders of runs that were killed. Refuses a non-empty folder
-// of other files unless told to.
-void ClearPreviousRun(const fs::path& folder, bool overwrite) {
+    void MoveAside(const std::vector<std::string>& names) {
+        std::error_code ec;
+        fs::create_directory(aside_, ec);
+        if (ec) throw io::WriteError(aside_, "cannot create (" + ec.message() + ")");
+        for (const std::string& name : names) {
+            Rename(folder_ / name, aside_ / name);
+            aside_names_.push_back(name);
+        }
+    }
+
+    void MoveIn(const std::vector<std::string>& names) {
+        for (const std::string& name : names) {
+            Rename(staging_ / name, folder_ / name);
+            in_names_.push_back(name);
+        }
+    }
+
+    void Undo() noexcept {
+        std::error_code ec;
+        for (const std::string& name : in_names_) fs::remove_all(folder_ / name, ec);
+        for (const std::string& name : aside_names_) fs::rename(aside_ / name, folder_ / name, ec);
+        Finish();
+    }
+
+    void Finish() noexcept {
+        std::error_code ec;
+        fs::remove_all(aside_, ec);
+        fs::remove_all(staging_, ec);
+    }
+
+private:
+    fs::path folder_;
+    fs::path staging_;
+    fs::path aside_;
+    std::vector<std::string> aside_names_;
+    std::vector<std::string> in_names_;
+};
+
+// The files in `folder` that the new run replaces: those of the same names, and every file the
+// earlier run listed (none of them may survive into this run's results). A file no run.json
+// lists is replaced only when told to overwrite.
+std::vector<std::string> FilesToReplace(const fs::path& folder,
+                                        const std::vector<std::string>& staged, bool overwrite) {
+    const std::optional<io::RunRecord> earlier = io::ReadRunRecord(folder);
+    const std::vector<std::string> listed = earlier ? earlier->files : std::vector<std::string>();
+    std::vector<std::string> replaced;
     std::error_code ec;
-    const auto previous = PreviousRunFiles(folder);
-    for (const auto& entry : fs::directory_iterator(folder, ec)) {
-        if (IsStaging(entry.path())) fs::remove_all(entry.path(), ec);
+    for (const std::string& name : staged) {
+        if (!fs::exists(folder / name, ec)) continue;
+        if (!overwrite && !Contains(listed, name)) {
+            throw io::WriteError(folder / name,
+                                 "exists, and no lidarloop run.json lists it; move it away, or "
+                                 "give --overwrite to replace it");
+        }
+        replaced.push_back(name);
     }
-    if (previous) {
-        for (const std::string& file : *previous) fs::remove_all(folder / file, ec);
-        fs::remove(folder / kManifest, ec);
-        return;
+    for (const std::string& name : listed) {
+        if (!Contains(staged, name) && fs::exists(folder / name, ec)) replaced.push_back(name);
     }
-    if (!overwrite && !fs::is_empty(folder, ec)) {
-        throw io::WriteError(folder,
-                             "is not empty and holds no lidarloop run.json; choose an empty or new "
-                             "folder, or give --overwrite to write into it anyway");
-    }
+    return replaced;
 }
 
 }  // namespace
@@ -102,19 +243,16 @@ std::string ToString(RunStatus status) {
 
 RunFolder::RunFolder(fs::path folder, RunInfo info)
     : folder_(std::move(folder)), info_(std::move(info)), started_(UtcNow()) {
-    if (!info_.dataset.empty() && IsInside(folder_, info_.dataset)) {
-        throw io::WriteError(folder_, "lies inside the dataset " + info_.dataset.string() +
-                                          ", whose scans it would mix with; write the results "
-                                          "elsewhere");
-    }
+    RefuseInputOverlap(folder_, info_.inputs);
     std::error_code ec;
     fs::create_directories(folder_, ec);
     if (ec || !fs::is_directory(folder_)) {
         throw io::WriteError(folder_, "cannot create the output folder" +
                                           (ec ? " (" + ec.message() + ")" : std::string()));
     }
-    ClearPreviousRun(folder_, info_.overwrite);
-    staging_ = folder_ / (kStagingPrefix + std::to_string(::getpid()));
+    RemoveLeftovers(folder_);
+    RefuseForeignFolder(folder_, io::ReadRunRecord(folder_), info_);
+    staging_ = folder_ / (kStagingPrefix + UniqueSuffix());
     fs::create_directory(staging_, ec);
     if (ec)
         throw io::WriteError(staging_, "cannot create the staging folder (" + ec.message() + ")");
@@ -125,35 +263,21 @@ RunFolder::~RunFolder() { Abandon(RunStatus::kFailed, "the run stopped with an e
 std::vector<std::string> RunFolder::Complete() {
     const std::lock_guard<std::mutex> lock(mutex_);
     if (finished_) throw io::WriteError(folder_, "the run was already abandoned");
+    finished_ = true;
+    FolderSwap swap(folder_, staging_, folder_ / (kEarlierPrefix + UniqueSuffix()));
     std::vector<std::string> files;
-    std::error_code ec;
-    for (const auto& entry : fs::directory_iterator(staging_, ec))
-        files.push_back(entry.path().filename().string());
-    std::sort(files.begin(), files.end());
-    std::vector<std::string> moved;
     try {
-        if (ec)
-            throw io::WriteError(staging_, "cannot list the staged files (" + ec.message() + ")");
-        for (const std::string& file : files) {
-            fs::rename(staging_ / file, folder_ / file, ec);
-            if (ec)
-                throw io::WriteError(folder_ / file,
-                                     "cannot move into place (" + ec.message() + ")");
-            moved.push_back(file);
-        }
-        fs::remove_all(staging_, ec);
+        files = ListNames(staging_);
+        swap.MoveAside(FilesToReplace(folder_, files, info_.overwrite));
+        swap.MoveIn(files);
+        // run.json is renamed into place last: until then the earlier one describes the folder.
         WriteManifest(RunStatus::kComplete, files, "");
     } catch (const io::WriteError& e) {
-        for (const std::string& file : moved) fs::remove_all(folder_ / file, ec);
-        fs::remove_all(staging_, ec);
-        try {
-            WriteManifest(RunStatus::kFailed, {}, e.what());
-        } catch (const std::exception&) {  // the first error is the one to report
-        }
-        finished_ = true;
+        swap.Undo();
+        RecordFailure(RunStatus::kFailed, e.what());
         throw;
     }
-    finished_ = true;
+    swap.Finish();
     return files;
 }
 
@@ -163,9 +287,17 @@ void RunFolder::Abandon(RunStatus status, const std::string& message) noexcept {
     finished_ = true;
     std::error_code ec;
     fs::remove_all(staging_, ec);
+    RecordFailure(status, message);
+}
+
+// An earlier run's results stay as they were, run.json included; only a folder without results
+// gets a run.json that says how this run ended.
+void RunFolder::RecordFailure(RunStatus status, const std::string& message) noexcept {
     try {
+        const std::optional<io::RunRecord> earlier = io::ReadRunRecord(folder_);
+        if (earlier && !earlier->files.empty()) return;
         WriteManifest(status, {}, message);
-    } catch (const std::exception&) {  // nothing left to tell: the folder holds no results
+    } catch (const std::exception&) {  // the first error is the one to report
     }
 }
 
@@ -197,24 +329,49 @@ void RunFolder::WriteManifest(RunStatus status, const std::vector<std::string>& 
     json["tool"] = "lidarloop";
     json["version"] = LIDARLOOP_VERSION;
     json["command_line"] = info_.command_line;
+    json["kind"] = io::ToString(info_.kind);
     json["status"] = ToString(status);
     json["started"] = started_;
     json["ended"] = UtcNow();
     json["files"] = files;
     if (!message.empty()) json["message"] = message;
-    // Written beside, then renamed: run.json is whole or absent.
-    const fs::path temporary = folder_ / (std::string(".") + kManifest + ".tmp");
-    std::ofstream out(temporary);
-    out << json.dump(2) << "\n";
+    WriteFileAtomically(folder_ / io::kRunRecordName, json.dump(2) + "\n");
+}
+
+void WriteFileAtomically(const fs::path& file, const std::string& text) {
+    const fs::path temporary =
+        file.parent_path() / ("." + file.filename().string() + ".tmp-" + UniqueSuffix());
+    std::ofstream out(temporary, std::ios::binary);
+    out << text;
     out.close();
     std::error_code ec;
     if (!out) {
         fs::remove(temporary, ec);
-        throw io::WriteError(folder_ / kManifest, "writing failed (disk full?)");
+        throw io::WriteError(file, "writing failed (disk full?)");
     }
-    fs::rename(temporary, folder_ / kManifest, ec);
-    if (ec)
-        throw io::WriteError(folder_ / kManifest, "cannot move into place (" + ec.message() + ")");
+    fs::rename(temporary, file, ec);
+    if (ec) {
+        fs::remove(temporary, ec);
+        throw io::WriteError(file, "cannot move into place (" + ec.message() + ")");
+    }
+}
+
+void CheckOutputFile(const fs::path& file, const std::vector<fs::path>& inputs, bool overwrite) {
+    RefuseInputOverlap(file, inputs);
+    std::error_code ec;
+    if (fs::is_directory(file, ec)) throw io::WriteError(file, "is a folder, not a file");
+    if (fs::exists(file, ec) && !overwrite && !IsLidarloopJson(file)) {
+        throw io::WriteError(file,
+                             "exists and is not a JSON file that lidarloop wrote; choose another "
+                             "file, or give --overwrite to replace it");
+    }
+}
+
+void WriteOutputJson(const fs::path& file, nlohmann::json json, const std::vector<fs::path>& inputs,
+                     bool overwrite) {
+    CheckOutputFile(file, inputs, overwrite);
+    json["tool"] = "lidarloop";
+    WriteFileAtomically(file, json.dump(2) + "\n");
 }
 
 }  // namespace lidarloop::app

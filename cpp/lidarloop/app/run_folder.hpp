@@ -6,6 +6,10 @@
 #include <utility>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include "lidarloop/io/run_record.hpp"
+
 namespace lidarloop::app {
 
 /// How a run ended, as its run.json says.
@@ -16,21 +20,27 @@ std::string ToString(RunStatus status);
 
 /// What a RunFolder checks and records besides its files.
 struct RunInfo {
-    std::string command_line;       ///< the command as typed, for run.json
-    std::filesystem::path dataset;  ///< the folder the run reads (empty: none)
-    /// Write into a non-empty folder that holds no lidarloop run.json (its other files stay).
+    std::string command_line;  ///< the command as typed, for run.json
+    /// Every file and folder the run reads (dataset, poses, map, loops, odometry); the results
+    /// folder may neither lie inside one nor hold one. Empty paths are ignored.
+    std::vector<std::filesystem::path> inputs;
+    /// Write into a non-empty folder that holds no lidarloop run.json, or one of the other kind,
+    /// replacing the files of the same names (its other files stay).
     bool overwrite = false;
+    io::RunKind kind = io::RunKind::kResults;  ///< what run.json says the folder holds
 };
 
-/// A results folder that never lies (what `detect` and `evaluate` write into):
-/// - the run writes into staging(), a hidden folder inside it, and Complete() moves every file
-///   into place by renaming (a file is whole or absent, never half-written), then writes
-///   run.json last: version, command line, status, start and end time (UTC), the files;
-/// - a run that fails or is interrupted leaves none of its files, only a run.json saying so;
-/// - the files of the run before, which its run.json lists, are removed first, so none
-///   survives into this run's results;
-/// - a folder inside the dataset (whose files would be read as scans), and a non-empty folder
-///   without a lidarloop run.json unless RunInfo::overwrite, are refused.
+/// The results-folder rule of every command that writes (docs/cli.md, "Results folders"):
+/// - a folder inside an input, or holding an input, is refused before anything is written;
+/// - a non-empty folder without a lidarloop run.json, or with one of the other kind (results
+///   against a simulated dataset), is refused unless RunInfo::overwrite;
+/// - the run writes into staging(), a hidden folder inside it; Complete() moves the earlier
+///   run's files aside, renames the new ones into place (a file is whole or absent, never
+///   half-written), writes run.json last (version, command line, kind, status, start and end
+///   time in UTC, the files) and only then deletes the earlier files;
+/// - a run that fails or is interrupted leaves the earlier run's files and run.json as they
+///   were; in a folder without an earlier run it leaves only a run.json saying how it ended;
+/// - a file of the folder that no run.json lists is never replaced unless RunInfo::overwrite.
 /// Complete and Abandon are thread-safe with each other (Abandon may come from a signal
 /// watcher thread); the first of them decides.
 class RunFolder {
@@ -50,12 +60,15 @@ public:
     /// Moves the files of staging() into folder() and writes run.json (status complete).
     /// Returns the files' names, sorted. Throws io::WriteError (then run.json says failed).
     std::vector<std::string> Complete();
-    /// Removes staging() and writes run.json with `status` and `message`; never throws.
+    /// Removes staging(); writes run.json with `status` and `message` unless the folder holds
+    /// an earlier run's results, which stay as they were. Never throws.
     void Abandon(RunStatus status, const std::string& message) noexcept;
 
 private:
+    void SwapIn(const std::vector<std::string>& staged);
     void WriteManifest(RunStatus status, const std::vector<std::string>& files,
                        const std::string& message) const;
+    void RecordFailure(RunStatus status, const std::string& message) noexcept;
 
     std::filesystem::path folder_;
     std::filesystem::path staging_;
@@ -83,11 +96,26 @@ private:
 /// writes one. Thread-safe; never throws.
 std::filesystem::path AbandonActiveRun(RunStatus status, const std::string& message) noexcept;
 
+/// Writes `text` to `file` beside it first and then renames it, so that `file` is whole or
+/// absent. Throws io::WriteError.
+void WriteFileAtomically(const std::filesystem::path& file, const std::string& text);
+
+/// The results-folder rule for one output file: throws io::WriteError when `file` is or lies
+/// inside one of `inputs`, is a folder, or exists and is not a JSON file that lidarloop wrote
+/// (unless `overwrite`).
+void CheckOutputFile(const std::filesystem::path& file,
+                     const std::vector<std::filesystem::path>& inputs, bool overwrite);
+
+/// Writes `json` with "tool": "lidarloop" to `file` (bench --json) after CheckOutputFile,
+/// atomically. Throws io::WriteError.
+void WriteOutputJson(const std::filesystem::path& file, nlohmann::json json,
+                     const std::vector<std::filesystem::path>& inputs, bool overwrite);
+
 /// Runs `run(staging)` for the results folder `out` with RunFolder's guarantees: when `run`
-/// returns, its files move into place and run.json says complete; when it throws, only a
-/// run.json saying failed is left and the error propagates; meanwhile AbandonActiveRun can stop
-/// it as interrupted. What library callers, the CLI and Python use to write a results folder.
-/// Returns what `run` returns.
+/// returns, its files replace the earlier run's and run.json says complete; when it throws, the
+/// folder is left as it was (or with a run.json saying failed) and the error propagates; meanwhile
+/// AbandonActiveRun can stop it as interrupted. What library callers, the CLI and Python use to
+/// write a results folder. Returns what `run` returns.
 template <typename Run>
 auto RunInFolder(const std::filesystem::path& out, RunInfo info, Run&& run) {
     RunFolder folder(out, std::move(info));

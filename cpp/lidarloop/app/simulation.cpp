@@ -13,6 +13,7 @@
 
 #include "lidarloop/io/kitti_sequence.hpp"
 #include "lidarloop/io/read_error.hpp"
+#include "lidarloop/io/run_record.hpp"
 
 namespace lidarloop::app {
 namespace {
@@ -115,13 +116,17 @@ void WritePoses(const sim::Simulator& simulator, io::KittiSequenceWriter& writer
 }  // namespace
 
 SimulationSummary WriteSimulation(const sim::Simulator& simulator, const std::filesystem::path& out,
-                                  bool overwrite, int threads, const Progress& progress) {
+                                  RunInfo run, int threads, const Progress& progress) {
     const auto start = std::chrono::steady_clock::now();
-    io::KittiSequenceWriter writer(out, overwrite);
+    run.kind = io::RunKind::kDataset;
     ScanStats stats;
-    WriteScans(simulator, writer, threads, progress, stats);
-    WritePoses(simulator, writer);
-    WriteSimulationYaml(writer.dir() / "simulation.yaml", simulator);
+    RunInFolder(out, std::move(run), [&](const std::filesystem::path& staging) {
+        io::KittiSequenceWriter writer(staging);
+        WriteScans(simulator, writer, threads, progress, stats);
+        WritePoses(simulator, writer);
+        WriteSimulationYaml(staging / "simulation.yaml", simulator);
+        return 0;
+    });
     SimulationSummary summary;
     summary.mean_points = stats.points / simulator.size();
     summary.min_points = stats.min_points;
@@ -132,12 +137,16 @@ SimulationSummary WriteSimulation(const sim::Simulator& simulator, const std::fi
     return summary;
 }
 
-DemoSequence PrepareDemoSequence(const std::filesystem::path& folder, const Progress& progress) {
+DemoSequence PrepareDemoSequence(const std::filesystem::path& folder, RunInfo run,
+                                 const Progress& progress) {
     DemoSequence demo{folder, std::nullopt};
-    if (std::filesystem::exists(folder / "simulation.yaml")) return demo;
+    const std::optional<io::RunRecord> record = io::ReadRunRecord(folder);
+    if (record && record->kind == io::RunKind::kDataset && record->status == "complete" &&
+        std::filesystem::exists(folder / "simulation.yaml")) {
+        return demo;
+    }
     const sim::Simulator simulator(sim::DemoConfig());
-    demo.generated =
-        WriteSimulation(simulator, folder, /*overwrite=*/true, /*threads=*/0, progress);
+    demo.generated = WriteSimulation(simulator, folder, std::move(run), /*threads=*/0, progress);
     return demo;
 }
 

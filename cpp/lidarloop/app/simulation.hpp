@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "lidarloop/app/progress.hpp"
+#include "lidarloop/app/run_folder.hpp"
 #include "lidarloop/sim/simulator.hpp"
 
 namespace lidarloop::app {
@@ -24,17 +25,21 @@ struct SimulationSummary {
 
 /// Writes the whole sequence of `simulator` to `out` in KITTI layout (velodyne/*.bin, poses.txt,
 /// times.txt, poses_odometry.txt) with simulation.yaml, scans in parallel on `threads` threads
-/// (0: all cores). Without `overwrite`, a folder holding scans is an error (io::WriteError).
+/// (0: all cores), by the results-folder rule (RunFolder, with `run` as its command line, inputs
+/// and overwrite; the kind is always a dataset): staged and swapped in whole, so that an
+/// interrupted run leaves the earlier sequence, or a run.json that makes readers refuse the
+/// folder. Throws io::WriteError.
 SimulationSummary WriteSimulation(const sim::Simulator& simulator, const std::filesystem::path& out,
-                                  bool overwrite, int threads, const Progress& progress = {});
+                                  RunInfo run, int threads, const Progress& progress = {});
 
-/// The demo sequence (sim::DemoConfig) in `folder`: generated when `folder` holds no
-/// simulation.yaml yet (then `generated` is set), reused otherwise.
+/// The demo sequence (sim::DemoConfig) in `folder`: reused when `folder` holds a complete
+/// sequence that lidarloop wrote, generated otherwise (then `generated` is set) under the
+/// results-folder rule of `run`.
 struct DemoSequence {
     std::filesystem::path folder;
     std::optional<SimulationSummary> generated;
 };
-DemoSequence PrepareDemoSequence(const std::filesystem::path& folder,
+DemoSequence PrepareDemoSequence(const std::filesystem::path& folder, RunInfo run,
                                  const Progress& progress = {});
 
 }  // namespace lidarloop::app

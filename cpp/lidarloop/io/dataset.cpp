@@ -8,6 +8,7 @@
 #include "lidarloop/io/osnabrueck.hpp"
 #include "lidarloop/io/poses.hpp"
 #include "lidarloop/io/read_error.hpp"
+#include "lidarloop/io/run_record.hpp"
 #include "lidarloop/io/scan_reader.hpp"
 
 namespace lidarloop::io {
@@ -181,6 +182,7 @@ Dataset OpenDataset(const fs::path& path, const DatasetOptions& options) {
     if (!fs::is_directory(path, ec)) {
         throw ReadError(path, "is a file; a dataset is a folder of scans");
     }
+    RefuseIncompleteDataset(path);
     const DatasetFormat format =
         options.format == DatasetFormat::kAuto ? DetectFormat(path) : options.format;
     Dataset dataset = format == DatasetFormat::kKitti        ? OpenKitti(path, options)

@@ -13,7 +13,7 @@ inline io::Dataset SmallSequence(const std::filesystem::path& folder) {
     sim::SimulationConfig config = sim::DemoConfig();
     config.scans = 200;
     config.sensor.horizontal_steps = 360;
-    app::WriteSimulation(sim::Simulator(config), folder, /*overwrite=*/false, /*threads=*/0);
+    app::WriteSimulation(sim::Simulator(config), folder, /*run=*/{}, /*threads=*/0);
     return io::OpenDataset(folder);
 }
 

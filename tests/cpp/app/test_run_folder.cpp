@@ -1,6 +1,8 @@
 // Results folders that never lie: staged files appear only when the run completes, run.json is
 // written last and says how the run ended, earlier runs leave nothing behind, folders of other
 // files and folders inside the dataset are refused, and a full disk is an error.
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -37,7 +39,7 @@ TEST(RunFolder, FilesAppearOnlyWhenTheRunCompletesAndRunJsonSaysSo) {
     test::TempDir dir;
     const fs::path out = dir / "results";
     {
-        RunFolder folder(out, {"lidarloop detect x --out results", dir / "dataset", false});
+        RunFolder folder(out, {"lidarloop detect x --out results", {dir / "dataset"}, false});
         test::WriteFile(folder.staging() / "loops.csv", "query,match\n");
         test::WriteFile(folder.staging() / "b.txt", "b");
         EXPECT_FALSE(fs::exists(out / "loops.csv"));  // still staged
@@ -85,9 +87,10 @@ TEST(RunFolder, TheFilesOfTheRunBeforeAreRemovedOthersRefused) {
     test::WriteFile(out / "notes.md", "mine");  // the user's, not the run's
     {
         RunFolder second(out, {});
+        // The earlier results stay until the new ones are complete.
         EXPECT_EQ(Entries(out),
-                  (std::vector<std::string>{".lidarloop-staging-" + std::to_string(::getpid()),
-                                            "notes.md"}));
+                  (std::vector<std::string>{second.staging().filename().string(), "loops.csv",
+                                            "notes.md", "run.json", "skipped.txt"}));
         test::WriteFile(second.staging() / "loops.csv", "2");
         second.Complete();
     }
@@ -133,10 +136,155 @@ TEST(RunFolder, AFolderInsideTheDatasetIsRefused) {
     for (const fs::path& inside :
          {dir / "dataset", dir / "dataset" / "velodyne", dir / "dataset" / "velodyne" / "out",
           dir / "dataset" / "velodyne" / ".." / "results"}) {
-        EXPECT_THROW(RunFolder(inside, {"", dir / "dataset", true}), io::WriteError) << inside;
+        EXPECT_THROW(RunFolder(inside, {"", {dir / "dataset"}, true}), io::WriteError) << inside;
     }
-    EXPECT_NO_THROW(RunFolder(dir / "dataset_results", {"", dir / "dataset", false}));
+    EXPECT_NO_THROW(RunFolder(dir / "dataset_results", {"", {dir / "dataset"}, false}));
     EXPECT_FALSE(fs::exists(dir / "dataset" / "velodyne" / "out"));
+}
+
+// A detect folder (results) with its files, for the tests of reruns into it.
+void WriteDetectResults(const fs::path& out) {
+    RunInFolder(out, {}, [](const fs::path& staging) {
+        test::WriteFile(staging / "loops.csv", "first");
+        test::WriteFile(staging / "database.lldb", "map");
+        return 0;
+    });
+}
+
+// Issue 25 (3): a rerun that fails must not have removed the results it would have replaced.
+TEST(RunFolder, AFailedOrInterruptedRerunLeavesTheEarlierResultsIntact) {
+    test::TempDir dir;
+    const fs::path out = dir / "results";
+    WriteDetectResults(out);
+    const std::string manifest = test::ReadFile(out / "run.json");
+    EXPECT_THROW(RunInFolder(out, {},
+                             [](const fs::path& staging) -> int {
+                                 test::WriteFile(staging / "loops.csv", "half");
+                                 throw io::ReadError("scan7.bin", "truncated");
+                             }),
+                 io::ReadError);
+    {
+        RunFolder interrupted(out, {});
+        test::WriteFile(interrupted.staging() / "loops.csv", "half");
+        interrupted.Abandon(RunStatus::kInterrupted, "signal 2");
+    }
+    EXPECT_EQ(Entries(out), (std::vector<std::string>{"database.lldb", "loops.csv", "run.json"}));
+    EXPECT_EQ(test::ReadFile(out / "loops.csv"), "first");
+    EXPECT_EQ(test::ReadFile(out / "run.json"), manifest);
+}
+
+// Issue 25 (2): optimise --loops res/loops.csv --out res, evaluate --results res/loops.csv
+// --out res and detect --map res/database.lldb --out res would replace their own input.
+TEST(RunFolder, AFolderHoldingAnInputIsRefusedBeforeAnythingIsRemoved) {
+    test::TempDir dir;
+    const fs::path out = dir / "results";
+    WriteDetectResults(out);
+    for (const fs::path& input : {out / "loops.csv", out / "database.lldb", out}) {
+        for (const bool overwrite : {false, true}) {
+            try {
+                RunFolder refused(out, {"", {dir / "dataset", input}, overwrite});
+                FAIL() << "a folder holding the input " << input << " was accepted";
+            } catch (const io::WriteError& e) {
+                EXPECT_NE(std::string(e.what()).find(input.string()), std::string::npos)
+                    << e.what();
+            }
+        }
+    }
+    EXPECT_EQ(Entries(out), (std::vector<std::string>{"database.lldb", "loops.csv", "run.json"}));
+    EXPECT_NO_THROW(RunFolder(dir / "other", {"", {out / "loops.csv"}, false}));
+}
+
+// A file in a lidarloop folder that no run.json lists is the user's: a run that would replace
+// it fails, and the folder stays as it was.
+TEST(RunFolder, AnUnlistedFileOfTheSameNameIsNotReplaced) {
+    test::TempDir dir;
+    const fs::path out = dir / "results";
+    WriteDetectResults(out);
+    test::WriteFile(out / "report.md", "my notes");
+    EXPECT_THROW(RunInFolder(out, {},
+                             [](const fs::path& staging) {
+                                 test::WriteFile(staging / "loops.csv", "second");
+                                 test::WriteFile(staging / "report.md", "generated");
+                                 return 0;
+                             }),
+                 io::WriteError);
+    EXPECT_EQ(test::ReadFile(out / "report.md"), "my notes");
+    EXPECT_EQ(test::ReadFile(out / "loops.csv"), "first");
+    EXPECT_EQ(Manifest(out)["status"], "complete");
+    RunInFolder(out, {"", {}, /*overwrite=*/true}, [](const fs::path& staging) {
+        test::WriteFile(staging / "report.md", "generated");
+        return 0;
+    });
+    EXPECT_EQ(test::ReadFile(out / "report.md"), "generated");
+    EXPECT_EQ(Entries(out), (std::vector<std::string>{"report.md", "run.json"}));
+}
+
+// A sequence is input to other runs: only --overwrite replaces it, by a sequence or results.
+TEST(RunFolder, ASequenceIsReplacedOnlyWhenToldTo) {
+    test::TempDir dir;
+    const fs::path sequence = dir / "sequence";
+    const RunInfo dataset_run{"lidarloop simulate", {}, false, io::RunKind::kDataset};
+    RunInFolder(sequence, dataset_run, [](const fs::path& staging) {
+        test::WriteFile(staging / "poses.txt", "1");
+        return 0;
+    });
+    EXPECT_EQ(Manifest(sequence)["kind"], "dataset");
+    EXPECT_THROW(RunFolder(sequence, dataset_run), io::WriteError);
+    EXPECT_THROW(RunFolder(sequence, {"lidarloop detect", {}, false}), io::WriteError);
+    EXPECT_EQ(test::ReadFile(sequence / "poses.txt"), "1");
+    RunInfo replace = dataset_run;
+    replace.overwrite = true;
+    RunInFolder(sequence, replace, [](const fs::path& staging) {
+        test::WriteFile(staging / "poses.txt", "2");
+        return 0;
+    });
+    EXPECT_EQ(test::ReadFile(sequence / "poses.txt"), "2");
+    // Results into a results folder need no flag.
+    WriteDetectResults(dir / "results");
+    EXPECT_NO_THROW(WriteDetectResults(dir / "results"));
+}
+
+// What a killed run leaves is removed; what a running one uses is not.
+TEST(RunFolder, LeftoversOfKilledRunsAreRemoved) {
+    test::TempDir dir;
+    const fs::path out = dir / "results";
+    WriteDetectResults(out);
+    const fs::path dead = out / ".lidarloop-staging-2147483000-0";  // no such process
+    const fs::path dead_aside = out / ".lidarloop-earlier-2147483000-0";
+    const fs::path live = out / (".lidarloop-staging-" + std::to_string(::getppid()) + "-0");
+    for (const fs::path& folder : {dead, dead_aside, live}) fs::create_directories(folder / "x");
+    WriteDetectResults(out);
+    EXPECT_FALSE(fs::exists(dead));
+    EXPECT_FALSE(fs::exists(dead_aside));
+    EXPECT_TRUE(fs::exists(live));
+}
+
+// Issue 25 (5): bench --json must not replace the ground truth or a scan of the dataset.
+TEST(WriteOutputJson, ReplacesOnlyWhatLidarloopWroteAndNothingInsideAnInput) {
+    test::TempDir dir;
+    const fs::path dataset = dir / "sequence";
+    fs::create_directories(dataset);
+    test::WriteFile(dataset / "poses.txt", "1 0 0 0 0 1 0 0 0 0 1 0");
+    for (const fs::path& file : {dataset / "poses.txt", dataset / "velodyne" / "zz.bin", dataset}) {
+        EXPECT_THROW(WriteOutputJson(file, {{"a", 1}}, {dataset}, /*overwrite=*/true),
+                     io::WriteError)
+            << file;
+    }
+    EXPECT_EQ(test::ReadFile(dataset / "poses.txt"), "1 0 0 0 0 1 0 0 0 0 1 0");
+    EXPECT_FALSE(fs::exists(dataset / "velodyne"));
+
+    const fs::path figures = dir / "bench.json";
+    WriteOutputJson(figures, {{"a", 1}}, {dataset}, false);
+    WriteOutputJson(figures, {{"a", 2}}, {dataset}, false);  // its own: replaced
+    EXPECT_EQ(nlohmann::json::parse(test::ReadFile(figures))["a"], 2);
+    EXPECT_EQ(nlohmann::json::parse(test::ReadFile(figures))["tool"], "lidarloop");
+
+    const fs::path notes = dir / "notes.json";
+    test::WriteFile(notes, R"({"mine": true})");
+    EXPECT_THROW(WriteOutputJson(notes, {{"a", 1}}, {}, false), io::WriteError);
+    EXPECT_EQ(test::ReadFile(notes), R"({"mine": true})");
+    WriteOutputJson(notes, {{"a", 1}}, {}, /*overwrite=*/true);
+    EXPECT_EQ(nlohmann::json::parse(test::ReadFile(notes))["a"], 1);
 }
 
 TEST(RunInFolder, ReturnsWhatTheRunReturnsAndLeavesOnlyRunJsonWhenItThrows) {

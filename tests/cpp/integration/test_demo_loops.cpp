@@ -14,7 +14,7 @@ namespace {
 io::Dataset SimulateDemo(std::uint64_t seed, const std::filesystem::path& folder) {
     sim::SimulationConfig config = sim::DemoConfig();
     config.seed = seed;
-    app::WriteSimulation(sim::Simulator(config), folder, /*overwrite=*/false, /*threads=*/0);
+    app::WriteSimulation(sim::Simulator(config), folder, /*run=*/{}, /*threads=*/0);
     return io::OpenDataset(folder);
 }
 
