@@ -18,6 +18,8 @@
 namespace lidarloop::io {
 namespace {
 
+using detail::Quoted;
+
 // lidarloop 0.1 kept the decision thresholds in the descriptor sections and wrote these defaults
 // into every config.yaml and database; they are read only to say where the key moved.
 constexpr double kLegacyHistogramThreshold = 0.005;
@@ -323,8 +325,8 @@ public:
                 value = child.as<T>();
             }
         } catch (const YAML::BadConversion&) {
-            Fail(key, std::string("expected ") + ExpectedKind<T>() + ", got '" + YAML::Dump(child) +
-                          "'");
+            Fail(key, std::string("expected ") + ExpectedKind<T>() + ", got " +
+                          Quoted(YAML::Dump(child)));
         } catch (const core::ConfigError& e) {
             Fail(key, e.what());
         }
@@ -342,11 +344,18 @@ public:
             return;
         }
         if (value == legacy_default) return;
+        std::string written;  // the value as the new key takes it; a non-number quoted and cut
+        if (value) {
+            detail::AppendNumber(written, *value, ' ');
+            written.pop_back();
+        } else {
+            written = Quoted(YAML::Dump(child));
+        }
         Fail(key, std::string("moved to '") + new_key +
                       "' (the decision threshold is no longer a descriptor parameter and applies "
                       "to the run's method; this one was for " +
                       (prefix_ == "ndt." ? "ndt" : "height and range") + "): write " + new_key +
-                      ": " + YAML::Dump(child) + " instead");
+                      ": " + written + " instead");
     }
     template <typename Struct>
     void Section(const char* key, Struct& section) {
@@ -371,7 +380,7 @@ public:
 
 private:
     [[noreturn]] void Fail(const std::string& key, const std::string& problem) const {
-        throw ReadError(source_, "key '" + prefix_ + key + "': " + problem);
+        throw ReadError(source_, "key " + Quoted(prefix_ + key) + ": " + problem);
     }
     // A key that is a list, a map or empty (`[a]: 1`, `{x: 1}: 2`, `? :`) names no setting.
     [[noreturn]] void FailKeyNotAName(const YAML::Node& key) const {

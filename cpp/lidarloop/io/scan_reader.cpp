@@ -50,8 +50,8 @@ core::PointCloud ReadScan(const std::filesystem::path& file) {
         std::string known;
         for (const auto& format : kFormats)
             known += std::string(known.empty() ? "" : " ") + format.extension;
-        throw ReadError(file, "unknown scan format '" + file.extension().string() +
-                                  "' (known extensions: " + known + ")");
+        throw ReadError(file, "unknown scan format " + core::Quoted(file.extension().string()) +
+                                  " (known extensions: " + known + ")");
     }
     return reader(file);
 }
