@@ -364,12 +364,27 @@ public:
         if (!child || child.IsNull()) return;
         if (!child.IsMap()) Fail(key, "expected a section of keys");
         YamlReader reader(child, source_, prefix_ + key + ".", legacy_, moved_);
+        reader.RejectBadKeys();
         VisitFields(section, reader);
         reader.RejectUnknownKeys();
     }
-    void RejectUnknownKeys() const {
+    // yaml-cpp 0.7 keeps both entries of a repeated key and node[key] finds the first, so the
+    // second would be ignored silently. Checked before any value is read, so that the repeat is
+    // what the message names.
+    void RejectBadKeys() const {
+        std::map<std::string, int> first_line;
         for (const auto& entry : node_) {
             if (!entry.first.IsScalar()) FailKeyNotAName(entry.first);
+            const int line = entry.first.Mark().line + 1;
+            const auto [it, inserted] = first_line.emplace(entry.first.Scalar(), line);
+            if (inserted) continue;
+            throw ReadError(
+                source_, "line " + std::to_string(line) + ": key " + Quoted(prefix_ + it->first) +
+                             " appears twice (first on line " + std::to_string(it->second) + ")");
+        }
+    }
+    void RejectUnknownKeys() const {
+        for (const auto& entry : node_) {
             const std::string& key = entry.first.Scalar();
             if (known_.count(key) != 0) continue;
             std::string valid;
@@ -428,6 +443,7 @@ void ApplyConfigYaml(const std::string& yaml_text, const std::string& source, Ru
         if (!root.IsMap()) throw ReadError(source, "expected a map of keys at the top level");
         std::map<std::string, double> moved;
         YamlReader reader(root, source, "", legacy, &moved);
+        reader.RejectBadKeys();
         VisitFields(updated, reader);
         reader.RejectUnknownKeys();
         MigrateThreshold(moved, updated);

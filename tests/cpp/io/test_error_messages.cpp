@@ -102,6 +102,7 @@ TEST(LongTokens, ConfigYamlCutsKeysAndValues) {
     };
     // An implicit key is at most 1024 characters in YAML; an explicit one ("? ") is unlimited.
     expect_short("histogram:\n  ? x" + HugeToken() + "\n  : 1\n", "unknown key");
+    expect_short("? x" + HugeToken() + "\n: 1\n? x" + HugeToken() + "\n: 2\n", "appears twice");
     expect_short("histogram:\n  bins: x" + HugeToken() + "\n", "expected an integer");
     expect_short("method: x" + HugeToken() + "\n", "unknown method");
     expect_short("histogram:\n  out_of_range: x" + HugeToken() + "\n", "histogram.out_of_range");
