@@ -24,8 +24,15 @@ int main(int argc, char** argv) {
     lidarloop::cli::AddVerifyCommand(app);
     try {
         app.parse(argc, argv);
+    } catch (const CLI::ValidationError& e) {
+        // A value that fails its check (a missing input file, a folder given for a file, a name
+        // not in the list) is an input error like any other: one line and exit code 1, not
+        // CLI11's 105 (docs/cli.md, "Errors").
+        std::cerr << "lidarloop: error: " << e.what() << "\n";
+        return 1;
     } catch (const CLI::ParseError& e) {
-        return app.exit(e);
+        // --help and --version exit 0; a bad command line prints CLI11's message and exits 1.
+        return app.exit(e) == 0 ? 0 : 1;
     } catch (const lidarloop::core::Error& e) {
         std::cerr << "lidarloop: error: " << e.what() << "\n";
         return 1;

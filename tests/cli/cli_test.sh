@@ -8,7 +8,7 @@
 # output; the last line is "cli <sections>: N passed, N failed".
 set -u
 sections=(describe distance ndt verify detect bench demo evaluate dump-config bad-input simulate
-    optimise results-folders)
+    optimise results-folders errors)
 if [ "${1-}" = "--list" ]; then
     printf '%s\n' "${sections[@]}"
     exit 0
@@ -52,6 +52,22 @@ expect_error() {
         fail "$name: expected a clean error exit, got code $code: $(cat "$work/stderr")"
     elif ! grep -qF -- "$phrase" "$work/stderr"; then
         fail "$name: error message lacks '$phrase': $(cat "$work/stderr")"
+    else
+        pass
+    fi
+}
+
+# expect_exit_1 NAME PHRASE CMD...: exit code exactly 1 (docs/cli.md) and one stderr line
+# containing PHRASE.
+expect_exit_1() {
+    local name="$1" phrase="$2"
+    shift 2
+    "$@" >"$work/stdout" 2>"$work/stderr"
+    local code=$?
+    if [ "$code" -ne 1 ]; then
+        fail "$name: expected exit code 1, got $code: $(head -c 300 "$work/stderr")"
+    elif [ "$(wc -l <"$work/stderr")" -ne 1 ] || ! grep -qF -- "$phrase" "$work/stderr"; then
+        fail "$name: expected one stderr line with '$phrase': $(head -c 300 "$work/stderr")"
     else
         pass
     fi
@@ -596,6 +612,32 @@ section_results_folders() {
     if grep -q "my report" "$work/demo/evaluation/report.md"; then pass; else
         fail "demo replaced a foreign report.md"
     fi
+}
+
+# --- errors: every input error exits 1 with one short line naming the problem ---------------
+section_errors() {
+    expect_exit_1 "missing --config" "missing.yaml" "$cli" dump-config --config "$work/missing.yaml"
+    expect_exit_1 "folder as --config" "$work" "$cli" dump-config --config "$work"
+    expect_exit_1 "missing verify scan" "missing.bin" "$cli" verify "$work/missing.bin" \
+        "$samples/corner_a.bin"
+    expect_exit_1 "folder as verify scan" "$work" "$cli" verify "$samples/corner_a.bin" "$work"
+    expect_exit_1 "missing describe scan" "missing.pcd: no such file" "$cli" describe \
+        "$work/missing.pcd"
+    expect_exit_1 "folder as describe scan" "is a folder, not a file" "$cli" describe "$work"
+    expect_exit_1 "value not in the list" "--format" "$cli" detect "$work" --format bogus \
+        --out "$work/out"
+    printf 'histogram:\n  bins: 12\n  range_max_m: 50\n  bins: 40\n' >"$work/twice.yaml"
+    expect_exit_1 "repeated yaml key" "line 4: key 'histogram.bins' appears twice" "$cli" \
+        dump-config --config "$work/twice.yaml"
+    { printf '1 2 '; head -c 1000000 /dev/zero | tr '\0' 7; printf '\n'; } >"$work/long.xyz"
+    expect_exit_1 "long token cut" "(1000000 characters) is not a number" "$cli" describe \
+        "$work/long.xyz"
+    if [ "$(wc -c <"$work/stderr")" -lt 300 ]; then pass; else
+        fail "long token: the message has $(wc -c <"$work/stderr") bytes"
+    fi
+    "$cli" describe --no-such-flag "$samples/corner_a.bin" >/dev/null 2>&1
+    local code=$?
+    if [ "$code" -eq 1 ]; then pass; else fail "unknown flag: exit code $code, expected 1"; fi
 }
 
 # --- run the sections named on the command line -------------------------------------------------

@@ -27,8 +27,7 @@ public:
     /// ConfigError when `name` is empty or longer than kMaxName.
     constexpr explicit Method(std::string_view name) {
         if (name.empty() || name.size() > kMaxName) {
-            throw ConfigError("a method name has 1 to 31 characters, got '" + std::string(name) +
-                              "'");
+            throw ConfigError("a method name has 1 to 31 characters, got " + Quoted(name));
         }
         std::copy(name.begin(), name.end(), name_.begin());
         size_ = name.size();

@@ -75,8 +75,8 @@ std::string JoinNames(const EnumNames<Enum, N>& table, std::string_view last_sep
 template <typename Enum, std::size_t N>
 Enum ParseEnum(const EnumNames<Enum, N>& table, std::string_view name, std::string_view what) {
     if (const std::optional<Enum> value = FindEnum(table, name)) return *value;
-    throw ConfigError("unknown " + std::string(what) + " '" + std::string(name) +
-                      "' (valid: " + JoinNames(table) + ")");
+    throw ConfigError("unknown " + std::string(what) + " " + Quoted(name) +
+                      " (valid: " + JoinNames(table) + ")");
 }
 
 }  // namespace lidarloop::core

@@ -18,6 +18,8 @@
 namespace lidarloop::io {
 namespace {
 
+using detail::Quoted;
+
 // lidarloop 0.1 kept the decision thresholds in the descriptor sections and wrote these defaults
 // into every config.yaml and database; they are read only to say where the key moved.
 constexpr double kLegacyHistogramThreshold = 0.005;
@@ -323,8 +325,8 @@ public:
                 value = child.as<T>();
             }
         } catch (const YAML::BadConversion&) {
-            Fail(key, std::string("expected ") + ExpectedKind<T>() + ", got '" + YAML::Dump(child) +
-                          "'");
+            Fail(key, std::string("expected ") + ExpectedKind<T>() + ", got " +
+                          Quoted(YAML::Dump(child)));
         } catch (const core::ConfigError& e) {
             Fail(key, e.what());
         }
@@ -342,11 +344,18 @@ public:
             return;
         }
         if (value == legacy_default) return;
+        std::string written;  // the value as the new key takes it; a non-number quoted and cut
+        if (value) {
+            detail::AppendNumber(written, *value, ' ');
+            written.pop_back();
+        } else {
+            written = Quoted(YAML::Dump(child));
+        }
         Fail(key, std::string("moved to '") + new_key +
                       "' (the decision threshold is no longer a descriptor parameter and applies "
                       "to the run's method; this one was for " +
                       (prefix_ == "ndt." ? "ndt" : "height and range") + "): write " + new_key +
-                      ": " + YAML::Dump(child) + " instead");
+                      ": " + written + " instead");
     }
     template <typename Struct>
     void Section(const char* key, Struct& section) {
@@ -355,12 +364,27 @@ public:
         if (!child || child.IsNull()) return;
         if (!child.IsMap()) Fail(key, "expected a section of keys");
         YamlReader reader(child, source_, prefix_ + key + ".", legacy_, moved_);
+        reader.RejectBadKeys();
         VisitFields(section, reader);
         reader.RejectUnknownKeys();
     }
-    void RejectUnknownKeys() const {
+    // yaml-cpp 0.7 keeps both entries of a repeated key and node[key] finds the first, so the
+    // second would be ignored silently. Checked before any value is read, so that the repeat is
+    // what the message names.
+    void RejectBadKeys() const {
+        std::map<std::string, int> first_line;
         for (const auto& entry : node_) {
             if (!entry.first.IsScalar()) FailKeyNotAName(entry.first);
+            const int line = entry.first.Mark().line + 1;
+            const auto [it, inserted] = first_line.emplace(entry.first.Scalar(), line);
+            if (inserted) continue;
+            throw ReadError(
+                source_, "line " + std::to_string(line) + ": key " + Quoted(prefix_ + it->first) +
+                             " appears twice (first on line " + std::to_string(it->second) + ")");
+        }
+    }
+    void RejectUnknownKeys() const {
+        for (const auto& entry : node_) {
             const std::string& key = entry.first.Scalar();
             if (known_.count(key) != 0) continue;
             std::string valid;
@@ -371,7 +395,7 @@ public:
 
 private:
     [[noreturn]] void Fail(const std::string& key, const std::string& problem) const {
-        throw ReadError(source_, "key '" + prefix_ + key + "': " + problem);
+        throw ReadError(source_, "key " + Quoted(prefix_ + key) + ": " + problem);
     }
     // A key that is a list, a map or empty (`[a]: 1`, `{x: 1}: 2`, `? :`) names no setting.
     [[noreturn]] void FailKeyNotAName(const YAML::Node& key) const {
@@ -419,6 +443,7 @@ void ApplyConfigYaml(const std::string& yaml_text, const std::string& source, Ru
         if (!root.IsMap()) throw ReadError(source, "expected a map of keys at the top level");
         std::map<std::string, double> moved;
         YamlReader reader(root, source, "", legacy, &moved);
+        reader.RejectBadKeys();
         VisitFields(updated, reader);
         reader.RejectUnknownKeys();
         MigrateThreshold(moved, updated);

@@ -174,10 +174,10 @@ void CheckEntryCount(const std::filesystem::path& file, const std::string& keywo
 PcdField MakeField(const std::filesystem::path& file, const RawPcdHeader& raw, std::size_t i) {
     PcdField field{raw.names[i], raw.sizes[i], raw.types[i], raw.counts[i]};
     if (field.size != 1 && field.size != 2 && field.size != 4 && field.size != 8) {
-        throw ReadError(file, "field '" + field.name + "' has SIZE " + std::to_string(field.size) +
-                                  " (expected 1, 2, 4 or 8)");
+        throw ReadError(file, "field " + Quoted(field.name) + " has SIZE " +
+                                  std::to_string(field.size) + " (expected 1, 2, 4 or 8)");
     }
-    if (field.count == 0) throw ReadError(file, "field '" + field.name + "' has COUNT 0");
+    if (field.count == 0) throw ReadError(file, "field " + Quoted(field.name) + " has COUNT 0");
     return field;
 }
 
@@ -195,23 +195,32 @@ std::size_t CheckPoints(const std::filesystem::path& file, const RawPcdHeader& r
     return *raw.points;
 }
 
+// The first few field names, quoted: a header may hold a million of them.
+std::string FieldNames(const std::vector<PcdField>& fields) {
+    constexpr std::size_t kMaxNames = 8;
+    std::string names;
+    for (std::size_t i = 0; i < std::min(fields.size(), kMaxNames); ++i) {
+        names += (i == 0 ? "" : " ") + Quoted(fields[i].name);
+    }
+    if (fields.size() > kMaxNames) names += " ... (" + std::to_string(fields.size()) + " fields)";
+    return names;
+}
+
 std::size_t FindCoordinate(const std::filesystem::path& file, const std::vector<PcdField>& fields,
                            const std::string& name) {
     const auto it = std::find_if(fields.begin(), fields.end(),
                                  [&](const PcdField& field) { return field.name == name; });
     if (it == fields.end()) {
-        std::string names;
-        for (const auto& field : fields) names += " " + field.name;
-        throw ReadError(file, "no '" + name + "' field (FIELDS:" + names + ")");
+        throw ReadError(file, "no " + Quoted(name) + " field (FIELDS: " + FieldNames(fields) + ")");
     }
     if (it->type != 'F' || (it->size != 4 && it->size != 8)) {
-        throw ReadError(file, "field '" + name + "' has TYPE " + it->type + " SIZE " +
+        throw ReadError(file, "field " + Quoted(name) + " has TYPE " + it->type + " SIZE " +
                                   std::to_string(it->size) +
                                   "; coordinates must be F 4 (float) or F 8 (double)");
     }
     if (it->count != 1) {
-        throw ReadError(
-            file, "field '" + name + "' has COUNT " + std::to_string(it->count) + " (expected 1)");
+        throw ReadError(file, "field " + Quoted(name) + " has COUNT " + std::to_string(it->count) +
+                                  " (expected 1)");
     }
     return static_cast<std::size_t>(it - fields.begin());
 }
@@ -228,7 +237,7 @@ void CheckPointFitsFile(const std::filesystem::path& file, const std::vector<Pcd
         const std::size_t per_value = encoding == PcdEncoding::kAscii ? 2 : field.size;
         const auto bytes = CheckedMul(field.count, per_value);
         if (!bytes || *bytes > limit - point_bytes) {
-            throw ReadError(file, "field '" + field.name + "' with COUNT " +
+            throw ReadError(file, "field " + Quoted(field.name) + " with COUNT " +
                                       std::to_string(field.count) + " makes one point larger " +
                                       "than the " + std::to_string(file_size) + "-byte file");
         }

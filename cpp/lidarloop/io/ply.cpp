@@ -250,7 +250,7 @@ void CheckAsciiCount(const std::filesystem::path& file, const PlyElement& elemen
                      std::size_t file_size) {
     const std::size_t min_row = std::max<std::size_t>(1, 2 * element.properties.size());
     if (element.count > file_size / min_row) {
-        throw ReadError(file, "element '" + element.name + "' declares " +
+        throw ReadError(file, "element " + Quoted(element.name) + " declares " +
                                   std::to_string(element.count) + " items, more than the " +
                                   std::to_string(file_size) + "-byte file can hold");
     }
@@ -260,8 +260,8 @@ void SkipAsciiElement(LineReader& reader, const PlyElement& element) {
     std::string line;
     for (std::size_t i = 0; i < element.count; ++i) {
         if (!reader.Next(line)) {
-            throw ReadError(reader.file(), "file ends in element '" + element.name + "' after " +
-                                               std::to_string(i) + " of " +
+            throw ReadError(reader.file(), "file ends in element " + Quoted(element.name) +
+                                               " after " + std::to_string(i) + " of " +
                                                std::to_string(element.count) + " items");
         }
     }
@@ -366,17 +366,18 @@ private:
         if (row == 0 || element.count <= Remaining() / row) return;
         const bool fixed = !element.HasLists();
         std::string problem = "binary data truncated";
-        if (fixed) problem += " in " + element.name + " " + std::to_string(Remaining() / row);
-        problem += ": element '" + element.name + "' declares " + std::to_string(element.count) +
-                   " items of " + (fixed ? "" : "at least ") + std::to_string(row) + " bytes (" +
-                   BytesText(CheckedMul(element.count, row)) + " bytes), but " +
-                   std::to_string(Remaining()) + " remain";
+        if (fixed)
+            problem += " in " + Quoted(element.name) + " " + std::to_string(Remaining() / row);
+        problem += ": element " + Quoted(element.name) + " declares " +
+                   std::to_string(element.count) + " items of " + (fixed ? "" : "at least ") +
+                   std::to_string(row) + " bytes (" + BytesText(CheckedMul(element.count, row)) +
+                   " bytes), but " + std::to_string(Remaining()) + " remain";
         throw ReadError(file_, problem);
     }
 
     const char* Take(std::size_t size, const PlyElement& element, std::size_t index) {
         if (size > Remaining()) {
-            throw ReadError(file_, "binary data truncated in " + element.name + " " +
+            throw ReadError(file_, "binary data truncated in " + Quoted(element.name) + " " +
                                        std::to_string(index) + " of " +
                                        std::to_string(element.count));
         }
@@ -393,8 +394,8 @@ private:
         const double count = LoadScalar(Take(TypeSize(*property.count_type), element, index),
                                         *property.count_type, order_);
         if (count < 0) {
-            throw ReadError(file_,
-                            "negative list count in " + element.name + " " + std::to_string(index));
+            throw ReadError(file_, "negative list count in " + Quoted(element.name) + " " +
+                                       std::to_string(index));
         }
         const auto bytes = CheckedMul(static_cast<std::size_t>(count), TypeSize(property.type));
         Take(bytes.value_or(std::numeric_limits<std::size_t>::max()), element, index);

@@ -33,8 +33,8 @@ Columns FindColumns(const detail::LineReader& reader, const std::vector<std::str
 std::size_t ParseIndex(const detail::LineReader& reader, std::string_view field, const char* name) {
     const auto value = detail::ParseSize(field);
     if (!value) {
-        reader.Fail(std::string(name) + " '" + std::string(field) +
-                    "' is not a scan number (an integer >= 0)");
+        reader.Fail(std::string(name) + " " + detail::Quoted(field) +
+                    " is not a scan number (an integer >= 0)");
     }
     return *value;
 }
@@ -44,11 +44,11 @@ std::size_t ParseIndex(const detail::LineReader& reader, std::string_view field,
 double ParseDistance(const detail::LineReader& reader, std::string_view field) {
     const auto distance = detail::ParseDouble(field);
     if (!distance || std::isnan(*distance)) {
-        reader.Fail("distance '" + std::string(field) + "' is not a number");
+        reader.Fail("distance " + detail::Quoted(field) + " is not a number");
     }
     if (*distance == -std::numeric_limits<double>::infinity()) {
-        reader.Fail("distance '" + std::string(field) +
-                    "' is -inf; a pair the detector rejects is +inf or left out");
+        reader.Fail("distance " + detail::Quoted(field) +
+                    " is -inf; a pair the detector rejects is +inf or left out");
     }
     return *distance;
 }

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <filesystem>
+#include <system_error>
 
 #include "lidarloop/io/kitti_bin.hpp"
 #include "lidarloop/io/osnabrueck.hpp"
@@ -45,13 +47,16 @@ Reader FindReader(const std::filesystem::path& file) {
 bool IsScanFile(const std::filesystem::path& file) { return FindReader(file) != nullptr; }
 
 core::PointCloud ReadScan(const std::filesystem::path& file) {
+    // Before the extension: a folder has none, and "unknown scan format ''" would hide the cause.
+    std::error_code ec;
+    if (std::filesystem::is_directory(file, ec)) throw ReadError(file, "is a folder, not a file");
     const Reader reader = FindReader(file);
     if (reader == nullptr) {
         std::string known;
         for (const auto& format : kFormats)
             known += std::string(known.empty() ? "" : " ") + format.extension;
-        throw ReadError(file, "unknown scan format '" + file.extension().string() +
-                                  "' (known extensions: " + known + ")");
+        throw ReadError(file, "unknown scan format " + core::Quoted(file.extension().string()) +
+                                  " (known extensions: " + known + ")");
     }
     return reader(file);
 }

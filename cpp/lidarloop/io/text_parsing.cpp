@@ -81,12 +81,6 @@ std::optional<std::size_t> ParseSize(std::string_view token) {
     return value;
 }
 
-std::string Quoted(std::string_view token) {
-    constexpr std::size_t kMaxChars = 40;
-    if (token.size() <= kMaxChars) return "'" + std::string(token) + "'";
-    return "'" + std::string(token.substr(0, kMaxChars)) + "...'";
-}
-
 std::string ShortNumber(double value) {
     char text[32];
     std::snprintf(text, sizeof(text), "%.3g", value);
@@ -162,7 +156,7 @@ void LineReader::ParseNumbers(const std::vector<std::string_view>& fields, std::
     }
     for (std::size_t i = 0; i < count; ++i) {
         const auto value = ParseDouble(fields[i]);
-        if (!value) Fail("'" + std::string(fields[i]) + "' is not a number");
+        if (!value) Fail(Quoted(fields[i]) + " is not a number");
         out[i] = *value;
     }
 }
@@ -171,7 +165,7 @@ void LineReader::ParseFiniteNumbers(const std::vector<std::string_view>& fields,
                                     double* out) const {
     ParseNumbers(fields, count, out);
     for (std::size_t i = 0; i < count; ++i) {
-        if (!std::isfinite(out[i])) Fail("'" + std::string(fields[i]) + "' is not a finite number");
+        if (!std::isfinite(out[i])) Fail(Quoted(fields[i]) + " is not a finite number");
     }
 }
 

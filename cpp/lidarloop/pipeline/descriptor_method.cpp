@@ -57,8 +57,8 @@ Registry& TheRegistry() {
 }
 
 [[noreturn]] void FailUnknown(std::string_view name) {
-    throw core::ConfigError("unknown method '" + std::string(name) +
-                            "' (valid: " + MethodNamesText(", ") + ")");
+    throw core::ConfigError("unknown method " + core::Quoted(name) +
+                            " (valid: " + MethodNamesText(", ") + ")");
 }
 
 }  // namespace

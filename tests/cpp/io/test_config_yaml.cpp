@@ -106,6 +106,26 @@ TEST(ConfigYaml, AKeyThatIsNoNameIsAReadError) {
     expect_error("verification:\n  icp:\n    [1, 2]: 3\n", "in section 'verification.icp'");
 }
 
+// yaml-cpp 0.7 keeps a repeated key and finds its first value, so the second was ignored silently.
+TEST(ConfigYaml, ARepeatedKeyIsAReadErrorNamingKeyAndLines) {
+    const auto expect_error = [](const std::string& yaml, const std::string& phrase) {
+        const std::string message = ErrorOf(yaml);
+        EXPECT_NE(message.find("my.yaml"), std::string::npos) << yaml << ": " << message;
+        EXPECT_NE(message.find(phrase), std::string::npos) << yaml << ": " << message;
+    };
+    expect_error("method: ndt\nmethod: height\n",
+                 "line 2: key 'method' appears twice (first on line 1)");
+    expect_error("histogram:\n  bins: 12\n  range_max_m: 50\n  bins: 40\n",
+                 "line 4: key 'histogram.bins' appears twice (first on line 2)");
+    expect_error("histogram:\n  bins: 12\nndt:\n  cell_size_m: 1\nhistogram:\n  bins: 40\n",
+                 "line 5: key 'histogram' appears twice (first on line 1)");
+    expect_error("posegraph:\n  robust:\n    gate_sigmas: 3\n    gate_sigmas: 4\n",
+                 "key 'posegraph.robust.gate_sigmas' appears twice");
+    expect_error("histogram: {bins: 3, bins: 4}\n", "key 'histogram.bins' appears twice");
+    // The repeat is named even when the first value is bad.
+    expect_error("histogram:\n  bins: many\n  bins: 4\n", "appears twice");
+}
+
 TEST(ConfigYaml, NdtSectionWithListsAndBooleans) {
     RunConfig config;
     ApplyConfigYaml("method: ndt\nndt:\n  range_limits_m: [2, 4.5]\n  regrid_rotations: true\n",

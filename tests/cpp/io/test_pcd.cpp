@@ -287,7 +287,7 @@ TEST_F(PcdErrors, UnsupportedVersion) {
 TEST_F(PcdErrors, MissingXField) {
     std::string text = XyzHeader(1, "ascii") + "1 2 3\n";
     ReplaceOnce(text, "FIELDS x y z", "FIELDS a y z");
-    ExpectReadError(Write(text), "no 'x' field (FIELDS: a y z)");
+    ExpectReadError(Write(text), "no 'x' field (FIELDS: 'a' 'y' 'z')");
 }
 
 TEST_F(PcdErrors, UnsignedXField) {

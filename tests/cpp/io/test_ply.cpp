@@ -380,7 +380,7 @@ TEST_F(PlyErrors, TruncatedBinaryNamesTheVertex) {
     const std::size_t header_size = bytes.find("end_header\n") + 11;
     ASSERT_EQ(bytes.size(), header_size + 2400);
     ExpectReadError(Write(bytes.substr(0, header_size + 1205)),
-                    "binary data truncated in vertex 50: element 'vertex' declares 100 items of "
+                    "binary data truncated in 'vertex' 50: element 'vertex' declares 100 items of "
                     "24 bytes (2400 bytes), but 1205 remain");
 }
 
@@ -392,7 +392,7 @@ TEST_F(PlyErrors, TruncatedInsideAVertexList) {
     const std::size_t vertex_2 = vertices + (before_list + 4) + (before_list + 3 * 2 + 4);
     // Cut inside the list of vertex 2 (one int16 item); the sizes without lists still fit.
     ExpectReadError(Write(text.substr(0, vertex_2 + before_list + 1)),
-                    "binary data truncated in vertex 2 of 3");
+                    "binary data truncated in 'vertex' 2 of 3");
 }
 
 TEST_F(PlyErrors, TruncatedInAListElementBeforeTheVertices) {
@@ -403,7 +403,7 @@ TEST_F(PlyErrors, TruncatedInAListElementBeforeTheVertices) {
         "ply\nformat binary_little_endian 1.0\nelement face 2\n"
         "property list uchar int vertex_indices\n" +
         XyzElement(0) + "end_header\n" + body.bytes();
-    ExpectReadError(Write(text), "binary data truncated in face 1 of 2");
+    ExpectReadError(Write(text), "binary data truncated in 'face' 1 of 2");
 }
 
 TEST_F(PlyErrors, NegativeListCount) {
@@ -413,7 +413,7 @@ TEST_F(PlyErrors, NegativeListCount) {
         "ply\nformat binary_little_endian 1.0\nelement face 1\n"
         "property list char int vertex_indices\n" +
         XyzElement(0) + "end_header\n" + body.bytes();
-    ExpectReadError(Write(text), "negative list count in face 0");
+    ExpectReadError(Write(text), "negative list count in 'face' 0");
 }
 
 TEST_F(PlyErrors, AbsurdCountsAreRejectedBeforeAllocating) {

@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "lidarloop/core/error.hpp"
 #include "lidarloop/core/point_cloud.hpp"
 
 namespace lidarloop::io::detail {
@@ -37,9 +38,8 @@ std::optional<double> ParseDouble(std::string_view token);
 /// Parses a whole token as a non-negative integer; nullopt when it is not one.
 std::optional<std::size_t> ParseSize(std::string_view token);
 
-/// `token` in single quotes for a message, cut to 40 characters ("...") so that binary garbage
-/// does not flood it.
-std::string Quoted(std::string_view token);
+/// `token` in single quotes for a message, cut when long (core::Quoted).
+using core::Quoted;
 
 /// `value` with 3 significant digits ("%.3g") for a message.
 std::string ShortNumber(double value);
