@@ -37,6 +37,13 @@ std::string Figure(double value, const char* format) {
     return text;
 }
 
+// KITTI's RPE averages segments of 100 m and more; a shorter path has none.
+std::string RpeText(const app::TrajectoryMetrics& before, const app::TrajectoryMetrics& after) {
+    if (before.rpe.segments == 0 || after.rpe.segments == 0) return "n/a (path shorter than 100 m)";
+    return Figure(before.rpe.translation_percent, "%.2f") + " % -> " +
+           Figure(after.rpe.translation_percent, "%.2f") + " %";
+}
+
 void PrintOutcome(const app::OptimiseRequest& request, const app::OptimiseOutcome& outcome) {
     const posegraph::OptimisationResult& r = outcome.result;
     std::cout << "lidarloop optimise: " << outcome.loops.size() << " accepted loops, "
@@ -47,9 +54,7 @@ void PrintOutcome(const app::OptimiseRequest& request, const app::OptimiseOutcom
     if (outcome.odometry && outcome.optimised) {
         std::cout << "  ATE RMSE: odometry " << Figure(outcome.odometry->ate_rmse_m, "%.3f")
                   << " m -> optimised " << Figure(outcome.optimised->ate_rmse_m, "%.3f")
-                  << " m; RPE " << Figure(outcome.odometry->rpe.translation_percent, "%.2f")
-                  << " % -> " << Figure(outcome.optimised->rpe.translation_percent, "%.2f")
-                  << " %\n";
+                  << " m; RPE " << RpeText(*outcome.odometry, *outcome.optimised) << "\n";
     }
     for (const std::string& note : outcome.notes) std::cout << "  note: " << note << "\n";
     std::cout << "  results in " << request.out.string()
