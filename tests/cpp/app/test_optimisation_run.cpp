@@ -72,6 +72,24 @@ TEST_F(OptimisationRun, WithoutLoopsTheOdometryComesBackWithANote) {
     EXPECT_DOUBLE_EQ(outcome.optimised->ate_rmse_m, outcome.odometry->ate_rmse_m);
 }
 
+// Odometry that jumps farther than any vehicle moves between two scans is an error naming the
+// line (issue 25, item 8).
+TEST_F(OptimisationRun, OdometryThatJumpsNamesTheLine) {
+    auto odometry = io::ReadKittiPoses(dir_ / "sequence" / "poses_odometry.txt");
+    for (std::size_t i = 120; i < odometry.size(); ++i) {
+        odometry[i].T_world_sensor.translation().x() += 500.0;  // a reset to a far origin
+    }
+    io::WriteKittiPoses(dir_ / "jump.txt", odometry);
+    app::OptimiseRequest request = Request("jump");
+    request.odometry_file = dir_ / "jump.txt";
+    try {
+        app::RunOptimisation(*dataset_, request);
+        FAIL() << "no error";
+    } catch (const io::ReadError& e) {
+        EXPECT_TRUE(test::Contains(e.what(), "jump.txt: line 121: the pose is ")) << e.what();
+    }
+}
+
 TEST_F(OptimisationRun, BadInputNamesTheFileAndLine) {
     const auto odometry = io::ReadKittiPoses(dir_ / "sequence" / "poses_odometry.txt");
     io::WriteKittiPoses(dir_ / "short.txt",
