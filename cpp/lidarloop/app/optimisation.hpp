@@ -59,7 +59,8 @@ struct OptimiseOutcome {
 /// dataset's scan count; the pose readers name the line of a non-finite value, a 3x3 part that
 /// is no rotation, a time that does not increase or a step above max_odometry_step_m) and the
 /// loops (io::ReadLoopsCsv: a scan that does not exist or a value out of its range names the
-/// line), or detects them, builds and optimises the pose graph, and writes into request.out:
+/// line; rows repeating an earlier row's two scans, in either order, are merged into it, with a
+/// note), or detects them, builds and optimises the pose graph, and writes into request.out:
 /// poses_optimised.txt, graph.g2o (optimised vertices, the odometry edges and the loops used;
 /// rejected loops commented), loop_verdicts.csv, metrics.json, report.md, config.yaml and,
 /// when gnuplot is installed, trajectory.png (top view).
