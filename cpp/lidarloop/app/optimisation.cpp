@@ -175,6 +175,8 @@ OptimiseOutcome RunOptimisation(const io::Dataset& dataset, const OptimiseReques
         posegraph::BuildPoseGraph(Transforms(odometry), outcome.loops, request.config.posegraph);
     outcome.result = posegraph::Optimise(graph, request.config.posegraph);
     if (!outcome.result.note.empty()) outcome.notes.push_back(outcome.result.note);
+    const std::string rejections = posegraph::SummariseRejections(graph, outcome.result);
+    if (!rejections.empty()) outcome.notes.push_back(rejections);
     if (dataset.HasPoses()) {
         const std::vector<core::Transform> truth = Transforms(dataset.poses());
         outcome.loop_is_true = JudgeLoops(outcome.loops, truth, request);
