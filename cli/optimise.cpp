@@ -26,6 +26,7 @@ struct OptimiseFlags {
     std::string loops;
     std::string out;
     std::string format = "kitti";
+    double max_odometry_step_m = app::OptimiseRequest{}.max_odometry_step_m;
     bool skip_bad = false;
     bool overwrite = false;
     bool quiet = false;
@@ -77,6 +78,7 @@ void RunOptimise(const OptimiseFlags& flags) {
     request.odometry_file = flags.odometry;
     request.loops_file = flags.loops;
     request.format = flags.format == "tum" ? app::PoseFormat::kTum : app::PoseFormat::kKitti;
+    request.max_odometry_step_m = flags.max_odometry_step_m;
     request.skip_bad = flags.skip_bad;
     request.progress = progress.Callback();
     request.out = flags.out;
@@ -107,6 +109,11 @@ void AddOptimiseCommand(CLI::App& app) {
     command->add_option("--out", flags->out, "folder for the results (created)")->required();
     command->add_option("--format", flags->format, "poses_optimised.txt format: kitti | tum")
         ->check(CLI::IsMember({"kitti", "tum"}))
+        ->capture_default_str();
+    command
+        ->add_option("--max-odometry-step", flags->max_odometry_step_m,
+                     "M: odometry moving farther between two scans is an error (a jump or reset)")
+        ->check(CLI::PositiveNumber)
         ->capture_default_str();
     flags->descriptor.AddTo(*command);
     flags->detection.AddTo(*command, /*decides_loops=*/true,

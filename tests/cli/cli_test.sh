@@ -8,7 +8,7 @@
 # output; the last line is "cli <sections>: N passed, N failed".
 set -u
 sections=(describe distance ndt verify detect bench demo evaluate dump-config bad-input simulate
-    optimise results-folders errors)
+    optimise results-folders errors loops)
 if [ "${1-}" = "--list" ]; then
     printf '%s\n' "${sections[@]}"
     exit 0
@@ -642,6 +642,43 @@ section_errors() {
     "$cli" describe --no-such-flag "$samples/corner_a.bin" >/dev/null 2>&1
     local code=$?
     if [ "$code" -eq 1 ]; then pass; else fail "unknown flag: exit code $code, expected 1"; fi
+}
+
+# --- loops: each loop enters the pose graph once; implausible loops and odometry are errors -----
+section_loops() {
+    "$cli" simulate --sensor vlp16 --route grid --scans 40 --horizontal-steps 90 --quiet \
+        --out "$work/seq" >/dev/null 2>&1
+    local odometry="$work/seq/poses_odometry.txt"
+    local header="query,match,distance,second_ratio,accepted,rank,tx,ty,tz,qx,qy,qz,qw"
+    header+=",overlap_query,overlap_match,distinctive_query,distinctive_match,rmse_m,reason"
+    local loop="35,2,0.001,,1,1,0,0,0,0,0,0,1,0.6,0.5,0.4,0.3,0.1,none"
+    printf '%s\n' "$header" "$loop" "$loop" "2,35,0.001,,1,1,0,0,0,0,0,0,1,0.6,0.5,0.4,0.3,0.1,none" \
+        "$loop" >"$work/loops.csv"
+    expect_ok "duplicate loops merged" "3 duplicate rows of loops.csv merged" "$cli" optimise \
+        "$work/seq" --odometry "$odometry" --loops "$work/loops.csv" --format tum --out "$work/opt"
+    if [ "$(grep -c '^[0-9]' "$work/opt/loop_verdicts.csv")" -eq 1 ]; then pass; else
+        fail "duplicate loops: loop_verdicts.csv does not hold the loop once"
+    fi
+    printf '%s\n' "$header" "35,2,0.001,,1,1,0,0,0,0,0,0,1,-5,0.5,0.4,0.3,0.1,none" >"$work/neg.csv"
+    expect_exit_1 "overlap -5" "neg.csv: line 2: overlap_query '-5' is outside [0, 1]" "$cli" \
+        optimise "$work/seq" --odometry "$odometry" --loops "$work/neg.csv" --out "$work/bad"
+    awk 'NR == 5 { $4 = "1e30" } { print }' "$odometry" >"$work/far.txt"
+    expect_exit_1 "odometry at 1e30" "far.txt: line 5: the position is 1e+30 m from the origin" \
+        "$cli" optimise "$work/seq" --odometry "$work/far.txt" --loops "$work/loops.csv" \
+        --out "$work/bad"
+    awk 'NR >= 20 { $4 += 500 } { print }' "$odometry" >"$work/jump.txt"
+    expect_exit_1 "odometry jump" "jump.txt: line 20: the pose is " \
+        "$cli" optimise "$work/seq" --odometry "$work/jump.txt" --loops "$work/loops.csv" \
+        --out "$work/bad"
+    awk 'NR == 3 { $1 = "0.5" } { print }' "$work/opt/poses_optimised.txt" >"$work/back.tum"
+    expect_exit_1 "TUM time going back" "back.tum: line 3: time 0.5 goes back" "$cli" optimise \
+        "$work/seq" --odometry "$work/back.tum" --loops "$work/loops.csv" --out "$work/bad"
+    # Odometry that freezes from scan 10 on: the loops disagree with it, and a summary says so.
+    awk 'NR == 11 { frozen = $0 } NR > 11 { $0 = frozen } { print }' "$odometry" >"$work/frozen.txt"
+    printf '%s\n' "$header" "$loop" "36,3${loop#35,2}" "37,4${loop#35,2}" "38,5${loop#35,2}" \
+        >"$work/four.csv"
+    expect_ok "odometry that freezes" "longest standstill: scans 10 to 39" "$cli" optimise \
+        "$work/seq" --odometry "$work/frozen.txt" --loops "$work/four.csv" --out "$work/frozen"
 }
 
 # --- run the sections named on the command line -------------------------------------------------

@@ -1,8 +1,12 @@
 #include "lidarloop/app/optimisation.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <numbers>
+#include <set>
+#include <string>
+#include <utility>
 
 #include "lidarloop/app/detection.hpp"
 #include "lidarloop/app/optimisation_report.hpp"
@@ -16,7 +20,8 @@ namespace {
 
 std::vector<core::StampedPose> LoadOdometry(const OptimiseRequest& request,
                                             const io::Dataset& dataset) {
-    std::vector<core::StampedPose> odometry = io::ReadPoses(request.odometry_file);
+    std::vector<core::StampedPose> odometry = io::ReadPoses(
+        request.odometry_file, core::Transform::Identity(), {}, request.max_odometry_step_m);
     if (odometry.size() != dataset.size()) {
         throw io::ReadError(request.odometry_file, "holds " + std::to_string(odometry.size()) +
                                                        " poses but " + dataset.root().string() +
@@ -47,19 +52,57 @@ std::vector<posegraph::LoopConstraint> DetectLoops(const io::Dataset& dataset,
     return loops;
 }
 
-std::vector<posegraph::LoopConstraint> LoadLoops(const io::Dataset& dataset,
-                                                 const OptimiseRequest& request) {
-    if (request.loops_file.empty()) return DetectLoops(dataset, request);
+// "lines 5, 6, 7 and 3 more" for a note.
+std::string LineList(const std::vector<std::size_t>& lines) {
+    constexpr std::size_t kShown = 5;
+    std::string text = lines.size() == 1 ? "line " : "lines ";
+    for (std::size_t k = 0; k < std::min(lines.size(), kShown); ++k) {
+        text += (k == 0 ? "" : ", ") + std::to_string(lines[k]);
+    }
+    if (lines.size() > kShown) text += " and " + std::to_string(lines.size() - kShown) + " more";
+    return text;
+}
+
+// The loops of a loops.csv, one per pair of scans. A repeated row (the same query and match, or
+// the two swapped: the same constraint inverted, between the same two poses) is one measurement;
+// counted n times it weighs n times (one wrong loop repeated 20 times pushed 22 true loops out of
+// the graph). The first row is kept: detect writes one row per query, so repeats come from
+// concatenated or edited files, and ranking them by their overlap or RMSE would let a wrong row
+// that claims a better fit replace a right one.
+std::vector<posegraph::LoopConstraint> ReadLoops(const io::Dataset& dataset,
+                                                 const OptimiseRequest& request,
+                                                 std::vector<std::string>& notes) {
     std::vector<posegraph::LoopConstraint> loops;
+    std::set<std::pair<std::size_t, std::size_t>> pairs;  // (smaller scan, larger scan)
+    std::vector<std::size_t> merged_lines;
     for (const io::LoopRow& row : io::ReadLoopsCsv(request.loops_file, dataset.size())) {
-        if (row.loop.query == row.loop.match) {
-            throw io::ReadError(request.loops_file,
-                                "line " + std::to_string(row.line) + ": a loop from scan " +
-                                    std::to_string(row.loop.query) + " to itself");
+        const std::size_t query = row.loop.query, match = row.loop.match;
+        if (query == match) {
+            throw io::ReadError(request.loops_file, "line " + std::to_string(row.line) +
+                                                        ": a loop from scan " +
+                                                        std::to_string(query) + " to itself");
+        }
+        if (!pairs.emplace(std::min(query, match), std::max(query, match)).second) {
+            merged_lines.push_back(row.line);
+            continue;
         }
         loops.push_back(row.loop);
     }
+    if (!merged_lines.empty()) {
+        notes.push_back(std::to_string(merged_lines.size()) + " duplicate row" +
+                        (merged_lines.size() == 1 ? "" : "s") + " of " +
+                        request.loops_file.filename().string() +
+                        " merged (the same two scans as an earlier row, in either order; " +
+                        LineList(merged_lines) + "): each loop is used once, as first given");
+    }
     return loops;
+}
+
+std::vector<posegraph::LoopConstraint> LoadLoops(const io::Dataset& dataset,
+                                                 const OptimiseRequest& request,
+                                                 std::vector<std::string>& notes) {
+    if (request.loops_file.empty()) return DetectLoops(dataset, request);
+    return ReadLoops(dataset, request, notes);
 }
 
 std::vector<core::Transform> Transforms(const std::vector<core::StampedPose>& poses) {
@@ -127,11 +170,13 @@ OptimiseOutcome RunOptimisation(const io::Dataset& dataset, const OptimiseReques
     io::WriteConfigYaml(out / "config.yaml", request.config);
     const std::vector<core::StampedPose> odometry = LoadOdometry(request, dataset);
     OptimiseOutcome outcome;
-    outcome.loops = LoadLoops(dataset, request);
+    outcome.loops = LoadLoops(dataset, request, outcome.notes);
     const posegraph::PoseGraph graph =
         posegraph::BuildPoseGraph(Transforms(odometry), outcome.loops, request.config.posegraph);
     outcome.result = posegraph::Optimise(graph, request.config.posegraph);
     if (!outcome.result.note.empty()) outcome.notes.push_back(outcome.result.note);
+    const std::string rejections = posegraph::SummariseRejections(graph, outcome.result);
+    if (!rejections.empty()) outcome.notes.push_back(rejections);
     if (dataset.HasPoses()) {
         const std::vector<core::Transform> truth = Transforms(dataset.poses());
         outcome.loop_is_true = JudgeLoops(outcome.loops, truth, request);

@@ -14,6 +14,14 @@ namespace lidarloop::io {
 namespace {
 
 constexpr std::size_t kMissing = SIZE_MAX;
+// detect writes quaternions with 9 digits: a norm further from 1 is an edited or foreign file.
+constexpr double kQuaternionNormTolerance = 1e-3;
+// The largest acceptance.max_rmse_m (and overlap_radius_m) verification allows: an accepted loop
+// never has a larger RMS plane distance.
+constexpr double kMaxRmseM = 100.0;
+// Scans overlap only within twice the sensor's range (reduction.max_range_m <= 1000 m); 10 km is
+// the largest acceptance.max_loop_distance_m.
+constexpr double kMaxLoopTranslationM = 1e4;
 
 // Column indices of loops.csv; pose = tx ty tz qx qy qz qw.
 struct LoopColumns {
@@ -21,6 +29,7 @@ struct LoopColumns {
     std::array<std::size_t, 7> pose{kMissing, kMissing, kMissing, kMissing,
                                     kMissing, kMissing, kMissing};
     std::size_t overlap_query = kMissing, overlap_match = kMissing, rmse = kMissing;
+    std::size_t distinctive_query = kMissing, distinctive_match = kMissing;
     std::size_t count = 0;
 };
 
@@ -37,6 +46,8 @@ LoopColumns FindLoopColumns(const detail::LineReader& reader,
         if (names[i] == "overlap_query") c.overlap_query = i;
         if (names[i] == "overlap_match") c.overlap_match = i;
         if (names[i] == "rmse_m") c.rmse = i;
+        if (names[i] == "distinctive_query") c.distinctive_query = i;
+        if (names[i] == "distinctive_match") c.distinctive_match = i;
         for (std::size_t k = 0; k < kPose.size(); ++k) {
             if (names[i] == kPose[k]) c.pose[k] = i;
         }
@@ -77,10 +88,35 @@ double ParseFinite(const detail::LineReader& reader, std::string_view field, con
     return *value;
 }
 
+// An optional column's value in [low, high]; NaN when the column is missing or the field empty.
 double ParseOptional(const detail::LineReader& reader, const std::vector<std::string_view>& fields,
-                     std::size_t column, const char* name) {
+                     std::size_t column, const char* name, double low, double high) {
     if (column == kMissing || fields[column].empty()) return std::nan("");
-    return ParseFinite(reader, fields[column], name);
+    const double value = ParseFinite(reader, fields[column], name);
+    if (value < low || value > high) {
+        reader.Fail(std::string(name) + " " + detail::Quoted(fields[column]) + " is outside [" +
+                    detail::ShortNumber(low) + ", " + detail::ShortNumber(high) + "]");
+    }
+    return value;
+}
+
+// T_match_query from tx ty tz qx qy qz qw (`v`), or a failure naming what is implausible.
+core::Transform LoopPose(const detail::LineReader& reader, const std::array<double, 7>& v) {
+    const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);  // Eigen takes w first
+    if (std::abs(q.norm() - 1.0) > kQuaternionNormTolerance) {
+        reader.Fail("quaternion (qx qy qz qw) has norm " + detail::ShortNumber(q.norm()) +
+                    ", expected 1 (within " + detail::ShortNumber(kQuaternionNormTolerance) + ")");
+    }
+    const Eigen::Vector3d t(v[0], v[1], v[2]);
+    if (t.stableNorm() > kMaxLoopTranslationM) {
+        reader.Fail("the loop's translation (tx ty tz) is " + detail::ShortNumber(t.stableNorm()) +
+                    " m long; scans that far apart cannot overlap (at most " +
+                    detail::ShortNumber(kMaxLoopTranslationM) + " m)");
+    }
+    core::Transform T = core::Transform::Identity();
+    T.linear() = q.normalized().toRotationMatrix();
+    T.translation() = t;
+    return T;
 }
 
 LoopRow ParseLoopRow(const detail::LineReader& reader, const std::vector<std::string_view>& f,
@@ -95,17 +131,14 @@ LoopRow ParseLoopRow(const detail::LineReader& reader, const std::vector<std::st
         if (f[c.pose[k]].empty()) reader.Fail("an accepted loop without a pose (empty tx..qw)");
         v[k] = ParseFinite(reader, f[c.pose[k]], kNames[k]);
     }
-    const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);  // Eigen takes w first
-    if (q.norm() < 0.9 || q.norm() > 1.1) {
-        reader.Fail("quaternion (qx qy qz qw) has norm " + detail::ShortNumber(q.norm()) +
-                    ", expected 1");
-    }
-    row.loop.T_match_query.linear() = q.normalized().toRotationMatrix();
-    row.loop.T_match_query.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
-    const double overlap_query = ParseOptional(reader, f, c.overlap_query, "overlap_query");
-    const double overlap_match = ParseOptional(reader, f, c.overlap_match, "overlap_match");
+    row.loop.T_match_query = LoopPose(reader, v);
+    // Fractions of points; the distinctive ones are only checked.
+    const double overlap_query = ParseOptional(reader, f, c.overlap_query, "overlap_query", 0, 1);
+    const double overlap_match = ParseOptional(reader, f, c.overlap_match, "overlap_match", 0, 1);
+    ParseOptional(reader, f, c.distinctive_query, "distinctive_query", 0, 1);
+    ParseOptional(reader, f, c.distinctive_match, "distinctive_match", 0, 1);
     row.loop.overlap = std::fmin(overlap_query, overlap_match);  // NaN only when both are
-    row.loop.rmse_m = ParseOptional(reader, f, c.rmse, "rmse_m");
+    row.loop.rmse_m = ParseOptional(reader, f, c.rmse, "rmse_m", 0, kMaxRmseM);
     return row;
 }
 

@@ -23,8 +23,10 @@ struct LoopRow {
 /// Throws ReadError naming the file and line for a header without query, match, accepted or the
 /// pose columns (a loops.csv from `detect --no-verify` has no pose), an accepted row without a
 /// pose, a row with more fields than the header, a scan index not below `scan_count`, a
-/// non-number, a non-finite value, or a quaternion whose norm is far from 1 (< 0.9 or > 1.1;
-/// others are normalised).
+/// non-number, a non-finite value, a quaternion whose norm is not within 1e-3 of 1 (others are
+/// normalised), a translation longer than 10 km, an overlap or distinctive fraction outside
+/// [0, 1], or an rmse_m outside [0, 100] m (the verification accepts none larger). Rows are
+/// returned as they are: duplicates are the caller's to merge.
 std::vector<LoopRow> ReadLoopsCsv(const std::filesystem::path& file, std::size_t scan_count);
 
 /// Writes a pose graph in g2o's text format: one `VERTEX_SE3:QUAT id x y z qx qy qz qw` per pose

@@ -1,5 +1,6 @@
 #include "lidarloop/io/poses.hpp"
 
+#include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -14,6 +15,10 @@ namespace lidarloop::io {
 namespace {
 
 using Fields = std::vector<std::string_view>;
+
+// Farther from the origin than any Earth-fixed frame puts a sensor (UTM northings reach 1e7 m,
+// ECEF coordinates 6.4e6 m): a corrupt value, which would otherwise make the ATE 1e28 m.
+constexpr double kMaxPositionM = 1e8;
 
 // Next line that is neither blank nor a '#' comment; `fields` view into `line`.
 bool NextDataLine(detail::LineReader& reader, std::string& line, Fields& fields) {
@@ -42,6 +47,35 @@ core::Transform ParseMatrix3x4(const detail::LineReader& reader, const Fields& f
     return T;
 }
 
+// Fails naming the current line when `pose` is implausible: farther than kMaxPositionM from the
+// origin, more than max_step_m from `previous` (nullptr for the first pose).
+void CheckPosition(const detail::LineReader& reader, const core::Transform& pose,
+                   const core::Transform* previous, double max_step_m) {
+    const double distance_m = pose.translation().stableNorm();  // 1e200 squared overflows
+    if (distance_m > kMaxPositionM) {
+        reader.Fail("the position is " + detail::ShortNumber(distance_m) +
+                    " m from the origin (more than " + detail::ShortNumber(kMaxPositionM) +
+                    " m: a corrupt value?)");
+    }
+    if (previous == nullptr) return;
+    const double step_m = (pose.translation() - previous->translation()).norm();
+    if (step_m > max_step_m) {
+        reader.Fail("the pose is " + detail::ShortNumber(step_m) +
+                    " m from the one before (at most " + detail::ShortNumber(max_step_m) +
+                    " m between consecutive scans: does the odometry jump or reset?)");
+    }
+}
+
+// Fails naming the current line unless `time_s` comes after `previous_s`.
+void CheckTimeIncreases(const detail::LineReader& reader, double time_s, double previous_s) {
+    if (time_s > previous_s) return;
+    reader.Fail("time " + detail::ShortNumber(time_s) +
+                (time_s == previous_s
+                     ? " repeats the time before"
+                     : " goes back from the time before, " + detail::ShortNumber(previous_s)) +
+                " (times must increase)");
+}
+
 std::vector<double> ReadTimes(const std::filesystem::path& times_file) {
     detail::LineReader reader(times_file);
     std::vector<double> times;
@@ -53,6 +87,7 @@ std::vector<double> ReadTimes(const std::filesystem::path& times_file) {
         }
         double time_s = 0.0;
         reader.ParseFiniteNumbers(fields, 1, &time_s);
+        if (!times.empty()) CheckTimeIncreases(reader, time_s, times.back());
         times.push_back(time_s);
     }
     return times;
@@ -72,9 +107,13 @@ core::Transform ReadKittiCalibTr(const std::filesystem::path& calib_file) {
                     "calib.txt?");
 }
 
-std::vector<core::StampedPose> ReadKittiPoses(const std::filesystem::path& poses_file,
-                                              const core::Transform& T_cam0_velo,
-                                              const std::filesystem::path& times_file) {
+namespace {
+
+// ReadKittiPoses with a bound on the step between consecutive poses (ReadPoses).
+std::vector<core::StampedPose> ReadKittiPosesBounded(const std::filesystem::path& poses_file,
+                                                     const core::Transform& T_cam0_velo,
+                                                     const std::filesystem::path& times_file,
+                                                     double max_step_m) {
     detail::LineReader reader(poses_file);
     const core::Transform T_velo_cam0 = T_cam0_velo.inverse();
     std::vector<core::StampedPose> poses;
@@ -85,6 +124,8 @@ std::vector<core::StampedPose> ReadKittiPoses(const std::filesystem::path& poses
         pose.time_s = static_cast<double>(poses.size());
         // P_i = T_cam0first_cam0i; conjugating by the calibration gives T_velo0_veloi.
         pose.T_world_sensor = T_velo_cam0 * ParseMatrix3x4(reader, fields, 0) * T_cam0_velo;
+        CheckPosition(reader, pose.T_world_sensor,
+                      poses.empty() ? nullptr : &poses.back().T_world_sensor, max_step_m);
         poses.push_back(pose);
     }
     if (times_file.empty()) return poses;
@@ -96,6 +137,19 @@ std::vector<core::StampedPose> ReadKittiPoses(const std::filesystem::path& poses
     }
     for (std::size_t i = 0; i < poses.size(); ++i) poses[i].time_s = times[i];
     return poses;
+}
+
+// ReadTumPoses with a bound on the step between consecutive poses (ReadPoses).
+std::vector<core::StampedPose> ReadTumPosesBounded(const std::filesystem::path& file,
+                                                   double max_step_m);
+
+}  // namespace
+
+std::vector<core::StampedPose> ReadKittiPoses(const std::filesystem::path& poses_file,
+                                              const core::Transform& T_cam0_velo,
+                                              const std::filesystem::path& times_file) {
+    return ReadKittiPosesBounded(poses_file, T_cam0_velo, times_file,
+                                 std::numeric_limits<double>::infinity());
 }
 
 void WriteKittiPoses(const std::filesystem::path& poses_file,
@@ -112,7 +166,10 @@ void WriteKittiPoses(const std::filesystem::path& poses_file,
     detail::WriteTextFile(poses_file, text);
 }
 
-std::vector<core::StampedPose> ReadTumPoses(const std::filesystem::path& file) {
+namespace {
+
+std::vector<core::StampedPose> ReadTumPosesBounded(const std::filesystem::path& file,
+                                                   double max_step_m) {
     detail::LineReader reader(file);
     std::vector<core::StampedPose> poses;
     std::string line;
@@ -133,20 +190,33 @@ std::vector<core::StampedPose> ReadTumPoses(const std::filesystem::path& file) {
         pose.time_s = v[0];
         pose.T_world_sensor.linear() = q.normalized().toRotationMatrix();
         pose.T_world_sensor.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
+        const core::StampedPose* previous = poses.empty() ? nullptr : &poses.back();
+        if (previous != nullptr) CheckTimeIncreases(reader, pose.time_s, previous->time_s);
+        CheckPosition(reader, pose.T_world_sensor,
+                      previous != nullptr ? &previous->T_world_sensor : nullptr, max_step_m);
         poses.push_back(pose);
     }
     return poses;
 }
 
+}  // namespace
+
+std::vector<core::StampedPose> ReadTumPoses(const std::filesystem::path& file) {
+    return ReadTumPosesBounded(file, std::numeric_limits<double>::infinity());
+}
+
 std::vector<core::StampedPose> ReadPoses(const std::filesystem::path& file,
                                          const core::Transform& T_cam0_velo,
-                                         const std::filesystem::path& times_file) {
+                                         const std::filesystem::path& times_file,
+                                         double max_step_m) {
     detail::LineReader reader(file);
     std::string line;
     Fields fields;
     if (!NextDataLine(reader, line, fields)) return {};
-    if (fields.size() == 12) return ReadKittiPoses(file, T_cam0_velo, times_file);
-    if (fields.size() == 8) return ReadTumPoses(file);
+    if (fields.size() == 12) {
+        return ReadKittiPosesBounded(file, T_cam0_velo, times_file, max_step_m);
+    }
+    if (fields.size() == 8) return ReadTumPosesBounded(file, max_step_m);
     reader.Fail("cannot tell the pose format: expected 12 numbers (KITTI) or 8 (TUM), got " +
                 std::to_string(fields.size()));
 }

@@ -4,6 +4,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <string>
@@ -415,6 +416,66 @@ OptimisationResult Optimise(const PoseGraph& graph, const PoseGraphConfig& confi
     result.seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
+}
+
+namespace {
+
+// Steps shorter than this are a standstill (a frozen odometry repeats its pose exactly).
+constexpr double kStandstillStepM = 1e-6;
+
+std::string Metres(double value) {
+    char text[32];
+    std::snprintf(text, sizeof(text), value < 10.0 ? "%.2f m" : "%.1f m", value);
+    return text;
+}
+
+// What in the odometry may make it disagree with the loops: its largest step (a reset or a
+// jump), against the median step, and its longest run of repeated poses (a freeze).
+std::string OdometryEvidence(const std::vector<core::Transform>& poses) {
+    if (poses.size() < 2) return "";
+    std::vector<double> steps;
+    std::size_t largest = 0, run_begin = 0, best_begin = 0, best_length = 0;
+    for (std::size_t i = 0; i + 1 < poses.size(); ++i) {
+        steps.push_back((poses[i + 1].translation() - poses[i].translation()).norm());
+        if (steps[i] > steps[largest]) largest = i;
+        if (steps[i] >= kStandstillStepM) run_begin = i + 1;
+        if (i + 1 - run_begin > best_length) {
+            best_begin = run_begin;
+            best_length = i + 1 - run_begin;
+        }
+    }
+    const double largest_m = steps[largest];
+    std::string text = "largest step " + Metres(largest_m) + ", median " + Metres(Median(steps)) +
+                       ", from scan " + std::to_string(largest) + " to " +
+                       std::to_string(largest + 1) + "; ";
+    if (best_length == 0) return text + "no standstill";
+    return text + "longest standstill: scans " + std::to_string(best_begin) + " to " +
+           std::to_string(best_begin + best_length);
+}
+
+}  // namespace
+
+std::string SummariseRejections(const PoseGraph& graph, const OptimisationResult& result) {
+    const std::size_t total = result.loops.size();
+    const std::size_t rejected = total - result.loops_used;
+    // One or two rejected loops are wrong loops more likely than a broken odometry.
+    constexpr std::size_t kEnMasse = 3;
+    if (rejected < kEnMasse || 2 * rejected <= total) return "";
+    std::string text =
+        std::to_string(rejected) + " of " + std::to_string(total) + " loops rejected, ";
+    // The gate compares each loop with the odometry alone: when it rejects most, the odometry
+    // is the suspect; otherwise the loops disagree with each other or with the optimised graph.
+    if (2 * result.rejected_by_odometry >= rejected) {
+        text += std::to_string(result.rejected_by_odometry) +
+                " of them against the odometry: does the odometry reset or freeze?";
+    } else {
+        text += std::to_string(result.rejected_by_odometry) + " against the odometry, " +
+                std::to_string(result.rejected_by_consistency) + " without support, " +
+                std::to_string(result.rejected_by_residual) +
+                " by their residual: are the loops of this sequence, and is the odometry right?";
+    }
+    const std::string evidence = OdometryEvidence(graph.poses);
+    return evidence.empty() ? text : text + " (" + evidence + ")";
 }
 
 }  // namespace lidarloop::posegraph

@@ -71,4 +71,12 @@ struct OptimisationResult {
 /// edge naming a pose that does not exist. Pure: no I/O; thread-safe for distinct graphs.
 OptimisationResult Optimise(const PoseGraph& graph, const PoseGraphConfig& config);
 
+/// When the back end rejected more than half of the loops of `result` (the outcome of Optimise
+/// on `graph`), and at least 3: one line with the count, the main cause and what in the odometry
+/// (graph.poses) may explain it, its largest step against the median step and its longest
+/// standstill, e.g. "178 of 183 loops rejected, 178 of them against the odometry: does the odometry
+/// reset or freeze? (largest step 45.2 m, median 0.9 m, from scan 811 to 812; longest standstill:
+/// scans 300 to 420)". Empty otherwise.
+std::string SummariseRejections(const PoseGraph& graph, const OptimisationResult& result);
+
 }  // namespace lidarloop::posegraph

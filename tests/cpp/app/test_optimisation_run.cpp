@@ -72,6 +72,49 @@ TEST_F(OptimisationRun, WithoutLoopsTheOdometryComesBackWithANote) {
     EXPECT_DOUBLE_EQ(outcome.optimised->ate_rmse_m, outcome.odometry->ate_rmse_m);
 }
 
+// A loop repeated in loops.csv, also with its two scans swapped, enters the graph once, with a
+// note (issue 25, item 4).
+TEST_F(OptimisationRun, DuplicateLoopsAreMergedWithANote) {
+    const std::string header =
+        "query,match,distance,second_ratio,accepted,rank,tx,ty,tz,qx,qy,qz,qw\n";
+    test::WriteFile(dir_ / "loops.csv",
+                    header + "150,30,0.1,,1,1,1,2,0,0,0,0,1\n" + "150,30,0.1,,1,1,1,2,0,0,0,0,1\n" +
+                        "30,150,0.1,,1,1,-1,-2,0,0,0,0,1\n" + "160,40,0.1,,1,1,0,0,0,0,0,0,1\n" +
+                        "150,30,0.1,,1,1,5,5,0,0,0,0,1\n");
+    app::OptimiseRequest request = Request("merged");
+    request.loops_file = dir_ / "loops.csv";
+    const app::OptimiseOutcome outcome = app::RunOptimisation(*dataset_, request);
+    ASSERT_EQ(outcome.loops.size(), 2u);
+    EXPECT_EQ(outcome.loops[0].query, 150u);
+    EXPECT_DOUBLE_EQ(outcome.loops[0].T_match_query.translation().x(), 1.0);  // the first row
+    EXPECT_EQ(outcome.loops[1].query, 160u);
+    EXPECT_EQ(outcome.result.loops.size(), 2u);
+    bool noted = false;
+    for (const std::string& note : outcome.notes) {
+        if (test::Contains(note, "3 duplicate rows of loops.csv merged"))
+            noted = test::Contains(note, "lines 3, 4, 6)");
+    }
+    EXPECT_TRUE(noted) << ::testing::PrintToString(outcome.notes);
+}
+
+// Odometry that jumps farther than any vehicle moves between two scans is an error naming the
+// line (issue 25, item 8).
+TEST_F(OptimisationRun, OdometryThatJumpsNamesTheLine) {
+    auto odometry = io::ReadKittiPoses(dir_ / "sequence" / "poses_odometry.txt");
+    for (std::size_t i = 120; i < odometry.size(); ++i) {
+        odometry[i].T_world_sensor.translation().x() += 500.0;  // a reset to a far origin
+    }
+    io::WriteKittiPoses(dir_ / "jump.txt", odometry);
+    app::OptimiseRequest request = Request("jump");
+    request.odometry_file = dir_ / "jump.txt";
+    try {
+        app::RunOptimisation(*dataset_, request);
+        FAIL() << "no error";
+    } catch (const io::ReadError& e) {
+        EXPECT_TRUE(test::Contains(e.what(), "jump.txt: line 121: the pose is ")) << e.what();
+    }
+}
+
 TEST_F(OptimisationRun, BadInputNamesTheFileAndLine) {
     const auto odometry = io::ReadKittiPoses(dir_ / "sequence" / "poses_odometry.txt");
     io::WriteKittiPoses(dir_ / "short.txt",

@@ -73,6 +73,45 @@ TEST(ReadLoopsCsv, BadInputNamesTheFileAndLine) {
                          "missing.csv: no such file"));
 }
 
+// Values out of their range are errors naming the line (issue 25, item 8).
+TEST(ReadLoopsCsv, ImplausibleValuesNameTheLine) {
+    TempDir dir;
+    const auto file = dir / "loops.csv";
+    // The full header of detect, with the distinctive fractions.
+    const std::string header =
+        "query,match,distance,second_ratio,accepted,rank,tx,ty,tz,qx,qy,qz,qw,overlap_query,"
+        "overlap_match,distinctive_query,distinctive_match,rmse_m,shifted_overlap,reason\n";
+    const auto row = [](const std::string& pose, const std::string& fit) {
+        return "40,3,0.004,0.5,1,1," + pose + "," + fit + ",,none\n";
+    };
+    const auto error = [&](const std::string& text) {
+        WriteFile(file, header + "41,4,0.004,,0\n" + text);
+        return ReadErrorOf([&] { ReadLoopsCsv(file, 50); });
+    };
+    const std::string pose = "1,2,0,0,0,0,1";
+    EXPECT_TRUE(Contains(error(row(pose, "0.6,0.4,0.3,0.2,0.1")), "no ReadError"));
+    EXPECT_TRUE(Contains(error(row(pose, ",,,,")), "no ReadError"));  // unknown: NaN
+    EXPECT_TRUE(Contains(error(row(pose, "-5,0.4,0.3,0.2,0.1")),
+                         "loops.csv: line 3: overlap_query '-5' is outside [0, 1]"));
+    EXPECT_TRUE(Contains(error(row(pose, "0.6,1.5,0.3,0.2,0.1")),
+                         "line 3: overlap_match '1.5' is outside [0, 1]"));
+    EXPECT_TRUE(Contains(error(row(pose, "0.6,0.4,-0.1,0.2,0.1")),
+                         "line 3: distinctive_query '-0.1' is outside [0, 1]"));
+    EXPECT_TRUE(Contains(error(row(pose, "0.6,0.4,0.3,2,0.1")),
+                         "line 3: distinctive_match '2' is outside [0, 1]"));
+    EXPECT_TRUE(Contains(error(row(pose, "0.6,0.4,0.3,0.2,-1")),
+                         "line 3: rmse_m '-1' is outside [0, 100]"));
+    EXPECT_TRUE(Contains(error(row(pose, "0.6,0.4,0.3,0.2,1e300")),
+                         "line 3: rmse_m '1e300' is outside [0, 100]"));
+    EXPECT_TRUE(Contains(error(row(pose, "0.6,0.4,0.3,0.2,inf")),
+                         "line 3: rmse_m 'inf' is not a finite number"));
+    EXPECT_TRUE(Contains(error(row("1,2,0,0,0,0,1.01", "0.6,0.4,0.3,0.2,0.1")),
+                         "line 3: quaternion (qx qy qz qw) has norm 1.01, expected 1"));
+    EXPECT_TRUE(Contains(error(row("1,2,0,0,0,0,1.0001", "0.6,0.4,0.3,0.2,0.1")), "no ReadError"));
+    EXPECT_TRUE(Contains(error(row("1e300,2,0,0,0,0,1", "0.6,0.4,0.3,0.2,0.1")),
+                         "line 3: the loop's translation (tx ty tz) is 1e+300 m long"));
+}
+
 // A plain g2o reader for the round trip: vertices and edges by their tags.
 struct G2oFile {
     std::vector<std::vector<double>> vertices;  // id x y z qx qy qz qw

@@ -1,4 +1,5 @@
 #include <cmath>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -145,6 +146,47 @@ TEST(KittiPoses, TimesCountMismatchNamesBothCounts) {
                          "times.txt: line 2: expected 1 number (time in s), got 2"));
 }
 
+// Implausible poses are errors naming the line (issue 25, item 8); a standstill is not.
+TEST(KittiPoses, ImplausiblePositionsNameTheLine) {
+    test::TempDir dir;
+    const auto file = dir / "poses.txt";
+    const auto error_of = [&](const std::string& text, double max_step_m) {
+        test::WriteFile(file, text);
+        return ReadErrorOf([&] { ReadPoses(file, core::Transform::Identity(), {}, max_step_m); });
+    };
+    const double kAny = std::numeric_limits<double>::infinity();
+    EXPECT_TRUE(Contains(error_of(kIdentityLine + "1 0 0 1e30 0 1 0 0 0 0 1 0\n", kAny),
+                         "poses.txt: line 2: the position is 1e+30 m from the origin"));
+    EXPECT_TRUE(Contains(error_of("1 0 0 0 0 1 0 -2e8 0 0 1 0\n", kAny), "line 1: the position"));
+    // UTM coordinates are fine, and so is any step without a bound (ground truth).
+    EXPECT_TRUE(Contains(error_of("1 0 0 5e5 0 1 0 9.9e6 0 0 1 0\n", 100), "no ReadError"));
+    EXPECT_TRUE(
+        Contains(error_of(kIdentityLine + "1 0 0 5e5 0 1 0 0 0 0 1 0\n", kAny), "no ReadError"));
+    EXPECT_TRUE(Contains(error_of(kIdentityLine + "1 0 0 0 0 1 0 150 0 0 1 0\n", 100),
+                         "line 2: the pose is 150 m from the one before (at most 100 m"));
+    EXPECT_TRUE(
+        Contains(error_of(kIdentityLine + "1 0 0 0 0 1 0 99 0 0 1 0\n", 100), "no ReadError"));
+    // A standstill (identical poses) is legal.
+    EXPECT_TRUE(
+        Contains(error_of(kIdentityLine + kIdentityLine + kIdentityLine, 100), "no ReadError"));
+}
+
+TEST(KittiPoses, TimesThatDoNotIncreaseNameTheLine) {
+    test::TempDir dir;
+    test::WriteFile(dir / "poses.txt", kIdentityLine + kIdentityLine + kIdentityLine);
+    const auto error_of = [&](const std::string& times) {
+        test::WriteFile(dir / "times.txt", times);
+        return ReadErrorOf([&] {
+            ReadKittiPoses(dir / "poses.txt", core::Transform::Identity(), dir / "times.txt");
+        });
+    };
+    EXPECT_TRUE(
+        Contains(error_of("0\n0.1\n0.1\n"), "times.txt: line 3: time 0.1 repeats the time before"));
+    EXPECT_TRUE(Contains(error_of("0\n0.2\n0.1\n"),
+                         "times.txt: line 3: time 0.1 goes back from the time before, 0.2"));
+    EXPECT_TRUE(Contains(error_of("0\n0.1\n0.2\n"), "no ReadError"));
+}
+
 TEST(KittiCalib, MissingOrBadTrLineIsAReadError) {
     test::TempDir dir;
     const std::string p0 = "P0: 718.856 0 607.1928 0 0 718.856 185.2157 0 0 0 1 0\n";
@@ -205,6 +247,27 @@ TEST(TumPoses, BadLinesNameFileAndLine) {
     EXPECT_TRUE(Contains(error_of("1 0 0 zero 0 0 0 1\n"), "line 1: 'zero' is not a number"));
     EXPECT_TRUE(Contains(error_of("1 nan 0 0 0 0 0 1\n"), "'nan' is not a finite number"));
     EXPECT_TRUE(Contains(ReadErrorOf([&] { ReadTumPoses(dir / "none.txt"); }), "no such file"));
+}
+
+TEST(TumPoses, ImplausibleTimesAndPositionsNameTheLine) {
+    test::TempDir dir;
+    const auto error_of = [&](const std::string& text, double max_step_m) {
+        test::WriteFile(dir / "traj.txt", text);
+        return ReadErrorOf(
+            [&] { ReadPoses(dir / "traj.txt", core::Transform::Identity(), {}, max_step_m); });
+    };
+    const double kAny = std::numeric_limits<double>::infinity();
+    const std::string first = "1.0 0 0 0 0 0 0 1\n";
+    EXPECT_TRUE(Contains(error_of(first + "0.5 0 0 0 0 0 0 1\n", kAny),
+                         "traj.txt: line 2: time 0.5 goes back from the time before, 1"));
+    EXPECT_TRUE(Contains(error_of(first + "1.0 0 0 0 0 0 0 1\n", kAny),
+                         "line 2: time 1 repeats the time before"));
+    EXPECT_TRUE(Contains(error_of(first + "2 1e30 0 0 0 0 0 1\n", kAny),
+                         "line 2: the position is 1e+30 m from the origin"));
+    EXPECT_TRUE(Contains(error_of(first + "2 0 0 101 0 0 0 1\n", 100),
+                         "line 2: the pose is 101 m from the one before"));
+    EXPECT_TRUE(Contains(error_of(first + "2 0 0 0 0 0 0 1\n3 0 0 0 0 0 0 1\n", 100),
+                         "no ReadError"));  // a standstill
 }
 
 TEST(TumPoses, EmptyFileGivesNoPoses) {

@@ -198,6 +198,54 @@ TEST(Optimise, WithoutLoopsTheOdometryComesBackUnchangedWithANote) {
     }
 }
 
+// Odometry that freezes early in the second lap, then goes on from where it stopped: every loop
+// after the freeze disagrees with it by the missing 80 m (issue 25, item 8).
+TEST(SummariseRejections, NamesTheCauseWhenMostLoopsAreRejected) {
+    const std::vector<core::Transform> truth = EllipseLaps(2);
+    const std::size_t begin = truth.size() / 2 + 5, end = begin + 40;
+    std::vector<core::Transform> odometry = {truth.front()};
+    for (std::size_t i = 1; i < truth.size(); ++i) {
+        const bool frozen = i > begin && i <= end;
+        odometry.push_back(frozen ? odometry.back()
+                                  : odometry.back() * (truth[i - 1].inverse() * truth[i]));
+    }
+    const PoseGraph graph = BuildPoseGraph(odometry, TrueLoops(truth, 3, 2), {});
+    const OptimisationResult result = Optimise(graph, {});
+    ASSERT_GT(2 * (result.loops.size() - result.loops_used), result.loops.size());
+    const std::string summary = SummariseRejections(graph, result);
+    EXPECT_NE(summary.find(" loops rejected, "), std::string::npos) << summary;
+    EXPECT_NE(summary.find("against the odometry: does the odometry reset or freeze?"),
+              std::string::npos)
+        << summary;
+    EXPECT_NE(summary.find("longest standstill: scans " + std::to_string(begin) + " to " +
+                           std::to_string(end)),
+              std::string::npos)
+        << summary;
+    // Good odometry: no summary.
+    const PoseGraph good = BuildPoseGraph(truth, TrueLoops(truth, 3, 2), {});
+    EXPECT_EQ(SummariseRejections(good, Optimise(good, {})), "");
+}
+
+TEST(SummariseRejections, NamesTheCountsWhenTheLoopsDisagreeAmongThemselves) {
+    PoseGraph graph;
+    graph.poses = {PlanarPose(0, 0, 0), PlanarPose(1, 0, 0), PlanarPose(31, 0, 0)};
+    OptimisationResult result;
+    result.loops.resize(4);
+    result.loops_used = 1;
+    result.rejected_by_odometry = 1;
+    result.rejected_by_residual = 2;
+    EXPECT_EQ(SummariseRejections(graph, result),
+              "3 of 4 loops rejected, 1 against the odometry, 0 without support, 2 by their "
+              "residual: are the loops of this sequence, and is the odometry right? (largest "
+              "step 30.0 m, median 30.0 m, from scan 1 to 2; no standstill)");
+    result.loops_used = 2;
+    result.rejected_by_residual = 1;
+    EXPECT_EQ(SummariseRejections(graph, result), "");  // half is not most
+    result.loops.resize(2);
+    result.loops_used = 0;
+    EXPECT_EQ(SummariseRejections(graph, result), "");  // two wrong loops are no pattern
+}
+
 TEST(Optimise, BadInput) {
     const std::vector<core::Transform> poses = EllipseLaps(1);
     EXPECT_THROW(BuildPoseGraph(poses, {{poses.size(), 0, core::Transform::Identity()}}, {}),
