@@ -22,8 +22,8 @@ const std::string& CommandLine();
 /// neither lie inside nor hold; `overwrite` allows a non-empty folder of other files.
 template <typename Run>
 auto RunInFolder(const std::filesystem::path& out, std::vector<std::filesystem::path> inputs,
-                 bool overwrite, Run&& run, io::RunKind kind = io::RunKind::kResults) {
-    return app::RunInFolder(out, {CommandLine(), std::move(inputs), overwrite, kind},
+                 bool overwrite, Run&& run) {
+    return app::RunInFolder(out, {CommandLine(), std::move(inputs), overwrite},
                             std::forward<Run>(run));
 }
 
