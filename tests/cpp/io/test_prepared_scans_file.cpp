@@ -1,5 +1,7 @@
 // database.scans: a round trip keeps every point, normal, flag and figure; damaged files are read
 // errors naming the file, never a crash.
+#include <sys/resource.h>
+
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -43,6 +45,26 @@ TEST(PreparedScansFile, RoundTripKeepsEverything) {
         EXPECT_EQ(a.input_points, b.input_points);
     }
     EXPECT_EQ(PreparedScansPathOf(dir / "database.lldb"), dir / "database.scans");
+}
+
+long PeakResidentKiB() {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return usage.ru_maxrss;
+}
+
+// Issue 25 (12): saving once encoded the whole file in memory, so the end of a long detect run
+// peaked at its prepared scans plus the size of database.scans. 2,000 entries that share one
+// scan make a ~100 MB file from almost no memory; saving it must not raise the peak by that.
+TEST(PreparedScansFile, SavingHoldsNoCopyOfTheFile) {
+    const std::vector<registration::PreparedScan> one = TwoScansAndAGap();
+    const std::vector<registration::PreparedScan> scans(2000, one.front());
+    const auto scan_bytes = static_cast<long>(24 * one.front().structure->size());
+    const long file_kib = 2000 * scan_bytes / 1024;
+    ASSERT_GT(file_kib, 40 * 1024) << "too small a file to tell";
+    const long before_kib = PeakResidentKiB();
+    SavePreparedScans("/dev/null", scans, {});
+    EXPECT_LT(PeakResidentKiB() - before_kib, file_kib / 4) << "file " << file_kib << " KiB";
 }
 
 // Written as it goes: a failed write must still be an error, not a file that looks whole.
