@@ -74,6 +74,8 @@ public:
     }
     void PutMagic(const char* magic) { data_.append(magic); }
     const std::string& data() const { return data_; }
+    /// Empties the buffer and keeps its capacity, for writing a file piece by piece.
+    void Clear() { data_.clear(); }
 
 private:
     std::string data_;

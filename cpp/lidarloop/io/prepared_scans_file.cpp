@@ -93,8 +93,9 @@ void SavePreparedScans(const std::filesystem::path& file,
     header.PutString(DumpConfigYaml(config));
     header.Put<std::uint64_t>(scans.size());
     Append(out, header);
+    core::ByteWriter bytes;  // one buffer for all scans
     for (const registration::PreparedScan& scan : scans) {
-        core::ByteWriter bytes;
+        bytes.Clear();
         PutScan(bytes, scan);
         Append(out, bytes);
     }
