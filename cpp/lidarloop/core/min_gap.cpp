@@ -12,6 +12,7 @@ namespace {
 constexpr auto kUnitNames = std::to_array<EnumName<MinGap::Unit>>({
     {MinGap::Unit::kScans, "scans"},
     {MinGap::Unit::kSeconds, "seconds"},
+    {MinGap::Unit::kMetres, "metres"},
 });
 static_assert(IsOneToOne(kUnitNames));
 
@@ -27,6 +28,21 @@ std::string ToString(MinGap::Unit unit) { return std::string(NameOf(kUnitNames, 
 
 MinGap::Unit ParseMinGapUnit(std::string_view name) {
     return ParseEnum(kUnitNames, name, "gap unit");
+}
+
+std::vector<double> CumulativePathM(const std::vector<StampedPose>& poses) {
+    std::vector<double> path_m;
+    path_m.reserve(poses.size());
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+        const Eigen::Vector3d position = poses[i].T_world_sensor.translation();
+        if (!position.allFinite()) {
+            throw Error("path length: pose " + std::to_string(i) + " has a non-finite position");
+        }
+        path_m.push_back(
+            i == 0 ? 0.0
+                   : path_m.back() + (position - poses[i - 1].T_world_sensor.translation()).norm());
+    }
+    return path_m;
 }
 
 }  // namespace lidarloop::core

@@ -3,26 +3,37 @@
 #include <cstddef>
 #include <string>
 #include <string_view>
+#include <vector>
+
+#include "lidarloop/core/point_cloud.hpp"
 
 namespace lidarloop::core {
 
 /// Minimum loop size S (Magnusson et al. 2009, II-E): scans this close in the sequence are never
 /// loop candidates of each other, since consecutive scans trivially look alike. Counted in scans
-/// (the paper: "each scan S_i is compared to all other scans, except for S_{i-S}, ..., S_{i+S}")
-/// or in seconds of recording time.
+/// (the paper: "each scan S_i is compared to all other scans, except for S_{i-S}, ..., S_{i+S}"),
+/// in seconds of recording time, or in metres of path travelled between the two scans (the drift
+/// a loop can remove; on a slow platform 30 scans may be only a few metres).
 struct MinGap {
-    enum class Unit { kScans, kSeconds };
+    enum class Unit { kScans, kSeconds, kMetres };
 
     double value = 30.0;  ///< S; the paper uses 30 scans
     Unit unit = Unit::kScans;
 
-    /// True when scans i and j (recorded at t_i_s, t_j_s) are far enough apart to be compared.
-    bool Allows(std::size_t i, std::size_t j, double t_i_s, double t_j_s) const {
+    /// True when scans i and j are far enough apart to be compared. `along_i`, `along_j`: where
+    /// the scans lie along the sequence in the gap's unit, ignored for scans: the recording time
+    /// (s) for seconds, the cumulative path length (m, CumulativePathM) for metres.
+    bool Allows(std::size_t i, std::size_t j, double along_i, double along_j) const {
         if (unit == Unit::kScans) {
             const double apart = i > j ? static_cast<double>(i - j) : static_cast<double>(j - i);
             return apart > value;
         }
-        return (t_i_s > t_j_s ? t_i_s - t_j_s : t_j_s - t_i_s) > value;
+        return (along_i > along_j ? along_i - along_j : along_j - along_i) > value;
+    }
+    /// The per-scan positions Allows takes in this unit: `path_m` for metres, else `times_s`.
+    const std::vector<double>& Along(const std::vector<double>& times_s,
+                                     const std::vector<double>& path_m) const {
+        return unit == Unit::kMetres ? path_m : times_s;
     }
 
     /// Throws ConfigError naming `field` when value is negative or not finite.
@@ -31,7 +42,13 @@ struct MinGap {
 };
 
 std::string ToString(MinGap::Unit unit);
-/// Parses "scans" / "seconds"; throws ConfigError listing the valid names.
+/// Parses "scans" / "seconds" / "metres"; throws ConfigError listing the valid names.
 MinGap::Unit ParseMinGapUnit(std::string_view name);
+
+/// Per scan, the length of the path travelled from the first scan, metres: the sum of the
+/// straight-line steps between consecutive sensor positions (T_world_sensor). The path between
+/// scans i and j is |path[i] - path[j]|. Empty for no poses. Throws Error naming the pose when a
+/// position is not finite.
+std::vector<double> CumulativePathM(const std::vector<StampedPose>& poses);
 
 }  // namespace lidarloop::core

@@ -19,16 +19,19 @@ double SecondRatio(double best, double second) {
 }
 
 // Fills second_ratio and accepted from the candidates and a search for the best candidate
-// outside the gap around the best match.
-void Finish(LoopQuery& result, const core::MinGap& gap, const std::vector<double>& times_s,
+// outside the gap around the best match. `along`: the scans' positions in the gap's unit
+// (MinGap::Along); empty when unknown (a gap in metres without a path), which leaves
+// second_ratio NaN.
+void Finish(LoopQuery& result, const core::MinGap& gap, const std::vector<double>& along,
             const DescriptorMethod& method, double threshold,
             const std::function<std::vector<Neighbor>(const std::function<bool(std::size_t)>&)>&
                 search_one) {
     if (!result.has_match()) return;
     const Neighbor best = result.candidates.front();
     result.accepted = method.IsMatch(best.distance, threshold);
+    if (gap.unit != core::MinGap::Unit::kScans && along.empty()) return;
     const auto other_place = [&](std::size_t j) {
-        return gap.Allows(best.index, j, times_s[best.index], times_s[j]);
+        return gap.Allows(best.index, j, along[best.index], along[j]);
     };
     const std::vector<Neighbor> second = search_one(other_place);
     if (!second.empty()) result.second_ratio = SecondRatio(best.distance, second.front().distance);
@@ -36,13 +39,20 @@ void Finish(LoopQuery& result, const core::MinGap& gap, const std::vector<double
 
 // Validates an offline detection and returns its threshold.
 double CheckOfflineDetection(const DetectorConfig& detector, const core::Method& method,
-                             const std::vector<double>& times_s, std::size_t scans) {
+                             const std::vector<double>& times_s, const std::vector<double>& path_m,
+                             std::size_t scans) {
     detector.Validate();
     const double threshold = detector.ThresholdFor(method);
     MethodOf(method).ValidateThreshold(threshold);
     if (times_s.size() != scans) {
         throw core::ConfigError("offline detection: " + std::to_string(times_s.size()) +
                                 " times for " + std::to_string(scans) + " scans");
+    }
+    if (detector.min_gap.unit == core::MinGap::Unit::kMetres && path_m.size() != scans) {
+        throw core::ConfigError(
+            "detection.min_gap_unit is metres, which needs the path length "
+            "of every scan: got " +
+            std::to_string(path_m.size()) + " for " + std::to_string(scans) + " scans");
     }
     return threshold;
 }
@@ -54,16 +64,16 @@ using CandidateSearch = std::function<std::vector<Neighbor>(std::size_t count, c
 
 // Scan i's candidates among the scans j < i outside the gap, as LoopDetector::Process gives them
 // online.
-LoopQuery DetectOne(std::size_t i, const CandidateSearch& search,
-                    const std::vector<double>& times_s, const DetectorConfig& detector,
-                    const DescriptorMethod& method, double threshold) {
+LoopQuery DetectOne(std::size_t i, const CandidateSearch& search, const std::vector<double>& along,
+                    const DetectorConfig& detector, const DescriptorMethod& method,
+                    double threshold) {
     const auto eligible = [&](std::size_t j) {
-        return j < i && detector.min_gap.Allows(i, j, times_s[i], times_s[j]);
+        return j < i && detector.min_gap.Allows(i, j, along[i], along[j]);
     };
     LoopQuery result;
     result.query = i;
     result.candidates = search(static_cast<std::size_t>(detector.top_k), eligible);
-    Finish(result, detector.min_gap, times_s, method, threshold, [&](const Filter& other_place) {
+    Finish(result, detector.min_gap, along, method, threshold, [&](const Filter& other_place) {
         return search(1, [&](std::size_t j) { return eligible(j) && other_place(j); });
     });
     return result;
@@ -177,7 +187,10 @@ LoopQuery LoopDetector::Search(const PreparedQuery& query, std::size_t query_ind
     LoopQuery result;
     result.query = query_index;
     result.candidates = search(k, eligible);
-    Finish(result, detector_.min_gap, database_.times_s(), database_.definition(), threshold_,
+    // The online detector knows no path: a gap in metres leaves second_ratio NaN.
+    static const std::vector<double> kNoPath;
+    Finish(result, detector_.min_gap, detector_.min_gap.Along(database_.times_s(), kNoPath),
+           database_.definition(), threshold_,
            [&](const std::function<bool(std::size_t)>& other_place) {
                return search(1, [&](std::size_t j) { return eligible(j) && other_place(j); });
            });
@@ -207,6 +220,12 @@ LoopQuery LoopDetector::Process(const core::PointCloud& scan, double time_s) {
 
 LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_s,
                                 registration::PreparedScan scan) {
+    if (detector_.min_gap.unit == core::MinGap::Unit::kMetres) {
+        throw core::ConfigError(
+            "detection.min_gap_unit metres: the online detector knows no path lengths; detect "
+            "the sequence offline (DetectStreaming with the path) or give the gap in scans or "
+            "seconds");
+    }
     const std::unique_ptr<PreparedQuery> query = database_.Prepare(descriptor);
     const std::size_t query_index = database_.size();
     const auto& times_s = database_.times_s();
@@ -260,9 +279,11 @@ std::vector<LoopQuery> LocaliseSequence(
 
 std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,
                                         const std::vector<double>& times_s,
-                                        const DetectorConfig& detector,
-                                        const core::Method& method) {
-    const double threshold = CheckOfflineDetection(detector, method, times_s, matrix.size());
+                                        const DetectorConfig& detector, const core::Method& method,
+                                        const std::vector<double>& path_m) {
+    const double threshold =
+        CheckOfflineDetection(detector, method, times_s, path_m, matrix.size());
+    const std::vector<double>& along = detector.min_gap.Along(times_s, path_m);
     std::vector<LoopQuery> results(matrix.size());
     for (std::size_t i = 0; i < matrix.size(); ++i) {
         const auto distance_of = [&](std::size_t j) { return double{matrix.at(i, j)}; };
@@ -271,16 +292,18 @@ std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,
             [&](std::size_t count, const Filter& filter) {
                 return NearestCandidates(i, count, distance_of, filter);
             },
-            times_s, detector, MethodOf(method), threshold);
+            along, detector, MethodOf(method), threshold);
     }
     return results;
 }
 
 std::vector<LoopQuery> DetectStreaming(const DescriptorDatabase& database,
-                                       const DetectorConfig& detector, Execution execution) {
+                                       const DetectorConfig& detector, Execution execution,
+                                       const std::vector<double>& path_m) {
     const std::vector<double>& times_s = database.times_s();
     const std::size_t n = database.size();
-    const double threshold = CheckOfflineDetection(detector, database.method(), times_s, n);
+    const double threshold = CheckOfflineDetection(detector, database.method(), times_s, path_m, n);
+    const std::vector<double>& along = detector.min_gap.Along(times_s, path_m);
     // The method's exact index (histograms), over the valid scans; candidates are filtered to
     // j < i, so one index over all scans serves every query.
     std::unique_ptr<NeighborIndex> index = database.store().MakeIndex();
@@ -296,7 +319,7 @@ std::vector<LoopQuery> DetectStreaming(const DescriptorDatabase& database,
                 row.resize(i);
                 for (std::size_t j = 0; j < i; ++j) {
                     // Distance(j, i) with j < i, rounded to float: the matrix's entry (j, i).
-                    if (detector.min_gap.Allows(i, j, times_s[i], times_s[j]))
+                    if (detector.min_gap.Allows(i, j, along[i], along[j]))
                         row[j] = static_cast<float>(database.Distance(j, i));
                 }
                 row_filled = true;
@@ -312,7 +335,7 @@ std::vector<LoopQuery> DetectStreaming(const DescriptorDatabase& database,
                 return NearestCandidates(
                     i, count, [&](std::size_t j) { return double{row[j]}; }, filter);
             };
-            results[i] = DetectOne(i, search, times_s, detector, database.definition(), threshold);
+            results[i] = DetectOne(i, search, along, detector, database.definition(), threshold);
         }
     };
     const tbb::blocked_range<std::size_t> all(0, n);

@@ -48,7 +48,8 @@ struct LoopQuery {
     std::vector<Neighbor> candidates;  ///< up to top_k eligible scans, nearest first
     /// Distinctiveness of the best match: its distance over the distance of the best candidate
     /// that lies outside the gap around the best match (another place). Near 1: ambiguous;
-    /// near 0: distinctive. NaN when there is no such second candidate; 1 when both are 0.
+    /// near 0: distinctive. NaN when there is no such second candidate, or the gap is in metres
+    /// and the path unknown (localisation); 1 when both are 0.
     double second_ratio = std::numeric_limits<double>::quiet_NaN();
     /// Without verification: the best match passes the threshold (W <= tau, sigma' < t_d).
     /// With: some candidate passed verification (see loop()).
@@ -94,7 +95,8 @@ public:
     LoopDetector& operator=(const LoopDetector&) = delete;
 
     /// Describes `scan`, finds its candidates among the stored scans (and verifies them when
-    /// verify is on), then stores it.
+    /// verify is on), then stores it. ConfigError for a gap in metres: the online detector knows
+    /// no path (DetectStreaming does).
     LoopQuery Process(const core::PointCloud& scan, double time_s);
     /// The same for a scan described (and, for verification, prepared) by the caller; an empty
     /// `scan` is not verified.
@@ -141,9 +143,12 @@ std::vector<LoopQuery> LocaliseSequence(
 
 /// Offline detection from a full similarity matrix: for every scan i, the candidates among the
 /// scans j < i outside the gap, exactly as LoopDetector::Process would give them online.
+/// `path_m`: per scan, the cumulative path length (core::CumulativePathM), needed (one per scan,
+/// else ConfigError) only for a gap in metres.
 std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,
                                         const std::vector<double>& times_s,
-                                        const DetectorConfig& detector, const core::Method& method);
+                                        const DetectorConfig& detector, const core::Method& method,
+                                        const std::vector<double>& path_m = {});
 
 /// Offline detection without the similarity matrix: exactly DetectFromMatrix on
 /// ComputeSimilarityMatrix(database) (distances rounded to float as the matrix holds them), a
@@ -151,9 +156,10 @@ std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,
 /// index where it has one (histograms: a few more than asked, re-ranked by the float distance;
 /// when a float tie at the last place could hide another scan, from comparing them all), else
 /// from comparing every eligible scan (NDT). Memory: the results, the index and one row of n
-/// floats per thread, instead of the matrix's 2 n^2 bytes.
+/// floats per thread, instead of the matrix's 2 n^2 bytes. `path_m` as DetectFromMatrix's.
 std::vector<LoopQuery> DetectStreaming(const DescriptorDatabase& database,
                                        const DetectorConfig& detector,
-                                       Execution execution = Execution::kParallel);
+                                       Execution execution = Execution::kParallel,
+                                       const std::vector<double>& path_m = {});
 
 }  // namespace lidarloop::pipeline

@@ -74,7 +74,7 @@ TEST(EnumNames, CoreParseErrorsKeepTheirMessages) {
     EXPECT_EQ(ConfigErrorOf([] { ParseOutOfRangePolicy("wrap"); }),
               "unknown out-of-range policy 'wrap' (valid: clamp, drop)");
     EXPECT_EQ(ConfigErrorOf([] { ParseMinGapUnit("frames"); }),
-              "unknown gap unit 'frames' (valid: scans, seconds)");
+              "unknown gap unit 'frames' (valid: scans, seconds, metres)");
 }
 
 TEST(EnumNames, CoreNamesRoundTrip) {
@@ -86,7 +86,8 @@ TEST(EnumNames, CoreNamesRoundTrip) {
     EXPECT_EQ(ToString(OutOfRangePolicy::kDrop), "drop");
     EXPECT_EQ(ToString(MinGap::Unit::kScans), "scans");
     EXPECT_EQ(ToString(MinGap::Unit::kSeconds), "seconds");
-    for (const auto unit : {MinGap::Unit::kScans, MinGap::Unit::kSeconds}) {
+    EXPECT_EQ(ToString(MinGap::Unit::kMetres), "metres");
+    for (const auto unit : {MinGap::Unit::kScans, MinGap::Unit::kSeconds, MinGap::Unit::kMetres}) {
         EXPECT_EQ(ParseMinGapUnit(ToString(unit)), unit);
     }
 }

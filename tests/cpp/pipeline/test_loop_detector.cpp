@@ -331,6 +331,78 @@ TEST(DetectStreaming, EqualsDetectFromMatrixForNdt) {
                                             detector, core::Method::kNdt));
 }
 
+// A slow platform: 40 scans driven 2 m apart, then 80 scans creeping 5 cm apart that all look
+// like the query; scan 5 looks like it too, a little less. Returns the database (the query is
+// the last scan, 120) and the scans' cumulative path, metres.
+DescriptorDatabase SlowPlatform(std::vector<double>& path_m) {
+    std::mt19937 rng(21);
+    std::normal_distribution<double> noise(0.0, 1.0);
+    std::exponential_distribution<double> weight(1.0);
+    const auto place = [&] {
+        std::vector<double> h(40);
+        for (double& v : h) v = weight(rng);
+        return h;
+    };
+    const std::vector<double> here = place();
+    const auto near_here = [&](double spread) {
+        std::vector<double> h = here;
+        for (double& v : h) v = std::max(0.0, v + spread * noise(rng));
+        return h;
+    };
+    DescriptorDatabase database(HeightConfig(40));
+    for (std::size_t i = 0; i <= 120; ++i) {
+        const bool creeping = i >= 40;
+        path_m.push_back(i == 0 ? 0.0 : path_m.back() + (creeping ? 0.05 : 2.0));
+        const std::vector<double> h = i == 120   ? here
+                                      : creeping ? near_here(0.001)
+                                      : i == 5   ? near_here(0.02)
+                                                 : place();
+        database.Add(test::HistogramDescriptor(h), 0.1 * static_cast<double>(i));
+    }
+    return database;
+}
+
+TEST(LoopDetector, AGapInMetresKeepsTheRecentPastOutOfTheCandidates) {
+    std::vector<double> path_m;
+    const DescriptorDatabase database = SlowPlatform(path_m);
+    const SimilarityMatrix matrix = ComputeSimilarityMatrix(database);
+    DetectorConfig detector = Deciding(DetectorConfig{}, 0.01);
+    detector.top_k = 5;
+    // 30 scans back is only 1.5 m of path: the candidates are the recent past.
+    detector.min_gap = {30.0, core::MinGap::Unit::kScans};
+    const LoopQuery scans =
+        DetectFromMatrix(matrix, database.times_s(), detector, core::Method::kHeight, path_m)
+            .back();
+    ASSERT_EQ(scans.candidates.size(), 5u);
+    for (const Neighbor& n : scans.candidates) EXPECT_LT(path_m[120] - path_m[n.index], 5.0);
+    // 20 m of path: only the scans driven before, of which scan 5 is the place.
+    detector.min_gap = {20.0, core::MinGap::Unit::kMetres};
+    const std::vector<LoopQuery> metres =
+        DetectFromMatrix(matrix, database.times_s(), detector, core::Method::kHeight, path_m);
+    ASSERT_EQ(metres.back().candidates.size(), 5u);
+    EXPECT_EQ(metres.back().candidates.front().index, 5u);
+    for (const LoopQuery& q : metres) {
+        for (const Neighbor& n : q.candidates) EXPECT_GT(path_m[q.query] - path_m[n.index], 20.0);
+    }
+    ExpectIdenticalQueries(DetectStreaming(database, detector, Execution::kParallel, path_m),
+                           metres);
+}
+
+TEST(LoopDetector, AGapInMetresNeedsThePath) {
+    std::vector<double> path_m;
+    const DescriptorDatabase database = SlowPlatform(path_m);
+    DetectorConfig detector = Deciding(DetectorConfig{}, 0.01);
+    detector.min_gap = {20.0, core::MinGap::Unit::kMetres};
+    EXPECT_THROW(DetectStreaming(database, detector), core::ConfigError);
+    path_m.pop_back();
+    EXPECT_THROW(DetectFromMatrix(ComputeSimilarityMatrix(database), database.times_s(), detector,
+                                  core::Method::kHeight, path_m),
+                 core::ConfigError);
+    LoopDetector online(HeightConfig(40), detector);  // localisation needs no gap
+    EXPECT_THROW(online.Process(test::HistogramDescriptor(std::vector<double>(40, 1.0)), 0.0),
+                 core::ConfigError);
+}
+
 TEST(LoopDetector, RejectsBadConfigAndMixedMethods) {
     DetectorConfig detector;
     detector.top_k = 0;
