@@ -23,7 +23,8 @@ struct DetectFlags {
     DescriptorOptions descriptor;
     DetectionOptions detection;
     std::string out;
-    std::string map;  // a database.lldb to localise against (query-only mode)
+    std::string map;       // a database.lldb to localise against (query-only mode)
+    std::string odometry;  // poses the path is measured on (a gap in metres, path_m)
     bool skip_bad = false;
     bool overwrite = false;
     bool quiet = false;
@@ -71,6 +72,7 @@ void PrintOutcome(const io::Dataset& dataset, const app::DetectRequest& request,
 std::vector<std::filesystem::path> Inputs(const DetectFlags& flags) {
     std::vector<std::filesystem::path> inputs = flags.dataset.Inputs();
     inputs.emplace_back(flags.map);
+    inputs.emplace_back(flags.odometry);
     return inputs;
 }
 
@@ -80,6 +82,7 @@ void RunDetect(const DetectFlags& flags) {
     request.skip_bad = flags.skip_bad;
     request.progress = progress.Callback();
     request.out = flags.out;
+    request.odometry_file = flags.odometry;
     if (!flags.map.empty()) {
         app::LoadedMap map = app::LoadMap(flags.map);
         request.config = ResolveAgainstMap(flags, map);
@@ -120,6 +123,11 @@ void AddDetectCommand(CLI::App& app) {
         ->add_option("--map", flags->map,
                      "localise against this database.lldb (written by an earlier detect): "
                      "every scan is a query, none is added, the map's descriptor config is used")
+        ->check(CLI::ExistingFile);
+    command
+        ->add_option("--odometry", flags->odometry,
+                     "odometry poses, KITTI or TUM, one per scan: the path a gap in metres and "
+                     "loops.csv's path_m are measured on (default: the dataset's poses)")
         ->check(CLI::ExistingFile);
     command->add_flag("--skip-bad", flags->skip_bad,
                       "skip unreadable scans (listed in skipped.txt) instead of stopping");

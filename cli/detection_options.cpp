@@ -7,7 +7,9 @@ namespace lidarloop::cli {
 void DetectionOptions::AddTo(CLI::App& command, bool decides_loops,
                              const std::string& min_gap_help) {
     min_gap_option_ = command.add_option("--min-gap", min_gap_, min_gap_help);
-    command.add_option("--min-gap-unit", min_gap_unit_, "unit of --min-gap: scans | seconds");
+    command.add_option(
+        "--min-gap-unit", min_gap_unit_,
+        "unit of --min-gap: scans | seconds | metres (of path, from the poses or odometry)");
     if (!decides_loops) return;
     threshold_option_ = command.add_option(
         "--threshold", threshold_, "tau (height, range) or t_d (ndt); default from the config");

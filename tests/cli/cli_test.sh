@@ -179,12 +179,12 @@ section_detect() {
     done
     verified_header="query,match,distance,second_ratio,accepted,rank,tx,ty,tz,qx,qy,qz,qw"
     verified_header+=",overlap_query,overlap_match,distinctive_query,distinctive_match,rmse_m"
-    verified_header+=",shifted_overlap,reason"
+    verified_header+=",shifted_overlap,reason,path_m"  # path_m empty: the folder has no poses
     if head -1 "$work/det/loops.csv" | grep -qx "$verified_header"; then
         pass
     else fail "loops.csv header: $(head -1 "$work/det/loops.csv")"; fi
     # Scan 3 is a copy of scan 0: verified at the identity pose.
-    if grep -q "^3,0,0,,1,1,0,0,0,0,0,0,1,1,1,[^,]*,[^,]*,0,[^,]*,none$" "$work/det/loops.csv"; then
+    if grep -q "^3,0,0,,1,1,0,0,0,0,0,0,1,1,1,[^,]*,[^,]*,0,[^,]*,none,$" "$work/det/loops.csv"; then
         pass
     else
         fail "scan 3 (a copy of scan 0) is not a verified loop: $(cat "$work/det/loops.csv")"
@@ -196,10 +196,10 @@ section_detect() {
     expect_ok "detect --no-verify" "8 scans (folder)" "$cli" detect "$seq" --min-gap 2 --quiet \
         --no-verify --out "$work/det_descriptor"
     if head -1 "$work/det_descriptor/loops.csv" |
-        grep -qx "query,match,distance,second_ratio,accepted"; then
+        grep -qx "query,match,distance,second_ratio,accepted,path_m"; then
         pass
     else fail "--no-verify loops.csv header: $(head -1 "$work/det_descriptor/loops.csv")"; fi
-    if grep -q "^3,0,0,.*,1$" "$work/det_descriptor/loops.csv"; then pass; else
+    if grep -q "^3,0,0,.*,1,$" "$work/det_descriptor/loops.csv"; then pass; else
         fail "--no-verify: scan 3 is not an accepted loop: $(cat "$work/det_descriptor/loops.csv")"
     fi
     if grep -q "min_gap: 2" "$work/det/config.yaml"; then pass; else
@@ -218,7 +218,7 @@ section_detect() {
     # distance 0.
     expect_ok "detect --map" "localised against the map" "$cli" detect "$seq" \
         --map "$work/det/database.lldb" --threshold 0.001 --quiet --out "$work/loc"
-    if [ "$(grep -c '^[0-9]*,[0-9]*,0,[^,]*,1,.*,none$' "$work/loc/loops.csv")" -eq 8 ]; then pass; else
+    if [ "$(grep -c '^[0-9]*,[0-9]*,0,[^,]*,1,.*,none,$' "$work/loc/loops.csv")" -eq 8 ]; then pass; else
         fail "localisation did not match every scan at distance 0: $(cat "$work/loc/loops.csv")"
     fi
     if grep -q "^6,6,0," "$work/loc/loops.csv" && grep -q "^7,7,0," "$work/loc/loops.csv"; then

@@ -114,13 +114,13 @@ struct StepTimes {
 };
 
 // Verifies the top-k candidates of `queries` evenly spaced scans that have candidates, one pair
-// at a time on this thread.
+// at a time on this thread. `path_m`: per scan, for a gap in metres (empty: none known).
 nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
                                 const pipeline::SimilarityMatrix& matrix,
                                 const PreparedScans& prepared, const io::RunConfig& config,
-                                std::size_t queries) {
+                                std::size_t queries, const std::vector<double>& path_m) {
     std::vector<pipeline::LoopQuery> all = pipeline::DetectFromMatrix(
-        matrix, described.database.times_s(), config.detection, config.descriptor.method);
+        matrix, described.database.times_s(), config.detection, config.descriptor.method, path_m);
     std::erase_if(all, [](const pipeline::LoopQuery& q) { return !q.has_match(); });
     const registration::VerificationConfig& verification = config.detection.verification;
     StepTimes coarse_times;
@@ -193,8 +193,10 @@ nlohmann::json RunBench(const io::Dataset& dataset, const BenchRequest& request)
             4 * rows->stride() + 4 * pipeline::HistogramIndex::kBlocks + 16 + 9;
     }
     if (verify) {
+        const std::vector<double> path_m =
+            dataset.HasPoses() ? core::CumulativePathM(dataset.poses()) : std::vector<double>{};
         json["verification"] =
-            TimeVerification(described, matrix, prepared, config, request.verify_queries);
+            TimeVerification(described, matrix, prepared, config, request.verify_queries, path_m);
     }
     json["peak_memory_mib"] = PeakMemoryMiB();
     return json;

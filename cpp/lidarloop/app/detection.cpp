@@ -7,9 +7,12 @@
 #include "lidarloop/app/verification_run.hpp"
 #include "lidarloop/core/descriptor.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/core/min_gap.hpp"
 #include "lidarloop/io/database_file.hpp"
 #include "lidarloop/io/png.hpp"
+#include "lidarloop/io/poses.hpp"
 #include "lidarloop/io/prepared_scans_file.hpp"
+#include "lidarloop/io/read_error.hpp"
 #include "lidarloop/io/similarity_file.hpp"
 #include "lidarloop/io/similarity_image.hpp"
 
@@ -24,14 +27,38 @@ void RequireTimesForSeconds(const io::RunConfig& config, const io::Dataset& data
     }
 }
 
+// Per scan, the path travelled (core::CumulativePathM): on the odometry when given, else on the
+// dataset's poses; empty when there are neither (ConfigError when the gap is in metres).
+std::vector<double> PathOfScans(const DetectRequest& request, const io::Dataset& dataset) {
+    std::vector<double> path_m;
+    if (!request.odometry_file.empty()) {
+        const std::vector<core::StampedPose> odometry = io::ReadPoses(request.odometry_file);
+        if (odometry.size() != dataset.size()) {
+            throw io::ReadError(request.odometry_file,
+                                "holds " + std::to_string(odometry.size()) +
+                                    " poses, the dataset " + std::to_string(dataset.size()) +
+                                    " scans: odometry needs one pose per scan");
+        }
+        path_m = core::CumulativePathM(odometry);
+    } else if (dataset.HasPoses()) {
+        path_m = core::CumulativePathM(dataset.poses());
+    }
+    if (path_m.empty() && request.config.detection.min_gap.unit == core::MinGap::Unit::kMetres) {
+        throw core::ConfigError("a minimum gap in metres needs the path travelled, and " +
+                                dataset.root().string() +
+                                " has no poses; give --odometry FILE, --poses or a gap in scans");
+    }
+    return path_m;
+}
+
 // `matrix` is null when the sequence was detected without one (output.similarity_matrix_mib).
 void WriteDetectResults(const std::filesystem::path& out_dir, const io::RunConfig& config,
                         const pipeline::SequenceDescriptors& described,
                         const pipeline::SimilarityMatrix* matrix, const DetectOutcome& outcome,
-                        const PreparedScans& prepared) {
+                        const PreparedScans& prepared, const std::vector<double>& path_m) {
     const core::Method method = config.descriptor.method;
-    WriteLoopsCsv(out_dir / "loops.csv", outcome.queries);
-    WriteCandidatesCsv(out_dir / "candidates.csv", outcome.queries);
+    WriteLoopsCsv(out_dir / "loops.csv", outcome.queries, path_m);
+    WriteCandidatesCsv(out_dir / "candidates.csv", outcome.queries, path_m);
     if (matrix != nullptr) {
         io::WriteSimilarityMatrix(out_dir / "similarity.bin", *matrix, method);
         io::WritePng(out_dir / "similarity.png",
@@ -93,6 +120,7 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     const double threshold = config.detection.ThresholdFor(config.descriptor.method);
     pipeline::MethodOf(config.descriptor.method).ValidateThreshold(threshold);
     RequireTimesForSeconds(config, dataset);
+    const std::vector<double> path_m = PathOfScans(request, dataset);
     const std::filesystem::path out_dir = PrepareOutputFolder(request.out);
     io::WriteConfigYaml(out_dir / "config.yaml", config);
 
@@ -111,10 +139,12 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     outcome.threshold = threshold;
     if (config.output.KeepsSimilarityMatrix(dataset.size())) {
         matrix = pipeline::ComputeSimilarityMatrix(described.database);
-        outcome.queries = pipeline::DetectFromMatrix(*matrix, described.database.times_s(),
-                                                     config.detection, config.descriptor.method);
+        outcome.queries =
+            pipeline::DetectFromMatrix(*matrix, described.database.times_s(), config.detection,
+                                       config.descriptor.method, path_m);
     } else {
-        outcome.queries = pipeline::DetectStreaming(described.database, config.detection);
+        outcome.queries = pipeline::DetectStreaming(described.database, config.detection,
+                                                    pipeline::Execution::kParallel, path_m);
     }
     const double matrix_s = matrix_clock.Seconds();
     Stopwatch verify_clock;
@@ -126,7 +156,8 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     const double verify_s = verify_clock.Seconds();
     outcome.accepted = CountAccepted(outcome.queries);
     outcome.skipped = described.skipped;
-    WriteDetectResults(out_dir, config, described, matrix ? &*matrix : nullptr, outcome, prepared);
+    WriteDetectResults(out_dir, config, described, matrix ? &*matrix : nullptr, outcome, prepared,
+                       path_m);
 
     const std::size_t n = dataset.size();
     nlohmann::json timings = TimingsJson(described, n > 1 ? n * (n - 1) / 2 : 0, matrix_s);

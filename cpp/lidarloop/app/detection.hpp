@@ -19,6 +19,9 @@ struct DetectRequest {
     bool skip_bad = false;  ///< unreadable scans are listed in skipped.txt instead of stopping
     Progress progress;
     std::filesystem::path out;  ///< the results folder (created)
+    /// Odometry, KITTI or TUM, one pose per scan (T_world_sensor): the path a gap in metres and
+    /// loops.csv's path_m are measured on. Empty: the dataset's poses, when it has them.
+    std::filesystem::path odometry_file;
 };
 
 struct DetectOutcome {
@@ -36,6 +39,8 @@ struct DetectOutcome {
 /// database.lldb (with the detection config), config.yaml, timings.json (and skipped.txt) into
 /// request.out. With config.detection.verify the candidates are verified (registration::Verify)
 /// and the scans reduced for it are saved as database.scans, so the map can verify too.
+/// ConfigError when the gap is in seconds and there are no poses, or in metres and there is
+/// neither odometry nor poses; io::ReadError when the odometry has not one pose per scan.
 DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request);
 
 /// A saved descriptor database to localise against.

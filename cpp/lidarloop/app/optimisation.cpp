@@ -40,6 +40,7 @@ std::vector<posegraph::LoopConstraint> DetectLoops(const io::Dataset& dataset,
     detect.skip_bad = request.skip_bad;
     detect.progress = request.progress;
     detect.out = request.out / "detection";
+    detect.odometry_file = request.odometry_file;  // the path a gap in metres is measured on
     const DetectOutcome detected = RunDetect(dataset, detect);
     std::vector<posegraph::LoopConstraint> loops;
     for (const pipeline::LoopQuery& query : detected.queries) {

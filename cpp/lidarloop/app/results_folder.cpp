@@ -55,6 +55,17 @@ bool AnyVerified(const std::vector<pipeline::LoopQuery>& queries) {
 constexpr char kVerificationColumns[] =
     "tx,ty,tz,qx,qy,qz,qw,overlap_query,overlap_match,distinctive_query,distinctive_match,rmse_m,"
     "shifted_overlap,reason";
+// The empty verification fields of an unverified row in a verified file (14 columns), so that
+// path_m stays under its header.
+constexpr char kNoVerification[] = ",,,,,,,,,,,,,";
+
+// Writes ",path_m": the path travelled between the two scans, or "," when it is unknown.
+void WritePathM(std::ostream& out, const std::vector<double>& path_m, std::size_t query,
+                std::size_t match) {
+    out << ',';
+    if (query < path_m.size() && match < path_m.size())
+        out << std::abs(path_m[query] - path_m[match]);
+}
 
 // The verification columns of one candidate: T_match_query (translation in metres, unit
 // quaternion x, y, z, w), the overlap both ways, the RMSE, the degeneracy test's overlap ratio
@@ -82,11 +93,12 @@ void WriteVerification(std::ostream& out, const registration::Verification& v) {
 }  // namespace
 
 void WriteLoopsCsv(const std::filesystem::path& file,
-                   const std::vector<pipeline::LoopQuery>& queries) {
+                   const std::vector<pipeline::LoopQuery>& queries,
+                   const std::vector<double>& path_m) {
     std::ofstream out(file);
     const bool verified = AnyVerified(queries);
     out << "query,match,distance,second_ratio,accepted";
-    out << (verified ? std::string(",rank,") + kVerificationColumns : std::string()) << "\n";
+    out << (verified ? std::string(",rank,") + kVerificationColumns : std::string()) << ",path_m\n";
     out.precision(9);
     for (const auto& q : queries) {
         if (!q.has_match()) continue;
@@ -98,7 +110,10 @@ void WriteLoopsCsv(const std::filesystem::path& file,
         if (q.verified()) {
             out << ',' << rank + 1 << ',';
             WriteVerification(out, q.verifications[rank]);
+        } else if (verified) {
+            out << ',' << ',' << kNoVerification;  // rank and the verification fields
         }
+        WritePathM(out, path_m, q.query, q.candidates[rank].index);
         out << '\n';
     }
     out.close();
@@ -106,11 +121,13 @@ void WriteLoopsCsv(const std::filesystem::path& file,
 }
 
 void WriteCandidatesCsv(const std::filesystem::path& file,
-                        const std::vector<pipeline::LoopQuery>& queries) {
+                        const std::vector<pipeline::LoopQuery>& queries,
+                        const std::vector<double>& path_m) {
     std::ofstream out(file);
     const bool verified = AnyVerified(queries);
     out << "query,rank,match,distance";
-    out << (verified ? std::string(",accepted,") + kVerificationColumns : std::string()) << "\n";
+    out << (verified ? std::string(",accepted,") + kVerificationColumns : std::string())
+        << ",path_m\n";
     out.precision(9);
     for (const auto& q : queries) {
         for (std::size_t r = 0; r < q.candidates.size(); ++r) {
@@ -119,7 +136,10 @@ void WriteCandidatesCsv(const std::filesystem::path& file,
             if (q.verified()) {
                 out << ',' << (q.verifications[r].accepted ? 1 : 0) << ',';
                 WriteVerification(out, q.verifications[r]);
+            } else if (verified) {
+                out << ',' << ',' << kNoVerification;  // accepted and the verification fields
             }
+            WritePathM(out, path_m, q.query, q.candidates[r].index);
             out << '\n';
         }
     }

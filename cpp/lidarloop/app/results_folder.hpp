@@ -40,13 +40,17 @@ void WriteSkipped(const std::filesystem::path& folder, const std::vector<std::st
 /// first accepted candidate, else the best one), then its rank and verification columns
 /// (rank,tx,ty,tz,qx,qy,qz,qw,overlap_query,overlap_match,distinctive_query,distinctive_match,rmse_m,
 /// shifted_overlap,reason;
-/// docs/cli.md).
+/// docs/cli.md), and last path_m: the path travelled between query and match, metres, from
+/// `path_m` (per scan, core::CumulativePathM); empty when `path_m` is empty. In a verified file an
+/// unverified row has empty verification fields, so every row has the header's columns.
 void WriteLoopsCsv(const std::filesystem::path& file,
-                   const std::vector<pipeline::LoopQuery>& queries);
+                   const std::vector<pipeline::LoopQuery>& queries,
+                   const std::vector<double>& path_m = {});
 /// candidates.csv: every candidate of every query (query,rank,match,distance), and when verified
-/// accepted and the verification columns of loops.csv.
+/// accepted and the verification columns of loops.csv; last path_m as in loops.csv.
 void WriteCandidatesCsv(const std::filesystem::path& file,
-                        const std::vector<pipeline::LoopQuery>& queries);
+                        const std::vector<pipeline::LoopQuery>& queries,
+                        const std::vector<double>& path_m = {});
 
 /// Query scans with an accepted loop.
 std::size_t CountAccepted(const std::vector<pipeline::LoopQuery>& queries);

@@ -75,7 +75,8 @@ void VisitFields(core::NdtConfig& c, Visitor& v) {
 template <typename Visitor>
 void VisitFields(pipeline::DetectorConfig& c, Visitor& v) {
     v.Field("min_gap", c.min_gap.value, "S: candidates are at least this far back (Magnusson)");
-    v.Field("min_gap_unit", c.min_gap.unit, "unit of min_gap: scans | seconds");
+    v.Field("min_gap_unit", c.min_gap.unit,
+            "unit of min_gap: scans | seconds | metres (of path travelled)");
     v.Field("top_k", c.top_k, "candidates reported per query scan");
     v.Field("threshold", c.threshold, ThresholdHelp());
     v.Field("verify", c.verify,

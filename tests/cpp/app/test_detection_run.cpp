@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <set>
@@ -15,7 +16,10 @@
 #include "lidarloop/app/detection.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/io/kitti_bin.hpp"
+#include "lidarloop/io/pose_graph_files.hpp"
+#include "lidarloop/io/poses.hpp"
 #include "lidarloop/io/prepared_scans_file.hpp"
+#include "lidarloop/io/read_error.hpp"
 #include "lidarloop/io/results_csv.hpp"
 #include "lidarloop/registration/verification.hpp"
 #include "test_utils.hpp"
@@ -349,6 +353,128 @@ TEST_F(DetectionRun, AGapInSecondsWithoutTimesIsAClearError) {
     app::DetectRequest request = Request("detect", core::Method::kHeight);
     request.config.detection.min_gap = {5.0, core::MinGap::Unit::kSeconds};
     EXPECT_THROW(app::RunDetect(bare, request), core::ConfigError);
+}
+
+// The rows of a CSV file, split at commas (the header first).
+std::vector<std::vector<std::string>> CsvCells(const std::filesystem::path& file) {
+    std::ifstream in(file);
+    std::vector<std::vector<std::string>> rows;
+    for (std::string line; std::getline(in, line);) {
+        std::vector<std::string> cells(1);
+        for (const char c : line) {
+            if (c == ',') {
+                cells.emplace_back();
+            } else {
+                cells.back() += c;
+            }
+        }
+        rows.push_back(std::move(cells));
+    }
+    return rows;
+}
+
+// The path between scans i and j, walked step by step over `poses`.
+double BrutePathM(const std::vector<core::StampedPose>& poses, std::size_t i, std::size_t j) {
+    double path_m = 0.0;
+    for (std::size_t k = std::min(i, j); k < std::max(i, j); ++k) {
+        path_m +=
+            (poses[k + 1].T_world_sensor.translation() - poses[k].T_world_sensor.translation())
+                .norm();
+    }
+    return path_m;
+}
+
+// Every row of loops.csv and candidates.csv has the header's column count and ends with path_m,
+// the path between its query and match over `poses`; returns the smallest path_m seen.
+double ExpectPathColumn(const std::filesystem::path& file,
+                        const std::vector<core::StampedPose>& poses) {
+    const auto rows = CsvCells(file);
+    EXPECT_GT(rows.size(), 1u) << file;
+    EXPECT_EQ(rows.front().back(), "path_m") << file;
+    double smallest_m = std::numeric_limits<double>::infinity();
+    for (std::size_t r = 1; r < rows.size(); ++r) {
+        EXPECT_EQ(rows[r].size(), rows.front().size()) << file << " row " << r;
+        const std::size_t query = std::stoul(rows[r][0]);
+        const std::size_t match = std::stoul(rows[r][rows.front()[1] == "match" ? 1 : 2]);
+        const double path_m = std::stod(rows[r].back());
+        EXPECT_NEAR(path_m, BrutePathM(poses, query, match), 1e-6 * path_m + 1e-9)
+            << file << " row " << r;
+        smallest_m = std::min(smallest_m, path_m);
+    }
+    return smallest_m;
+}
+
+TEST_F(DetectionRun, PathMIsThePathBetweenQueryAndMatchOnThePosesOrTheOdometry) {
+    app::DetectRequest request = Request("poses", core::Method::kRange);
+    request.config.detection.verify = false;
+    app::RunDetect(*dataset_, request);
+    const std::vector<core::StampedPose>& poses = dataset_->poses();
+    for (const char* file : {"loops.csv", "candidates.csv"})
+        ExpectPathColumn(request.out / file, poses);
+
+    // Odometry twice as far apart, gap in metres: measured on the odometry, outside the gap.
+    std::vector<core::StampedPose> odometry = poses;
+    for (auto& pose : odometry) pose.T_world_sensor.translation() *= 2.0;
+    io::WriteTumPoses(dir_ / "odometry.txt", odometry);
+    request.out = dir_ / "odometry";
+    request.odometry_file = dir_ / "odometry.txt";
+    request.config.detection.min_gap = {60.0, core::MinGap::Unit::kMetres};
+    app::RunDetect(*dataset_, request);
+    EXPECT_GT(ExpectPathColumn(request.out / "candidates.csv", odometry), 60.0);
+    ExpectPathColumn(request.out / "loops.csv", odometry);
+
+    odometry.pop_back();
+    io::WriteTumPoses(dir_ / "short.txt", odometry);
+    request.odometry_file = dir_ / "short.txt";
+    EXPECT_THROW(app::RunDetect(*dataset_, request), io::ReadError);
+}
+
+TEST_F(DetectionRun, AGapInMetresWithoutPosesOrOdometryIsAClearError) {
+    std::filesystem::create_directories(dir_ / "bare" / "velodyne");
+    std::filesystem::copy(dir_ / "sequence" / "velodyne", dir_ / "bare" / "velodyne");
+    const io::Dataset bare = io::OpenDataset(dir_ / "bare");
+    app::DetectRequest request = Request("detect", core::Method::kHeight);
+    request.config.detection.verify = false;
+    request.config.detection.min_gap = {5.0, core::MinGap::Unit::kMetres};
+    try {
+        app::RunDetect(bare, request);
+        ADD_FAILURE() << "no error";
+    } catch (const core::ConfigError& e) {
+        EXPECT_NE(std::string(e.what()).find("--odometry"), std::string::npos) << e.what();
+    }
+    // Without poses path_m is empty, and the gap in scans still works.
+    request.config.detection.min_gap = {10.0, core::MinGap::Unit::kScans};
+    app::RunDetect(bare, request);
+    const auto rows = CsvCells(request.out / "loops.csv");
+    ASSERT_GT(rows.size(), 1u);
+    EXPECT_EQ(rows.front().back(), "path_m");
+    for (std::size_t r = 1; r < rows.size(); ++r) {
+        EXPECT_EQ(rows[r].size(), rows.front().size());
+        EXPECT_EQ(rows[r].back(), "");
+    }
+}
+
+// optimise --loops reads a verified loops.csv with path_m, and one written before it existed.
+TEST_F(DetectionRun, TheLoopsReaderTakesFilesWithAndWithoutPathM) {
+    app::DetectRequest request = Request("verified", core::Method::kRange);
+    request.config.detection.top_k = 1;
+    const app::DetectOutcome outcome = app::RunDetect(*dataset_, request);
+    ASSERT_GT(outcome.accepted, 0u);
+    const auto with = io::ReadLoopsCsv(request.out / "loops.csv", dataset_->size());
+    EXPECT_EQ(with.size(), outcome.accepted);
+    std::string without;
+    for (const auto& row : CsvCells(request.out / "loops.csv")) {
+        for (std::size_t c = 0; c + 1 < row.size(); ++c) without += (c ? "," : "") + row[c];
+        without += "\n";
+    }
+    test::WriteFile(dir_ / "old_loops.csv", without);
+    const auto old = io::ReadLoopsCsv(dir_ / "old_loops.csv", dataset_->size());
+    ASSERT_EQ(old.size(), with.size());
+    for (std::size_t k = 0; k < old.size(); ++k) {
+        EXPECT_EQ(old[k].loop.query, with[k].loop.query);
+        EXPECT_EQ(old[k].loop.match, with[k].loop.match);
+        EXPECT_TRUE(old[k].loop.T_match_query.isApprox(with[k].loop.T_match_query));
+    }
 }
 
 }  // namespace
