@@ -29,6 +29,7 @@ struct EvaluateFlags {
     std::vector<std::string> results;
     double distance_m = 10.0;
     double max_heading_deg = 0.0;
+    double min_path_m = 0.0;
     double train_fraction = 0.5;
     std::string criterion = "mcc";
     std::vector<double> fixed_thresholds;
@@ -84,6 +85,7 @@ app::EvaluationRequest RequestOf(const EvaluateFlags& flags) {
     request.results_files = flags.results;
     request.distance_m = flags.distance_m;
     request.max_heading_deg = flags.max_heading_deg;
+    request.min_path_m = flags.min_path_m;
     request.learning.train_fraction = flags.train_fraction;
     request.learning.criterion = eval::ParseCriterion(flags.criterion);
     request.fixed_thresholds = flags.fixed_thresholds;
@@ -145,6 +147,9 @@ void AddGroundTruthFlags(CLI::App& command, EvaluateFlags& flags) {
                        "same place when closer than this, metres (Roehling 10, Magnusson 3-10)");
     command.add_option("--max-heading", flags.max_heading_deg,
                        "and headings differ by less than this, degrees (0: any; Kvarntorp 20)");
+    command.add_option("--min-path", flags.min_path_m,
+                       "pairs not more than this much path apart (metres on the poses) are not "
+                       "evaluated, besides the gap (0: no path rule; SLAM revisits: 50)");
     flags.detection.AddTo(command, /*decides_loops=*/true,
                           "S: pairs closer in the sequence are not evaluated");
 }

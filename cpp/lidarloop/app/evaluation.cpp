@@ -246,9 +246,11 @@ MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method m
         keep_matrix
             ? CompareRetrieval(e.matrix, database.times_s(), config.detection, method, truth,
                                dataset.poses(), prepared, &verification.cache, request.progress)
-            : CompareRetrieval(pipeline::DetectStreaming(database, config.detection),
-                               config.detection, method, truth, dataset.poses(), prepared,
-                               &verification.cache, request.progress);
+            : CompareRetrieval(
+                  pipeline::DetectStreaming(database, config.detection,
+                                            pipeline::Execution::kParallel, truth.path_m),
+                  config.detection, method, truth, dataset.poses(), prepared, &verification.cache,
+                  request.progress);
     return e;
 }
 
@@ -398,6 +400,7 @@ eval::GroundTruthConfig GroundTruthRule(const EvaluationRequest& request) {
     rule.distance_m = request.distance_m;
     rule.max_heading_deg = request.max_heading_deg;
     rule.min_gap = request.config.detection.min_gap;
+    rule.min_path_m = request.min_path_m;
     rule.Validate();
     return rule;
 }

@@ -104,6 +104,9 @@ struct EvaluationRequest {
     std::vector<std::string> results_files;  ///< other detectors' query,match,distance CSVs
     double distance_m = 10.0;                ///< same place when closer (Röhling d, Magnusson t_r)
     double max_heading_deg = 0.0;            ///< and headings closer than this; 0: any
+    /// Pairs not more than this much path apart (on the poses), metres, are not evaluated,
+    /// besides the gap; 0: no path rule (eval::GroundTruthConfig::min_path_m).
+    double min_path_m = 0.0;
     eval::ThresholdLearningConfig learning;
     std::vector<double> fixed_thresholds;  ///< MCC at each, as Röhling's table II
     bool skip_bad = false;
@@ -117,7 +120,8 @@ struct EvaluationOutcome {
     std::vector<std::string> notes;  ///< figures that could not be drawn
 };
 
-/// The ground-truth rule of `request`: its distance, heading and the config's minimum gap.
+/// The ground-truth rule of `request`: its distance, heading, minimum path and the config's
+/// minimum gap.
 eval::GroundTruthConfig GroundTruthRule(const EvaluationRequest& request);
 
 /// Evaluates every method and results file on one ground truth from the dataset's poses

@@ -152,7 +152,8 @@ nlohmann::json EvaluationMetricsJson(const std::string& dataset, std::size_t sca
                                {"distance_m", truth.config.distance_m},
                                {"max_heading_deg", truth.config.max_heading_deg},
                                {"min_gap", truth.config.min_gap.value},
-                               {"min_gap_unit", core::ToString(truth.config.min_gap.unit)}};
+                               {"min_gap_unit", core::ToString(truth.config.min_gap.unit)},
+                               {"min_path_m", truth.config.min_path_m}};
     for (const MethodEvaluation& e : outcome.methods) metrics["methods"][e.name] = MetricsJson(e);
     return metrics;
 }

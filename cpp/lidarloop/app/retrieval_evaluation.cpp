@@ -49,8 +49,10 @@ RetrievalComparison CompareRetrieval(const pipeline::SimilarityMatrix& matrix,
                                      std::span<const core::StampedPose> poses,
                                      const PreparedScans* prepared,
                                      pipeline::VerificationCache* cache, const Progress& progress) {
-    return CompareRetrieval(pipeline::DetectFromMatrix(matrix, times_s, detector, method), detector,
-                            method, truth, poses, prepared, cache, progress);
+    // A gap in metres is measured on the ground-truth path.
+    return CompareRetrieval(
+        pipeline::DetectFromMatrix(matrix, times_s, detector, method, truth.path_m), detector,
+        method, truth, poses, prepared, cache, progress);
 }
 
 RetrievalComparison CompareRetrieval(std::vector<pipeline::LoopQuery> queries,

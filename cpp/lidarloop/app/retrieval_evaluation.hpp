@@ -44,8 +44,8 @@ std::vector<eval::QueryCandidates> DescriptorCandidates(
 std::vector<eval::QueryCandidates> VerifiedCandidates(std::span<const pipeline::LoopQuery> queries);
 
 /// Detects the top-k candidates of every scan from `matrix` (pipeline::DetectFromMatrix with
-/// `detector`), verifies them when detector.verify (with `prepared`, sharing `cache`), and
-/// scores both against `truth` (built from `poses`).
+/// `detector`; a gap in metres on truth.path_m), verifies them when detector.verify (with
+/// `prepared`, sharing `cache`), and scores both against `truth` (built from `poses`).
 RetrievalComparison CompareRetrieval(const pipeline::SimilarityMatrix& matrix,
                                      const std::vector<double>& times_s,
                                      const pipeline::DetectorConfig& detector,

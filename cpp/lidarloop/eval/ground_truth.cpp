@@ -18,6 +18,18 @@ std::string Format(double value) {
     return out.str();
 }
 
+const char* UnitSymbol(core::MinGap::Unit unit) {
+    switch (unit) {
+        case core::MinGap::Unit::kScans:
+            return "scans";
+        case core::MinGap::Unit::kSeconds:
+            return "s";
+        case core::MinGap::Unit::kMetres:
+            return "m of path";
+    }
+    return "";
+}
+
 // The sensor's forward axis projected on the world ground plane (not normalised).
 Eigen::Vector2d GroundHeading(const core::Transform& T_world_sensor) {
     return T_world_sensor.linear().col(0).head<2>();
@@ -72,6 +84,33 @@ void FillNearest(GroundTruth& truth) {
     }
 }
 
+// Comparable pairs under a path rule. The path grows with the index, and so do the scan gap and
+// (when the times are sorted) the time gap: Comparable(k, j) for j > k then holds from some j on,
+// found by bisection with Comparable itself. Unsorted times: every pair, O(n^2).
+std::size_t ComparablePairsAlongPath(const GroundTruth& truth) {
+    const std::size_t n = truth.size();
+    const bool monotone = truth.config.min_gap.unit != core::MinGap::Unit::kSeconds ||
+                          std::is_sorted(truth.times_s.begin(), truth.times_s.end());
+    std::size_t count = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+        if (!monotone) {
+            for (std::size_t j = k + 1; j < n; ++j) count += truth.Comparable(k, j) ? 1 : 0;
+            continue;
+        }
+        std::size_t lo = k + 1, hi = n;  // the first comparable j lies in [lo, hi]
+        while (lo < hi) {
+            const std::size_t mid = lo + (hi - lo) / 2;
+            if (truth.Comparable(k, mid)) {
+                hi = mid;
+            } else {
+                lo = mid + 1;
+            }
+        }
+        count += n - lo;
+    }
+    return count;
+}
+
 }  // namespace
 
 void GroundTruthConfig::Validate() const {
@@ -85,6 +124,10 @@ void GroundTruthConfig::Validate() const {
             Format(max_heading_deg));
     }
     min_gap.Validate("ground_truth.min_gap");
+    if (!std::isfinite(min_path_m) || min_path_m < 0.0) {
+        throw core::ConfigError("ground_truth.min_path_m must be a finite number >= 0, got " +
+                                Format(min_path_m));
+    }
 }
 
 std::string GroundTruthConfig::Describe() const {
@@ -97,13 +140,14 @@ std::string GroundTruthConfig::Describe() const {
             Format(max_heading_deg) + " deg";
     }
     const bool scans = min_gap.unit == core::MinGap::Unit::kScans;
-    if (scans && min_gap.value == 0.0) {
+    if (scans && min_gap.value == 0.0 && min_path_m == 0.0) {
         text += "; every pair of distinct scans is evaluated";
-    } else {
-        text += "; only pairs more than " + Format(min_gap.value) + (scans ? " scans" : " s") +
-                " apart in the sequence are evaluated";
+        return text;
     }
-    return text;
+    text += "; only pairs more than " + Format(min_gap.value) + " " + UnitSymbol(min_gap.unit) +
+            " apart in the sequence";
+    if (min_path_m > 0.0) text += " and more than " + Format(min_path_m) + " m of path apart";
+    return text + " are evaluated";
 }
 
 double HeadingDifferenceDeg(const core::Transform& T_world_a, const core::Transform& T_world_b) {
@@ -149,6 +193,8 @@ std::size_t GroundTruth::OverlappingCount() const {
 
 std::size_t GroundTruth::ComparablePairCount() const {
     const std::size_t n = size();
+    if (config.min_path_m > 0.0 || config.min_gap.unit == core::MinGap::Unit::kMetres)
+        return ComparablePairsAlongPath(*this);
     if (config.min_gap.unit == core::MinGap::Unit::kScans) {
         // |i - j| > S  <=>  |i - j| >= floor(S) + 1.
         const double first_apart = std::floor(config.min_gap.value) + 1.0;
@@ -193,6 +239,7 @@ GroundTruth BuildGroundTruth(const std::vector<core::StampedPose>& poses,
         for (const auto& pose : poses)
             truth.ground_headings.push_back(GroundHeading(pose.T_world_sensor));
     }
+    truth.path_m = core::CumulativePathM(poses);
     truth.tree = std::make_shared<const core::KdTree3>(truth.positions_m);
     FillPartners(truth);
     FillNearest(truth);

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <functional>
 #include <limits>
@@ -36,6 +37,10 @@ struct GroundTruthConfig {
     /// Pairs closer than this in the sequence are never evaluated (neither positive nor
     /// negative). Röhling evaluates every pair (0 scans, the default); Magnusson uses S = 30.
     core::MinGap min_gap{0.0, core::MinGap::Unit::kScans};
+    /// And pairs whose path between them (along the poses, core::CumulativePathM) is not longer
+    /// than this, metres >= 0, are not evaluated either: revisits as SLAM users count them, the
+    /// drift a loop removes. 0 (the default) disables the rule.
+    double min_path_m = 0.0;
 
     /// Throws core::ConfigError naming the first invalid field (prefix "ground_truth.").
     void Validate() const;
@@ -66,6 +71,7 @@ struct LoopPair {
 struct GroundTruth {
     GroundTruthConfig config;
     std::vector<double> times_s;               ///< per scan, the pose times (for a gap in seconds)
+    std::vector<double> path_m;                ///< per scan, core::CumulativePathM of the poses
     std::vector<Eigen::Vector3d> positions_m;  ///< per scan, the sensor position, world frame
     /// Per scan, the sensor's forward axis projected on the world ground plane (not
     /// normalised); empty when the heading rule is off.
@@ -81,9 +87,17 @@ struct GroundTruth {
     std::shared_ptr<const core::KdTree3> tree;  ///< over positions_m, for ForEachLoop
 
     std::size_t size() const { return times_s.size(); }
-    /// True when scans i and j are far enough apart in the sequence to be evaluated.
+    /// True when scans i and j are distinct and outside the minimum gap (the rule a detector's
+    /// candidates obey).
+    bool OutsideGap(std::size_t i, std::size_t j) const {
+        const std::vector<double>& along = config.min_gap.Along(times_s, path_m);
+        return i != j && config.min_gap.Allows(i, j, along[i], along[j]);
+    }
+    /// True when scans i and j are far enough apart in the sequence to be evaluated: outside
+    /// the gap, and more than min_path_m of path apart when that rule is on.
     bool Comparable(std::size_t i, std::size_t j) const {
-        return i != j && config.min_gap.Allows(i, j, times_s[i], times_s[j]);
+        return OutsideGap(i, j) &&
+               (config.min_path_m <= 0.0 || std::abs(path_m[i] - path_m[j]) > config.min_path_m);
     }
     /// The rules besides the distance: Comparable, and headings closer than max_heading_deg
     /// when the heading rule is on.

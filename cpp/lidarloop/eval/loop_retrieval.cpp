@@ -32,7 +32,7 @@ void CheckCandidate(const QueryCandidates& q, std::size_t rank, const GroundTrut
     const RankedCandidate& c = q.ranked[rank];
     const std::string where = "loop retrieval: query " + std::to_string(q.query) + ", candidate " +
                               std::to_string(rank) + " (scan " + std::to_string(c.match) + ")";
-    if (c.match >= truth.size() || c.match >= q.query || !truth.Comparable(q.query, c.match)) {
+    if (c.match >= truth.size() || c.match >= q.query || !truth.OutsideGap(q.query, c.match)) {
         throw core::Error(where + " is not an earlier scan outside the minimum gap");
     }
     if (std::isnan(c.distance)) throw core::Error(where + ": distance is NaN");
@@ -84,6 +84,10 @@ std::optional<AcceptedLoop> FirstAccepted(const QueryCandidates& q, const Ground
     for (std::size_t rank = 0; rank < q.ranked.size(); ++rank) {
         const RankedCandidate& c = q.ranked[rank];
         if (!c.accepted) continue;
+        // The same place too little path back (min_path_m) is no revisit, and no error either.
+        const double apart_m = (truth.positions_m[q.query] - truth.positions_m[c.match]).norm();
+        if (!truth.Comparable(q.query, c.match) && apart_m < truth.config.distance_m)
+            return std::nullopt;
         AcceptedLoop loop{q.query, c.match, rank, c.score, truth.IsLoop(q.query, c.match), {}, {}};
         if (c.T_match_query) {
             loop.pose_error = PoseError(

@@ -141,6 +141,8 @@ struct LoopRetrievalEvaluation {
     double recall_at_k = std::numeric_limits<double>::quiet_NaN();
 
     /// Decisions: each query's first accepted candidate is its loop (at most one per query).
+    /// With GroundTruthConfig::min_path_m, a loop to the same place too little path back is no
+    /// revisit and no error: it is in none of these counts (as tools/verified_recall.py strict).
     std::size_t true_loops = 0;   ///< correct loops (necessarily of revisiting queries)
     std::size_t false_loops = 0;  ///< wrong loops, including all of non-revisiting queries
     double precision = std::numeric_limits<double>::quiet_NaN();  ///< true / (true + false)
@@ -162,7 +164,7 @@ struct LoopRetrievalEvaluation {
 ///
 /// Throws core::Error, naming the query and candidate, when: poses.size() != truth.size(); a
 /// query index is out of range or given twice; a candidate is not an earlier scan outside the
-/// minimum gap of its query (GroundTruth::Comparable) or appears twice in one list; a distance
+/// minimum gap of its query (GroundTruth::OutsideGap) or appears twice in one list; a distance
 /// or score is NaN; a T_match_query is not finite or its linear part is not a rotation (within
 /// 1e-4). O(n + C log C) for n scans and C candidates. Thread-safe.
 LoopRetrievalEvaluation EvaluateLoopRetrieval(std::span<const QueryCandidates> queries,

@@ -1,5 +1,6 @@
 // evaluate's ranked-candidate figures recounted by hand from detect's verified candidates and the
 // poses: the same candidates, verdicts and ground truth must give the same numbers.
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 
@@ -111,6 +112,102 @@ TEST(RetrievalEvaluation, EvaluateRecountsFromDetectsCandidates) {
     EXPECT_EQ(metrics["verified"]["true_loops"], verified.true_loops);
     EXPECT_EQ(metrics["verified"]["wrong_pose_loops"], verified.wrong_pose);
     EXPECT_EQ(metrics["descriptor"]["revisiting_scans"], verified.revisiting);
+}
+
+// The path between scans a and b, walked step by step over the poses.
+double BrutePathM(const io::Dataset& dataset, std::size_t a, std::size_t b) {
+    const auto& poses = dataset.poses();
+    double path_m = 0.0;
+    for (std::size_t k = std::min(a, b); k < std::max(a, b); ++k) {
+        path_m +=
+            (poses[k + 1].T_world_sensor.translation() - poses[k].T_world_sensor.translation())
+                .norm();
+    }
+    return path_m;
+}
+
+// RecountFrom's rules with --min-path: a revisit needs more than `min_path_m` of path back too; a
+// loop to the same place with less path is neither true nor false.
+Recount RecountWithPath(const io::Dataset& dataset, const std::vector<pipeline::LoopQuery>& queries,
+                        double min_path_m) {
+    const auto revisit = [&](std::size_t a, std::size_t b) {
+        return SamePlace(dataset, a, b) && BrutePathM(dataset, a, b) > min_path_m;
+    };
+    Recount r;
+    for (std::size_t i = 0; i < dataset.size(); ++i) {
+        for (std::size_t j = 0; j + kGapScans < i; ++j) {
+            if (revisit(i, j)) {
+                ++r.revisiting;
+                break;
+            }
+        }
+    }
+    for (const pipeline::LoopQuery& q : queries) {
+        if (!q.has_match()) continue;
+        r.hits_at_1 += revisit(q.query, q.candidates.front().index) ? 1 : 0;
+        bool hit = false;
+        for (const auto& c : q.candidates) hit = hit || revisit(q.query, c.index);
+        r.hits_at_k += hit ? 1 : 0;
+        const std::optional<std::size_t> loop = q.loop();
+        if (!loop) continue;
+        const std::size_t match = q.candidates[*loop].index;
+        if (revisit(q.query, match)) {
+            ++r.true_loops;
+        } else if (!SamePlace(dataset, q.query, match)) {
+            ++r.false_loops;
+        }
+    }
+    return r;
+}
+
+TEST(RetrievalEvaluation, MinPathCountsOnlyRevisitsFarBackInPath) {
+    const test::TempDir dir;
+    const io::Dataset dataset = test::SmallSequence(dir / "sequence");
+    app::EvaluationRequest request;
+    request.methods = {core::Method::kRange};
+    request.config.descriptor.method = core::Method::kRange;
+    request.config.detection.min_gap.value = static_cast<double>(kGapScans);
+    request.config.detection.top_k = 3;
+    request.config.detection.verify = false;
+    request.config.detection.threshold = 0.02;  // loose: loops to the recent past too
+    request.distance_m = kDistanceM;
+    // The median over revisiting scans of the longest path back to the same place: about half
+    // of the revisits are then too little path back.
+    std::vector<double> longest_back_m;
+    for (std::size_t i = 0; i < dataset.size(); ++i) {
+        double longest_m = 0.0;
+        for (std::size_t j = 0; j + kGapScans < i; ++j) {
+            if (SamePlace(dataset, i, j))
+                longest_m = std::max(longest_m, BrutePathM(dataset, i, j));
+        }
+        if (longest_m > 0.0) longest_back_m.push_back(longest_m);
+    }
+    ASSERT_FALSE(longest_back_m.empty());
+    std::sort(longest_back_m.begin(), longest_back_m.end());
+    request.min_path_m = longest_back_m[longest_back_m.size() / 2];
+    request.out = dir / "evaluation";
+    const app::EvaluationOutcome evaluated = app::RunEvaluation(dataset, request);
+    const app::RetrievalComparison& r = *evaluated.methods.at(0).retrieval;
+    const Recount expected = RecountWithPath(dataset, r.queries, request.min_path_m);
+    ExpectSame(expected, r.descriptor, dataset.size());
+    // The rule must bite: without it more scans revisit, and some loops are to the recent past.
+    const Recount without = RecountWithPath(dataset, r.queries, 0.0);
+    EXPECT_GT(without.revisiting, expected.revisiting);
+    EXPECT_GT(without.true_loops, expected.true_loops);
+    EXPECT_GT(expected.revisiting, 0u);
+    EXPECT_EQ(evaluated.truth.OverlappingCount(), [&] {
+        std::size_t overlapping = 0;  // either direction, outside the gap
+        for (std::size_t i = 0; i < dataset.size(); ++i) {
+            bool any = false;
+            for (std::size_t j = 0; j < dataset.size() && !any; ++j) {
+                const std::size_t apart = i > j ? i - j : j - i;
+                any = apart > kGapScans && SamePlace(dataset, i, j) &&
+                      BrutePathM(dataset, i, j) > request.min_path_m;
+            }
+            overlapping += any ? 1 : 0;
+        }
+        return overlapping;
+    }());
 }
 
 }  // namespace

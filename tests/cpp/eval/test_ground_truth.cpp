@@ -29,12 +29,40 @@ struct BruteTruth {
     std::size_t comparable_pairs = 0;
 };
 
+// The path between scans i and j: the sum of the steps between them, walked anew.
+double PathBetweenM(const std::vector<core::StampedPose>& poses, std::size_t i, std::size_t j) {
+    double path_m = 0.0;
+    for (std::size_t k = std::min(i, j); k < std::max(i, j); ++k) {
+        path_m +=
+            (poses[k + 1].T_world_sensor.translation() - poses[k].T_world_sensor.translation())
+                .norm();
+    }
+    return path_m;
+}
+
+// The gap and the path rule, written out again.
+bool BruteComparable(const std::vector<core::StampedPose>& poses, const GroundTruthConfig& c,
+                     std::size_t i, std::size_t j) {
+    if (i == j) return false;
+    const double path_m = PathBetweenM(poses, i, j);
+    if (c.min_path_m > 0.0 && !(path_m > c.min_path_m)) return false;
+    switch (c.min_gap.unit) {
+        case MinGap::Unit::kScans:
+            return static_cast<double>(std::max(i, j) - std::min(i, j)) > c.min_gap.value;
+        case MinGap::Unit::kSeconds:
+            return std::abs(poses[i].time_s - poses[j].time_s) > c.min_gap.value;
+        case MinGap::Unit::kMetres:
+            return path_m > c.min_gap.value;
+    }
+    return false;
+}
+
 BruteTruth BruteForce(const std::vector<core::StampedPose>& poses, const GroundTruthConfig& c) {
     const std::size_t n = poses.size();
     std::vector<Eigen::Vector3d> position(n);
     for (std::size_t i = 0; i < n; ++i) position[i] = poses[i].T_world_sensor.translation();
     const auto rules = [&](std::size_t i, std::size_t j) {
-        if (i == j || !c.min_gap.Allows(i, j, poses[i].time_s, poses[j].time_s)) return false;
+        if (!BruteComparable(poses, c, i, j)) return false;
         return c.max_heading_deg == 0.0 ||
                HeadingDifferenceDeg(poses[i].T_world_sensor, poses[j].T_world_sensor) <
                    c.max_heading_deg;
@@ -45,9 +73,7 @@ BruteTruth BruteForce(const std::vector<core::StampedPose>& poses, const GroundT
     for (std::size_t i = 0; i < n; ++i) {
         double best = std::numeric_limits<double>::infinity();
         for (std::size_t j = 0; j < n; ++j) {
-            if (i < j && c.min_gap.Allows(i, j, poses[i].time_s, poses[j].time_s)) {
-                ++truth.comparable_pairs;
-            }
+            if (i < j && BruteComparable(poses, c, i, j)) ++truth.comparable_pairs;
             const double squared = (position[i] - position[j]).squaredNorm();
             const bool near = i < j && squared < c.distance_m * c.distance_m;
             // The rules are the expensive part; a pair that can change nothing skips them.
@@ -126,6 +152,33 @@ TEST(GroundTruth, KdTreeEqualsBruteForceOnRandomTrajectories) {
             ExpectSameAsBruteForce(poses, config);
         }
     }
+}
+
+// Revisits as SLAM users count them: a metres gap, and min_path_m beside a gap in scans or
+// seconds, against the brute force that walks the path between every pair anew.
+TEST(GroundTruth, PathRulesEqualBruteForce) {
+    std::vector<GroundTruthConfig> configs(4);
+    configs[0].min_gap = {60.0, MinGap::Unit::kMetres};
+    configs[1].min_gap = {10.0, MinGap::Unit::kScans};
+    configs[1].min_path_m = 50.0;
+    configs[2].min_gap = {2.0, MinGap::Unit::kSeconds};
+    configs[2].min_path_m = 80.0;
+    configs[3].distance_m = 5.0;
+    configs[3].max_heading_deg = 30.0;
+    configs[3].min_gap = {20.0, MinGap::Unit::kMetres};
+    configs[3].min_path_m = 40.0;
+    for (const unsigned seed : {4u, 5u}) {
+        const auto poses = RandomTrajectory(seed, 400);
+        for (const auto& config : configs) {
+            SCOPED_TRACE("seed " + std::to_string(seed) + ": " + config.Describe());
+            ExpectSameAsBruteForce(poses, config);
+        }
+    }
+    // Times out of order: the pair count cannot bisect on them.
+    auto shuffled = RandomTrajectory(6, 200);
+    std::reverse(shuffled.begin(), shuffled.end());
+    for (std::size_t i = 0; i < shuffled.size(); i += 2) shuffled[i].time_s = -shuffled[i].time_s;
+    ExpectSameAsBruteForce(shuffled, configs[2]);
 }
 
 TEST(GroundTruth, HandMadeSequence) {
@@ -236,6 +289,10 @@ TEST(GroundTruth, DescribeNamesTheRule) {
     EXPECT_NE(text.find("30 scans"), std::string::npos) << text;
     config.min_gap = {12.5, MinGap::Unit::kSeconds};
     EXPECT_NE(config.Describe().find("12.5 s"), std::string::npos);
+    config.min_gap = {40.0, MinGap::Unit::kMetres};
+    config.min_path_m = 50.0;
+    EXPECT_NE(config.Describe().find("40 m of path"), std::string::npos) << config.Describe();
+    EXPECT_NE(config.Describe().find("50 m of path apart"), std::string::npos);
     const GroundTruth truth = BuildGroundTruth(RandomTrajectory(4, 50), config);
     EXPECT_NE(truth.Describe().find("50 scans"), std::string::npos);
 }
@@ -269,6 +326,11 @@ TEST(GroundTruth, RejectsAbsurdConfigsAndPoses) {
     GroundTruthConfig gap;
     gap.min_gap.value = -3.0;
     ExpectConfigError(gap, "ground_truth.min_gap");
+    for (const double path : {-1.0, nan, inf}) {
+        GroundTruthConfig config;
+        config.min_path_m = path;
+        ExpectConfigError(config, "ground_truth.min_path_m");
+    }
     EXPECT_THROW(BuildGroundTruth({}, gap), core::ConfigError);
     std::vector<core::StampedPose> poses{MakePose(0, 0, 0), MakePose(1, nan, 0)};
     EXPECT_THROW(BuildGroundTruth(poses, GroundTruthConfig{}), core::Error);
