@@ -46,7 +46,8 @@ class DetectResult:
     def loops(self) -> dict[str, Any]:
         """loops.csv's rows as columns: query, match, distance, second_ratio (NaN: none),
         accepted (bool), rank (1-based verified candidate, 0: not verified), T_match_query
-        ((R, 4, 4), NaN when not verified), verification (list of Verification or None)."""
+        ((R, 4, 4), NaN when not verified), verification (list of Verification or None),
+        path_m (the path between query and match, metres; NaN when no poses or odometry)."""
     @property
     def accepted_loops(self) -> list[LoopConstraint]:
         """The accepted, verified loops, ready for build_pose_graph."""
@@ -71,10 +72,13 @@ def detect(
     format: str = "auto",
     poses: Optional[PathLike] = None,
     calib: Optional[PathLike] = None,
+    odometry: Optional[PathLike] = None,
 ) -> DetectResult:
     """`lidarloop detect DATASET --out OUT` (None keeps the config's value; verification is on
     by default). `out` is a results folder with run.json (refused inside the dataset, or when it
-    holds other files unless overwrite=True; a failed run leaves only run.json)."""
+    holds other files unless overwrite=True; a failed run leaves only run.json).
+    min_gap_unit: 'scans', 'seconds' or 'metres' of path, measured on `odometry` (KITTI or TUM,
+    one pose per scan) when given, else on the dataset's poses."""
 
 class MethodEvaluation:
     """Everything `lidarloop evaluate` computed for one method."""
@@ -141,6 +145,7 @@ def evaluate(
     results: Sequence[PathLike] = ...,
     distance_m: Optional[float] = None,
     max_heading_deg: Optional[float] = None,
+    min_path_m: Optional[float] = None,
     train_fraction: Optional[float] = None,
     criterion: Optional[str] = None,
     fixed_thresholds: Sequence[float] = ...,
@@ -158,7 +163,8 @@ def evaluate(
     train_on: Union[None, PathLike, Dataset] = None,
 ) -> EvaluateResult:
     """`lidarloop evaluate DATASET --out OUT`: every method (default all) on one ground truth
-    (distance_m default 10 m, max_heading_deg 0: any, the config's min gap); train_on: learn
+    (distance_m default 10 m, max_heading_deg 0: any, the config's min gap, min_path_m 0: no
+    path rule, else pairs must be more than that much path apart too); train_on: learn
     each method's threshold on that dataset (with poses) instead of the first part."""
 
 class OptimiseResult:

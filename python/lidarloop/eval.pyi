@@ -31,14 +31,16 @@ class Confusion:
 
 class GroundTruthConfig:
     """Same place: positions closer than distance_m (metres, strictly), headings closer than
-    max_heading_deg (0: any), scans more than min_gap (min_gap_unit 'scans' | 'seconds') apart.
-    Keywords override the C++ defaults (10 m, 0 deg, 0 scans)."""
+    max_heading_deg (0: any), scans more than min_gap (min_gap_unit 'scans' | 'seconds' |
+    'metres' of path) apart and more than min_path_m of path apart (0: any). Keywords override
+    the C++ defaults (10 m, 0 deg, 0 scans, 0 m)."""
 
     def __init__(self, **fields: Any) -> None: ...
     distance_m: float
     max_heading_deg: float
     min_gap: float
     min_gap_unit: str
+    min_path_m: float
     def describe(self) -> str: ...
 
 class GroundTruth:

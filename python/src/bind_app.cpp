@@ -161,9 +161,10 @@ struct DetectResult {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// The rows of loops.csv (one per query with a candidate; app::WriteLoopsCsv) as column arrays.
-py::dict LoopsTable(const std::vector<pipeline::LoopQuery>& queries) {
+py::dict LoopsTable(const std::vector<pipeline::LoopQuery>& queries,
+                    const std::vector<double>& path_m) {
     std::vector<long long> query, match, rank;
-    std::vector<double> distance, second_ratio;
+    std::vector<double> distance, second_ratio, path_between_m;
     std::vector<bool> accepted;
     std::vector<core::Transform> poses;
     py::list verifications;
@@ -174,6 +175,8 @@ py::dict LoopsTable(const std::vector<pipeline::LoopQuery>& queries) {
         match.push_back(static_cast<long long>(q.candidates[r].index));
         distance.push_back(q.candidates[r].distance);
         second_ratio.push_back(q.second_ratio);
+        path_between_m.push_back(
+            path_m.empty() ? kNaN : std::abs(path_m[q.query] - path_m[q.candidates[r].index]));
         accepted.push_back(q.accepted);
         rank.push_back(q.verified() ? static_cast<long long>(r + 1) : 0);
         core::Transform T = core::Transform::Identity();
@@ -197,6 +200,7 @@ py::dict LoopsTable(const std::vector<pipeline::LoopQuery>& queries) {
     table["rank"] = ArrayOf(rank);
     table["T_match_query"] = TransformsToArray(poses);
     table["verification"] = verifications;
+    table["path_m"] = ArrayOf(path_between_m);
     return table;
 }
 
@@ -226,11 +230,12 @@ void BindDetect(py::module_& m) {
         .def_property_readonly("skipped", [](const DetectResult& r) { return r.outcome.skipped; })
         .def_property_readonly("total_s", [](const DetectResult& r) { return r.outcome.total_s; })
         .def_property_readonly(
-            "loops", [](const DetectResult& r) { return LoopsTable(r.outcome.queries); },
+            "loops",
+            [](const DetectResult& r) { return LoopsTable(r.outcome.queries, r.outcome.path_m); },
             "loops.csv's rows as columns: query, match, distance, second_ratio (NaN: none), "
             "accepted (bool), rank (1-based verified candidate, 0: not verified), "
             "T_match_query (R, 4, 4; NaN when not verified), verification (Verification or "
-            "None per row)")
+            "None per row), path_m (path between query and match, metres; NaN: unknown)")
         .def_property_readonly(
             "accepted_loops",
             [](const DetectResult& r) { return AcceptedLoops(r.outcome.queries); },
@@ -263,7 +268,8 @@ void BindDetect(py::module_& m) {
            std::optional<int> top_k, std::optional<double> min_gap,
            const std::optional<std::string>& min_gap_unit, bool skip_bad, bool overwrite,
            const py::object& progress, const std::string& format,
-           const std::optional<fs::path>& poses, const std::optional<fs::path>& calib) {
+           const std::optional<fs::path>& poses, const std::optional<fs::path>& calib,
+           const std::optional<fs::path>& odometry) {
             const py::dict given(py::arg("out") = out.string(), py::arg("method") = method,
                                  py::arg("verify") = verify, py::arg("threshold") = threshold,
                                  py::arg("top_k") = top_k, py::arg("min_gap") = min_gap,
@@ -275,15 +281,18 @@ void BindDetect(py::module_& m) {
             request.skip_bad = skip_bad;
             request.progress = python_progress.Callback();
             request.out = out;
+            if (odometry) request.odometry_file = *odometry;
             const io::Dataset data = DatasetOf(dataset, format, poses, calib);
+            std::vector<fs::path> inputs = InputsOf(data, poses, calib);
+            if (odometry) inputs.push_back(*odometry);
             DetectResult result;
-            result.outcome = RunInFolder(out, InputsOf(data, poses, calib), overwrite,
-                                         CallText("detect", dataset, given), python_progress,
-                                         [&](const fs::path& staging) {
-                                             app::DetectRequest staged = request;
-                                             staged.out = staging;
-                                             return app::RunDetect(data, staged);
-                                         });
+            result.outcome =
+                RunInFolder(out, std::move(inputs), overwrite, CallText("detect", dataset, given),
+                            python_progress, [&](const fs::path& staging) {
+                                app::DetectRequest staged = request;
+                                staged.out = staging;
+                                return app::RunDetect(data, staged);
+                            });
             result.out = out;
             result.method = core::ToString(request.config.descriptor.method);
             return result;
@@ -294,6 +303,7 @@ void BindDetect(py::module_& m) {
         py::arg("min_gap") = py::none(), py::arg("min_gap_unit") = py::none(),
         py::arg("skip_bad") = false, py::arg("overwrite") = false, py::arg("progress") = py::none(),
         py::arg("format") = "auto", py::arg("poses") = py::none(), py::arg("calib") = py::none(),
+        py::arg("odometry") = py::none(),
         "`lidarloop detect DATASET --out OUT` on a dataset folder (or a Dataset of "
         "open_dataset): describes every scan, finds each scan's "
         "candidates, verifies them (unless verify=False or the config says so) and writes "
@@ -399,11 +409,12 @@ void BindEvaluate(py::module_& m) {
         [](const py::object& dataset, const fs::path& out,
            const std::optional<std::vector<std::string>>& methods, const py::object& config,
            const std::vector<fs::path>& results, std::optional<double> distance_m,
-           std::optional<double> max_heading_deg, std::optional<double> train_fraction,
-           const std::optional<std::string>& criterion, const std::vector<double>& fixed_thresholds,
-           std::optional<bool> verify, std::optional<double> threshold, std::optional<int> top_k,
-           std::optional<double> min_gap, const std::optional<std::string>& min_gap_unit,
-           bool skip_bad, bool overwrite, const py::object& progress, const std::string& format,
+           std::optional<double> max_heading_deg, std::optional<double> min_path_m,
+           std::optional<double> train_fraction, const std::optional<std::string>& criterion,
+           const std::vector<double>& fixed_thresholds, std::optional<bool> verify,
+           std::optional<double> threshold, std::optional<int> top_k, std::optional<double> min_gap,
+           const std::optional<std::string>& min_gap_unit, bool skip_bad, bool overwrite,
+           const py::object& progress, const std::string& format,
            const std::optional<fs::path>& poses, const std::optional<fs::path>& calib,
            const py::object& train_on) {
             const py::dict given(py::arg("out") = out.string(), py::arg("methods") = methods,
@@ -418,6 +429,7 @@ void BindEvaluate(py::module_& m) {
             for (const fs::path& file : results) request.results_files.push_back(file.string());
             request.distance_m = distance_m.value_or(request.distance_m);
             request.max_heading_deg = max_heading_deg.value_or(request.max_heading_deg);
+            request.min_path_m = min_path_m.value_or(request.min_path_m);
             request.learning.train_fraction =
                 train_fraction.value_or(request.learning.train_fraction);
             if (criterion) request.learning.criterion = eval::ParseCriterion(*criterion);
@@ -449,12 +461,13 @@ void BindEvaluate(py::module_& m) {
         py::arg("dataset"), py::kw_only(), py::arg("out"), py::arg("methods") = py::none(),
         py::arg("config") = py::none(), py::arg("results") = std::vector<fs::path>{},
         py::arg("distance_m") = py::none(), py::arg("max_heading_deg") = py::none(),
-        py::arg("train_fraction") = py::none(), py::arg("criterion") = py::none(),
-        py::arg("fixed_thresholds") = std::vector<double>{}, py::arg("verify") = py::none(),
-        py::arg("threshold") = py::none(), py::arg("top_k") = py::none(),
-        py::arg("min_gap") = py::none(), py::arg("min_gap_unit") = py::none(),
-        py::arg("skip_bad") = false, py::arg("overwrite") = false, py::arg("progress") = py::none(),
-        py::arg("format") = "auto", py::arg("poses") = py::none(), py::arg("calib") = py::none(),
+        py::arg("min_path_m") = py::none(), py::arg("train_fraction") = py::none(),
+        py::arg("criterion") = py::none(), py::arg("fixed_thresholds") = std::vector<double>{},
+        py::arg("verify") = py::none(), py::arg("threshold") = py::none(),
+        py::arg("top_k") = py::none(), py::arg("min_gap") = py::none(),
+        py::arg("min_gap_unit") = py::none(), py::arg("skip_bad") = false,
+        py::arg("overwrite") = false, py::arg("progress") = py::none(), py::arg("format") = "auto",
+        py::arg("poses") = py::none(), py::arg("calib") = py::none(),
         py::arg("train_on") = py::none(),
         "`lidarloop evaluate DATASET --out OUT`: scores every method (default all) and "
         "results file on one ground truth from the dataset's poses (distance_m, "

@@ -82,12 +82,16 @@ void BindGroundTruthConfig(py::module_& m) {
     py::class_<GroundTruthConfig>(
         m, "GroundTruthConfig",
         "When two scans show the same place: positions closer than distance_m (strictly), "
-        "headings closer than max_heading_deg (0: any), scans more than min_gap apart.")
+        "headings closer than max_heading_deg (0: any), scans more than min_gap apart and more "
+        "than min_path_m of path apart (0: any).")
         .def(py::init(&FromKeywords<GroundTruthConfig>),
              "Keyword arguments override the defaults (distance_m=10, max_heading_deg=0, "
-             "min_gap=0, min_gap_unit='scans')")
+             "min_gap=0, min_gap_unit='scans', min_path_m=0)")
         .def_readwrite("distance_m", &GroundTruthConfig::distance_m)
         .def_readwrite("max_heading_deg", &GroundTruthConfig::max_heading_deg)
+        .def_readwrite("min_path_m", &GroundTruthConfig::min_path_m,
+                       "pairs not more than this much path apart (metres on the poses) are not "
+                       "evaluated; 0: no path rule")
         .def_property(
             "min_gap", [](const GroundTruthConfig& c) { return c.min_gap.value; },
             [](GroundTruthConfig& c, double value) { c.min_gap.value = value; },
@@ -98,7 +102,7 @@ void BindGroundTruthConfig(py::module_& m) {
             [](GroundTruthConfig& c, const std::string& unit) {
                 c.min_gap.unit = core::ParseMinGapUnit(unit);
             },
-            "'scans' or 'seconds'")
+            "'scans', 'seconds' or 'metres' (of path on the poses)")
         .def("describe", &GroundTruthConfig::Describe);
 }
 

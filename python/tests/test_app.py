@@ -236,3 +236,29 @@ def test_stubs_match_the_module(area):
                    for m in node.body}
         public = {a for a in dir(getattr(module, name)) if not a.startswith("_")}
         assert public <= members, f"{name}: no stub for {public - members}"
+
+
+def test_a_gap_in_metres_and_min_path_match_the_cli(cli, sequence, tmp_path):
+    odometry = sequence / "poses_odometry.txt"
+    run_cli(cli, "detect", sequence, "--method", "range", "--no-verify", "--min-gap", "20",
+            "--min-gap-unit", "metres", "--odometry", odometry, "--out", tmp_path / "cli")
+    result = lidarloop.detect(sequence, out=tmp_path / "py", method="range", verify=False,
+                              min_gap=20, min_gap_unit="metres", odometry=odometry)
+    for name in ("loops.csv", "candidates.csv", "config.yaml"):
+        assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), \
+            name
+    rows = read_csv(tmp_path / "cli" / "loops.csv")
+    assert len(rows) > 10 and all(float(r["path_m"]) > 20 for r in rows)
+    np.testing.assert_allclose(result.loops["path_m"], [float(r["path_m"]) for r in rows],
+                               rtol=1e-8)
+    # Half the path: the revisits near the U-turn are too little path back.
+    positions = np.loadtxt(sequence / "poses.txt").reshape(-1, 3, 4)[:, :, 3]
+    min_path = round(0.5 * np.linalg.norm(np.diff(positions, axis=0), axis=1).sum())
+    run_cli(cli, "evaluate", sequence, "--method", "range", "--no-verify", "--min-path", min_path,
+            "--out", tmp_path / "cli_eval")
+    evaluated = lidarloop.evaluate(sequence, out=tmp_path / "py_eval", methods=["range"],
+                                   verify=False, min_path_m=min_path)
+    cli_metrics = json.loads((tmp_path / "cli_eval" / "metrics.json").read_text())
+    assert without_timings(evaluated.metrics) == without_timings(cli_metrics)
+    assert cli_metrics["ground_truth"]["min_path_m"] == min_path
+    assert 0 < evaluated.truth.overlapping_count < 55  # fewer revisits than without the rule

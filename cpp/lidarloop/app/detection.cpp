@@ -137,6 +137,7 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     std::optional<pipeline::SimilarityMatrix> matrix;
     DetectOutcome outcome;
     outcome.threshold = threshold;
+    outcome.path_m = path_m;
     if (config.output.KeepsSimilarityMatrix(dataset.size())) {
         matrix = pipeline::ComputeSimilarityMatrix(described.database);
         outcome.queries =

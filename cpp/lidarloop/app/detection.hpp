@@ -30,6 +30,9 @@ struct DetectOutcome {
     std::size_t accepted = 0;                  ///< scans whose best match was accepted
     std::vector<std::string> skipped;          ///< "scan 17: <reason>" per skipped scan
     std::size_t map_scans = 0;                 ///< scans of the map (localisation only)
+    /// Per scan, the path travelled (core::CumulativePathM of the odometry or the poses), which
+    /// loops.csv's path_m is taken from; empty when neither is known and when localising.
+    std::vector<double> path_m;
     double total_s = 0.0;
 };
 
