@@ -8,7 +8,7 @@
 # output; the last line is "cli <sections>: N passed, N failed".
 set -u
 sections=(describe distance ndt verify detect bench demo evaluate dump-config bad-input simulate
-    optimise results-folders errors loops)
+    optimise results-folders errors loops path-gap)
 if [ "${1-}" = "--list" ]; then
     printf '%s\n' "${sections[@]}"
     exit 0
@@ -679,6 +679,46 @@ section_loops() {
         >"$work/four.csv"
     expect_ok "odometry that freezes" "longest standstill: scans 10 to 39" "$cli" optimise \
         "$work/seq" --odometry "$work/frozen.txt" --loops "$work/four.csv" --out "$work/frozen"
+}
+
+# --- a gap in metres of path, path_m, evaluate --min-path -------------------------------------
+section_path_gap() {
+    "$cli" simulate --sensor vlp16 --route grid --scans 40 --horizontal-steps 90 --quiet \
+        --out "$work/seq" >/dev/null 2>&1
+    local odometry="$work/seq/poses_odometry.txt"
+    expect_ok "detect gap in metres" "40 scans" "$cli" detect "$work/seq" --min-gap 20 \
+        --min-gap-unit metres --odometry "$odometry" --no-verify --top-k 3 --quiet --out "$work/det"
+    # Every candidate lies more than 20 m of path back, and path_m is the path walked anew.
+    local wrong
+    wrong="$(awk -F, 'NR == FNR { x[FNR - 1] = $4; y[FNR - 1] = $8; z[FNR - 1] = $12; next }
+        FNR == 1 { if ($NF != "path_m") print "no path_m column"; next }
+        { q = $1; m = $3; p = 0
+          for (k = m; k < q; ++k) p += sqrt((x[k+1]-x[k])^2 + (y[k+1]-y[k])^2 + (z[k+1]-z[k])^2)
+          if ($NF <= 20 || (p - $NF)^2 > 1e-8) print "row " FNR ": path_m " $NF ", walked " p }' \
+        FS=' ' "$odometry" FS=, "$work/det/candidates.csv")"
+    if [ -z "$wrong" ] && [ "$(wc -l <"$work/det/candidates.csv")" -gt 5 ]; then pass; else
+        fail "candidates.csv path_m: ${wrong:-too few rows}"
+    fi
+    seq="$work/bare"
+    make_sequence "$seq"
+    expect_error "detect metres without poses" "needs the path travelled" "$cli" detect "$seq" \
+        --min-gap 5 --min-gap-unit metres --quiet --out "$work/det_bare"
+    head -n 39 "$odometry" >"$work/short.txt"
+    expect_error "detect short odometry" "short.txt: holds 39 poses" "$cli" detect "$work/seq" \
+        --min-gap-unit metres --odometry "$work/short.txt" --quiet --out "$work/det_short"
+    printf 'detection:\n  min_gap: 50\n  min_gap_unit: metres\n' >"$work/metres.yaml"
+    expect_ok "dump-config metres" "min_gap_unit: metres" "$cli" dump-config \
+        --config "$work/metres.yaml"
+    expect_ok "evaluate --min-path" "report:" "$cli" evaluate "$work/seq" --method range \
+        --no-verify --min-gap 5 --min-path 30 --quiet --out "$work/eval"
+    if grep -q '"min_path_m": 30' "$work/eval/metrics.json"; then pass; else
+        fail "evaluate --min-path: metrics.json lacks min_path_m"
+    fi
+    # optimise --loops reads a loops.csv with path_m last.
+    printf '%s\n%s\n' "query,match,distance,second_ratio,accepted,rank,tx,ty,tz,qx,qy,qz,qw,path_m" \
+        "35,2,0.001,,1,1,0,0,0,0,0,0,1,42.5" >"$work/loops.csv"
+    expect_ok "optimise loops with path_m" "ATE RMSE: odometry" "$cli" optimise "$work/seq" \
+        --odometry "$odometry" --loops "$work/loops.csv" --out "$work/opt"
 }
 
 # --- run the sections named on the command line -------------------------------------------------
