@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <bit>
 #include <cmath>
@@ -10,6 +11,7 @@
 #include <random>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <unistd.h>
 
@@ -94,6 +96,19 @@ inline core::PointCloud Transformed(const core::PointCloud& cloud, const Eigen::
 }
 
 /// Path of a fixture under tests/data.
+/// The path between scans i and j (metres), walked step by step over `poses`: the brute-force
+/// reference for core::CumulativePathM and the gaps and columns built on it.
+inline double BrutePathM(const std::vector<core::StampedPose>& poses, std::size_t i,
+                         std::size_t j) {
+    double path_m = 0.0;
+    for (std::size_t k = std::min(i, j); k < std::max(i, j); ++k) {
+        path_m +=
+            (poses[k + 1].T_world_sensor.translation() - poses[k].T_world_sensor.translation())
+                .norm();
+    }
+    return path_m;
+}
+
 inline std::filesystem::path DataFile(const std::string& name) {
     return std::filesystem::path(LIDARLOOP_TEST_DATA_DIR) / name;
 }

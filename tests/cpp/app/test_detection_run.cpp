@@ -373,17 +373,6 @@ std::vector<std::vector<std::string>> CsvCells(const std::filesystem::path& file
     return rows;
 }
 
-// The path between scans i and j, walked step by step over `poses`.
-double BrutePathM(const std::vector<core::StampedPose>& poses, std::size_t i, std::size_t j) {
-    double path_m = 0.0;
-    for (std::size_t k = std::min(i, j); k < std::max(i, j); ++k) {
-        path_m +=
-            (poses[k + 1].T_world_sensor.translation() - poses[k].T_world_sensor.translation())
-                .norm();
-    }
-    return path_m;
-}
-
 // Every row of loops.csv and candidates.csv has the header's column count and ends with path_m,
 // the path between its query and match over `poses`; returns the smallest path_m seen.
 double ExpectPathColumn(const std::filesystem::path& file,
@@ -397,7 +386,7 @@ double ExpectPathColumn(const std::filesystem::path& file,
         const std::size_t query = std::stoul(rows[r][0]);
         const std::size_t match = std::stoul(rows[r][rows.front()[1] == "match" ? 1 : 2]);
         const double path_m = std::stod(rows[r].back());
-        EXPECT_NEAR(path_m, BrutePathM(poses, query, match), 1e-6 * path_m + 1e-9)
+        EXPECT_NEAR(path_m, test::BrutePathM(poses, query, match), 1e-6 * path_m + 1e-9)
             << file << " row " << r;
         smallest_m = std::min(smallest_m, path_m);
     }

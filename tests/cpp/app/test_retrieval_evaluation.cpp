@@ -114,24 +114,12 @@ TEST(RetrievalEvaluation, EvaluateRecountsFromDetectsCandidates) {
     EXPECT_EQ(metrics["descriptor"]["revisiting_scans"], verified.revisiting);
 }
 
-// The path between scans a and b, walked step by step over the poses.
-double BrutePathM(const io::Dataset& dataset, std::size_t a, std::size_t b) {
-    const auto& poses = dataset.poses();
-    double path_m = 0.0;
-    for (std::size_t k = std::min(a, b); k < std::max(a, b); ++k) {
-        path_m +=
-            (poses[k + 1].T_world_sensor.translation() - poses[k].T_world_sensor.translation())
-                .norm();
-    }
-    return path_m;
-}
-
 // RecountFrom's rules with --min-path: a revisit needs more than `min_path_m` of path back too; a
 // loop to the same place with less path is neither true nor false.
 Recount RecountWithPath(const io::Dataset& dataset, const std::vector<pipeline::LoopQuery>& queries,
                         double min_path_m) {
     const auto revisit = [&](std::size_t a, std::size_t b) {
-        return SamePlace(dataset, a, b) && BrutePathM(dataset, a, b) > min_path_m;
+        return SamePlace(dataset, a, b) && test::BrutePathM(dataset.poses(), a, b) > min_path_m;
     };
     Recount r;
     for (std::size_t i = 0; i < dataset.size(); ++i) {
@@ -178,7 +166,7 @@ TEST(RetrievalEvaluation, MinPathCountsOnlyRevisitsFarBackInPath) {
         double longest_m = 0.0;
         for (std::size_t j = 0; j + kGapScans < i; ++j) {
             if (SamePlace(dataset, i, j))
-                longest_m = std::max(longest_m, BrutePathM(dataset, i, j));
+                longest_m = std::max(longest_m, test::BrutePathM(dataset.poses(), i, j));
         }
         if (longest_m > 0.0) longest_back_m.push_back(longest_m);
     }
@@ -202,7 +190,7 @@ TEST(RetrievalEvaluation, MinPathCountsOnlyRevisitsFarBackInPath) {
             for (std::size_t j = 0; j < dataset.size() && !any; ++j) {
                 const std::size_t apart = i > j ? i - j : j - i;
                 any = apart > kGapScans && SamePlace(dataset, i, j) &&
-                      BrutePathM(dataset, i, j) > request.min_path_m;
+                      test::BrutePathM(dataset.poses(), i, j) > request.min_path_m;
             }
             overlapping += any ? 1 : 0;
         }

@@ -8,6 +8,7 @@
 
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/core/min_gap.hpp"
+#include "test_utils.hpp"
 
 namespace lidarloop::core {
 namespace {
@@ -27,17 +28,6 @@ std::vector<StampedPose> Wander(unsigned seed, std::size_t count) {
     return poses;
 }
 
-// The path between scans i and j, walked step by step anew.
-double BrutePathM(const std::vector<StampedPose>& poses, std::size_t i, std::size_t j) {
-    double path_m = 0.0;
-    for (std::size_t k = std::min(i, j); k < std::max(i, j); ++k) {
-        path_m +=
-            (poses[k + 1].T_world_sensor.translation() - poses[k].T_world_sensor.translation())
-                .norm();
-    }
-    return path_m;
-}
-
 TEST(MinGap, MetresCountThePathBetweenTheScans) {
     const std::vector<StampedPose> poses = Wander(7, 150);
     const std::vector<double> path_m = CumulativePathM(poses);
@@ -46,7 +36,7 @@ TEST(MinGap, MetresCountThePathBetweenTheScans) {
     std::size_t allowed = 0;
     for (std::size_t i = 0; i < poses.size(); ++i) {
         for (std::size_t j = 0; j < poses.size(); ++j) {
-            const double brute_m = BrutePathM(poses, i, j);
+            const double brute_m = test::BrutePathM(poses, i, j);
             EXPECT_NEAR(std::abs(path_m[i] - path_m[j]), brute_m, 1e-9);
             EXPECT_EQ(gap.Allows(i, j, path_m[i], path_m[j]), brute_m > gap.value)
                 << i << ", " << j << ": " << brute_m << " m";

@@ -29,22 +29,11 @@ struct BruteTruth {
     std::size_t comparable_pairs = 0;
 };
 
-// The path between scans i and j: the sum of the steps between them, walked anew.
-double PathBetweenM(const std::vector<core::StampedPose>& poses, std::size_t i, std::size_t j) {
-    double path_m = 0.0;
-    for (std::size_t k = std::min(i, j); k < std::max(i, j); ++k) {
-        path_m +=
-            (poses[k + 1].T_world_sensor.translation() - poses[k].T_world_sensor.translation())
-                .norm();
-    }
-    return path_m;
-}
-
 // The gap and the path rule, written out again.
 bool BruteComparable(const std::vector<core::StampedPose>& poses, const GroundTruthConfig& c,
                      std::size_t i, std::size_t j) {
     if (i == j) return false;
-    const double path_m = PathBetweenM(poses, i, j);
+    const double path_m = test::BrutePathM(poses, i, j);
     if (c.min_path_m > 0.0 && !(path_m > c.min_path_m)) return false;
     switch (c.min_gap.unit) {
         case MinGap::Unit::kScans:
