@@ -2,6 +2,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,7 +27,7 @@ struct OptimiseFlags {
     std::string loops;
     std::string out;
     std::string format = "kitti";
-    double max_odometry_step_m = app::OptimiseRequest{}.max_odometry_step_m;
+    std::optional<double> max_odometry_step_m;  // posegraph.max_odometry_step_m when given
     bool skip_bad = false;
     bool overwrite = false;
     bool quiet = false;
@@ -78,7 +79,8 @@ void RunOptimise(const OptimiseFlags& flags) {
     request.odometry_file = flags.odometry;
     request.loops_file = flags.loops;
     request.format = flags.format == "tum" ? app::PoseFormat::kTum : app::PoseFormat::kKitti;
-    request.max_odometry_step_m = flags.max_odometry_step_m;
+    if (flags.max_odometry_step_m)
+        request.config.posegraph.max_odometry_step_m = *flags.max_odometry_step_m;
     request.skip_bad = flags.skip_bad;
     request.progress = progress.Callback();
     request.out = flags.out;
@@ -112,9 +114,9 @@ void AddOptimiseCommand(CLI::App& app) {
         ->capture_default_str();
     command
         ->add_option("--max-odometry-step", flags->max_odometry_step_m,
-                     "M: odometry moving farther between two scans is an error (a jump or reset)")
-        ->check(CLI::PositiveNumber)
-        ->capture_default_str();
+                     "M: odometry moving farther between two scans is an error (a jump or "
+                     "reset); posegraph.max_odometry_step_m, default 100")
+        ->check(CLI::PositiveNumber);
     flags->descriptor.AddTo(*command);
     flags->detection.AddTo(*command, /*decides_loops=*/true,
                            "S: candidates at least this far back (default 30 scans)");

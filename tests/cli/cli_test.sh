@@ -670,6 +670,18 @@ section_loops() {
     expect_exit_1 "odometry jump" "jump.txt: line 20: the pose is " \
         "$cli" optimise "$work/seq" --odometry "$work/jump.txt" --loops "$work/loops.csv" \
         --out "$work/bad"
+    # The bound is a config key (posegraph.max_odometry_step_m) that the flag overrides.
+    printf 'posegraph:\n  max_odometry_step_m: 1000\n' >"$work/far_steps.yaml"
+    expect_ok "odometry jump within the configured bound" "ATE RMSE" "$cli" optimise "$work/seq" \
+        --odometry "$work/jump.txt" --loops "$work/loops.csv" --config "$work/far_steps.yaml" \
+        --out "$work/far_ok"
+    expect_exit_1 "the flag overrides the config" "jump.txt: line 20: the pose is " "$cli" \
+        optimise "$work/seq" --odometry "$work/jump.txt" --loops "$work/loops.csv" \
+        --config "$work/far_steps.yaml" --max-odometry-step 100 --out "$work/bad"
+    printf 'posegraph:\n  max_odometry_step_m: 0\n' >"$work/zero_steps.yaml"
+    expect_exit_1 "a zero step bound" "posegraph.max_odometry_step_m must be in (0, 100000000]" \
+        "$cli" optimise "$work/seq" --odometry "$odometry" --loops "$work/loops.csv" \
+        --config "$work/zero_steps.yaml" --out "$work/bad"
     awk 'NR == 3 { $1 = "0.5" } { print }' "$work/opt/poses_optimised.txt" >"$work/back.tum"
     expect_exit_1 "TUM time going back" "back.tum: line 3: time 0.5 goes back" "$cli" optimise \
         "$work/seq" --odometry "$work/back.tum" --loops "$work/loops.csv" --out "$work/bad"

@@ -20,8 +20,9 @@ namespace {
 
 std::vector<core::StampedPose> LoadOdometry(const OptimiseRequest& request,
                                             const io::Dataset& dataset) {
-    std::vector<core::StampedPose> odometry = io::ReadPoses(
-        request.odometry_file, core::Transform::Identity(), {}, request.max_odometry_step_m);
+    std::vector<core::StampedPose> odometry =
+        io::ReadPoses(request.odometry_file, core::Transform::Identity(), {},
+                      request.config.posegraph.max_odometry_step_m);
     if (odometry.size() != dataset.size()) {
         throw io::ReadError(request.odometry_file, "holds " + std::to_string(odometry.size()) +
                                                        " poses but " + dataset.root().string() +

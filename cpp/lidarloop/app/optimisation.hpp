@@ -28,11 +28,6 @@ struct OptimiseRequest {
     /// truth's relative pose of its scans (for the plot, the report and metrics.json).
     double true_loop_translation_m = 2.0;
     double true_loop_rotation_deg = 5.0;
-    /// Odometry whose position moves more than this between consecutive scans is an error
-    /// naming the line (a jump or a reset). No vehicle a LiDAR rides on covers it at sensor
-    /// rate: a car on a motorway (40 m/s) moves 4 m between scans at 10 Hz, a train at 360 km/h
-    /// 10 m; 100 m still allows 1 Hz at that speed or skipped scans.
-    double max_odometry_step_m = 100.0;
     bool skip_bad = false;  ///< for the detection run
     Progress progress;
     std::filesystem::path out;  ///< the results folder (created)
@@ -57,8 +52,8 @@ struct OptimiseOutcome {
 
 /// Reads the odometry (io::ReadError naming the file when its pose count differs from the
 /// dataset's scan count; the pose readers name the line of a non-finite value, a 3x3 part that
-/// is no rotation, a time that does not increase or a step above max_odometry_step_m) and the
-/// loops (io::ReadLoopsCsv: a scan that does not exist or a value out of its range names the
+/// is no rotation, a time that does not increase or a step above posegraph.max_odometry_step_m) and
+/// the loops (io::ReadLoopsCsv: a scan that does not exist or a value out of its range names the
 /// line; rows repeating an earlier row's two scans, in either order, are merged into it, with a
 /// note), or detects them, builds and optimises the pose graph, and writes into request.out:
 /// poses_optimised.txt, graph.g2o (optimised vertices, the odometry edges and the loops used;

@@ -195,6 +195,8 @@ template <typename Visitor>
 void VisitFields(posegraph::PoseGraphConfig& c, Visitor& v) {
     v.Section("information", c.information);
     v.Section("robust", c.robust);
+    v.Field("max_odometry_step_m", c.max_odometry_step_m,
+            "optimise: odometry moving farther between two scans is an error (a jump or reset), m");
     v.Field("max_iterations", c.max_iterations, "Ceres trust-region iterations per solve");
     v.Field("threads", c.threads, "Ceres threads");
 }

@@ -66,6 +66,11 @@ struct RobustConfig {
 struct PoseGraphConfig {
     InformationConfig information;
     RobustConfig robust;
+    /// Odometry whose position moves more than this between consecutive scans is an error naming
+    /// the line (a jump or a reset), metres, (0, 1e8]. No vehicle a LiDAR rides on covers it at
+    /// sensor rate: a car on a motorway (40 m/s) moves 4 m between scans at 10 Hz, a train at
+    /// 360 km/h 10 m; 100 m still allows 1 Hz at that speed or skipped scans.
+    double max_odometry_step_m = 100.0;
     int max_iterations = 50;  ///< Ceres (dogleg) iterations per solve, [1, 10000]
     int threads = 1;          ///< Ceres threads, [1, 256]
 
