@@ -32,14 +32,7 @@ void RequireTimesForSeconds(const io::RunConfig& config, const io::Dataset& data
 std::vector<double> PathOfScans(const DetectRequest& request, const io::Dataset& dataset) {
     std::vector<double> path_m;
     if (!request.odometry_file.empty()) {
-        const std::vector<core::StampedPose> odometry = io::ReadPoses(request.odometry_file);
-        if (odometry.size() != dataset.size()) {
-            throw io::ReadError(request.odometry_file,
-                                "holds " + std::to_string(odometry.size()) +
-                                    " poses, the dataset " + std::to_string(dataset.size()) +
-                                    " scans: odometry needs one pose per scan");
-        }
-        path_m = core::CumulativePathM(odometry);
+        path_m = core::CumulativePathM(ReadOdometry(request.odometry_file, dataset));
     } else if (dataset.HasPoses()) {
         path_m = core::CumulativePathM(dataset.poses());
     }
@@ -50,6 +43,23 @@ std::vector<double> PathOfScans(const DetectRequest& request, const io::Dataset&
     }
     return path_m;
 }
+
+}  // namespace
+
+std::vector<core::StampedPose> ReadOdometry(const std::filesystem::path& file,
+                                            const io::Dataset& dataset, double max_step_m) {
+    std::vector<core::StampedPose> odometry =
+        io::ReadPoses(file, core::Transform::Identity(), {}, max_step_m);
+    if (odometry.size() != dataset.size()) {
+        throw io::ReadError(file, "holds " + std::to_string(odometry.size()) + " poses but " +
+                                      dataset.root().string() + " has " +
+                                      std::to_string(dataset.size()) +
+                                      " scans: odometry needs one pose per scan");
+    }
+    return odometry;
+}
+
+namespace {
 
 // `matrix` is null when the sequence was detected without one (output.similarity_matrix_mib).
 void WriteDetectResults(const std::filesystem::path& out_dir, const io::RunConfig& config,

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -45,6 +46,13 @@ struct DetectOutcome {
 /// ConfigError when the gap is in seconds and there are no poses, or in metres and there is
 /// neither odometry nor poses; io::ReadError when the odometry has not one pose per scan.
 DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request);
+
+/// The odometry of `dataset` from `file` (KITTI or TUM, T_world_sensor): io::ReadError naming the
+/// file when it has not one pose per scan, or when a step between consecutive poses exceeds
+/// `max_step_m` (a jump or a reset). Shared by detect (the path of a gap in metres) and optimise.
+std::vector<core::StampedPose> ReadOdometry(
+    const std::filesystem::path& file, const io::Dataset& dataset,
+    double max_step_m = std::numeric_limits<double>::infinity());
 
 /// A saved descriptor database to localise against.
 struct LoadedMap {

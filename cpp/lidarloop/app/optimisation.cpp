@@ -18,20 +18,6 @@
 namespace lidarloop::app {
 namespace {
 
-std::vector<core::StampedPose> LoadOdometry(const OptimiseRequest& request,
-                                            const io::Dataset& dataset) {
-    std::vector<core::StampedPose> odometry =
-        io::ReadPoses(request.odometry_file, core::Transform::Identity(), {},
-                      request.config.posegraph.max_odometry_step_m);
-    if (odometry.size() != dataset.size()) {
-        throw io::ReadError(request.odometry_file, "holds " + std::to_string(odometry.size()) +
-                                                       " poses but " + dataset.root().string() +
-                                                       " has " + std::to_string(dataset.size()) +
-                                                       " scans");
-    }
-    return odometry;
-}
-
 // The accepted loops of a detection run with verification (the verified candidate's pose).
 std::vector<posegraph::LoopConstraint> DetectLoops(const io::Dataset& dataset,
                                                    const OptimiseRequest& request) {
@@ -170,7 +156,8 @@ OptimiseOutcome RunOptimisation(const io::Dataset& dataset, const OptimiseReques
     request.config.Validate();
     const std::filesystem::path out = PrepareOutputFolder(request.out);
     io::WriteConfigYaml(out / "config.yaml", request.config);
-    const std::vector<core::StampedPose> odometry = LoadOdometry(request, dataset);
+    const std::vector<core::StampedPose> odometry =
+        ReadOdometry(request.odometry_file, dataset, request.config.posegraph.max_odometry_step_m);
     OptimiseOutcome outcome;
     outcome.loops = LoadLoops(dataset, request, outcome.notes);
     const posegraph::PoseGraph graph =
