@@ -167,13 +167,17 @@ CoarseQuery::CoarseQuery(const SurfacePoints& query_structure, const CoarseConfi
         if (row_searched) search_rows_.push_back(y);
     }
     const int yaws = static_cast<int>(std::lround(360.0 / config.yaw_step_deg));
-    spectra_.reserve(static_cast<std::size_t>(yaws));
-    for (int i = 0; i < yaws; ++i) {
-        Spectrum spectrum = ToSpectrum(
-            OccupancyImage(query_structure.points(), i * 2.0 * std::numbers::pi / yaws, config),
-            config.grid_cells);
+    spectra_.resize(static_cast<std::size_t>(yaws));
+    const auto image_at = [&](int i) {
+        return OccupancyImage(query_structure.points(), i * 2.0 * std::numbers::pi / yaws, config);
+    };
+    // Two yaws per transform: the images are real (detail::Fft2dForwardRealPair).
+    for (int a = 0; a < yaws; a += 2) {
+        const int b = std::min(a + 1, yaws - 1);
+        detail::Fft2dForwardRealPair(image_at(a), image_at(b), n, spectra_[a], spectra_[b]);
+    }
+    for (auto& spectrum : spectra_) {
         for (auto& value : spectrum) value = std::conj(value);
-        spectra_.push_back(std::move(spectrum));
     }
 }
 

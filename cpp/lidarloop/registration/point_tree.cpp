@@ -73,7 +73,8 @@ std::int64_t PointTree::Nearest(const Eigen::Vector3f& query, float max_distance
 void PointTree::Knn(const Eigen::Vector3f& query, int k,
                     std::vector<std::uint32_t>& indices) const {
     indices.resize(static_cast<std::size_t>(k));
-    std::vector<float> squared_m2(indices.size());
+    thread_local std::vector<float> squared_m2;  // no allocation per query
+    squared_m2.resize(indices.size());
     const std::size_t found =
         impl_->index.knnSearch(query.data(), indices.size(), indices.data(), squared_m2.data());
     indices.resize(found);

@@ -3,9 +3,11 @@
 #include <complex>
 #include <limits>
 #include <random>
+#include <utility>
 
 #include <gtest/gtest.h>
 
+#include "lidarloop/registration/coarse_alignment.hpp"
 #include "lidarloop/registration/detail/fft2d.hpp"
 #include "lidarloop/registration/point_tree.hpp"
 #include "lidarloop/registration/prepared_scan.hpp"
@@ -96,6 +98,41 @@ TEST(Fft2d, MatchesTheDefinitionAndInverts) {
     for (const int row : {1, 5})
         for (int x = 0; x < n; ++x)
             EXPECT_NEAR(std::abs(rows[row * n + x] - grid[row * n + x]), 0.0, 1e-5);
+}
+
+TEST(Fft2d, ARealPairSplitsIntoTheSpectraOfEachImage) {
+    const int n = 16;
+    std::mt19937_64 rng(6);
+    std::uniform_real_distribution<float> u(0.0F, 1.0F);
+    std::vector<float> a(n * n), b(n * n);
+    for (auto& v : a) v = u(rng);
+    for (auto& v : b) v = u(rng) > 0.7F ? 1.0F : 0.0F;
+    std::vector<std::complex<float>> spectrum_a, spectrum_b;
+    detail::Fft2dForwardRealPair(a, b, n, spectrum_a, spectrum_b);
+    for (const auto& [image, spectrum] : {std::pair{&a, &spectrum_a}, std::pair{&b, &spectrum_b}}) {
+        std::vector<std::complex<float>> expected(image->begin(), image->end());
+        detail::Fft2dForward(expected, n);
+        ASSERT_EQ(spectrum->size(), expected.size());
+        for (std::size_t i = 0; i < expected.size(); ++i)
+            EXPECT_NEAR(std::abs((*spectrum)[i] - expected[i]), 0.0, 1e-3) << i;
+    }
+}
+
+TEST(CoarseQuery, HoldsTheConjugateSpectrumOfTheRotatedImageAtEveryYaw) {
+    ScanReductionConfig reduction;
+    const PreparedScan scan = PrepareScan(test::SyntheticPlace(), reduction);
+    CoarseConfig config;
+    config.yaw_step_deg = 360.0 / 9.0;  // an odd count: the last yaw has no partner
+    const CoarseQuery query(*scan.structure, config);
+    ASSERT_EQ(query.yaw_count(), 9);
+    for (int i = 0; i < query.yaw_count(); ++i) {
+        const auto image = OccupancyImage(scan.structure->points(), query.YawOf(i), config);
+        std::vector<std::complex<float>> expected(image.begin(), image.end());
+        detail::Fft2dForward(expected, config.grid_cells);
+        for (std::size_t k = 0; k < expected.size(); ++k)
+            ASSERT_NEAR(std::abs(query.spectrum(i)[k] - std::conj(expected[k])), 0.0, 1e-2)
+                << "yaw " << i << " frequency " << k;
+    }
 }
 
 TEST(PrepareScan, SplitsWallsFromGroundWithUnitNormalsFacingTheSensor) {

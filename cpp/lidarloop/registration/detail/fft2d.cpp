@@ -47,6 +47,27 @@ void Fft2dInverseRows(std::vector<std::complex<float>>& grid, int n, const std::
     }
 }
 
+void Fft2dForwardRealPair(const std::vector<float>& a, const std::vector<float>& b, int n,
+                          std::vector<std::complex<float>>& spectrum_a,
+                          std::vector<std::complex<float>>& spectrum_b) {
+    const auto size = static_cast<std::size_t>(n);
+    std::vector<std::complex<float>> packed(size * size);
+    for (std::size_t i = 0; i < packed.size(); ++i) packed[i] = {a[i], b[i]};
+    Transform2d(packed, n, false);
+    spectrum_a.resize(packed.size());
+    spectrum_b.resize(packed.size());
+    for (std::size_t row = 0; row < size; ++row) {
+        const std::size_t mirrored_row = (size - row) % size;
+        for (std::size_t col = 0; col < size; ++col) {
+            const std::complex<float> z = packed[row * size + col];
+            const std::complex<float> mirrored =
+                std::conj(packed[mirrored_row * size + (size - col) % size]);
+            spectrum_a[row * size + col] = 0.5F * (z + mirrored);
+            spectrum_b[row * size + col] = std::complex<float>(0.0F, -0.5F) * (z - mirrored);
+        }
+    }
+}
+
 void Fft2dForward(std::vector<std::complex<float>>& grid, int n) { Transform2d(grid, n, false); }
 void Fft2dInverse(std::vector<std::complex<float>>& grid, int n) { Transform2d(grid, n, true); }
 

@@ -9,6 +9,12 @@ namespace lidarloop::registration::detail {
 /// columns). The inverse is scaled by 1 / n^2, so Inverse(Forward(x)) == x. Thread-safe.
 void Fft2dForward(std::vector<std::complex<float>>& grid, int n);
 void Fft2dInverse(std::vector<std::complex<float>>& grid, int n);
+/// The forward transforms of two real n x n images at the cost of one complex transform: `a` is
+/// packed into the real part, `b` into the imaginary part, and the spectra are separated by their
+/// conjugate symmetry (A[k] = (Z[k] + conj(Z[-k])) / 2, B[k] = (Z[k] - conj(Z[-k])) / 2i).
+void Fft2dForwardRealPair(const std::vector<float>& a, const std::vector<float>& b, int n,
+                          std::vector<std::complex<float>>& spectrum_a,
+                          std::vector<std::complex<float>>& spectrum_b);
 /// The inverse transform computed only for the rows listed in `rows` (columns first, then those
 /// rows); the other rows hold partial results. For correlations read in a band of rows.
 void Fft2dInverseRows(std::vector<std::complex<float>>& grid, int n, const std::vector<int>& rows);
