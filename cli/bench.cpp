@@ -1,5 +1,7 @@
+#include <cstdio>
 #include <iostream>
 #include <memory>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
@@ -25,16 +27,88 @@ struct BenchFlags {
     bool quiet = false;
 };
 
+// "12.3 ms" with sensible precision; microseconds below 0.1 ms.
+std::string Duration(double ms) {
+    char text[32];
+    if (ms < 0.1) {
+        std::snprintf(text, sizeof(text), "%.2f us", 1e3 * ms);
+    } else {
+        std::snprintf(text, sizeof(text), ms < 10.0 ? "%.2f ms" : "%.1f ms", ms);
+    }
+    return text;
+}
+
+void PrintRow(const std::string& stage, const std::string& per, const nlohmann::json& summary,
+              double scale = 1.0) {
+    std::printf(
+        "| %-34s | %-14s | %10s | %10s |\n", stage.c_str(), per.c_str(),
+        Duration(scale * summary.value("median", 0.0)).c_str(),
+        summary.contains("p95") ? Duration(scale * summary["p95"].get<double>()).c_str() : "");
+}
+
+// The figures as a table a user reads: the stages of the online step and their sum.
+void PrintSummary(const nlohmann::json& figures) {
+    std::printf("lidarloop bench: %d scans, method %s (medians and 95th percentiles)\n\n",
+                figures.value("scans", 0), figures.value("method", std::string()).c_str());
+    std::printf("| %-34s | %-14s | %10s | %10s |\n", "stage", "per", "median", "p95");
+    std::printf("|%s|%s|%s|%s|\n", std::string(36, '-').c_str(), std::string(16, '-').c_str(),
+                std::string(12, '-').c_str(), std::string(12, '-').c_str());
+    PrintRow("read the file", "scan", figures["load_ms_per_scan"]);
+    PrintRow("describe", "scan", figures["describe_ms_per_scan"]);
+    const nlohmann::json& queries = figures["queries"];
+    if (queries.contains("index_us")) {
+        PrintRow("retrieval (index)", "query", queries["index_us"], 1e-3);
+    } else {
+        PrintRow("retrieval (every scan compared)", "query", queries["brute_force_us"], 1e-3);
+    }
+    double online_ms = 0.0;
+    if (figures.contains("verification")) {
+        const nlohmann::json& verification = figures["verification"];
+        PrintRow("prepare for verification (CPU)", "scan", verification["prepare_cpu_ms_per_scan"]);
+        PrintRow("coarse images (CPU)", "query",
+                 verification["coarse_images_ms_per_query"]["thread_cpu"]);
+        PrintRow("verify (CPU)", "candidate pair",
+                 verification["verify_ms_per_pair"]["thread_cpu"]);
+        PrintRow("online step, top " + std::to_string(verification.value("top_k", 0)) + " verified",
+                 "scan", verification["online_step_ms_per_scan"]);
+        online_ms = verification["online_step_ms_per_scan"].value("median", 0.0);
+        std::printf(
+            "\nonline step: %s per scan on one core = %.1f Hz (describe, retrieve, prepare, "
+            "coarse images and verify the top %d, over %d scans with candidates; file "
+            "reading excluded)\n",
+            Duration(online_ms).c_str(), verification.value("online_rate_hz", 0.0),
+            verification.value("top_k", 0), verification.value("queries", 0));
+        std::printf("memory: %.0f bytes per prepared scan (median)\n",
+                    verification["bytes_per_prepared_scan"].value("median", 0.0));
+    } else {
+        online_ms = figures["describe_ms_per_scan"].value("median", 0.0) +
+                    (queries.contains("index_us") ? queries["index_us"] : queries["brute_force_us"])
+                            .value("median", 0.0) /
+                        1e3;
+        std::printf("\nonline step without verification: %s per scan on one core\n",
+                    Duration(online_ms).c_str());
+    }
+    std::printf("similarity matrix: %.1f ns per comparison on one core\n",
+                figures.value("ns_per_comparison_one_core", 0.0));
+    std::printf("peak memory: %.1f MiB\n", figures.value("peak_memory_mib", 0.0));
+}
+
 void RunBench(BenchFlags& flags) {
     ProgressPrinter progress(flags.quiet);
     flags.request.config = flags.descriptor.Resolve();
     flags.detection.ApplyTo(flags.request.config);
     flags.request.progress = progress.Callback();
     // The file is checked before the run, so that a refused --json costs no measurement.
-    if (!flags.json.empty())
+    const bool json_to_stdout = flags.json == "-";
+    if (!flags.json.empty() && !json_to_stdout)
         app::CheckOutputFile(flags.json, flags.dataset.Inputs(), flags.overwrite);
     const nlohmann::json figures = app::RunBench(flags.dataset.Open(), flags.request);
-    std::cout << figures.dump(2) << "\n";
+    if (json_to_stdout) {
+        std::cout << figures.dump(2) << "\n";
+        return;
+    }
+    std::cout.flush();
+    PrintSummary(figures);
     if (!flags.json.empty())
         app::WriteOutputJson(flags.json, figures, flags.dataset.Inputs(), flags.overwrite);
 }
@@ -56,8 +130,9 @@ void AddBenchCommand(CLI::App& app) {
     flags->detection.AddTo(*command, /*decides_loops=*/true,
                            "S: candidates at least this far back");
     command->add_option("--json", flags->json,
-                        "also write the figures to this file (replaced only when lidarloop wrote "
-                        "it, or with --overwrite)");
+                        "also write the figures as JSON to this file (replaced only when "
+                        "lidarloop wrote it, or with --overwrite); '-': JSON to stdout instead of "
+                        "the table");
     command->add_flag("--overwrite", flags->overwrite,
                       "let --json replace a file that lidarloop did not write");
     command->add_flag("--quiet", flags->quiet, "no progress bar");

@@ -283,9 +283,17 @@ section_detect() {
 section_bench() {
     seq="$work/seq"
     make_sequence "$seq"
-    expect_ok "bench" '"ns_per_comparison_one_core"' "$cli" bench "$seq" --queries 3 --quiet
+    expect_ok "bench" '"ns_per_comparison_one_core"' "$cli" bench "$seq" --queries 3 --quiet \
+        --json -
     expect_ok "bench scaled" '"scaled_queries"' "$cli" bench "$seq" --queries 3 --scale-to 500 \
-        --quiet
+        --quiet --json -
+    # The table: the online step's stages and its rate, with the figures of the JSON.
+    expect_ok "bench table" "per scan on one core =" "$cli" bench "$seq" \
+        --queries 3 --verify-queries 2 --quiet
+    expect_ok "bench table without verification" "online step without verification" "$cli" \
+        bench "$seq" --queries 3 --verify-queries 0 --quiet
+    expect_ok "bench online step in the JSON" '"online_rate_hz"' "$cli" bench "$seq" --queries 3 \
+        --verify-queries 2 --quiet --json -
     # bench --method ndt reports the rotation candidates of each scan: copies of one scan have as
     # many as describe prints descriptors for it.
     ndt_seq="$work/ndt_seq"
@@ -293,7 +301,7 @@ section_bench() {
     for i in 0 1 2; do cp "$samples/corner_a.bin" "$ndt_seq/scan$i.bin"; done
     described="$("$cli" describe --method ndt "$samples/corner_a.bin" |
         grep -o '"R_aligned_sensor"' | wc -l)"
-    benched="$("$cli" bench "$ndt_seq" --method ndt --queries 3 --quiet | tr -d ' \n' |
+    benched="$("$cli" bench "$ndt_seq" --method ndt --queries 3 --quiet --json - | tr -d ' \n' |
         grep -o '"rotation_candidates_per_scan":{"max":[0-9.]*,"median":[0-9.]*' |
         grep -o '"median":[0-9]*' | cut -d: -f2)"
     if [ "$described" -ge 1 ] && [ "$benched" = "$described" ]; then pass; else
@@ -577,11 +585,14 @@ section_results_folders() {
     expect_error "bench --json onto a foreign file" "give --overwrite" "$cli" bench "$seq" \
         --queries 2 --verify-queries 0 --quiet --json "$work/mine.json"
     if grep -q "my figures" "$work/mine.json"; then pass; else fail "bench replaced mine.json"; fi
-    expect_ok "bench --json" "ns_per_comparison" "$cli" bench "$seq" --queries 2 \
+    expect_ok "bench --json" "online step" "$cli" bench "$seq" --queries 2 \
         --verify-queries 0 --quiet --json "$work/bench.json"
-    expect_ok "bench --json again" "ns_per_comparison" "$cli" bench "$seq" --queries 2 \
+    if grep -q '"ns_per_comparison_one_core"' "$work/bench.json"; then pass; else
+        fail "bench --json wrote no figures"
+    fi
+    expect_ok "bench --json again" "online step" "$cli" bench "$seq" --queries 2 \
         --verify-queries 0 --quiet --json "$work/bench.json"
-    expect_ok "bench --json --overwrite" "ns_per_comparison" "$cli" bench "$seq" --queries 2 \
+    expect_ok "bench --json --overwrite" "online step" "$cli" bench "$seq" --queries 2 \
         --verify-queries 0 --quiet --json "$work/mine.json" --overwrite
     # simulate into a foreign sequence folder, and a Ctrl-C halfway.
     mkdir -p "$work/foreign" && echo "my poses" >"$work/foreign/poses.txt"

@@ -1,5 +1,7 @@
 #include "lidarloop/app/results_folder.hpp"
 
+#include <time.h>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -17,6 +19,12 @@ std::filesystem::path PrepareOutputFolder(const std::filesystem::path& folder) {
                                          (ec ? " (" + ec.message() + ")" : std::string()));
     }
     return folder;
+}
+
+double ThreadCpuStopwatch::Now() {
+    timespec now{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+    return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
 }
 
 double Quantile(std::vector<double> values, double q) {

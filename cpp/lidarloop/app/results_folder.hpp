@@ -25,6 +25,18 @@ private:
     std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
+/// CPU seconds of the calling thread since construction: what a step costs on one core, whatever
+/// else the machine does (wall time is inflated by other processes).
+class ThreadCpuStopwatch {
+public:
+    ThreadCpuStopwatch() : start_(Now()) {}
+    double Seconds() const { return Now() - start_; }
+
+private:
+    static double Now();
+    double start_;
+};
+
 /// The q-quantile (0..1) of `values` (eval::Quantile after sorting); 0 for an empty list.
 double Quantile(std::vector<double> values, double q);
 

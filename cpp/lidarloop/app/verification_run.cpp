@@ -11,8 +11,10 @@ std::function<void(std::size_t, const core::PointCloud&)> PreparedScans::Collect
     const registration::ScanReductionConfig& reduction) {
     return [this, &reduction](std::size_t i, const core::PointCloud& cloud) {
         const Stopwatch clock;
+        const ThreadCpuStopwatch cpu_clock;
         scans.at(i) = registration::PrepareScan(cloud, reduction);
         prepare_seconds.at(i) = clock.Seconds();
+        prepare_cpu_seconds.at(i) = cpu_clock.Seconds();
     };
 }
 

@@ -18,9 +18,11 @@ namespace lidarloop::app {
 /// Every scan of a sequence prepared for verification, filled while the scans are described.
 struct PreparedScans {
     std::vector<registration::PreparedScan> scans;  ///< by scan index; empty for skipped scans
-    std::vector<double> prepare_seconds;            ///< per scan
+    std::vector<double> prepare_seconds;            ///< per scan, wall time
+    std::vector<double> prepare_cpu_seconds;        ///< per scan, thread CPU time
 
-    explicit PreparedScans(std::size_t count) : scans(count), prepare_seconds(count, 0.0) {}
+    explicit PreparedScans(std::size_t count)
+        : scans(count), prepare_seconds(count, 0.0), prepare_cpu_seconds(count, 0.0) {}
 
     /// A DescribeRun::with_cloud callback that prepares scan i into scans[i] (thread-safe for
     /// distinct scans). The callback refers to this object and `reduction`.

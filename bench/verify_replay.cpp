@@ -1,0 +1,205 @@
+// Replays the verifications of a `lidarloop detect` run from its saved prepared scans: every
+// registered candidate of candidates.csv is verified again with this build, timed on the calling
+// thread, and its verdict compared with the run's. The A/B harness for verification changes
+// (docs/BENCHMARK.md): same decisions and poses, time per pair. Run:
+//   taskset -c 1 ./build/bench/verify_replay RUN_FOLDER [--config FILE] [--pairs-csv FILE]
+// RUN_FOLDER holds database.scans, candidates.csv and config.yaml (detect with verification on);
+// --config verifies with another configuration, --pairs-csv writes one line per pair (verdict,
+// coarse score, occupied image cells, overlaps, ICP iterations, time).
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "lidarloop/io/config_yaml.hpp"
+#include "lidarloop/io/prepared_scans_file.hpp"
+#include "lidarloop/registration/verification.hpp"
+
+namespace {
+
+using namespace lidarloop;
+
+// One registered candidate of candidates.csv and the run's verdict.
+struct Candidate {
+    std::size_t query = 0;
+    std::size_t match = 0;
+    bool accepted = false;
+    std::string reason;
+    Eigen::Vector3d translation_m = Eigen::Vector3d::Zero();
+};
+
+std::vector<std::string> Fields(const std::string& line) {
+    std::vector<std::string> fields;
+    std::stringstream stream(line);
+    for (std::string field; std::getline(stream, field, ',');) fields.push_back(field);
+    return fields;
+}
+
+std::vector<Candidate> ReadCandidates(const std::filesystem::path& file) {
+    std::ifstream in(file);
+    if (!in) throw std::runtime_error("cannot read " + file.string());
+    std::string line;
+    std::getline(in, line);
+    const auto header = Fields(line);
+    const auto column = [&](const std::string& name) {
+        const auto it = std::find(header.begin(), header.end(), name);
+        if (it == header.end()) throw std::runtime_error(file.string() + " has no column " + name);
+        return static_cast<std::size_t>(it - header.begin());
+    };
+    const std::size_t query = column("query"), match = column("match"),
+                      accepted = column("accepted"), reason = column("reason"), tx = column("tx");
+    std::vector<Candidate> candidates;
+    while (std::getline(in, line)) {
+        const auto fields = Fields(line);
+        if (fields.size() != header.size() || fields[reason] == "pruned") continue;
+        Candidate candidate{std::stoul(fields[query]), std::stoul(fields[match]),
+                            fields[accepted] == "1", fields[reason]};
+        for (int i = 0; i < 3; ++i) candidate.translation_m[i] = std::stod(fields[tx + i]);
+        candidates.push_back(candidate);
+    }
+    return candidates;
+}
+
+double ThreadSeconds() {
+    timespec now{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+    return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
+}
+
+double Percentile(std::vector<double> values, double p) {
+    if (values.empty()) return 0.0;
+    const auto at = static_cast<std::size_t>(p * static_cast<double>(values.size() - 1));
+    std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(at),
+                     values.end());
+    return values[at];
+}
+
+double Mean(const std::vector<double>& values) {
+    double sum = 0.0;
+    for (const double value : values) sum += value;
+    return values.empty() ? 0.0 : sum / static_cast<double>(values.size());
+}
+
+struct Tally {
+    std::size_t pairs = 0, same_verdict = 0, accepted_before = 0, accepted_now = 0;
+    std::size_t lost = 0, gained = 0;  // accepted before and not now, and the reverse
+    double max_translation_change_m = 0.0;
+    std::vector<double> pair_ms, query_ms;
+    std::map<std::string, std::size_t> reasons_now;
+};
+
+// The occupied cells of a scan's top-down structure image (the coarse search's input).
+std::size_t OccupiedCells(const registration::SurfacePoints& structure,
+                          const registration::CoarseConfig& config) {
+    const auto image = registration::OccupancyImage(structure.points(), 0.0, config);
+    return static_cast<std::size_t>(std::count(image.begin(), image.end(), 1.0F));
+}
+
+// One line of --pairs-csv: the verdict now and what the coarse search saw.
+void WritePair(std::ofstream& out, const Candidate& candidate,
+               const registration::Verification& now, const registration::PreparedScan& query,
+               const registration::PreparedScan& match,
+               const registration::VerificationConfig& config, double ms) {
+    out << candidate.query << ',' << candidate.match << ',' << (now.accepted ? 1 : 0) << ','
+        << registration::ToString(now.reason) << ',' << now.coarse_score << ','
+        << OccupiedCells(*query.structure, config.coarse) << ','
+        << OccupiedCells(*match.structure, config.coarse) << ',' << now.overlap.Min() << ','
+        << now.overlap.MinDistinctive() << ',' << now.icp_iterations << ',' << ms << '\n';
+}
+
+void Replay(const std::filesystem::path& run, const registration::VerificationConfig& config,
+            const std::filesystem::path& pairs_csv) {
+    std::ofstream pairs;
+    if (!pairs_csv.empty()) {
+        pairs.open(pairs_csv);
+        pairs << "query,match,accepted,reason,coarse_score,query_cells,match_cells,overlap,"
+                 "distinctive_overlap,icp_iterations,ms\n";
+    }
+    const io::StoredPreparedScans stored = io::LoadPreparedScans(run / "database.scans");
+    if (!(stored.reduction == config.reduction))
+        std::printf("note: the scans were reduced with another configuration than --config's\n");
+    const std::vector<Candidate> candidates = ReadCandidates(run / "candidates.csv");
+    Tally tally;
+    std::optional<registration::CoarseQuery> coarse;
+    std::size_t coarse_of = static_cast<std::size_t>(-1);
+    for (const Candidate& candidate : candidates) {
+        const registration::PreparedScan& query = stored.scans.at(candidate.query);
+        const registration::PreparedScan& match = stored.scans.at(candidate.match);
+        if (!query.structure || !match.structure) continue;
+        if (coarse_of != candidate.query) {
+            const double start = ThreadSeconds();
+            coarse.emplace(*query.structure, config.coarse);
+            tally.query_ms.push_back(1e3 * (ThreadSeconds() - start));
+            coarse_of = candidate.query;
+        }
+        const double start = ThreadSeconds();
+        const registration::Verification now = registration::Verify(query, *coarse, match, config);
+        tally.pair_ms.push_back(1e3 * (ThreadSeconds() - start));
+        if (pairs.is_open())
+            WritePair(pairs, candidate, now, query, match, config, tally.pair_ms.back());
+        ++tally.pairs;
+        tally.accepted_before += candidate.accepted ? 1 : 0;
+        tally.accepted_now += now.accepted ? 1 : 0;
+        tally.same_verdict += now.accepted == candidate.accepted ? 1 : 0;
+        tally.lost += candidate.accepted && !now.accepted ? 1 : 0;
+        tally.gained += !candidate.accepted && now.accepted ? 1 : 0;
+        ++tally.reasons_now[registration::ToString(now.reason)];
+        if (candidate.accepted && now.accepted) {
+            tally.max_translation_change_m =
+                std::max(tally.max_translation_change_m,
+                         (now.T_match_query.translation() - candidate.translation_m).norm());
+        }
+    }
+    std::printf("%s: %zu pairs, %zu queries\n", run.c_str(), tally.pairs, tally.query_ms.size());
+    std::printf(
+        "  verdicts: %zu same, accepted %zu -> %zu (lost %zu, gained %zu), accepted "
+        "translation changed by at most %.4f m\n",
+        tally.same_verdict, tally.accepted_before, tally.accepted_now, tally.lost, tally.gained,
+        tally.max_translation_change_m);
+    std::printf("  reasons now:");
+    for (const auto& [reason, count] : tally.reasons_now)
+        std::printf(" %s %zu", reason.c_str(), count);
+    std::printf(
+        "\n  thread CPU: per pair median %.3f ms, p95 %.3f ms, mean %.3f ms; coarse "
+        "images per query median %.3f ms\n",
+        Percentile(tally.pair_ms, 0.5), Percentile(tally.pair_ms, 0.95), Mean(tally.pair_ms),
+        Percentile(tally.query_ms, 0.5));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    std::filesystem::path run, config_file, pairs_csv;
+    for (int i = 1; i < argc; ++i) {
+        const std::string argument = argv[i];
+        if ((argument == "--config" || argument == "--pairs-csv") && i + 1 < argc) {
+            (argument == "--config" ? config_file : pairs_csv) = argv[++i];
+        } else if (run.empty() && argument.rfind("--", 0) != 0) {
+            run = argument;
+        } else {
+            run.clear();
+            break;
+        }
+    }
+    if (run.empty()) {
+        std::fprintf(stderr, "usage: %s RUN_FOLDER [--config FILE] [--pairs-csv FILE]\n", argv[0]);
+        return 2;
+    }
+    try {
+        const io::RunConfig config =
+            io::LoadConfigYaml(config_file.empty() ? run / "config.yaml" : config_file);
+        Replay(run, config.detection.verification, pairs_csv);
+    } catch (const std::exception& error) {
+        std::fprintf(stderr, "verify_replay: %s\n", error.what());
+        return 1;
+    }
+    return 0;
+}
