@@ -2,12 +2,14 @@
 // registered candidate of candidates.csv is verified again with this build, timed on the calling
 // thread, and its verdict compared with the run's. The A/B harness for verification changes
 // (docs/BENCHMARK.md): same decisions and poses, time per pair. Run:
-//   taskset -c 1 ./build/bench/verify_replay RUN_FOLDER [--config FILE] [--pairs-csv FILE]
+//   taskset -c 1 ./build/bench/verify_replay RUN [--config FILE] [--pairs-csv FILE [--poses FILE]]
 // RUN_FOLDER holds database.scans, candidates.csv and config.yaml (detect with verification on);
 // --config verifies with another configuration, --pairs-csv writes one line per pair (verdict,
-// coarse score, occupied image cells, overlaps, ICP iterations, time).
+// coarse score, occupied image cells, overlaps, ICP iterations, time) and, with --poses (KITTI
+// or TUM, T_world_sensor, one per scan), the true distance and the overlap at the true pose.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <exception>
@@ -20,6 +22,7 @@
 #include <vector>
 
 #include "lidarloop/io/config_yaml.hpp"
+#include "lidarloop/io/poses.hpp"
 #include "lidarloop/io/prepared_scans_file.hpp"
 #include "lidarloop/registration/verification.hpp"
 
@@ -103,25 +106,64 @@ std::size_t OccupiedCells(const registration::SurfacePoints& structure,
     return static_cast<std::size_t>(std::count(image.begin(), image.end(), 1.0F));
 }
 
-// One line of --pairs-csv: the verdict now and what the coarse search saw.
+// The rank (0: best) of the first coarse hypothesis within 2 m and 10 degrees of the true planar
+// pose, -1 when none is: whether the coarse search or ICP lost a pair.
+int CoarseRankOfTruth(const registration::PreparedScan& query,
+                      const registration::PreparedScan& match, const core::Transform& T_truth,
+                      const registration::VerificationConfig& config) {
+    const registration::CoarseQuery coarse(*query.structure, config.coarse);
+    const auto hypotheses = registration::CoarseAlign(coarse, *match.structure);
+    const double true_yaw_rad = std::atan2(T_truth.linear()(1, 0), T_truth.linear()(0, 0));
+    for (std::size_t rank = 0; rank < hypotheses.size(); ++rank) {
+        const double yaw_error_rad =
+            std::abs(std::remainder(hypotheses[rank].yaw_rad - true_yaw_rad, 2.0 * M_PI));
+        const double offset_m =
+            (hypotheses[rank].translation_m - T_truth.translation().head<2>()).norm();
+        if (offset_m < 2.0 && yaw_error_rad < 10.0 * M_PI / 180.0) return static_cast<int>(rank);
+    }
+    return -1;
+}
+
+// With ground-truth poses: the sensors' distance and the overlap at the true relative pose (what
+// the pair can show at best), as CSV fields; empty fields without poses.
+std::string TruthFields(const std::vector<core::StampedPose>& poses, const Candidate& candidate,
+                        const registration::PreparedScan& query,
+                        const registration::PreparedScan& match,
+                        const registration::VerificationConfig& config) {
+    if (poses.empty()) return ",,,";
+    const core::Transform T_match_query = poses.at(candidate.match).T_world_sensor.inverse() *
+                                          poses.at(candidate.query).T_world_sensor;
+    const registration::Overlap overlap =
+        registration::MeasureOverlap(query, match, T_match_query, config.acceptance);
+    std::ostringstream fields;
+    fields << T_match_query.translation().norm() << ',' << overlap.Min() << ','
+           << overlap.MinDistinctive() << ','
+           << CoarseRankOfTruth(query, match, T_match_query, config);
+    return fields.str();
+}
+
+// One line of --pairs-csv: the verdict now, what the coarse search saw and, with poses, the truth.
 void WritePair(std::ofstream& out, const Candidate& candidate,
                const registration::Verification& now, const registration::PreparedScan& query,
                const registration::PreparedScan& match,
-               const registration::VerificationConfig& config, double ms) {
+               const registration::VerificationConfig& config, double ms,
+               const std::vector<core::StampedPose>& poses) {
     out << candidate.query << ',' << candidate.match << ',' << (now.accepted ? 1 : 0) << ','
         << registration::ToString(now.reason) << ',' << now.coarse_score << ','
         << OccupiedCells(*query.structure, config.coarse) << ','
         << OccupiedCells(*match.structure, config.coarse) << ',' << now.overlap.Min() << ','
-        << now.overlap.MinDistinctive() << ',' << now.icp_iterations << ',' << ms << '\n';
+        << now.overlap.MinDistinctive() << ',' << now.icp_iterations << ',' << ms << ','
+        << TruthFields(poses, candidate, query, match, config) << '\n';
 }
 
 void Replay(const std::filesystem::path& run, const registration::VerificationConfig& config,
-            const std::filesystem::path& pairs_csv) {
+            const std::filesystem::path& pairs_csv, const std::vector<core::StampedPose>& poses) {
     std::ofstream pairs;
     if (!pairs_csv.empty()) {
         pairs.open(pairs_csv);
         pairs << "query,match,accepted,reason,coarse_score,query_cells,match_cells,overlap,"
-                 "distinctive_overlap,icp_iterations,ms\n";
+                 "distinctive_overlap,icp_iterations,ms,true_distance_m,true_overlap,"
+                 "true_distinctive_overlap,coarse_rank_of_truth\n";
     }
     const io::StoredPreparedScans stored = io::LoadPreparedScans(run / "database.scans");
     if (!(stored.reduction == config.reduction))
@@ -144,7 +186,7 @@ void Replay(const std::filesystem::path& run, const registration::VerificationCo
         const registration::Verification now = registration::Verify(query, *coarse, match, config);
         tally.pair_ms.push_back(1e3 * (ThreadSeconds() - start));
         if (pairs.is_open())
-            WritePair(pairs, candidate, now, query, match, config, tally.pair_ms.back());
+            WritePair(pairs, candidate, now, query, match, config, tally.pair_ms.back(), poses);
         ++tally.pairs;
         tally.accepted_before += candidate.accepted ? 1 : 0;
         tally.accepted_now += now.accepted ? 1 : 0;
@@ -177,11 +219,15 @@ void Replay(const std::filesystem::path& run, const registration::VerificationCo
 }  // namespace
 
 int main(int argc, char** argv) {
-    std::filesystem::path run, config_file, pairs_csv;
+    std::filesystem::path run, config_file, pairs_csv, poses_file;
     for (int i = 1; i < argc; ++i) {
         const std::string argument = argv[i];
-        if ((argument == "--config" || argument == "--pairs-csv") && i + 1 < argc) {
-            (argument == "--config" ? config_file : pairs_csv) = argv[++i];
+        if (argument == "--config" && i + 1 < argc) {
+            config_file = argv[++i];
+        } else if (argument == "--pairs-csv" && i + 1 < argc) {
+            pairs_csv = argv[++i];
+        } else if (argument == "--poses" && i + 1 < argc) {
+            poses_file = argv[++i];
         } else if (run.empty() && argument.rfind("--", 0) != 0) {
             run = argument;
         } else {
@@ -190,13 +236,17 @@ int main(int argc, char** argv) {
         }
     }
     if (run.empty()) {
-        std::fprintf(stderr, "usage: %s RUN_FOLDER [--config FILE] [--pairs-csv FILE]\n", argv[0]);
+        std::fprintf(stderr,
+                     "usage: %s RUN_FOLDER [--config FILE] [--pairs-csv FILE [--poses FILE]]\n",
+                     argv[0]);
         return 2;
     }
     try {
         const io::RunConfig config =
             io::LoadConfigYaml(config_file.empty() ? run / "config.yaml" : config_file);
-        Replay(run, config.detection.verification, pairs_csv);
+        const std::vector<core::StampedPose> poses =
+            poses_file.empty() ? std::vector<core::StampedPose>{} : io::ReadPoses(poses_file);
+        Replay(run, config.detection.verification, pairs_csv, poses);
     } catch (const std::exception& error) {
         std::fprintf(stderr, "verify_replay: %s\n", error.what());
         return 1;
