@@ -2,9 +2,11 @@
 // registered candidate of candidates.csv is verified again with this build, timed on the calling
 // thread, and its verdict compared with the run's. The A/B harness for verification changes
 // (docs/BENCHMARK.md): same decisions and poses, time per pair. Run:
-//   taskset -c 1 ./build/bench/verify_replay RUN [--config FILE] [--pairs-csv FILE [--poses FILE]]
+//   taskset -c 1 ./build/bench/verify_replay RUN [--config FILE] [--compact]
+//                                            [--pairs-csv FILE [--poses FILE]]
 // RUN_FOLDER holds database.scans, candidates.csv and config.yaml (detect with verification on);
-// --config verifies with another configuration, --pairs-csv writes one line per pair (verdict,
+// --config verifies with another configuration, --compact with the scans kept compact (the
+// match expanded in the timed step, as detect does), --pairs-csv writes one line per pair (verdict,
 // coarse score, occupied image cells, overlaps, ICP iterations, time) and, with --poses (KITTI
 // or TUM, T_world_sensor, one per scan), the true distance and the overlap at the true pose.
 #include <algorithm>
@@ -24,6 +26,7 @@
 #include "lidarloop/io/config_yaml.hpp"
 #include "lidarloop/io/poses.hpp"
 #include "lidarloop/io/prepared_scans_file.hpp"
+#include "lidarloop/registration/compact_prepared_scan.hpp"
 #include "lidarloop/registration/verification.hpp"
 
 namespace {
@@ -156,8 +159,29 @@ void WritePair(std::ofstream& out, const Candidate& candidate,
         << TruthFields(poses, candidate, query, match, config) << '\n';
 }
 
+// The run's scans as a run keeps them: as loaded, or (--compact) encoded as
+// registration::CompactPreparedScan and expanded when used, as detect does.
+class ScanSource {
+public:
+    ScanSource(std::vector<registration::PreparedScan> scans, bool compact) {
+        if (!compact) {
+            scans_ = std::move(scans);
+            return;
+        }
+        for (const auto& scan : scans) compact_.emplace_back(scan);
+    }
+    registration::PreparedScan At(std::size_t i) const {
+        return compact_.empty() ? scans_.at(i) : compact_.at(i).Expand();
+    }
+
+private:
+    std::vector<registration::PreparedScan> scans_;
+    std::vector<registration::CompactPreparedScan> compact_;
+};
+
 void Replay(const std::filesystem::path& run, const registration::VerificationConfig& config,
-            const std::filesystem::path& pairs_csv, const std::vector<core::StampedPose>& poses) {
+            const std::filesystem::path& pairs_csv, const std::vector<core::StampedPose>& poses,
+            bool compact) {
     std::ofstream pairs;
     if (!pairs_csv.empty()) {
         pairs.open(pairs_csv);
@@ -165,24 +189,26 @@ void Replay(const std::filesystem::path& run, const registration::VerificationCo
                  "distinctive_overlap,icp_iterations,ms,true_distance_m,true_overlap,"
                  "true_distinctive_overlap,coarse_rank_of_truth\n";
     }
-    const io::StoredPreparedScans stored = io::LoadPreparedScans(run / "database.scans");
+    io::StoredPreparedScans stored = io::LoadPreparedScans(run / "database.scans");
+    const ScanSource scans(std::move(stored.scans), compact);
     if (!(stored.reduction == config.reduction))
         std::printf("note: the scans were reduced with another configuration than --config's\n");
     const std::vector<Candidate> candidates = ReadCandidates(run / "candidates.csv");
     Tally tally;
     std::optional<registration::CoarseQuery> coarse;
-    std::size_t coarse_of = static_cast<std::size_t>(-1);
+    registration::PreparedScan query;
+    std::size_t query_index = static_cast<std::size_t>(-1);
     for (const Candidate& candidate : candidates) {
-        const registration::PreparedScan& query = stored.scans.at(candidate.query);
-        const registration::PreparedScan& match = stored.scans.at(candidate.match);
-        if (!query.structure || !match.structure) continue;
-        if (coarse_of != candidate.query) {
+        if (query_index != candidate.query) {
             const double start = ThreadSeconds();
-            coarse.emplace(*query.structure, config.coarse);
+            query = scans.At(candidate.query);
+            if (query.structure) coarse.emplace(*query.structure, config.coarse);
             tally.query_ms.push_back(1e3 * (ThreadSeconds() - start));
-            coarse_of = candidate.query;
+            query_index = candidate.query;
         }
         const double start = ThreadSeconds();
+        const registration::PreparedScan match = scans.At(candidate.match);
+        if (!query.structure || !match.structure) continue;
         const registration::Verification now = registration::Verify(query, *coarse, match, config);
         tally.pair_ms.push_back(1e3 * (ThreadSeconds() - start));
         if (pairs.is_open())
@@ -220,9 +246,12 @@ void Replay(const std::filesystem::path& run, const registration::VerificationCo
 
 int main(int argc, char** argv) {
     std::filesystem::path run, config_file, pairs_csv, poses_file;
+    bool compact = false;
     for (int i = 1; i < argc; ++i) {
         const std::string argument = argv[i];
-        if (argument == "--config" && i + 1 < argc) {
+        if (argument == "--compact") {
+            compact = true;
+        } else if (argument == "--config" && i + 1 < argc) {
             config_file = argv[++i];
         } else if (argument == "--pairs-csv" && i + 1 < argc) {
             pairs_csv = argv[++i];
@@ -236,9 +265,10 @@ int main(int argc, char** argv) {
         }
     }
     if (run.empty()) {
-        std::fprintf(stderr,
-                     "usage: %s RUN_FOLDER [--config FILE] [--pairs-csv FILE [--poses FILE]]\n",
-                     argv[0]);
+        std::fprintf(
+            stderr,
+            "usage: %s RUN_FOLDER [--config FILE] [--compact] [--pairs-csv FILE [--poses FILE]]\n",
+            argv[0]);
         return 2;
     }
     try {
@@ -246,7 +276,7 @@ int main(int argc, char** argv) {
             io::LoadConfigYaml(config_file.empty() ? run / "config.yaml" : config_file);
         const std::vector<core::StampedPose> poses =
             poses_file.empty() ? std::vector<core::StampedPose>{} : io::ReadPoses(poses_file);
-        Replay(run, config.detection.verification, pairs_csv, poses);
+        Replay(run, config.detection.verification, pairs_csv, poses, compact);
     } catch (const std::exception& error) {
         std::fprintf(stderr, "verify_replay: %s\n", error.what());
         return 1;

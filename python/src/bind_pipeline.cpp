@@ -260,8 +260,8 @@ std::unique_ptr<LoopDetector> LoadDetector(const path& file, std::optional<bool>
 void SaveDetector(const LoopDetector& detector, const path& file) {
     io::SaveDatabase(file, detector.database(), detector.detector_config());
     const auto& scans = detector.prepared_scans();
-    const bool any = std::any_of(scans.begin(), scans.end(),
-                                 [](const auto& scan) { return scan.structure != nullptr; });
+    const bool any =
+        std::any_of(scans.begin(), scans.end(), [](const auto& scan) { return scan.prepared(); });
     if (any) {
         io::SavePreparedScans(io::PreparedScansPathOf(file), scans,
                               detector.detector_config().verification.reduction);

@@ -132,7 +132,7 @@ nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
     const std::size_t step =
         std::max<std::size_t>(1, all.size() / std::max<std::size_t>(1, queries));
     for (std::size_t q = 0; q < all.size() && coarse_times.wall_ms.size() < queries; q += step) {
-        const registration::PreparedScan& query = prepared.scans[all[q].query];
+        const registration::PreparedScan query = prepared.scans[all[q].query].Expand();
         if (!query.structure) continue;
         const auto coarse = coarse_times.Time([&] {
             return std::make_optional<registration::CoarseQuery>(*query.structure,
@@ -141,8 +141,8 @@ nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
         double verification_cpu_ms = coarse_times.cpu_ms.back();
         for (const pipeline::Neighbor& candidate : all[q].candidates) {
             const registration::Verification verdict = pair_times.Time([&] {
-                return registration::Verify(query, *coarse, prepared.scans[candidate.index],
-                                            verification);
+                return registration::Verify(query, *coarse,
+                                            prepared.scans[candidate.index].Expand(), verification);
             });
             verification_cpu_ms += pair_times.cpu_ms.back();
             accepted += verdict.accepted ? 1 : 0;

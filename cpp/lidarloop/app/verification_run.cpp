@@ -12,7 +12,8 @@ std::function<void(std::size_t, const core::PointCloud&)> PreparedScans::Collect
     return [this, &reduction](std::size_t i, const core::PointCloud& cloud) {
         const Stopwatch clock;
         const ThreadCpuStopwatch cpu_clock;
-        scans.at(i) = registration::PrepareScan(cloud, reduction);
+        scans.at(i) =
+            registration::CompactPreparedScan(registration::PrepareScan(cloud, reduction));
         prepare_seconds.at(i) = clock.Seconds();
         prepare_cpu_seconds.at(i) = cpu_clock.Seconds();
     };
@@ -21,7 +22,7 @@ std::function<void(std::size_t, const core::PointCloud&)> PreparedScans::Collect
 std::vector<double> PreparedScans::BytesPerScan() const {
     std::vector<double> bytes;
     for (const auto& scan : scans) {
-        if (scan.structure) bytes.push_back(static_cast<double>(scan.MemoryBytes()));
+        if (scan.prepared()) bytes.push_back(static_cast<double>(scan.MemoryBytes()));
     }
     return bytes;
 }

@@ -10,6 +10,7 @@
 #include "lidarloop/app/progress.hpp"
 #include "lidarloop/core/point_cloud.hpp"
 #include "lidarloop/pipeline/candidate_verification.hpp"
+#include "lidarloop/registration/compact_prepared_scan.hpp"
 #include "lidarloop/registration/prepared_scan.hpp"
 #include "lidarloop/registration/verification.hpp"
 
@@ -17,9 +18,10 @@ namespace lidarloop::app {
 
 /// Every scan of a sequence prepared for verification, filled while the scans are described.
 struct PreparedScans {
-    std::vector<registration::PreparedScan> scans;  ///< by scan index; empty for skipped scans
-    std::vector<double> prepare_seconds;            ///< per scan, wall time
-    std::vector<double> prepare_cpu_seconds;        ///< per scan, thread CPU time
+    /// By scan index, kept compact for the whole run; empty for skipped scans.
+    std::vector<registration::CompactPreparedScan> scans;
+    std::vector<double> prepare_seconds;      ///< per scan, wall time
+    std::vector<double> prepare_cpu_seconds;  ///< per scan, thread CPU time
 
     explicit PreparedScans(std::size_t count)
         : scans(count), prepare_seconds(count, 0.0), prepare_cpu_seconds(count, 0.0) {}

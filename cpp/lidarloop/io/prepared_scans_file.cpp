@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdint>
 #include <fstream>
+#include <functional>
 #include <memory>
 
 #include "lidarloop/io/config_yaml.hpp"
@@ -78,29 +79,47 @@ void Append(std::ofstream& out, const core::ByteWriter& bytes) {
     out.write(bytes.data().data(), static_cast<std::streamsize>(bytes.data().size()));
 }
 
-}  // namespace
-
-// Written scan by scan: encoding the whole file first held a second copy of every prepared scan
-// at the end of a long run, the peak of its memory.
-void SavePreparedScans(const std::filesystem::path& file,
-                       const std::vector<registration::PreparedScan>& scans,
-                       const registration::ScanReductionConfig& reduction) {
+// Writes `count` scans, scan i written by `put_scan(i, bytes)`, one in memory at a time:
+// encoding the whole file first held a second copy of every prepared scan at the end of a long
+// run, the peak of its memory.
+void SaveScans(const std::filesystem::path& file, std::size_t count,
+               const std::function<void(std::size_t, core::ByteWriter&)>& put_scan,
+               const registration::ScanReductionConfig& reduction) {
     std::ofstream out = detail::OpenForWriting(file, /*binary=*/true);
     core::ByteWriter header;
     header.PutMagic(kMagic);
     RunConfig config;
     config.detection.verification.reduction = reduction;
     header.PutString(DumpConfigYaml(config));
-    header.Put<std::uint64_t>(scans.size());
+    header.Put<std::uint64_t>(count);
     Append(out, header);
     core::ByteWriter bytes;  // one buffer for all scans
-    for (const registration::PreparedScan& scan : scans) {
+    for (std::size_t i = 0; i < count; ++i) {
         bytes.Clear();
-        PutScan(bytes, scan);
+        put_scan(i, bytes);
         Append(out, bytes);
     }
     out.close();
     if (!out) throw WriteError(file, "writing the prepared scans failed (disk full?)");
+}
+
+}  // namespace
+
+void SavePreparedScans(const std::filesystem::path& file,
+                       const std::vector<registration::PreparedScan>& scans,
+                       const registration::ScanReductionConfig& reduction) {
+    SaveScans(
+        file, scans.size(),
+        [&](std::size_t i, core::ByteWriter& bytes) { PutScan(bytes, scans[i]); }, reduction);
+}
+
+void SavePreparedScans(const std::filesystem::path& file,
+                       const std::vector<registration::CompactPreparedScan>& scans,
+                       const registration::ScanReductionConfig& reduction) {
+    SaveScans(
+        file, scans.size(),
+        [&](std::size_t i, core::ByteWriter& bytes) { PutScan(bytes, scans[i].Expand()); },
+        reduction);
 }
 
 StoredPreparedScans LoadPreparedScans(const std::filesystem::path& file) {

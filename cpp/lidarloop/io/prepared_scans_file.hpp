@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <vector>
 
+#include "lidarloop/registration/compact_prepared_scan.hpp"
 #include "lidarloop/registration/prepared_scan.hpp"
 #include "lidarloop/registration/verification_config.hpp"
 
@@ -15,6 +16,11 @@ namespace lidarloop::io {
 /// structure points' distinctive flags. About 24 bytes per kept point. Little-endian binary.
 void SavePreparedScans(const std::filesystem::path& file,
                        const std::vector<registration::PreparedScan>& scans,
+                       const registration::ScanReductionConfig& reduction);
+/// The same for scans kept compact (each expanded while it is written: the file holds the
+/// decoded points, one scan in memory at a time).
+void SavePreparedScans(const std::filesystem::path& file,
+                       const std::vector<registration::CompactPreparedScan>& scans,
                        const registration::ScanReductionConfig& reduction);
 
 /// Prepared scans saved by SavePreparedScans, with the reduction they were made with.

@@ -48,7 +48,7 @@ std::size_t VerificationCache::size() const {
 }
 
 void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
-                 const std::function<const registration::PreparedScan&(std::size_t)>& match_of,
+                 const std::function<registration::PreparedScan(std::size_t)>& match_of,
                  const DetectorConfig& detector, const core::Method& method,
                  VerificationTimes* times, VerificationCache* cache) {
     query.verifications.clear();
@@ -87,19 +87,17 @@ void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
 }
 
 VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
-                                const std::vector<registration::PreparedScan>& scans,
+                                const std::vector<registration::CompactPreparedScan>& scans,
                                 const DetectorConfig& detector, const core::Method& method,
                                 Execution execution,
                                 const std::function<void(std::size_t, std::size_t)>& progress,
                                 VerificationCache* cache) {
-    const auto scan_of = [&scans](std::size_t i) -> const registration::PreparedScan& {
-        return scans.at(i);
-    };
+    const auto scan_of = [&scans](std::size_t i) { return scans.at(i).Expand(); };
     std::vector<VerificationTimes> per_query(queries.size());
     std::atomic<std::size_t> done{0};
     const auto run = [&](std::size_t i) {
-        VerifyQuery(queries[i], scans.at(queries[i].query), scan_of, detector, method,
-                    &per_query[i], cache);
+        VerifyQuery(queries[i], scan_of(queries[i].query), scan_of, detector, method, &per_query[i],
+                    cache);
         const std::size_t finished = ++done;
         if (progress) progress(finished, queries.size());
     };

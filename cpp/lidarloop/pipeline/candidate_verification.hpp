@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "lidarloop/pipeline/loop_detector.hpp"
+#include "lidarloop/registration/compact_prepared_scan.hpp"
 #include "lidarloop/registration/prepared_scan.hpp"
 
 namespace lidarloop::pipeline {
@@ -38,20 +39,22 @@ private:
 
 /// Registers the candidates of `query` to it (registration::Verify) and fills
 /// query.verifications and query.accepted. `query_scan` is the query prepared with
-/// detector.verification.reduction, `match_of(j)` candidate j prepared the same way (an empty
-/// PreparedScan, e.g. of a skipped scan, is rejected as kTooFewPoints). A candidate whose
+/// detector.verification.reduction, `match_of(j)` candidate j prepared the same way (called once
+/// per registered candidate, e.g. to expand a CompactPreparedScan; an empty PreparedScan, e.g.
+/// of a skipped scan, is rejected as kTooFewPoints). A candidate whose
 /// distance fails an explicitly set detector.threshold is not registered (reason kPruned).
 /// Appends to `times` when given (pairs found in `cache` are not timed); takes verdicts from and
 /// adds them to `cache` when given.
 void VerifyQuery(LoopQuery& query, const registration::PreparedScan& query_scan,
-                 const std::function<const registration::PreparedScan&(std::size_t)>& match_of,
+                 const std::function<registration::PreparedScan(std::size_t)>& match_of,
                  const DetectorConfig& detector, const core::Method& method,
                  VerificationTimes* times = nullptr, VerificationCache* cache = nullptr);
 
 /// VerifyQuery for every query that has candidates (in parallel unless told otherwise);
-/// `scans[i]` is scan i prepared. `progress(done, total)` is called from worker threads.
+/// `scans[i]` is scan i prepared, kept compact (each expanded when verified; the pair times
+/// include expanding the candidate). `progress(done, total)` is called from worker threads.
 VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
-                                const std::vector<registration::PreparedScan>& scans,
+                                const std::vector<registration::CompactPreparedScan>& scans,
                                 const DetectorConfig& detector, const core::Method& method,
                                 Execution execution = Execution::kParallel,
                                 const std::function<void(std::size_t, std::size_t)>& progress = {},

@@ -161,7 +161,7 @@ LoopDetector::LoopDetector(DescriptorDatabase database, const DetectorConfig& de
     : database_(std::move(database)),
       detector_(detector),
       threshold_(detector.ThresholdFor(database_.method())),
-      scans_(std::move(scans)) {
+      scans_(scans.begin(), scans.end()) {
     detector_.Validate();
     if (!scans_.empty() && scans_.size() != database_.size()) {
         throw core::ConfigError("LoopDetector: " + std::to_string(scans_.size()) +
@@ -197,17 +197,17 @@ LoopQuery LoopDetector::Search(const PreparedQuery& query, std::size_t query_ind
     return result;
 }
 
-void LoopDetector::Verify(LoopQuery& result, const registration::PreparedScan& scan) const {
-    if (!detector_.verify || !scan.structure) return;
+void LoopDetector::Verify(LoopQuery& result, const registration::CompactPreparedScan& scan) const {
+    if (!detector_.verify || !scan.prepared()) return;
+    // The query as it is stored: online, offline and localisation see the same scans.
     VerifyQuery(
-        result, scan,
-        [this](std::size_t j) -> const registration::PreparedScan& { return scans_[j]; }, detector_,
+        result, scan.Expand(), [this](std::size_t j) { return scans_[j].Expand(); }, detector_,
         database_.method());
 }
 
 std::size_t LoopDetector::prepared_bytes() const {
     std::size_t bytes = 0;
-    for (const registration::PreparedScan& scan : scans_) bytes += scan.MemoryBytes();
+    for (const registration::CompactPreparedScan& scan : scans_) bytes += scan.MemoryBytes();
     return bytes;
 }
 
@@ -234,9 +234,10 @@ LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_
         return j < query_index && database_.IsValid(j) &&
                gap.Allows(query_index, j, time_s, times_s[j]);
     });
-    Verify(result, scan);
+    registration::CompactPreparedScan compact(scan);
+    Verify(result, compact);
     database_.Add(descriptor, time_s);
-    scans_.push_back(std::move(scan));
+    scans_.push_back(std::move(compact));
     if (index_) index_->Insert(query_index);
     return result;
 }
@@ -248,6 +249,11 @@ LoopQuery LoopDetector::Query(const core::Descriptor& descriptor,
 
 LoopQuery LoopDetector::Query(const PreparedQuery& query, std::size_t query_index,
                               const registration::PreparedScan& scan) const {
+    return Query(query, query_index, registration::CompactPreparedScan(scan));
+}
+
+LoopQuery LoopDetector::Query(const PreparedQuery& query, std::size_t query_index,
+                              const registration::CompactPreparedScan& scan) const {
     LoopQuery result =
         Search(query, query_index, [&](std::size_t j) { return database_.IsValid(j); });
     Verify(result, scan);
@@ -256,7 +262,7 @@ LoopQuery LoopDetector::Query(const PreparedQuery& query, std::size_t query_inde
 
 std::vector<LoopQuery> LocaliseSequence(
     const LoopDetector& map, const DescriptorDatabase& queries, Execution execution,
-    const std::vector<registration::PreparedScan>& query_scans) {
+    const std::vector<registration::CompactPreparedScan>& query_scans) {
     if (queries.config() != map.database().config()) {
         throw core::ConfigError(
             "the query scans were described with another configuration than the map's");
@@ -265,9 +271,9 @@ std::vector<LoopQuery> LocaliseSequence(
     const auto localise = [&](std::size_t i) {
         results[i].query = i;
         if (!queries.IsValid(i)) return;
-        static const registration::PreparedScan kNone;
-        results[i] = map.Query(*queries.PrepareStored(i), i,
-                               i < query_scans.size() ? query_scans[i] : kNone);
+        results[i] = map.Query(
+            *queries.PrepareStored(i), i,
+            i < query_scans.size() ? query_scans[i] : registration::CompactPreparedScan{});
     };
     if (execution == Execution::kSerial) {
         for (std::size_t i = 0; i < queries.size(); ++i) localise(i);

@@ -9,6 +9,7 @@
 #include "lidarloop/app/describe_run.hpp"
 #include "lidarloop/io/kitti_bin.hpp"
 #include "lidarloop/pipeline/similarity_matrix.hpp"
+#include "lidarloop/registration/compact_prepared_scan.hpp"
 #include "lidarloop/registration/verification.hpp"
 #include "lidarloop/sim/simulator.hpp"
 #include "test_utils.hpp"
@@ -103,8 +104,9 @@ TEST(BenchRun, VerificationFiguresAreRecountedIndependently) {
 
     std::vector<double> bytes;
     for (std::size_t i = 0; i < dataset.size(); ++i) {
-        bytes.push_back(static_cast<double>(
-            registration::PrepareScan(dataset.LoadScan(i), config.reduction).MemoryBytes()));
+        const registration::CompactPreparedScan kept(
+            registration::PrepareScan(dataset.LoadScan(i), config.reduction));
+        bytes.push_back(static_cast<double>(kept.MemoryBytes()));
     }
     EXPECT_DOUBLE_EQ(v["bytes_per_prepared_scan"]["median"].get<double>(), Median(bytes));
     EXPECT_EQ(v["bytes_per_prepared_scan"]["max"].get<double>(),

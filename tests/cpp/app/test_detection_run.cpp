@@ -21,6 +21,7 @@
 #include "lidarloop/io/prepared_scans_file.hpp"
 #include "lidarloop/io/read_error.hpp"
 #include "lidarloop/io/results_csv.hpp"
+#include "lidarloop/registration/compact_prepared_scan.hpp"
 #include "lidarloop/registration/verification.hpp"
 #include "test_utils.hpp"
 
@@ -263,10 +264,12 @@ void ExpectFilesStateTheVerdicts(const app::DetectRequest& request,
     std::ifstream timings_file(request.out / "timings.json");
     const nlohmann::json timings = nlohmann::json::parse(timings_file)["verification"];
     EXPECT_EQ(timings["pairs_verified"].get<std::size_t>(), registered);
-    // The bytes of the scans detect prepared, as it saved them in database.scans.
+    // The bytes of the scans detect prepared and kept compact, from what it saved in
+    // database.scans.
     std::vector<double> bytes;
     for (const auto& scan : io::LoadPreparedScans(request.out / "database.scans").scans) {
-        if (scan.structure) bytes.push_back(static_cast<double>(scan.MemoryBytes()));
+        const registration::CompactPreparedScan kept(scan);
+        if (scan.structure) bytes.push_back(static_cast<double>(kept.MemoryBytes()));
     }
     ASSERT_EQ(bytes.size(), dataset.size());
     std::sort(bytes.begin(), bytes.end());
@@ -276,7 +279,22 @@ void ExpectFilesStateTheVerdicts(const app::DetectRequest& request,
     }
 }
 
-// Verification inside detect gives what registering each candidate on its own gives.
+// A pair registered on its own, its scans kept as detect keeps them (compact).
+registration::Verification VerifyAsKept(const core::PointCloud& query,
+                                        const core::PointCloud& match,
+                                        const registration::VerificationConfig& config) {
+    const auto kept = [&](const core::PointCloud& scan) {
+        return registration::CompactPreparedScan(registration::PrepareScan(scan, config.reduction))
+            .Expand();
+    };
+    const registration::PreparedScan prepared_query = kept(query);
+    return registration::Verify(prepared_query,
+                                registration::CoarseQuery(*prepared_query.structure, config.coarse),
+                                kept(match), config);
+}
+
+// Verification inside detect gives what registering each candidate on its own gives, and the
+// same verdicts and poses within a centimetre as the scans at full precision.
 TEST_F(DetectionRun, VerifiesEveryCandidateAsRegisteringThePairAlone) {
     const app::DetectRequest request = Request("verified", core::Method::kRange);
     const app::DetectOutcome outcome = app::RunDetect(*dataset_, request);
@@ -289,11 +307,18 @@ TEST_F(DetectionRun, VerifiesEveryCandidateAsRegisteringThePairAlone) {
             const registration::Verification& v = q.verifications[r];
             any = any || v.accepted;
             if (q.query % 17 != 0) continue;  // a sample: each pair is a registration
-            const registration::Verification alone = registration::VerifyPair(
-                dataset_->LoadScan(q.query), dataset_->LoadScan(q.candidates[r].index), config);
+            const core::PointCloud query = dataset_->LoadScan(q.query);
+            const core::PointCloud match = dataset_->LoadScan(q.candidates[r].index);
+            const registration::Verification alone = VerifyAsKept(query, match, config);
             EXPECT_EQ(v.accepted, alone.accepted) << q.query << " " << r;
             EXPECT_EQ(v.reason, alone.reason) << q.query << " " << r;
             EXPECT_TRUE(v.T_match_query.isApprox(alone.T_match_query, 1e-9));
+            const registration::Verification full = registration::VerifyPair(query, match, config);
+            EXPECT_EQ(v.accepted, full.accepted) << q.query << " " << r;
+            if (v.accepted && full.accepted) {
+                EXPECT_LT((v.T_match_query.translation() - full.T_match_query.translation()).norm(),
+                          0.01);
+            }
             ++checked;
         }
         EXPECT_EQ(q.accepted, any) << q.query;

@@ -42,11 +42,11 @@ TEST(OnlineVerification, EqualsVerifyingTheOfflineCandidates) {
     LoopDetector online(config, detector);
     std::vector<LoopQuery> online_results;
     std::vector<double> times;
-    std::vector<registration::PreparedScan> prepared;
+    std::vector<registration::CompactPreparedScan> prepared;
     for (std::size_t i = 0; i < sequence.scans.size(); ++i) {
         times.push_back(static_cast<double>(i));
         online_results.push_back(online.Process(sequence.scans[i], times.back()));
-        prepared.push_back(
+        prepared.emplace_back(
             registration::PrepareScan(sequence.scans[i], detector.verification.reduction));
     }
     std::vector<LoopQuery> offline = DetectFromMatrix(ComputeSimilarityMatrix(online.database()),
@@ -88,7 +88,7 @@ TEST(OnlineVerification, KeepsReducedScansAndCountsTheirBytes) {
     std::size_t sum = 0;
     ASSERT_EQ(online.prepared_scans().size(), sequence.scans.size());
     for (const auto& scan : online.prepared_scans()) {
-        ASSERT_TRUE(scan.structure);
+        ASSERT_TRUE(scan.prepared());
         sum += scan.MemoryBytes();
     }
     EXPECT_EQ(online.prepared_bytes(), sum);
