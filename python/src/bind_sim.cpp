@@ -80,6 +80,8 @@ SimulationConfig ConfigFrom(const std::optional<std::string>& scene,
     r.spacing_min_m = Take<double>(options, "spacing_min_m").value_or(r.spacing_min_m);
     r.spacing_max_m = Take<double>(options, "spacing_max_m").value_or(r.spacing_max_m);
     r.uturn_blocks = Take<int>(options, "uturn_blocks").value_or(r.uturn_blocks);
+    config.front_end.keep_every =
+        Take<std::int64_t>(options, "keep_every").value_or(config.front_end.keep_every);
     if (const auto drift = Take<double>(options, "drift"))
         config.odometry = sim::ScaledOdometry(config.odometry, *drift);
     if (options.contains("trajectory")) {
@@ -130,10 +132,11 @@ void BindSimulator(py::module_& m) {
              py::arg("sensor") = py::none(), py::arg("scans") = py::none(),
              py::arg("seed") = py::none(),
              "scene: urban | rural | mine | indoor (default urban); route: uturn | figure8 | "
-             "grid (default uturn); sensor: hdl64 | vlp16 | tilt180 (default hdl64); scans "
-             "(default 100); seed (default 1). Options as `lidarloop simulate`'s flags: "
-             "noise_m, dropout, horizontal_steps, min_range_m, max_range_m, mount_height_m, "
-             "scan_period_s, spacing_min_m, spacing_max_m, uturn_blocks, drift (factor on the "
+             "grid (default uturn); sensor: hdl64 | vlp16 | tilt180 | hdl32 | ouster64-wide | "
+             "livox-avia (default hdl64); scans (default 100); seed (default 1). Options as "
+             "`lidarloop simulate`'s flags: noise_m, dropout, horizontal_steps, min_range_m, "
+             "max_range_m, mount_height_m, scan_period_s, spacing_min_m, spacing_max_m, "
+             "uturn_blocks, keep_every (every N-th point of a scan kept), drift (factor on the "
              "odometry noise), trajectory ((N, 3) positions or (N, 4, 4) poses to drive).")
         .def_static(
             "demo", [] { return MakeSimulator(sim::DemoConfig()); },
