@@ -1,5 +1,6 @@
 // The simulator (lidarloop::sim, app::WriteSimulation): synthetic LiDAR sequences with
 // ground-truth and drifting odometry poses, as arrays or written in the KITTI layout.
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
