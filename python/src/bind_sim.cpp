@@ -5,6 +5,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <pybind11/pybind11.h>
@@ -26,12 +27,28 @@ using sim::SimulationConfig;
 using sim::Simulator;
 
 template <typename T>
+constexpr const char* KindOf() {
+    if constexpr (std::is_integral_v<T>) {
+        return sizeof(T) == 4 ? "a 32-bit integer" : "a 64-bit integer";
+    } else {
+        return "a number";
+    }
+}
+
+// The option `name` of the keywords, removed from them; a value of the wrong type or out of the
+// C++ type's range is a TypeError naming the option (pybind11's own says neither).
+template <typename T>
 std::optional<T> Take(py::dict& options, const char* name) {
     if (!options.contains(name)) return std::nullopt;
     const py::object value = options[name];
     PyDict_DelItemString(options.ptr(), name);
     if (value.is_none()) return std::nullopt;
-    return value.cast<T>();
+    try {
+        return value.cast<T>();
+    } catch (const py::cast_error&) {
+        throw py::type_error(std::string(name) + " must be " + KindOf<T>() + ", got " +
+                             py::repr(value).cast<std::string>());
+    }
 }
 
 // Drives `positions` ((N, 3) positions or (N, 4, 4) poses, of which the positions) instead of

@@ -105,6 +105,11 @@ def test_new_sensors_and_a_front_ends_thinning():
     for bad in (0, -1, 1001):
         with pytest.raises(lidarloop.ConfigError, match="front_end.keep_every"):
             lidarloop.Simulator(**SMALL, keep_every=bad)
+    for bad in (2**70, 1.5, "3"):  # not a 64-bit integer: named, not pybind11's bare cast error
+        with pytest.raises(TypeError, match="keep_every must be a 64-bit integer"):
+            lidarloop.Simulator(**SMALL, keep_every=bad)
+    with pytest.raises(TypeError, match="horizontal_steps must be a 32-bit integer"):
+        lidarloop.Simulator(**{**SMALL, "horizontal_steps": 2**40})
 
 
 def test_writing_releases_the_gil(tmp_path):
