@@ -291,10 +291,10 @@ std::vector<Eigen::Vector3d> Simulator::ScanDirections(std::size_t index) const 
 core::PointCloud Simulator::Scan(std::size_t index) const {
     const core::Transform T_world_sensor = GroundTruthPose(index).T_world_sensor;
     // The repeating sensors' rays are computed once; a non-repetitive one's for each scan.
-    std::vector<Eigen::Vector3d> scan_directions;
-    if (!RepeatsEveryScan(sensor_.model)) scan_directions = BeamDirections(sensor_, index);
-    const std::vector<Eigen::Vector3d>& directions =
-        scan_directions.empty() ? directions_ : scan_directions;
+    const bool repeats = RepeatsEveryScan(sensor_.model);
+    std::vector<Eigen::Vector3d> own_directions;
+    if (!repeats) own_directions = BeamDirections(sensor_, index);
+    const std::vector<Eigen::Vector3d>& directions = repeats ? directions_ : own_directions;
     const Eigen::Matrix3d R = T_world_sensor.linear();
     detail::Random rng(detail::StreamSeed(config_.seed, detail::Stream::kScan,
                                           {static_cast<std::int64_t>(index)}));
