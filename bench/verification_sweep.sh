@@ -4,8 +4,10 @@
 # crossings). Simulates each sequence once into WORK, evaluates it with `lidarloop evaluate`
 # (descriptor alone and verified, top-k candidates), and prints one table row per sequence and
 # method from metrics.json. Usage:
-#   bench/verification_sweep.sh WORK [SEED] [TOP_K] [-- extra evaluate flags]
+#   [SEQUENCES=dense|sparse] bench/verification_sweep.sh WORK [SEED] [TOP_K] [-- evaluate flags]
 # e.g. bench/verification_sweep.sh /tmp/sweep 1 10
+# SEQUENCES=sparse: issue 24's sparse and narrow sensors and a front end's thinning, 300 scans of
+# the urban grid route, with hdl64 and vlp16 on the same route for reference.
 set -euo pipefail
 work="${1:?usage: verification_sweep.sh WORK [SEED] [TOP_K] [-- evaluate flags]}"
 seed="${2:-1}"
@@ -15,8 +17,8 @@ shift $(($# < 3 ? $# : 3))
 lidarloop="${LIDARLOOP:-$(dirname "$0")/../build/cli/lidarloop}"
 mkdir -p "$work"
 
-# scene sensor scans spacing_min spacing_max
-sequences=(
+# scene sensor scans spacing_min spacing_max [simulate flags]
+dense=(
     "urban hdl64 420 2 3"
     "urban vlp16 420 2 3"
     "rural hdl64 420 4 6"
@@ -26,16 +28,34 @@ sequences=(
     "indoor hdl64 300 0.4 0.8"
     "indoor vlp16 300 0.4 0.8"
 )
+sparse=(
+    "urban hdl64 300 2 3"
+    "urban vlp16 300 2 3"
+    "urban hdl32 300 2 3"
+    "urban ouster64-wide 300 2 3"
+    "urban livox-avia 300 2 3"
+    "urban hdl32 300 2 3 --keep-every 10"
+    "urban vlp16 300 2 3 --keep-every 4"
+    "urban livox-avia 300 2 3 --keep-every 5"
+)
+case "${SEQUENCES:-dense}" in
+    dense) sequences=("${dense[@]}") ;;
+    sparse) sequences=("${sparse[@]}") ;;
+    *) echo "SEQUENCES must be dense or sparse, got '${SEQUENCES}'" >&2; exit 2 ;;
+esac
 printf "| sequence | method | revisiting | recall@1 | recall@%s (ceiling) | descriptor true/false | verified true/false/wrong pose | verified recall | verified recall@100%%P | pose error m med/max | yaw deg med/max | ms/pair med |\n" "$top_k"
 printf "|---|---|---|---|---|---|---|---|---|---|---|---|\n"
 for row in "${sequences[@]}"; do
-    read -r scene sensor scans smin smax <<<"$row"
-    name="${scene}_${sensor}_s${seed}"
+    read -r scene sensor scans smin smax extra <<<"$row"
+    read -ra simulate_flags <<<"${extra:-}"
+    suffix="$(tr -d ' -' <<<"${extra:-}")"  # "--keep-every 10" -> "keepevery10"
+    name="${scene}_${sensor}${suffix:+_$suffix}_s${seed}"
     data="$work/$name"
-    if [ ! -f "$data/poses.txt" ]; then
+    # A sequence made before is reused only when it has the row's number of scans.
+    if [ ! -f "$data/poses.txt" ] || ! grep -qx "scans: $scans" "$data/simulation.yaml"; then
         "$lidarloop" simulate --scene "$scene" --sensor "$sensor" --route grid --scans "$scans" \
             --spacing-min-m "$smin" --spacing-max-m "$smax" --seed "$seed" --out "$data" \
-            --quiet >/dev/null
+            "${simulate_flags[@]}" --overwrite --quiet >/dev/null
     fi
     out="$work/eval_${name}_k${top_k}"
     rm -rf "$out"

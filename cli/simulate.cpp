@@ -1,4 +1,5 @@
 #include <charconv>
+#include <cstdint>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -29,6 +30,7 @@ struct SimulateFlags {
     double noise_m = sim::SensorConfig{}.noise_m;
     double dropout = sim::SensorConfig{}.dropout;
     double drift = 1.0;
+    std::int64_t keep_every = sim::FrontEndConfig{}.keep_every;
     int threads = 0;
     bool overwrite = false;
     bool quiet = false;
@@ -69,6 +71,7 @@ sim::SimulationConfig ToConfig(const SimulateFlags& flags) {
     config.route.spacing_max_m = flags.spacing_max_m.value_or(config.route.spacing_max_m);
     config.route.uturn_blocks = flags.uturn_blocks.value_or(config.route.uturn_blocks);
     config.odometry = sim::ScaledOdometry(config.odometry, flags.drift);
+    config.front_end.keep_every = flags.keep_every;
     config.Validate();
     return config;
 }
@@ -108,7 +111,9 @@ void AddSimulateCommand(CLI::App& app) {
     command->add_option("--scene", flags->scene, "urban, rural, mine or indoor")
         ->capture_default_str();
     command->add_option("--route", flags->route, "uturn, figure8 or grid")->capture_default_str();
-    command->add_option("--sensor", flags->sensor, "hdl64, vlp16 or tilt180")
+    command
+        ->add_option("--sensor", flags->sensor,
+                     "hdl64, vlp16, tilt180, hdl32, ouster64-wide or livox-avia")
         ->capture_default_str();
     command->add_option("--scans", flags->scans, "number of scans, 1-1000000")
         ->capture_default_str();
@@ -130,8 +135,14 @@ void AddSimulateCommand(CLI::App& app) {
     command->add_option("--mount-height-m", flags->mount_height_m,
                         "sensor height above the ground; default: the sensor's");
     command->add_option("--horizontal-steps", flags->horizontal_steps,
-                        "azimuth steps per revolution (hdl64 1875, vlp16 1800) or samples per "
-                        "line (tilt180 361); fewer for smaller files");
+                        "azimuth steps per revolution (hdl64 1875, vlp16 1800, hdl32 2170, "
+                        "ouster64-wide 1024), samples per line (tilt180 361) or per laser "
+                        "(livox-avia 4000); fewer for smaller files");
+    command
+        ->add_option("--keep-every", flags->keep_every,
+                     "keep every N-th returned point of each scan, as a LIO front end thins "
+                     "its keyframes, 1-1000")
+        ->capture_default_str();
     command->add_option("--spacing-min-m", flags->spacing_min_m, "default 1");
     command->add_option("--spacing-max-m", flags->spacing_max_m, "default 2");
     command->add_option("--uturn-blocks", flags->uturn_blocks,

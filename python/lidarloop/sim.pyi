@@ -23,10 +23,12 @@ class Simulator:
         **options: Any,
     ) -> None:
         """scene urban | rural | mine | indoor (default urban); route uturn | figure8 | grid
-        (default uturn); sensor hdl64 | vlp16 | tilt180 (default hdl64); scans (100); seed (1).
-        options as `lidarloop simulate`'s flags: noise_m, dropout, horizontal_steps,
-        min_range_m, max_range_m, mount_height_m, scan_period_s, spacing_min_m, spacing_max_m,
-        uturn_blocks, drift (factor on the odometry noise), trajectory ((N, 3) or (N, 4, 4))."""
+        (default uturn); sensor hdl64 | vlp16 | tilt180 | hdl32 | ouster64-wide | livox-avia
+        (default hdl64); scans (100); seed (1). options as `lidarloop simulate`'s flags:
+        noise_m, dropout, horizontal_steps, min_range_m, max_range_m, mount_height_m,
+        scan_period_s, spacing_min_m, spacing_max_m, uturn_blocks, keep_every (every N-th
+        returned point of each scan kept, as a LIO front end), drift (factor on the odometry
+        noise), trajectory ((N, 3) or (N, 4, 4))."""
     @staticmethod
     def demo() -> Simulator:
         """The sequence of `lidarloop demo` (320 VLP-16 scans, urban grid)."""

@@ -1,9 +1,11 @@
 // The simulator (lidarloop::sim, app::WriteSimulation): synthetic LiDAR sequences with
 // ground-truth and drifting odometry poses, as arrays or written in the KITTI layout.
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <pybind11/pybind11.h>
@@ -25,12 +27,28 @@ using sim::SimulationConfig;
 using sim::Simulator;
 
 template <typename T>
+constexpr const char* KindOf() {
+    if constexpr (std::is_integral_v<T>) {
+        return sizeof(T) == 4 ? "a 32-bit integer" : "a 64-bit integer";
+    } else {
+        return "a number";
+    }
+}
+
+// The option `name` of the keywords, removed from them; a value of the wrong type or out of the
+// C++ type's range is a TypeError naming the option (pybind11's own says neither).
+template <typename T>
 std::optional<T> Take(py::dict& options, const char* name) {
     if (!options.contains(name)) return std::nullopt;
     const py::object value = options[name];
     PyDict_DelItemString(options.ptr(), name);
     if (value.is_none()) return std::nullopt;
-    return value.cast<T>();
+    try {
+        return value.cast<T>();
+    } catch (const py::cast_error&) {
+        throw py::type_error(std::string(name) + " must be " + KindOf<T>() + ", got " +
+                             py::repr(value).cast<std::string>());
+    }
 }
 
 // Drives `positions` ((N, 3) positions or (N, 4, 4) poses, of which the positions) instead of
@@ -80,6 +98,8 @@ SimulationConfig ConfigFrom(const std::optional<std::string>& scene,
     r.spacing_min_m = Take<double>(options, "spacing_min_m").value_or(r.spacing_min_m);
     r.spacing_max_m = Take<double>(options, "spacing_max_m").value_or(r.spacing_max_m);
     r.uturn_blocks = Take<int>(options, "uturn_blocks").value_or(r.uturn_blocks);
+    config.front_end.keep_every =
+        Take<std::int64_t>(options, "keep_every").value_or(config.front_end.keep_every);
     if (const auto drift = Take<double>(options, "drift"))
         config.odometry = sim::ScaledOdometry(config.odometry, *drift);
     if (options.contains("trajectory")) {
@@ -130,10 +150,11 @@ void BindSimulator(py::module_& m) {
              py::arg("sensor") = py::none(), py::arg("scans") = py::none(),
              py::arg("seed") = py::none(),
              "scene: urban | rural | mine | indoor (default urban); route: uturn | figure8 | "
-             "grid (default uturn); sensor: hdl64 | vlp16 | tilt180 (default hdl64); scans "
-             "(default 100); seed (default 1). Options as `lidarloop simulate`'s flags: "
-             "noise_m, dropout, horizontal_steps, min_range_m, max_range_m, mount_height_m, "
-             "scan_period_s, spacing_min_m, spacing_max_m, uturn_blocks, drift (factor on the "
+             "grid (default uturn); sensor: hdl64 | vlp16 | tilt180 | hdl32 | ouster64-wide | "
+             "livox-avia (default hdl64); scans (default 100); seed (default 1). Options as "
+             "`lidarloop simulate`'s flags: noise_m, dropout, horizontal_steps, min_range_m, "
+             "max_range_m, mount_height_m, scan_period_s, spacing_min_m, spacing_max_m, "
+             "uturn_blocks, keep_every (every N-th point of a scan kept), drift (factor on the "
              "odometry noise), trajectory ((N, 3) positions or (N, 4, 4) poses to drive).")
         .def_static(
             "demo", [] { return MakeSimulator(sim::DemoConfig()); },

@@ -92,6 +92,26 @@ def test_bad_options_raise_typed_errors(tmp_path):
         lidarloop.write_simulation(lidarloop.Simulator(**SMALL), tmp_path / "seq")
 
 
+def test_new_sensors_and_a_front_ends_thinning():
+    """Issue 24: hdl32, ouster64-wide and livox-avia by name; keep_every keeps every N-th point."""
+    for sensor in ("hdl32", "ouster64-wide", "livox-avia"):
+        simulator = lidarloop.Simulator(**{**SMALL, "sensor": sensor})
+        assert simulator.sensor == sensor and len(simulator.scan(2)) > 500
+    livox = lidarloop.Simulator(**{**SMALL, "sensor": "livox-avia"}).scan(4)
+    assert (livox[:, 0] > 0).all()  # forward only
+    full = lidarloop.Simulator(**{**SMALL, "sensor": "hdl32"}).scan(5)
+    thinned = lidarloop.Simulator(**{**SMALL, "sensor": "hdl32", "keep_every": 3}).scan(5)
+    np.testing.assert_array_equal(thinned, full[::3])
+    for bad in (0, -1, 1001):
+        with pytest.raises(lidarloop.ConfigError, match="front_end.keep_every"):
+            lidarloop.Simulator(**SMALL, keep_every=bad)
+    for bad in (2**70, 1.5, "3"):  # not a 64-bit integer: named, not pybind11's bare cast error
+        with pytest.raises(TypeError, match="keep_every must be a 64-bit integer"):
+            lidarloop.Simulator(**SMALL, keep_every=bad)
+    with pytest.raises(TypeError, match="horizontal_steps must be a 32-bit integer"):
+        lidarloop.Simulator(**{**SMALL, "horizontal_steps": 2**40})
+
+
 def test_writing_releases_the_gil(tmp_path):
     """Another Python thread runs while the C++ side writes (a held GIL would stall it)."""
     import threading

@@ -495,6 +495,20 @@ section_simulate() {
         --out "$work/sim_bad"
     expect_error "simulate bad dropout" "sensor.dropout must be in [0, 1)" "$cli" simulate \
         --dropout 1.5 --out "$work/sim_bad"
+    expect_error "simulate bad sensor" \
+        "unknown sensor 'hdl33' (valid: hdl64, vlp16, tilt180, hdl32, ouster64-wide, livox-avia)" \
+        "$cli" simulate --sensor hdl33 --out "$work/sim_bad"
+    expect_error "simulate keep every 0" "front_end.keep_every must be in [1, 1000], got 0" \
+        "$cli" simulate --keep-every 0 --out "$work/sim_bad"
+    expect_error "simulate keep every huge" "front_end.keep_every must be in [1, 1000], got 5000" \
+        "$cli" simulate --keep-every 5000 --out "$work/sim_bad"
+    expect_ok "simulate livox-avia thinned" "simulated 3 scans (urban, uturn, livox-avia, seed 2)" \
+        "$cli" simulate --sensor livox-avia --scans 3 --seed 2 --horizontal-steps 400 \
+        --keep-every 4 --quiet --out "$work/sim_livox"
+    if grep -q "model: livox-avia" "$work/sim_livox/simulation.yaml" &&
+        grep -q "keep_every: 4" "$work/sim_livox/simulation.yaml"; then pass; else
+        fail "simulate did not record the livox-avia sensor and keep_every 4 in simulation.yaml"
+    fi
     expect_error "simulate into old scans" "holds a lidarloop dataset" "$cli" simulate \
         --sensor vlp16 --scans 2 --out "$work/sim"
     expect_ok "simulate --overwrite" "simulated 2 scans" "$cli" simulate --sensor vlp16 --scans 2 \

@@ -53,6 +53,9 @@ void WriteSimulationYaml(const std::filesystem::path& file, const sim::Simulator
         << "  scan_period_s: " << Number(s.scan_period_s) << "\n"
         << "  noise_m: " << Number(s.noise_m) << "\n"
         << "  dropout: " << Number(s.dropout) << "\n"
+        << "front_end:\n"
+        << "  keep_every: " << c.front_end.keep_every
+        << "  # every N-th returned point of a scan kept\n"
         << "odometry:\n"
         << "  yaw_noise_deg: " << Number(c.odometry.yaw_noise_deg) << "\n"
         << "  translation_noise: " << Number(c.odometry.translation_noise) << "\n"

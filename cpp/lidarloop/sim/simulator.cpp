@@ -204,6 +204,7 @@ void SimulationConfig::Validate() const {
     route.Validate();
     sensor.Validate();
     odometry.Validate();
+    front_end.Validate();
 }
 
 Simulator::Simulator(const SimulationConfig& config)
@@ -281,15 +282,26 @@ std::vector<core::StampedPose> Simulator::OdometryPoses(std::size_t first,
     return poses;
 }
 
+std::vector<Eigen::Vector3d> Simulator::ScanDirections(std::size_t index) const {
+    CheckIndex(index);
+    if (RepeatsEveryScan(sensor_.model)) return directions_;
+    return BeamDirections(sensor_, index);
+}
+
 core::PointCloud Simulator::Scan(std::size_t index) const {
     const core::Transform T_world_sensor = GroundTruthPose(index).T_world_sensor;
+    // The repeating sensors' rays are computed once; a non-repetitive one's for each scan.
+    const bool repeats = RepeatsEveryScan(sensor_.model);
+    std::vector<Eigen::Vector3d> own_directions;
+    if (!repeats) own_directions = BeamDirections(sensor_, index);
+    const std::vector<Eigen::Vector3d>& directions = repeats ? directions_ : own_directions;
     const Eigen::Matrix3d R = T_world_sensor.linear();
     detail::Random rng(detail::StreamSeed(config_.seed, detail::Stream::kScan,
                                           {static_cast<std::int64_t>(index)}));
     core::PointCloud cloud;
     cloud.reserve(directions_.size());
     Ray ray{T_world_sensor.translation(), Eigen::Vector3d::UnitX()};
-    for (const Eigen::Vector3d& direction : directions_) {
+    for (const Eigen::Vector3d& direction : directions) {
         ray.direction = R * direction;
         const double range = world_.CastRay(ray, sensor_.max_range_m);
         if (range == kNoHit || range < sensor_.min_range_m) continue;
@@ -299,6 +311,7 @@ core::PointCloud Simulator::Scan(std::size_t index) const {
         if (measured <= 0.0) continue;
         cloud.push_back((measured * direction).cast<float>());
     }
+    if (config_.front_end.keep_every > 1) return KeepEvery(cloud, config_.front_end.keep_every);
     return cloud;
 }
 

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "lidarloop/core/point_cloud.hpp"
+#include "lidarloop/sim/front_end.hpp"
 #include "lidarloop/sim/odometry.hpp"
 #include "lidarloop/sim/route.hpp"
 #include "lidarloop/sim/scene.hpp"
@@ -20,8 +21,9 @@ struct SimulationConfig {
     RouteConfig route;
     SensorConfig sensor;
     OdometryConfig odometry;
-    std::size_t scans = 100;  ///< number of scans, [1, 1e6]
-    std::uint64_t seed = 1;   ///< one seed for world, speed profile, noise and drift
+    FrontEndConfig front_end;  ///< the thinning of each scan, after the sensor's dropouts
+    std::size_t scans = 100;   ///< number of scans, [1, 1e6]
+    std::uint64_t seed = 1;    ///< one seed for world, speed profile, noise and drift
     /// A given trajectory to drive instead of the route (one pose per scan, so `scans` must equal
     /// its size): only the positions are used, projected onto their best-fit plane (so KITTI's
     /// camera-frame poses work as they are); the heading follows the direction of travel, and
@@ -59,8 +61,11 @@ public:
     const SceneLayout& layout() const { return layout_; }
     const RoutePath& route() const { return route_; }
     const World& world() const { return world_; }
-    /// Unit ray directions of one scan in the sensor frame (see BeamDirections).
+    /// Unit ray directions of scan 0 in the sensor frame (see BeamDirections); those of every
+    /// scan when RepeatsEveryScan(sensor().model).
     const std::vector<Eigen::Vector3d>& beam_directions() const { return directions_; }
+    /// Unit ray directions of scan `index` in the sensor frame, in the sensor's order.
+    std::vector<Eigen::Vector3d> ScanDirections(std::size_t index) const;
 
     /// Ground truth T_world_sensor of scan `index` (< size(), else std::out_of_range).
     core::StampedPose GroundTruthPose(std::size_t index) const;
@@ -69,8 +74,10 @@ public:
     core::StampedPose OdometryPose(std::size_t index) const;
     /// OdometryPose of scans first .. first + count - 1 in one pass (first + count <= size()).
     std::vector<core::StampedPose> OdometryPoses(std::size_t first, std::size_t count) const;
-    /// The scan taken at GroundTruthPose(index): ray cast, then dropouts and range noise drawn
-    /// from a generator seeded by (seed, index).
+    /// The scan taken at GroundTruthPose(index): ray cast along ScanDirections(index), then
+    /// dropouts and range noise drawn from a generator seeded by (seed, index), then thinned
+    /// as config().front_end says (so a thinned scan holds exactly every N-th point of the
+    /// unthinned one).
     core::PointCloud Scan(std::size_t index) const;
 
 private:

@@ -59,9 +59,10 @@ TEST(Sensor, BeamPatternsOfTheModels) {
          {SensorModel::kHdl64, SensorModel::kVlp16, SensorModel::kTilt180}) {
         EXPECT_EQ(ParseSensorModel(ToString(model)), model);
     }
-    EXPECT_THROW(ParseSensorModel("hdl32"), core::ConfigError);
-    EXPECT_EQ(test::ConfigErrorOf([] { ParseSensorModel("hdl32"); }),
-              "unknown sensor 'hdl32' (valid: hdl64, vlp16, tilt180)");
+    EXPECT_THROW(ParseSensorModel("hdl16"), core::ConfigError);
+    EXPECT_EQ(test::ConfigErrorOf([] { ParseSensorModel("hdl16"); }),
+              "unknown sensor 'hdl16' (valid: hdl64, vlp16, tilt180, hdl32, ouster64-wide, "
+              "livox-avia)");
 }
 
 // The number of points is the number of rays that hit something within range, thinned by the
