@@ -1,6 +1,8 @@
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -45,6 +47,13 @@ io::RunConfig ResolveAgainstMap(const DetectFlags& flags, const app::LoadedMap& 
     return config;
 }
 
+// "12.3", or "0.05" below 1.
+std::string FormatRate(double value) {
+    char text[32];
+    std::snprintf(text, sizeof(text), value < 1.0 ? "%.2f" : "%.1f", value);
+    return text;
+}
+
 void PrintOutcome(const io::Dataset& dataset, const app::DetectRequest& request,
                   const app::DetectOutcome& outcome, const std::string& map) {
     std::cout << "lidarloop detect: " << dataset.size() << " scans (" << dataset.FormatName()
@@ -56,6 +65,10 @@ void PrintOutcome(const io::Dataset& dataset, const app::DetectRequest& request,
               << outcome.threshold << ", " << outcome.accepted << " scans with an accepted "
               << (map.empty() ? "loop" : "match");
     if (!outcome.skipped.empty()) std::cout << ", " << outcome.skipped.size() << " skipped";
+    if (outcome.total_s > 0.0) {
+        std::cout << "; " << FormatRate(static_cast<double>(dataset.size()) / outcome.total_s)
+                  << " scans/s (" << FormatRate(outcome.total_s) << " s, files read included)";
+    }
     const bool matrix = request.config.output.KeepsSimilarityMatrix(dataset.size());
     std::cout << "\n  results in " << request.out.string() << "/ "
               << (!map.empty() ? "(loops.csv: query scan, map scan; candidates.csv, config.yaml, "
