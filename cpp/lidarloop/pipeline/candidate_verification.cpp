@@ -50,7 +50,7 @@ std::size_t VerificationCache::size() const {
 void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
                  const std::function<registration::PreparedScan(std::size_t)>& match_of,
                  const DetectorConfig& detector, const core::Method& method,
-                 VerificationTimes* times, VerificationCache* cache) {
+                 VerificationTimes* times, VerificationCache* cache, Execution execution) {
     query.verifications.clear();
     query.accepted = false;
     if (!query.has_match()) return;
@@ -59,29 +59,45 @@ void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
                                    Rejected(registration::RejectReason::kTooFewPoints));
         return;
     }
-    std::optional<registration::CoarseQuery> coarse;  // built at the first uncached pair
+    // Pruned and cached candidates are answered at once; the others are registered.
     const DescriptorMethod& definition = MethodOf(method);
-    for (const Neighbor& candidate : query.candidates) {
+    query.verifications.resize(query.candidates.size());
+    std::vector<std::size_t> to_register;
+    for (std::size_t c = 0; c < query.candidates.size(); ++c) {
+        const Neighbor& candidate = query.candidates[c];
+        std::optional<registration::Verification> cached;
+        if (cache) cached = cache->Find(query.query, candidate.index);
         if (detector.threshold && !definition.IsMatch(candidate.distance, *detector.threshold)) {
-            query.verifications.push_back(Rejected(registration::RejectReason::kPruned));
-            continue;
+            query.verifications[c] = Rejected(registration::RejectReason::kPruned);
+        } else if (cached) {
+            query.verifications[c] = *cached;
+        } else {
+            to_register.push_back(c);
         }
-        if (cache) {
-            if (auto cached = cache->Find(query.query, candidate.index)) {
-                query.verifications.push_back(*cached);
-                continue;
-            }
+    }
+    if (!to_register.empty()) {
+        const auto query_start = Clock::now();
+        const registration::CoarseQuery coarse(*prepared.structure, detector.verification.coarse);
+        if (times) times->query_seconds.push_back(SecondsSince(query_start));
+        std::vector<double> pair_seconds(to_register.size());
+        const auto register_one = [&](std::size_t k) {
+            const std::size_t c = to_register[k];
+            const std::size_t match = query.candidates[c].index;
+            const auto pair_start = Clock::now();
+            query.verifications[c] =
+                registration::Verify(prepared, coarse, match_of(match), detector.verification);
+            pair_seconds[k] = SecondsSince(pair_start);
+            if (cache) cache->Store(query.query, match, query.verifications[c]);
+        };
+        if (execution == Execution::kParallel) {
+            tbb::parallel_for(std::size_t{0}, to_register.size(), register_one);
+        } else {
+            for (std::size_t k = 0; k < to_register.size(); ++k) register_one(k);
         }
-        if (!coarse) {
-            const auto query_start = Clock::now();
-            coarse.emplace(*prepared.structure, detector.verification.coarse);
-            if (times) times->query_seconds.push_back(SecondsSince(query_start));
+        if (times) {
+            times->pair_seconds.insert(times->pair_seconds.end(), pair_seconds.begin(),
+                                       pair_seconds.end());
         }
-        const auto pair_start = Clock::now();
-        query.verifications.push_back(registration::Verify(
-            prepared, *coarse, match_of(candidate.index), detector.verification));
-        if (times) times->pair_seconds.push_back(SecondsSince(pair_start));
-        if (cache) cache->Store(query.query, candidate.index, query.verifications.back());
     }
     query.accepted = query.loop().has_value();
 }

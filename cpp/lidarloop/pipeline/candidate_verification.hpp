@@ -44,11 +44,13 @@ private:
 /// of a skipped scan, is rejected as kTooFewPoints). A candidate whose
 /// distance fails an explicitly set detector.threshold is not registered (reason kPruned).
 /// Appends to `times` when given (pairs found in `cache` are not timed); takes verdicts from and
-/// adds them to `cache` when given.
+/// adds them to `cache` when given. The candidates are registered in parallel unless told
+/// otherwise (`match_of` is then called from worker threads); the verdicts do not depend on it.
 void VerifyQuery(LoopQuery& query, const registration::PreparedScan& query_scan,
                  const std::function<registration::PreparedScan(std::size_t)>& match_of,
                  const DetectorConfig& detector, const core::Method& method,
-                 VerificationTimes* times = nullptr, VerificationCache* cache = nullptr);
+                 VerificationTimes* times = nullptr, VerificationCache* cache = nullptr,
+                 Execution execution = Execution::kParallel);
 
 /// VerifyQuery for every query that has candidates (in parallel unless told otherwise);
 /// `scans[i]` is scan i prepared, kept compact (each expanded when verified; the pair times
