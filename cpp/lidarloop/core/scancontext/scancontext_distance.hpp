@@ -21,25 +21,27 @@ public:
     /// Columns with a bin that is not 0.
     int occupied_columns() const { return occupied_columns_; }
 
-    /// Unit column values and occupancy (1 or 0) in reversed column order, one row per ring and
-    /// a last row for the occupancy: row[k] belongs to column (sectors - k) mod sectors. This
-    /// order turns every column shift into two contiguous runs (see CompareScanContexts).
+    /// Unit column values and occupancy (1 or 0) in reversed column order, twice over, one row
+    /// per ring and a last row for the occupancy: row[k] belongs to column (sectors - k mod
+    /// sectors) mod sectors, for k in [0, 2 sectors). This order makes the values every column
+    /// shift meets one contiguous run (see CompareScanContexts).
     const float* ReversedRow(int row) const {
-        return reversed_.data() + static_cast<std::ptrdiff_t>(row) * sectors_;
+        return reversed_.data() + static_cast<std::ptrdiff_t>(row) * 2 * sectors_;
     }
 
 private:
     int rings_ = 0;
     int sectors_ = 0;
     int occupied_columns_ = 0;
-    std::vector<float> reversed_;  // (rings + 1) x sectors
+    std::vector<float> reversed_;  // (rings + 1) x 2 sectors
 };
 
 /// The Scan Context distance of a query to a candidate and the shift that gives it.
 struct ScanContextMatch {
     /// min over shifts n of d(I_q, I_c shifted by n) (Kim & Kim eq. 5, 6): the mean over the
     /// columns j non-empty in both of 1 - cos(c_j^q, c_{j+n}^c). In [0, 1] (the bins are >= 0);
-    /// 0 for equal descriptors; 1 when no shift overlaps an occupied column of each.
+    /// 0 for equal descriptors (values below 2e-6, float rounding, read 0); 1 when no shift
+    /// overlaps an occupied column of each.
     double distance = 1.0;
     /// n in [0, sectors): query column j is compared with candidate column (j + n) mod sectors.
     int shift = 0;

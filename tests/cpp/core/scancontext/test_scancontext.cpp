@@ -183,7 +183,7 @@ TEST(ScanContext, AScanTurnedByKSectorsMatchesAtShiftKWithItsYaw) {
         EXPECT_EQ(turned.ring_key, original.ring_key) << k;  // the ring key ignores yaw
         const ScanContextMatch match = CompareScanContexts(original, turned);
         EXPECT_EQ(match.shift, k);
-        EXPECT_NEAR(match.distance, 0.0, 1e-6) << k;
+        EXPECT_EQ(match.distance, 0.0) << k;
         const double expected_yaw_rad = k <= 30 ? k * sector_rad : (k - 60) * sector_rad;
         EXPECT_NEAR(match.yaw_rad, expected_yaw_rad, 1e-9) << k;
         // The other way round the shift is -k.
@@ -195,7 +195,7 @@ TEST(ScanContext, EqualDescriptorsAreAtZeroAndTheDistanceIsSymmetric) {
     const ScanContextConfig config;
     const ScanContext a = ComputeScanContext(RandomScan(7, 3000), config);
     const ScanContext b = ComputeScanContext(RandomScan(8, 3000), config);
-    EXPECT_NEAR(CompareScanContexts(a, a).distance, 0.0, 1e-6);
+    EXPECT_EQ(CompareScanContexts(a, a).distance, 0.0);
     EXPECT_EQ(CompareScanContexts(a, a).shift, 0);
     const double ab = CompareScanContexts(a, b).distance;
     EXPECT_GT(ab, 0.01);
