@@ -94,15 +94,17 @@ ScanContextMatch CompareScanContexts(const ScanContextColumns& query,
                           std::to_string(candidate.sectors()));
     }
     // Per shift n: the sum of cos(c_j^q, c_{j+n}^c) (unit columns; empty ones are 0, so they add
-    // nothing) and the number of columns occupied in both.
+    // nothing) and the number of columns occupied in both (exact in float: counts < 2^24).
     std::array<float, kMaxSectors> cosines{};
     std::array<float, kMaxSectors> overlaps{};
     SumOverShifts(query, candidate, cosines.data(), overlaps.data());
+    // The columns occupied in either: a column occupied in one only adds 1 - 0 to the sum.
+    const int occupied = query.occupied_columns() + candidate.occupied_columns();
     ScanContextMatch best;
     for (int n = 0; n < sectors; ++n) {
-        if (overlaps[static_cast<std::size_t>(n)] < 0.5f) continue;  // no common column
-        const double distance = 1.0 - double{cosines[static_cast<std::size_t>(n)]} /
-                                          double{overlaps[static_cast<std::size_t>(n)]};
+        const double either = occupied - double{overlaps[static_cast<std::size_t>(n)]};
+        if (either < 0.5) continue;  // both descriptors empty
+        const double distance = 1.0 - double{cosines[static_cast<std::size_t>(n)]} / either;
         if (distance < best.distance) best = {distance, n, 0.0};
     }
     if (best.distance < kRoundingDistance) best.distance = 0.0;

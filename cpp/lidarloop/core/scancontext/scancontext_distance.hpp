@@ -38,10 +38,11 @@ private:
 
 /// The Scan Context distance of a query to a candidate and the shift that gives it.
 struct ScanContextMatch {
-    /// min over shifts n of d(I_q, I_c shifted by n) (Kim & Kim eq. 5, 6): the mean over the
-    /// columns j non-empty in both of 1 - cos(c_j^q, c_{j+n}^c). In [0, 1] (the bins are >= 0);
-    /// 0 for equal descriptors (values below 2e-6, float rounding, read 0); 1 when no shift
-    /// overlaps an occupied column of each.
+    /// min over shifts n of d(I_q, I_c shifted by n) (Kim & Kim eq. 5, 6): the mean of
+    /// 1 - cos(c_j^q, c_{j+n}^c) over the columns j occupied (not all 0) in either; a column
+    /// occupied in one only counts as 1 (cos 0), columns empty in both are skipped. In [0, 1]
+    /// (the bins are >= 0); 0 for equal descriptors (values below 2e-6, float rounding, read 0);
+    /// 1 when no shift overlaps an occupied column of each.
     double distance = 1.0;
     /// n in [0, sectors): query column j is compared with candidate column (j + n) mod sectors.
     int shift = 0;

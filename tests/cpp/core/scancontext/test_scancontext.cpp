@@ -49,7 +49,8 @@ struct BruteMatch {
     int shift = 0;
 };
 
-// Eq. 5 at shift n: the mean of 1 - cos over the columns non-empty in both (1 when none is).
+// Eq. 5 at shift n: the mean of 1 - cos over the columns occupied in either, a column occupied in
+// one only counting 1 (1 when both are empty).
 double BruteForceAtShift(const std::vector<float>& q, const std::vector<float>& c, int rings,
                          int sectors, int n) {
     double sum = 0.0;
@@ -61,8 +62,8 @@ double BruteForceAtShift(const std::vector<float>& q, const std::vector<float>& 
             const double a = q[i * sectors + j], b = c[i * sectors + jc];
             dot += a * b, qq += a * a, cc += b * b;
         }
-        if (qq == 0.0 || cc == 0.0) continue;
-        sum += 1.0 - dot / std::sqrt(qq * cc);
+        if (qq == 0.0 && cc == 0.0) continue;
+        sum += qq == 0.0 || cc == 0.0 ? 1.0 : 1.0 - dot / std::sqrt(qq * cc);
         ++columns;
     }
     return columns > 0 ? sum / columns : 1.0;
@@ -210,6 +211,18 @@ TEST(ScanContext, NoCommonColumnIsDistanceOne) {
         CompareScanContexts(ScanContextColumns(q, 2, 6), ScanContextColumns(c, 2, 6));
     EXPECT_EQ(none.distance, 1.0);
     EXPECT_EQ(none.shift, 0);
+}
+
+// A column occupied in one descriptor only counts as cos 0; a column empty in both is skipped.
+TEST(ScanContext, AColumnOccupiedInOneOnlyCountsAsDistanceOne) {
+    std::vector<float> q(2 * 6, 0.0f), c(2 * 6, 0.0f);
+    q[0] = c[0] = 1.0f;          // column 0, ring 0 in both
+    q[6 + 1] = c[6 + 1] = 2.0f;  // column 1, ring 1 in both
+    c[3] = 4.0f;                 // column 3, candidate only
+    const ScanContextMatch match =
+        CompareScanContexts(ScanContextColumns(q, 2, 6), ScanContextColumns(c, 2, 6));
+    EXPECT_EQ(match.shift, 0);
+    EXPECT_NEAR(match.distance, 1.0 / 3.0, 1e-7);  // (0 + 0 + 1) / 3 columns
 }
 
 TEST(ScanContext, NonFinitePointsAreSkippedAndFarPointsDropped) {
