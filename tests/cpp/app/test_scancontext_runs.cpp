@@ -81,11 +81,14 @@ TEST_F(ScanContextRuns, IsEvaluatedBesideRange) {
 }
 
 // With at least as many ring-key candidates as scans the two-stage search is the exhaustive
-// one; with few it returns a subset of scans ranked by the full distance.
+// one; with few it returns a subset of scans ranked by the full distance. (Offline detection that
+// keeps the similarity matrix ranks from the matrix, which compares every pair.)
 TEST_F(ScanContextRuns, TheRingKeySearchRanksItsCandidatesByTheFullDistance) {
     app::DetectRequest exact = Request("exact");
     exact.config.detection.verify = false;
     exact.config.detection.top_k = 5;
+    // Without the similarity matrix, detect searches through the method's index.
+    exact.config.output.similarity_matrix_mib = 0;
     app::DetectRequest all = exact;
     all.out = dir_ / "all";
     all.config.descriptor.scancontext.ring_key_candidates = 1000;
