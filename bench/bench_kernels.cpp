@@ -10,6 +10,8 @@
 #include "lidarloop/core/histogram.hpp"
 #include "lidarloop/core/ndt_cells.hpp"
 #include "lidarloop/core/ndt_descriptor.hpp"
+#include "lidarloop/core/scancontext/scancontext.hpp"
+#include "lidarloop/core/scancontext/scancontext_distance.hpp"
 #include "lidarloop/core/wasserstein.hpp"
 #include "lidarloop/sim/simulator.hpp"
 #include "synthetic_scan.hpp"
@@ -60,6 +62,32 @@ void BM_Wasserstein(benchmark::State& state) {
     }
 }
 BENCHMARK(BM_Wasserstein)->Arg(100)->Unit(benchmark::kNanosecond);
+
+// Scan Context (Kim & Kim 2018) of the 120k-point scan: 20 rings x 60 sectors, 80 m. Target
+// (issue 27): <= 1 ms.
+void BM_ScanContext(benchmark::State& state) {
+    const core::ScanContextConfig config;
+    for (auto _ : state) benchmark::DoNotOptimize(core::ComputeScanContext(Scan(), config));
+    SetPointCounters(state);
+}
+BENCHMARK(BM_ScanContext)->Unit(benchmark::kMicrosecond);
+
+// The column-shift distance of two prepared descriptors (all 60 shifts x 20 rings), of the scan
+// against itself turned by 50 degrees (dense: every column occupied). Target (issue 27): <= 3 us.
+void BM_ScanContextDistance(benchmark::State& state) {
+    const core::ScanContextConfig config;
+    core::PointCloud turned = SyntheticHdl64Scan(2);
+    const Eigen::Matrix3f R = Eigen::AngleAxisf(0.87f, Eigen::Vector3f::UnitZ()).toRotationMatrix();
+    for (Eigen::Vector3f& p : turned) p = R * p;
+    const core::ScanContextColumns a(core::ComputeScanContext(Scan(), config));
+    const core::ScanContextColumns b(core::ComputeScanContext(turned, config));
+    state.counters["occupied_columns"] = a.occupied_columns();
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(core::CompareScanContexts(a, b));
+        benchmark::ClobberMemory();
+    }
+}
+BENCHMARK(BM_ScanContextDistance)->Unit(benchmark::kNanosecond);
 
 // The cells as the descriptor computes them: into columns whose memory is reused across scans.
 void BM_NdtCells(benchmark::State& state) {

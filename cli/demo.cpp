@@ -11,6 +11,7 @@
 #include "lidarloop/app/optimisation.hpp"
 #include "lidarloop/app/simulation.hpp"
 #include "lidarloop/io/dataset.hpp"
+#include "lidarloop/pipeline/scancontext_method.hpp"
 #include "progress.hpp"
 #include "retrieval_print.hpp"
 #include "run_output.hpp"
@@ -94,7 +95,8 @@ void RunDemo(const DemoFlags& flags) {
     const io::Dataset dataset = io::OpenDataset(demo.folder);
     PrintSequence(demo, dataset.size());
     app::EvaluationRequest request;
-    request.methods = {core::Method::kHeight, core::Method::kRange, core::Method::kNdt};
+    request.methods = {core::Method::kHeight, core::Method::kRange, core::Method::kNdt,
+                       pipeline::ScanContextMethod::kMethod};
     request.distance_m = 10.0;  // Röhling's d
     request.progress = progress.Callback();
     request.out = out / "evaluation";

@@ -45,8 +45,10 @@ void DescriptorOptions::ApplyHistogramFlags(core::DescriptorConfig& descriptor) 
     for (const CLI::Option* flag : HistogramFlags()) {
         if (*flag && !core::IsHistogramMethod(descriptor.method)) {
             throw core::ConfigError(flag->get_name() +
-                                    " applies to the height and range methods; set NDT "
-                                    "parameters in the ndt section of --config");
+                                    " applies to the height and range methods; set the "
+                                    "parameters of " +
+                                    core::ToString(descriptor.method) +
+                                    " in its section of --config");
         }
     }
     for (const CLI::Option* flag : {up_option_, sensor_height_option_}) {

@@ -12,7 +12,8 @@ void DetectionOptions::AddTo(CLI::App& command, bool decides_loops,
         "unit of --min-gap: scans | seconds | metres (of path, from the poses or odometry)");
     if (!decides_loops) return;
     threshold_option_ = command.add_option(
-        "--threshold", threshold_, "tau (height, range) or t_d (ndt); default from the config");
+        "--threshold", threshold_,
+        "tau (height, range), t_d (ndt) or d (scancontext); default from the config");
     top_k_option_ = command.add_option("--top-k", top_k_, "candidates per query scan");
     command.add_flag("--no-verify", no_verify_,
                      "descriptor only: accept by the threshold, no geometric verification");

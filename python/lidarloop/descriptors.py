@@ -8,6 +8,7 @@ from ._lidarloop import (
     dump_config,
     is_match,
     method_names,
+    scancontext_match,
 )
 
 __all__ = [
@@ -18,4 +19,5 @@ __all__ = [
     "dump_config",
     "is_match",
     "method_names",
+    "scancontext_match",
 ]

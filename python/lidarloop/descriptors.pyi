@@ -13,8 +13,12 @@ class Descriptor:
     @property
     def method(self) -> str: ...
     @property
-    def bins(self) -> npt.NDArray[np.float64]:
-        """Histograms: bucket masses h_k (sum 1); read-only view, no copy."""
+    def bins(self) -> npt.NDArray[Any]:
+        """Histograms: bucket masses h_k (sum 1), float64; read-only view, no copy.
+        Scan Context: (rings, sectors) float32 max heights, metres; a copy."""
+    @property
+    def ring_key(self) -> list[float]:
+        """Scan Context: per ring the share of occupied sectors."""
     @property
     def min(self) -> float:
         """Histograms: v_min, metres."""
@@ -57,7 +61,11 @@ def describe(
     """The descriptor of an (N, 3)/(N, 4) scan (sensor frame, metres) or a scan file."""
 
 def distance(a: Descriptor, b: Descriptor) -> float:
-    """W (histograms) or sigma' (NDT) between two descriptors of one method and config."""
+    """W (histograms), sigma' (NDT) or d (Scan Context) between two descriptors of one method
+    and config."""
+
+def scancontext_match(query: Descriptor, candidate: Descriptor) -> dict[str, Any]:
+    """Scan Context: {'distance', 'shift', 'yaw_rad' (of T_candidate_query)}."""
 
 def method_names() -> list[str]: ...
 def default_threshold(method: str) -> float: ...
@@ -73,4 +81,5 @@ __all__ = [
     "dump_config",
     "is_match",
     "method_names",
+    "scancontext_match",
 ]

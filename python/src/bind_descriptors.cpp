@@ -11,7 +11,9 @@
 #include "lidarloop/app/describe_run.hpp"
 #include "lidarloop/app/descriptor_json.hpp"
 #include "lidarloop/core/descriptor.hpp"
+#include "lidarloop/core/scancontext/scancontext.hpp"
 #include "lidarloop/pipeline/descriptor_method.hpp"
+#include "lidarloop/pipeline/scancontext_method.hpp"
 #include "run_config.hpp"
 
 namespace lidarloop::python {
@@ -48,11 +50,17 @@ py::dict NdtDescriptorDict(const core::NdtDescriptor& f) {
     return entry;
 }
 
-// Points used: a histogram counts them in its buckets, an NDT set in its cells.
+const core::ScanContext* ScanContextOf(const Descriptor& descriptor) {
+    return std::any_cast<core::ScanContext>(&descriptor.value);
+}
+
+// Points used: a histogram counts them in its buckets, an NDT set in its cells, a Scan Context
+// in its bins.
 std::size_t PointsUsed(const Descriptor& descriptor) {
     if (const auto* set = std::any_cast<core::NdtDescriptorSet>(&descriptor.value)) {
         return set->cell_stats.points_used;
     }
+    if (const core::ScanContext* sc = ScanContextOf(descriptor)) return sc->points_used;
     return HistogramOf(descriptor, "points_used").points_used;
 }
 
@@ -60,6 +68,7 @@ std::size_t PointsSkipped(const Descriptor& descriptor) {
     if (const auto* set = std::any_cast<core::NdtDescriptorSet>(&descriptor.value)) {
         return set->cell_stats.points_skipped;
     }
+    if (const core::ScanContext* sc = ScanContextOf(descriptor)) return sc->points_skipped;
     return HistogramOf(descriptor, "points_skipped").points_skipped;
 }
 
@@ -71,6 +80,7 @@ std::optional<std::size_t> SkippedPoints(const Descriptor& descriptor) {
     if (const auto* histogram = std::any_cast<core::Histogram>(&descriptor.value)) {
         return histogram->points_skipped;
     }
+    if (const core::ScanContext* sc = ScanContextOf(descriptor)) return sc->points_skipped;
     return std::nullopt;
 }
 
@@ -120,11 +130,29 @@ void BindDescriptorClass(py::module_& m) {
                                [](const Descriptor& d) { return core::ToString(d.method); })
         .def_property_readonly(
             "bins",
-            [](const py::object& self) {
-                return ViewOf(HistogramOf(self.cast<const Descriptor&>(), "bins").mass, self);
+            [](const py::object& self) -> py::object {
+                const auto& d = self.cast<const Descriptor&>();
+                if (const core::ScanContext* sc = ScanContextOf(d)) {
+                    py::array_t<float> bins({sc->rings, sc->sectors});
+                    std::copy(sc->bins.begin(), sc->bins.end(), bins.mutable_data());
+                    return bins;
+                }
+                return ViewOf(HistogramOf(d, "bins").mass, self);
             },
             "Histograms: the masses h_k of the b buckets, float64, summing to 1 (a read-only "
-            "view of the C++ histogram, no copy).")
+            "view of the C++ histogram, no copy). Scan Context: the (rings, sectors) float32 "
+            "max heights, metres (a copy).")
+        .def_property_readonly(
+            "ring_key",
+            [](const Descriptor& d) {
+                const core::ScanContext* sc = ScanContextOf(d);
+                if (sc == nullptr) {
+                    throw py::attribute_error("a " + core::ToString(d.method) +
+                                              " descriptor has no ring_key (Scan Contexts have)");
+                }
+                return sc->ring_key;
+            },
+            "Scan Context: per ring the share of its sectors that are occupied (a list).")
         .def_property_readonly(
             "min", [](const Descriptor& d) { return HistogramOf(d, "min").min_value; },
             "Histograms: v_min, metres (height above the ground plane, or range).")
@@ -147,9 +175,11 @@ void BindDescriptorClass(py::module_& m) {
         .def_property_readonly(
             "points_out_of_range",
             [](const Descriptor& d) {
+                if (const core::ScanContext* sc = ScanContextOf(d)) return sc->points_out_of_range;
                 return HistogramOf(d, "points_out_of_range").points_out_of_range;
             },
-            "Histograms: finite points outside [min, max] (clamped or dropped).")
+            "Histograms: finite points outside [min, max] (clamped or dropped). Scan Context: "
+            "finite points at a planar range >= max_range_m (dropped).")
         .def_property_readonly(
             "descriptors",
             [](const Descriptor& d) {
@@ -221,8 +251,23 @@ Raises DtypeError, ShapeError, NonFiniteError, ConfigError, EmptyInputError (not
 ReadError (files). Releases the GIL while describing.)doc");
     m.def("distance", &pipeline::DescriptorDistance, py::arg("a"), py::arg("b"),
           "The method's distance between two descriptors of the same method and config: W "
-          "(Roehling eq. 6) for histograms, sigma' (Magnusson eq. 9) for NDT; 0 for equal "
-          "descriptors, symmetric. lidarloop.ConfigError for mixed methods.");
+          "(Roehling eq. 6) for histograms, sigma' (Magnusson eq. 9) for NDT, the column-shift "
+          "distance (Kim eq. 5-6) for scancontext; 0 for equal descriptors, symmetric. "
+          "lidarloop.ConfigError for mixed methods.");
+    m.def(
+        "scancontext_match",
+        [](const Descriptor& query, const Descriptor& candidate) {
+            const core::ScanContextMatch match = pipeline::MatchScanContexts(query, candidate);
+            py::dict result;
+            result["distance"] = match.distance;
+            result["shift"] = match.shift;
+            result["yaw_rad"] = match.yaw_rad;
+            return result;
+        },
+        py::arg("query"), py::arg("candidate"),
+        "Two scancontext descriptors: {'distance': d (Kim eq. 5-6), 'shift': n (query column j "
+        "meets candidate column j + n), 'yaw_rad': the yaw of T_candidate_query that shift "
+        "implies, in (-pi, pi]}. lidarloop.ConfigError for other descriptors.");
     m.def("method_names", &pipeline::MethodNames,
           "The registered descriptor methods: height, range, ndt, then any registered in C++.");
     m.def(

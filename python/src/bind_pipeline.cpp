@@ -152,8 +152,9 @@ void BindDatabase(py::module_& m) {
                 return Index{std::move(index), &d};
             },
             py::keep_alive<0, 1>(),
-            "An exact nearest-neighbour index over this database (None when the method has "
-            "none, e.g. NDT). It refers to the database: scans added later are searched only "
+            "A nearest-neighbour index over this database (None when the method has none, e.g. "
+            "NDT, or scancontext with ring_key_candidates 0); exact except scancontext's "
+            "ring-key search. It refers to the database: scans added later are searched only "
             "after insert().");
 }
 

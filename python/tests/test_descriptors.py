@@ -9,7 +9,7 @@ import pytest
 
 import lidarloop
 
-METHODS = ["height", "range", "ndt"]
+METHODS = ["height", "range", "ndt", "scancontext"]
 
 
 @pytest.fixture(scope="module")
@@ -40,6 +40,10 @@ def test_describe_gives_the_cli_json(cli, scan_file, points, method):
         for ours, theirs in zip(from_array.descriptors, expected["descriptors"]):
             np.testing.assert_array_equal(ours["F"], np.array(theirs["F"], dtype=np.float32))
             np.testing.assert_array_equal(ours["R_aligned_sensor"], theirs["R_aligned_sensor"])
+    elif method == "scancontext":
+        np.testing.assert_array_equal(from_array.bins, np.array(expected["bins"], dtype=np.float32))
+        assert from_array.bins.shape == (20, 60)
+        assert from_array.ring_key == pytest.approx(expected["ring_key"])
     else:
         np.testing.assert_array_equal(from_array.bins, expected["bins"])
         assert from_array.min == expected["min"] and from_array.max == expected["max"]
@@ -97,6 +101,20 @@ def test_distance_is_zero_to_itself_and_symmetric(points):
     b = lidarloop.describe(points[::3], "height")
     assert lidarloop.distance(a, a) == 0.0
     assert lidarloop.distance(a, b) == lidarloop.distance(b, a) == a.distance(b) > 0.0
+
+
+def test_scancontext_match_gives_the_yaw_of_a_turned_scan(points):
+    config = {"scancontext": {"max_range_m": 40.0}}
+    a = lidarloop.describe(points, "scancontext", config=config)
+    yaw = np.deg2rad(12.0)  # two sectors
+    turn = np.array([[np.cos(yaw), -np.sin(yaw), 0], [np.sin(yaw), np.cos(yaw), 0], [0, 0, 1]])
+    b = lidarloop.describe((points @ turn.T).astype(np.float32), "scancontext", config=config)
+    match = lidarloop.scancontext_match(a, b)
+    assert match["shift"] == 2
+    assert match["yaw_rad"] == pytest.approx(yaw)
+    assert match["distance"] == lidarloop.distance(a, b) < 0.05
+    with pytest.raises(lidarloop.ConfigError):
+        lidarloop.scancontext_match(lidarloop.describe(points, "range"), a)
 
 
 @pytest.mark.parametrize(
@@ -180,7 +198,7 @@ def test_fields_of_another_method_are_attribute_errors(points):
 
 
 def test_method_names_thresholds_and_config_dump(cli):
-    assert lidarloop.method_names()[:3] == METHODS
+    assert lidarloop.method_names()[: len(METHODS)] == METHODS
     assert lidarloop.is_match("range", 0.001, lidarloop.default_threshold("range"))
     assert lidarloop.dump_config() == run_cli(cli, "dump-config")
 

@@ -7,7 +7,7 @@
 # folder of its own, so any one runs alone. Every case checks the exit code and a phrase of the
 # output; the last line is "cli <sections>: N passed, N failed".
 set -u
-sections=(describe distance ndt verify detect bench demo evaluate dump-config bad-input simulate
+sections=(describe distance ndt scancontext verify detect bench demo evaluate dump-config bad-input simulate
     optimise results-folders errors loops path-gap)
 if [ "${1-}" = "--list" ]; then
     printf '%s\n' "${sections[@]}"
@@ -166,6 +166,38 @@ section_ndt() {
     printf '1 2 3\n1 2 3\n' >"$work/two.xyz"
     expect_error "ndt too few points" "two.xyz: no NDT cell could be classified" "$cli" describe \
         --method ndt "$work/two.xyz"
+}
+
+# --- scancontext: describe, distance, config section, detect -----------------------------------
+section_scancontext() {
+    expect_ok "describe scancontext" '"ring_key":[' "$cli" describe --method scancontext \
+        "$samples/corner_a.bin"
+    sc_same="$("$cli" distance --method scancontext "$samples/corner_a.pcd" "$samples/corner_a.bin")"
+    if [ "$sc_same" = "0" ]; then pass; else fail "scancontext distance to itself is $sc_same"; fi
+    sc_near="$("$cli" distance --method scancontext "$samples/corner_a.pcd" "$samples/corner_b.ply")"
+    sc_far="$("$cli" distance --method scancontext "$samples/corner_a.pcd" "$samples/courtyard.bin")"
+    if awk -v n="$sc_near" -v f="$sc_far" 'BEGIN { exit !(n > 0 && n < f && f <= 1) }'; then pass
+    else fail "expected 0 < d(same place)=$sc_near < d(other place)=$sc_far <= 1"; fi
+    printf 'method: scancontext\nscancontext:\n  rings: 10\n  sectors: 30\n' >"$work/sc.yaml"
+    expect_ok "scancontext from config" '"sectors":30' "$cli" describe --config "$work/sc.yaml" \
+        "$samples/corner_a.bin"
+    printf 'scancontext:\n  rings: 0\n' >"$work/sc_bad.yaml"
+    expect_error "scancontext absurd rings" "scancontext.rings must be in [1, 200], got 0" "$cli" \
+        describe --method scancontext --config "$work/sc_bad.yaml" "$samples/corner_a.bin"
+    printf 'scancontext:\n  ringz: 3\n' >"$work/sc_unknown.yaml"
+    expect_error "scancontext unknown key" "scancontext.ringz" "$cli" describe \
+        --config "$work/sc_unknown.yaml" "$samples/corner_a.bin"
+    expect_error "histogram flag with scancontext" "--bins applies to the height and range" \
+        "$cli" describe --method scancontext --bins 10 "$samples/corner_a.bin"
+    expect_ok "dump-config scancontext" "ring_key_candidates: 0" "$cli" dump-config
+    seq="$work/seq"
+    make_sequence "$seq"
+    expect_ok "detect scancontext" "method scancontext" "$cli" detect "$seq" --method scancontext \
+        --min-gap 2 --quiet --out "$work/det_sc"
+    # Scan 3 is a copy of scan 0: at distance 0, verified at the identity pose.
+    if grep -q "^3,0,0,,1,1,0,0,0,0,0,0,1," "$work/det_sc/loops.csv"; then pass; else
+        fail "scancontext: scan 3 (a copy of scan 0) is not a verified loop: $(cat "$work/det_sc/loops.csv")"
+    fi
 }
 
 # --- detect over a small sequence ------------------------------------------------------------

@@ -48,7 +48,8 @@ nlohmann::json TimeQueries(const pipeline::DescriptorDatabase& database, std::si
             Stopwatch indexed;
             const auto found = index->Search(*database.PrepareStored(id), 1, {});
             index_us.push_back(1e6 * indexed.Seconds());
-            if (found.empty() || found.front().distance > best_distance) {
+            // An approximate index (scancontext's ring key) may miss the nearest scan.
+            if (found.empty() || (index->IsExact() && found.front().distance > best_distance)) {
                 throw core::Error("bench: index and brute force disagree (a bug; please report)");
             }
         }

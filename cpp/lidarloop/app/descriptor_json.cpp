@@ -1,5 +1,7 @@
 #include "lidarloop/app/descriptor_json.hpp"
 
+#include "lidarloop/core/scancontext/scancontext.hpp"
+
 namespace lidarloop::app {
 namespace {
 
@@ -43,6 +45,23 @@ nlohmann::json NdtJson(const core::NdtDescriptorSet& set) {
     return json;
 }
 
+nlohmann::json ScanContextJson(const core::ScanContext& sc) {
+    nlohmann::json rows = nlohmann::json::array();
+    for (int ring = 0; ring < sc.rings; ++ring) {
+        const auto begin = sc.bins.begin() + static_cast<std::ptrdiff_t>(ring) * sc.sectors;
+        rows.push_back(std::vector<float>(begin, begin + sc.sectors));
+    }
+    nlohmann::json json;
+    json["rings"] = sc.rings;
+    json["sectors"] = sc.sectors;
+    json["bins"] = rows;
+    json["ring_key"] = sc.ring_key;
+    json["points_used"] = sc.points_used;
+    json["points_skipped"] = sc.points_skipped;
+    json["points_out_of_range"] = sc.points_out_of_range;
+    return json;
+}
+
 }  // namespace
 
 nlohmann::json DescriptorJson(const core::Descriptor& descriptor) {
@@ -54,6 +73,11 @@ nlohmann::json DescriptorJson(const core::Descriptor& descriptor) {
     }
     if (const auto* histogram = std::any_cast<core::Histogram>(&descriptor.value)) {
         nlohmann::json json = HistogramJson(*histogram);
+        json["method"] = core::ToString(descriptor.method);
+        return json;
+    }
+    if (const auto* sc = std::any_cast<core::ScanContext>(&descriptor.value)) {
+        nlohmann::json json = ScanContextJson(*sc);
         json["method"] = core::ToString(descriptor.method);
         return json;
     }

@@ -9,6 +9,7 @@
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/core/histogram.hpp"
 #include "lidarloop/core/ndt_config.hpp"
+#include "lidarloop/core/scancontext/scancontext_config.hpp"
 
 namespace lidarloop::core {
 
@@ -60,11 +61,13 @@ struct DescriptorConfig {
     Method method = Method::kRange;
     HistogramConfig histogram;
     NdtConfig ndt;
+    ScanContextConfig scancontext;
 
     /// Throws ConfigError naming the first invalid field.
     void Validate() const {
         histogram.Validate();
         ndt.Validate();
+        scancontext.Validate();
     }
     bool operator==(const DescriptorConfig&) const = default;
 };

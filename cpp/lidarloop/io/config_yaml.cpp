@@ -14,6 +14,7 @@
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/io/detail/text_parsing.hpp"
 #include "lidarloop/io/read_error.hpp"
+#include "lidarloop/pipeline/scancontext_method.hpp"
 
 namespace lidarloop::io {
 namespace {
@@ -29,11 +30,12 @@ constexpr char kUnsetValue[] = "default";
 
 std::string ThresholdHelp() {
     using detail::ShortNumber;
-    return "tau (height, range: a loop when W <= tau) or t_d (ndt: sigma' < t_d); default: the "
-           "method's (height " +
+    return "tau (height, range: a loop when W <= tau), t_d (ndt: sigma' < t_d) or d "
+           "(scancontext: d <= it); default: the method's (height " +
            ShortNumber(pipeline::DefaultThreshold(core::Method::kHeight)) + ", range " +
            ShortNumber(pipeline::DefaultThreshold(core::Method::kRange)) + ", ndt " +
-           ShortNumber(pipeline::DefaultThreshold(core::Method::kNdt)) + ")";
+           ShortNumber(pipeline::DefaultThreshold(core::Method::kNdt)) + ", scancontext " +
+           ShortNumber(pipeline::DefaultThreshold(pipeline::ScanContextMethod::kMethod)) + ")";
 }
 
 std::string MethodHelp() { return "descriptor: " + pipeline::MethodNamesText(" | "); }
@@ -70,6 +72,17 @@ void VisitFields(core::NdtConfig& c, Visitor& v) {
     v.Field("regrid_rotations", c.regrid_rotations,
             "new grid per rotation (paper) vs rotated cells");
     v.Moved("threshold", "detection.threshold", kLegacyNdtThreshold);
+}
+
+template <typename Visitor>
+void VisitFields(core::ScanContextConfig& c, Visitor& v) {
+    v.Field("rings", c.rings, "N_r, rings of equal width up to max_range_m");
+    v.Field("sectors", c.sectors, "N_s, sectors of equal azimuth");
+    v.Field("max_range_m", c.max_range_m, "L_max, farther points (planar range) are dropped");
+    v.Field("sensor_height_m", c.sensor_height_m,
+            "added to z, so that a bin holds max(0, z + this), metres");
+    v.Field("ring_key_candidates", c.ring_key_candidates,
+            "scans of nearest ring key ranked by the full distance; 0: compare every scan");
 }
 
 template <typename Visitor>
@@ -212,6 +225,7 @@ void VisitFields(RunConfig& c, Visitor& v) {
     v.Field("method", c.descriptor.method, MethodHelp());
     v.Section("histogram", c.descriptor.histogram);
     v.Section("ndt", c.descriptor.ndt);
+    v.Section("scancontext", c.descriptor.scancontext);
     v.Section("detection", c.detection);
     v.Section("verification", c.detection.verification);
     v.Section("posegraph", c.posegraph);

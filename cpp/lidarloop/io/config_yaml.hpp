@@ -30,7 +30,7 @@ struct OutputConfig {
 /// Every setting of a lidarloop run. The defaults live in the C++ config structs it holds; YAML
 /// files and command-line flags override only the keys they name.
 struct RunConfig {
-    core::DescriptorConfig descriptor;   ///< keys `method`, `histogram.*`, `ndt.*` at the top level
+    core::DescriptorConfig descriptor;   ///< keys `method`, `histogram.*`, `ndt.*`, `scancontext.*`
     pipeline::DetectorConfig detection;  ///< keys `detection.*`
     posegraph::PoseGraphConfig posegraph;  ///< keys `posegraph.*` (lidarloop optimise)
     OutputConfig output;                   ///< keys `output.*`

@@ -6,6 +6,7 @@
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/pipeline/histogram_method.hpp"
 #include "lidarloop/pipeline/ndt_method.hpp"
+#include "lidarloop/pipeline/scancontext_method.hpp"
 
 namespace lidarloop::pipeline {
 namespace {
@@ -19,6 +20,7 @@ public:
         Add(std::make_shared<HistogramMethod>(core::Method::kHeight));
         Add(std::make_shared<HistogramMethod>(core::Method::kRange));
         Add(std::make_shared<NdtMethod>());
+        Add(std::make_shared<ScanContextMethod>());
     }
 
     void Add(std::shared_ptr<const DescriptorMethod> method) {

@@ -60,8 +60,9 @@ public:
     /// The distance between a query prepared by a store like this one and stored scan j (valid).
     virtual double Distance(const PreparedQuery& query, std::size_t j) const = 0;
 
-    /// An exact k-nearest-neighbour index over this store, which must outlive it; nullptr when
-    /// the method has none (the detector then compares every eligible scan).
+    /// A k-nearest-neighbour index over this store, which must outlive it; nullptr when the
+    /// method has none (the detector then compares every eligible scan). Exact unless its
+    /// IsExact() says otherwise (scancontext's ring-key search).
     virtual std::unique_ptr<NeighborIndex> MakeIndex() const { return nullptr; }
     /// Per-scan work figures of the valid scans (`valid[i]` says which); none by default.
     virtual std::vector<WorkFigure> Work(const std::vector<std::uint8_t>& /*valid*/) const {
@@ -75,7 +76,7 @@ public:
     virtual void Decode(core::ByteReader& in, bool valid) = 0;
 };
 
-/// Exact nearest-neighbour search over a store's valid scans, faster than comparing each.
+/// Nearest-neighbour search over a store's valid scans, faster than comparing each.
 class NeighborIndex {
 public:
     virtual ~NeighborIndex() = default;
@@ -84,10 +85,13 @@ public:
     /// Indexes every scan of the store not yet indexed for which `include(id)` holds.
     virtual void InsertAll(const std::function<bool(std::size_t)>& include) = 0;
     /// The k indexed scans nearest to `query` for which `eligible(id)` holds (all when empty),
-    /// sorted by (distance, index): exactly what comparing every such scan would give.
+    /// sorted by (distance, index): exactly what comparing every such scan would give when
+    /// IsExact(), else a subset ranked the same way.
     virtual std::vector<Neighbor> Search(
         const PreparedQuery& query, std::size_t k,
         const std::function<bool(std::size_t)>& eligible) const = 0;
+    /// Whether Search always finds the true k nearest (true for the histogram index).
+    virtual bool IsExact() const { return true; }
 };
 
 /// One place descriptor method: how a scan is described, how two descriptions compare, how

@@ -310,7 +310,7 @@ std::vector<LoopQuery> DetectStreaming(const DescriptorDatabase& database,
     const std::size_t n = database.size();
     const double threshold = CheckOfflineDetection(detector, database.method(), times_s, path_m, n);
     const std::vector<double>& along = detector.min_gap.Along(times_s, path_m);
-    // The method's exact index (histograms), over the valid scans; candidates are filtered to
+    // The method's index (histograms: exact), over the valid scans; candidates are filtered to
     // j < i, so one index over all scans serves every query.
     std::unique_ptr<NeighborIndex> index = database.store().MakeIndex();
     if (index) index->InsertAll([&](std::size_t j) { return database.IsValid(j); });

@@ -74,8 +74,9 @@ std::vector<Neighbor> NearestCandidates(std::size_t count, std::size_t k,
                                         const std::function<bool(std::size_t)>& eligible);
 
 /// Online loop detection: scans arrive one at a time; each is compared with the stored scans
-/// older than the minimum gap, then stored. Candidates come from the method's exact index where
-/// it has one (histograms: HistogramIndex), else from comparing every eligible scan (NDT).
+/// older than the minimum gap, then stored. Candidates come from the method's index where it has
+/// one (histograms: the exact HistogramIndex; scancontext with ring_key_candidates > 0: the
+/// approximate ring-key search), else from comparing every eligible scan (NDT).
 /// With DetectorConfig::verify, a scan given as a point cloud is also kept reduced for
 /// registration (registration::PreparedScan: a few thousand voxel centroids with normals, about
 /// 0.1 MB instead of a raw HDL-64E scan's 2 MB; prepared_bytes()) and its candidates are
@@ -157,12 +158,13 @@ std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,
                                         const std::vector<double>& path_m = {});
 
 /// Offline detection without the similarity matrix: exactly DetectFromMatrix on
-/// ComputeSimilarityMatrix(database) (distances rounded to float as the matrix holds them), a
-/// query at a time, in parallel unless told otherwise. Candidates come from the method's exact
-/// index where it has one (histograms: a few more than asked, re-ranked by the float distance;
-/// when a float tie at the last place could hide another scan, from comparing them all), else
-/// from comparing every eligible scan (NDT). Memory: the results, the index and one row of n
-/// floats per thread, instead of the matrix's 2 n^2 bytes. `path_m` as DetectFromMatrix's.
+/// ComputeSimilarityMatrix(database) (distances rounded to float as the matrix holds them) when
+/// the method's index is exact, a query at a time, in parallel unless told otherwise (an
+/// approximate index, scancontext's ring-key search, gives its own candidates). Candidates come
+/// from the method's index where it has one (histograms: a few more than asked, re-ranked by the
+/// float distance; when a float tie at the last place could hide another scan, from comparing them
+/// all), else from comparing every eligible scan (NDT). Memory: the results, the index and one row
+/// of n floats per thread, instead of the matrix's 2 n^2 bytes. `path_m` as DetectFromMatrix's.
 std::vector<LoopQuery> DetectStreaming(const DescriptorDatabase& database,
                                        const DetectorConfig& detector,
                                        Execution execution = Execution::kParallel,

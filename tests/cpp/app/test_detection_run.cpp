@@ -21,6 +21,7 @@
 #include "lidarloop/io/prepared_scans_file.hpp"
 #include "lidarloop/io/read_error.hpp"
 #include "lidarloop/io/results_csv.hpp"
+#include "lidarloop/pipeline/scancontext_method.hpp"
 #include "lidarloop/registration/compact_prepared_scan.hpp"
 #include "lidarloop/registration/verification.hpp"
 #include "test_utils.hpp"
@@ -54,13 +55,19 @@ protected:
 };
 
 TEST_F(DetectionRun, EqualsThePipelineOnTheSameDescriptors) {
-    for (core::Method method : {core::Method::kRange, core::Method::kNdt}) {
+    for (core::Method method :
+         {core::Method::kRange, core::Method::kNdt, pipeline::ScanContextMethod::kMethod}) {
         app::DetectRequest request = Request("detect_" + core::ToString(method), method);
         request.config.detection.verify = false;  // the descriptor's own decision
+        if (method == pipeline::ScanContextMethod::kMethod) {
+            // Its default 0.13 accepts no scan of this short, thinned sequence; on the demo
+            // sequence its best MCC is at 0.27.
+            request.config.detection.threshold = 0.27;
+        }
         const app::DetectOutcome outcome = app::RunDetect(*dataset_, request);
         const auto described =
             pipeline::DescribeSequence(app::SourceOf(*dataset_), request.config.descriptor);
-        const double threshold = pipeline::DefaultThreshold(method);
+        const double threshold = request.config.detection.ThresholdFor(method);
         const auto expected = pipeline::DetectFromMatrix(
             pipeline::ComputeSimilarityMatrix(described.database), described.database.times_s(),
             request.config.detection, method);
@@ -88,7 +95,8 @@ TEST_F(DetectionRun, EqualsThePipelineOnTheSameDescriptors) {
 // Past the memory budget of the similarity matrix, detect finds the same loops without it and
 // writes neither similarity.bin nor the images.
 TEST_F(DetectionRun, WithoutTheMatrixGivesTheSameResults) {
-    for (core::Method method : {core::Method::kRange, core::Method::kNdt}) {
+    for (core::Method method :
+         {core::Method::kRange, core::Method::kNdt, pipeline::ScanContextMethod::kMethod}) {
         app::DetectRequest with = Request("with_" + core::ToString(method), method);
         with.config.detection.verify = false;
         app::DetectRequest without = with;

@@ -14,6 +14,7 @@
 
 #include "app_test_utils.hpp"
 #include "lidarloop/app/evaluation.hpp"
+#include "lidarloop/pipeline/scancontext_method.hpp"
 #include "test_utils.hpp"
 
 namespace lidarloop {
@@ -65,7 +66,8 @@ void ExpectSameEvaluation(const app::MethodEvaluation& got, const app::MethodEva
 
 app::EvaluationRequest Request(const std::filesystem::path& out) {
     app::EvaluationRequest request;
-    request.methods = {core::Method::kRange, core::Method::kNdt};
+    request.methods = {core::Method::kRange, core::Method::kNdt,
+                       pipeline::ScanContextMethod::kMethod};
     request.config.detection.min_gap.value = 10;
     request.config.detection.verify = false;
     request.fixed_thresholds = {0.05, 0.1, 0.5};

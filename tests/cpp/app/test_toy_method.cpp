@@ -191,7 +191,8 @@ TEST_F(ToyMethod, AMapOfAMethodThisProcessLacksIsAClearError) {
 }
 
 TEST_F(ToyMethod, IsNamedInConfigsAndShownByName) {
-    EXPECT_NE(io::DumpConfigYaml({}).find("height | range | ndt | rings"), std::string::npos);
+    EXPECT_NE(io::DumpConfigYaml({}).find("height | range | ndt | scancontext | rings"),
+              std::string::npos);
     const core::Descriptor d =
         pipeline::ComputeDescriptor(dataset_->LoadScan(0), RingsConfig().descriptor);
     EXPECT_EQ(app::DescriptorJson(d), (nlohmann::json{{"method", "rings"}}));

@@ -149,6 +149,34 @@ TEST(ConfigYaml, NdtSectionWithListsAndBooleans) {
               std::string::npos);
 }
 
+TEST(ConfigYaml, ScanContextSectionRoundTripsAndRejectsUnknownKeys) {
+    RunConfig config;
+    ApplyConfigYaml(
+        "method: scancontext\nscancontext:\n  rings: 10\n  sectors: 90\n  max_range_m: 40\n"
+        "  sensor_height_m: 1.5\n  ring_key_candidates: 25\n",
+        "sc.yaml", config);
+    EXPECT_EQ(core::ToString(config.descriptor.method), "scancontext");
+    const core::ScanContextConfig& sc = config.descriptor.scancontext;
+    EXPECT_EQ(sc.rings, 10);
+    EXPECT_EQ(sc.sectors, 90);
+    EXPECT_EQ(sc.max_range_m, 40.0);
+    EXPECT_EQ(sc.sensor_height_m, 1.5);
+    EXPECT_EQ(sc.ring_key_candidates, 25);
+    const std::string dump = DumpConfigYaml(config);
+    EXPECT_NE(dump.find("scancontext:\n  rings: 10"), std::string::npos) << dump;
+    RunConfig reloaded;
+    ApplyConfigYaml(dump, "dump", reloaded);
+    EXPECT_EQ(reloaded.descriptor, config.descriptor);
+    // The defaults are shown by dump-config.
+    EXPECT_NE(DumpConfigYaml({}).find("scancontext:\n  rings: 20"), std::string::npos);
+    EXPECT_NE(ErrorOf("scancontext:\n  ringz: 3\n").find("key 'scancontext.ringz': unknown key"),
+              std::string::npos)
+        << ErrorOf("scancontext:\n  ringz: 3\n");
+    EXPECT_NE(ErrorOf("scancontext:\n  rings: 0\n").find("scancontext.rings must be in [1, 200]"),
+              std::string::npos)
+        << ErrorOf("scancontext:\n  rings: 0\n");
+}
+
 TEST(ConfigYaml, FailedApplyLeavesConfigUnchanged) {
     RunConfig config;
     EXPECT_THROW(ApplyConfigYaml("histogram:\n  bins: 7\n  oops: 1\n", "f", config), ReadError);
