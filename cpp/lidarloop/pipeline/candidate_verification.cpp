@@ -113,7 +113,7 @@ VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
     std::atomic<std::size_t> done{0};
     const auto run = [&](std::size_t i) {
         VerifyQuery(queries[i], scan_of(queries[i].query), scan_of, detector, method, &per_query[i],
-                    cache);
+                    cache, execution);
         const std::size_t finished = ++done;
         if (progress) progress(finished, queries.size());
     };
