@@ -13,7 +13,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <ctime>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -23,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "lidarloop/app/results_folder.hpp"
 #include "lidarloop/io/config_yaml.hpp"
 #include "lidarloop/io/poses.hpp"
 #include "lidarloop/io/prepared_scans_file.hpp"
@@ -72,20 +72,6 @@ std::vector<Candidate> ReadCandidates(const std::filesystem::path& file) {
         candidates.push_back(candidate);
     }
     return candidates;
-}
-
-double ThreadSeconds() {
-    timespec now{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-    return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
-}
-
-double Percentile(std::vector<double> values, double p) {
-    if (values.empty()) return 0.0;
-    const auto at = static_cast<std::size_t>(p * static_cast<double>(values.size() - 1));
-    std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(at),
-                     values.end());
-    return values[at];
 }
 
 double Mean(const std::vector<double>& values) {
@@ -200,17 +186,17 @@ void Replay(const std::filesystem::path& run, const registration::VerificationCo
     std::size_t query_index = static_cast<std::size_t>(-1);
     for (const Candidate& candidate : candidates) {
         if (query_index != candidate.query) {
-            const double start = ThreadSeconds();
+            const app::ThreadCpuStopwatch clock;
             query = scans.At(candidate.query);
             if (query.structure) coarse.emplace(*query.structure, config.coarse);
-            tally.query_ms.push_back(1e3 * (ThreadSeconds() - start));
+            tally.query_ms.push_back(1e3 * clock.Seconds());
             query_index = candidate.query;
         }
-        const double start = ThreadSeconds();
+        const app::ThreadCpuStopwatch clock;
         const registration::PreparedScan match = scans.At(candidate.match);
         if (!query.structure || !match.structure) continue;
         const registration::Verification now = registration::Verify(query, *coarse, match, config);
-        tally.pair_ms.push_back(1e3 * (ThreadSeconds() - start));
+        tally.pair_ms.push_back(1e3 * clock.Seconds());
         if (pairs.is_open())
             WritePair(pairs, candidate, now, query, match, config, tally.pair_ms.back(), poses);
         ++tally.pairs;
@@ -238,8 +224,8 @@ void Replay(const std::filesystem::path& run, const registration::VerificationCo
     std::printf(
         "\n  thread CPU: per pair median %.3f ms, p95 %.3f ms, mean %.3f ms; coarse "
         "images per query median %.3f ms\n",
-        Percentile(tally.pair_ms, 0.5), Percentile(tally.pair_ms, 0.95), Mean(tally.pair_ms),
-        Percentile(tally.query_ms, 0.5));
+        app::Quantile(tally.pair_ms, 0.5), app::Quantile(tally.pair_ms, 0.95), Mean(tally.pair_ms),
+        app::Quantile(tally.query_ms, 0.5));
 }
 
 }  // namespace
