@@ -7,8 +7,10 @@
 // RUN_FOLDER holds database.scans, candidates.csv and config.yaml (detect with verification on);
 // --config verifies with another configuration, --compact with the scans kept compact (the
 // match expanded in the timed step, as detect does), --pairs-csv writes one line per pair (verdict,
-// coarse score, occupied image cells, overlaps, ICP iterations, time) and, with --poses (KITTI
-// or TUM, T_world_sensor, one per scan), the true distance and the overlap at the true pose.
+// coarse score, occupied image cells, overlaps, ICP iterations, time, both scans' point counts
+// and roughness, overlapping points, RMSE and the RMSE allowed, the degeneracy measures) and,
+// with --poses (KITTI or TUM, T_world_sensor, one per scan), the true distance, the overlap at
+// the true pose and the registered pose's error against it (metres, degrees).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -68,7 +70,9 @@ std::vector<Candidate> ReadCandidates(const std::filesystem::path& file) {
         if (fields.size() != header.size() || fields[reason] == "pruned") continue;
         Candidate candidate{std::stoul(fields[query]), std::stoul(fields[match]),
                             fields[accepted] == "1", fields[reason]};
-        for (int i = 0; i < 3; ++i) candidate.translation_m[i] = std::stod(fields[tx + i]);
+        for (int i = 0; i < 3; ++i) {
+            if (!fields[tx + i].empty()) candidate.translation_m[i] = std::stod(fields[tx + i]);
+        }
         candidates.push_back(candidate);
     }
     return candidates;
@@ -118,16 +122,29 @@ int CoarseRankOfTruth(const registration::PreparedScan& query,
 std::string TruthFields(const std::vector<core::StampedPose>& poses, const Candidate& candidate,
                         const registration::PreparedScan& query,
                         const registration::PreparedScan& match,
-                        const registration::VerificationConfig& config) {
-    if (poses.empty()) return ",,,";
+                        const registration::VerificationConfig& config,
+                        const core::Transform& T_registered) {
+    if (poses.empty()) return ",,,,,";
     const core::Transform T_match_query = poses.at(candidate.match).T_world_sensor.inverse() *
                                           poses.at(candidate.query).T_world_sensor;
     const registration::Overlap overlap =
         registration::MeasureOverlap(query, match, T_match_query, config.acceptance);
     std::ostringstream fields;
-    fields << T_match_query.translation().norm() << ',' << overlap.Min() << ','
-           << overlap.MinDistinctive() << ','
-           << CoarseRankOfTruth(query, match, T_match_query, config);
+    fields
+        << T_match_query.translation().norm() << ',' << overlap.Min() << ','
+        << overlap.MinDistinctive() << ',' << CoarseRankOfTruth(query, match, T_match_query, config)
+        << ',' << (T_registered.translation() - T_match_query.translation()).norm() << ','
+        << Eigen::AngleAxisd(T_registered.linear().transpose() * T_match_query.linear()).angle() *
+               180.0 / M_PI;
+    return fields.str();
+}
+
+// A scan's structure points, distinctive ones among them, ground points and roughness.
+std::string ScanFields(const registration::PreparedScan& scan) {
+    std::ostringstream fields;
+    fields << scan.structure->size() << ','
+           << std::count(scan.structure_distinctive.begin(), scan.structure_distinctive.end(), 1)
+           << ',' << scan.ground->size() << ',' << scan.structure_roughness_m;
     return fields.str();
 }
 
@@ -142,7 +159,12 @@ void WritePair(std::ofstream& out, const Candidate& candidate,
         << OccupiedCells(*query.structure, config.coarse) << ','
         << OccupiedCells(*match.structure, config.coarse) << ',' << now.overlap.Min() << ','
         << now.overlap.MinDistinctive() << ',' << now.icp_iterations << ',' << ms << ','
-        << TruthFields(poses, candidate, query, match, config) << '\n';
+        << TruthFields(poses, candidate, query, match, config, now.T_match_query) << ','
+        << ScanFields(query) << ',' << ScanFields(match) << ',' << now.overlap.query_overlapping
+        << ',' << now.overlap.match_overlapping << ',' << now.overlap.rmse_m << ','
+        << registration::AllowedRmse(query, match, config.acceptance) << ','
+        << now.overlap.shifted_overlap_ratio << ',' << now.overlap.constraining_points << ','
+        << now.T_match_query.translation().norm() << '\n';
 }
 
 // The run's scans as a run keeps them: as loaded, or (--compact) encoded as
@@ -173,7 +195,11 @@ void Replay(const std::filesystem::path& run, const registration::VerificationCo
         pairs.open(pairs_csv);
         pairs << "query,match,accepted,reason,coarse_score,query_cells,match_cells,overlap,"
                  "distinctive_overlap,icp_iterations,ms,true_distance_m,true_overlap,"
-                 "true_distinctive_overlap,coarse_rank_of_truth\n";
+                 "true_distinctive_overlap,coarse_rank_of_truth,pose_error_m,pose_error_deg,"
+                 "q_structure,q_distinctive,q_ground,q_roughness_m,m_structure,m_distinctive,"
+                 "m_ground,m_roughness_m,q_overlapping,m_overlapping,rmse_m,"
+                 "allowed_rmse_m,"
+                 "shifted_ratio,constraining,registered_distance_m\n";
     }
     io::StoredPreparedScans stored = io::LoadPreparedScans(run / "database.scans");
     const ScanSource scans(std::move(stored.scans), compact);
