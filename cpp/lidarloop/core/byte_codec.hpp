@@ -112,6 +112,9 @@ public:
         offset_ += size;
         return text;
     }
+    bool StartsWith(const std::string& prefix) const {
+        return data_.compare(0, prefix.size(), prefix) == 0;
+    }
     void ExpectMagic(const std::string& magic, const char* format) {
         if (data_.compare(0, magic.size(), magic) != 0) {
             Fail(std::string("not a ") + format + " file (wrong magic)");

@@ -14,7 +14,10 @@
 namespace lidarloop::io {
 namespace {
 
-constexpr char kMagic[] = "LLPS0001";
+// 0002: structure_roughness_m is the scan's self-residual (issue 24); 0001 stored a median
+// plane residual that the acceptance rule no longer understands.
+constexpr char kMagic[] = "LLPS0002";
+constexpr char kOldMagic[] = "LLPS0001";
 constexpr std::size_t kPointBytes = 6 * sizeof(float);  // x y z and the normal
 
 void PutSurface(core::ByteWriter& out, const registration::SurfacePoints& surface) {
@@ -124,6 +127,11 @@ void SavePreparedScans(const std::filesystem::path& file,
 
 StoredPreparedScans LoadPreparedScans(const std::filesystem::path& file) {
     core::ByteReader in = detail::FileReader(file, detail::ReadWholeFile(file));
+    if (in.StartsWith(kOldMagic)) {
+        in.Fail(
+            "written by an earlier lidarloop (another roughness measure); run detect again "
+            "to rebuild it");
+    }
     in.ExpectMagic(kMagic, "lidarloop prepared scans");
     RunConfig config;
     try {

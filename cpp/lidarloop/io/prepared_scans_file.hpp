@@ -10,7 +10,7 @@
 namespace lidarloop::io {
 
 /// The scans of a map reduced for verification (registration::PreparedScan), saved beside its
-/// database so that localising against the map can verify its candidates: "LLPS0001", the
+/// database so that localising against the map can verify its candidates: "LLPS0002", the
 /// reduction config as YAML, then per scan whether it is present, its point counts and roughness,
 /// and its structure and ground points with normals (float32, sensor frame, metres), and the
 /// structure points' distinctive flags. About 24 bytes per kept point. Little-endian binary.

@@ -54,15 +54,10 @@ std::vector<Eigen::Vector3f> VoxelCentroids(const core::PointCloud& scan,
     return centroids;
 }
 
-struct LocalPlane {
-    Eigen::Vector3f normal;
-    double residual_m = 0.0;  // RMS distance of the neighbours to the plane
-};
-
 // The plane through the neighbourhood: its unit normal (the eigenvector of the smallest
 // eigenvalue of the covariance) oriented towards the sensor so that both scans agree on its sign.
-LocalPlane PlaneAt(const std::vector<Eigen::Vector3f>& points,
-                   const std::vector<std::uint32_t>& neighbors, const Eigen::Vector3f& at) {
+Eigen::Vector3f NormalAt(const std::vector<Eigen::Vector3f>& points,
+                         const std::vector<std::uint32_t>& neighbors, const Eigen::Vector3f& at) {
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
     for (const auto index : neighbors) mean += points[index].cast<double>();
     mean /= static_cast<double>(neighbors.size());
@@ -75,9 +70,7 @@ LocalPlane PlaneAt(const std::vector<Eigen::Vector3f>& points,
     solver.computeDirect(covariance);
     Eigen::Vector3f normal = solver.eigenvectors().col(0).cast<float>();
     if (normal.dot(at) > 0.0F) normal = -normal;
-    const double residual_m2 =
-        std::max(0.0, solver.eigenvalues()(0)) / static_cast<double>(neighbors.size());
-    return {normal, std::sqrt(residual_m2)};
+    return normal;
 }
 
 // Whether `point` lies on a large plane: the surface variation of its k nearest centroids.
@@ -101,11 +94,47 @@ bool OnLargePlane(const std::vector<Eigen::Vector3f>& centroids, const PointTree
     return total > 0.0 && eigenvalues(0) / total <= config.max_plane_variation;
 }
 
-double Median(std::vector<double> values) {
-    if (values.empty()) return 0.0;
-    const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-    std::nth_element(values.begin(), middle, values.end());
-    return *middle;
+// The overlap test's default gates (AcceptanceConfig), with which a scan is matched to itself.
+struct SelfMatchGates {
+    float range_m = 40.0F;
+    float partner_m = 1.5F;
+    float plane_m = 0.3F;
+    float min_normal_cosine = 0.866F;  // 30 degrees
+};
+
+// Partners per probed point: the nearest lies along the scan line, closer than a second scan's
+// samples fall; four reach across the lines as well (docs/verification.md).
+constexpr int kSelfPartners = 4;
+// Probed points at most (an even stride): the statistic is an RMS over thousands of pairs.
+constexpr std::size_t kSelfProbes = 1000;
+
+// PreparedScan::structure_roughness_m: structure points against the planes of their nearest
+// other structure points, as the overlap test pairs two scans. Sampling, noise and surface
+// kind set how far apart and how flat such partners are, in one scan as between two.
+double SelfResidual(const SurfacePoints& structure) {
+    const SelfMatchGates gates;
+    const std::size_t stride = std::max<std::size_t>(1, structure.size() / kSelfProbes);
+    std::vector<std::uint32_t> nearest;
+    double squared_sum_m2 = 0.0;
+    std::size_t pairs = 0;
+    for (std::size_t i = 0; i < structure.size(); i += stride) {
+        const Eigen::Vector3f& point = structure.points()[i];
+        if (point.norm() > gates.range_m) continue;
+        structure.tree().Knn(point, kSelfPartners + 1, nearest);
+        for (const std::uint32_t partner : nearest) {
+            if (partner == i) continue;
+            const Eigen::Vector3f& partner_normal = structure.normals()[partner];
+            const Eigen::Vector3f offset = point - structure.points()[partner];
+            const float distance_m = partner_normal.dot(offset);
+            if (offset.norm() > gates.partner_m || std::abs(distance_m) > gates.plane_m ||
+                std::abs(partner_normal.dot(structure.normals()[i])) < gates.min_normal_cosine) {
+                continue;
+            }
+            squared_sum_m2 += static_cast<double>(distance_m) * distance_m;
+            ++pairs;
+        }
+    }
+    return pairs == 0 ? 0.0 : std::sqrt(squared_sum_m2 / static_cast<double>(pairs));
 }
 
 // Keeps at most `cap` of the points at an even stride.
@@ -154,17 +183,14 @@ PreparedScan PrepareScan(const core::PointCloud& scan, const ScanReductionConfig
         static_cast<float>(std::cos(config.structure_min_tilt_deg * std::numbers::pi / 180.0));
     std::vector<Eigen::Vector3f> structure, structure_normals, ground, ground_normals;
     std::vector<std::uint32_t> neighbors;
-    std::vector<double> structure_residuals_m;
     for (const auto& point : centroids) {
         tree.Knn(point, config.normal_neighbors, neighbors);
         if (neighbors.size() < 5) continue;  // no plane through fewer points
-        const LocalPlane plane = PlaneAt(centroids, neighbors, point);
-        const bool is_structure = std::abs(plane.normal.z()) <= max_vertical_z;
+        const Eigen::Vector3f normal = NormalAt(centroids, neighbors, point);
+        const bool is_structure = std::abs(normal.z()) <= max_vertical_z;
         (is_structure ? structure : ground).push_back(point);
-        (is_structure ? structure_normals : ground_normals).push_back(plane.normal);
-        if (is_structure) structure_residuals_m.push_back(plane.residual_m);
+        (is_structure ? structure_normals : ground_normals).push_back(normal);
     }
-    prepared.structure_roughness_m = Median(std::move(structure_residuals_m));
     Subsample(structure, structure_normals, config.max_structure_points);
     Subsample(ground, ground_normals, config.max_ground_points);
     prepared.structure_distinctive.reserve(structure.size());
@@ -176,6 +202,7 @@ PreparedScan PrepareScan(const core::PointCloud& scan, const ScanReductionConfig
         std::make_shared<const SurfacePoints>(std::move(structure), std::move(structure_normals));
     prepared.ground =
         std::make_shared<const SurfacePoints>(std::move(ground), std::move(ground_normals));
+    prepared.structure_roughness_m = SelfResidual(*prepared.structure);
     return prepared;
 }
 

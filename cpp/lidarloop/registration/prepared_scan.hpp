@@ -45,9 +45,13 @@ struct PreparedScan {
     std::shared_ptr<const SurfacePoints> ground;
     std::size_t input_points = 0;   ///< points of the raw scan
     std::size_t usable_points = 0;  ///< finite points within the range limits
-    /// Median RMS distance of a structure point's neighbours to its fitted plane, metres: how
-    /// rough the scan's own surfaces are at this voxel size (sensor noise, vegetation). A pair's
-    /// fit is judged against it (AcceptanceConfig::max_rmse_ratio).
+    /// How well the scan fits itself, metres: the RMS distance of its structure points (within
+    /// 40 m; at most 1000 of them, an even stride) to the planes of their 4 nearest other
+    /// structure points, each pair counted as the overlap test counts one (partner within 1.5 m,
+    /// normals within 30 degrees, plane within 0.3 m: the AcceptanceConfig defaults). It is the
+    /// residual a right registration leaves between two scans of this density, noise and
+    /// surface kind (sparse rings, vegetation, de-skewing); a pair's RMSE is judged against it
+    /// (AcceptanceConfig::max_rmse_ratio). 0 without pairs.
     double structure_roughness_m = 0.0;
     /// Per structure point: 1 when it is distinctive, i.e. not part of a large plane (a wall, a
     /// facade) at the scale of distinctive_neighbors voxels; poles, trunks, cars, door leaves,

@@ -145,7 +145,10 @@ bool TooFewPoints(const PreparedScan& scan, const AcceptanceConfig& config) {
 
 double AllowedRmse(const PreparedScan& query, const PreparedScan& match,
                    const AcceptanceConfig& config) {
-    const double roughness_m = std::hypot(query.structure_roughness_m, match.structure_roughness_m);
+    // The RMS of the two scans' own residuals: what a right pose leaves between them.
+    const double roughness_m =
+        std::sqrt(0.5 * (query.structure_roughness_m * query.structure_roughness_m +
+                         match.structure_roughness_m * match.structure_roughness_m));
     return std::clamp(config.max_rmse_ratio * roughness_m, config.min_allowed_rmse_m,
                       config.max_rmse_m);
 }

@@ -91,11 +91,13 @@ struct AcceptanceConfig {
     /// nothing whatever the fraction.
     int min_overlapping_points = 80;
     /// The RMS plane distance of the overlapping structure points may be at most this many
-    /// times the scans' own roughness (their points' RMS distance to their local planes, both
-    /// scans combined): a right alignment fits about as well as each scan fits itself, on any
-    /// sensor. Clamped to [min_allowed_rmse_m, max_rmse_m] (voxel discretisation; a cap).
-    double max_rmse_ratio = 1.5;
-    double min_allowed_rmse_m = 0.06;
+    /// times the scans' own roughness (PreparedScan::structure_roughness_m: how well each scan's
+    /// points sit on their nearest neighbour's plane, the RMS of the two): a right alignment fits
+    /// about as well as each scan fits itself, at any density and on any sensor (chosen on
+    /// simulated sparse and dense sequences, validated on real ones: docs/verification.md).
+    /// Clamped to [min_allowed_rmse_m, max_rmse_m] (noise-free input; a cap).
+    double max_rmse_ratio = 1.0;
+    double min_allowed_rmse_m = 0.02;
     double max_rmse_m = 0.3;
     /// Degeneracy test: the overlapping points whose surfaces face the least-constrained
     /// horizontal direction must be at least min_overlapping_points / 4, and after shifting the

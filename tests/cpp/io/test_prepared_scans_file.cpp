@@ -88,6 +88,8 @@ TEST(PreparedScansFile, DamagedFilesAreReadErrors) {
     };
     EXPECT_NE(error_of("").find("bad.scans"), std::string::npos);
     EXPECT_NE(error_of("LLDB0001" + bytes.substr(8)).find("wrong magic"), std::string::npos);
+    // A file of the previous format holds a roughness the acceptance rule no longer reads.
+    EXPECT_NE(error_of("LLPS0001" + bytes.substr(8)).find("run detect again"), std::string::npos);
     EXPECT_NE(error_of(bytes.substr(0, bytes.size() / 2)).find("truncated"), std::string::npos);
     EXPECT_NE(error_of(bytes + "x").find("trailing"), std::string::npos);
     // The last float of the file is a ground normal's z: make it NaN.

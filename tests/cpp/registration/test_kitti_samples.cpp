@@ -123,11 +123,12 @@ core::PointCloud Thinned(const core::PointCloud& scan, std::size_t stride) {
 }
 
 // The rule is density-aware (voxel centroids, fractions, roughness-relative RMSE): the same
-// decisions on scans thinned to 1/4 (~30k points, a VLP-32's) and 1/8 (~15k, a VLP-16's).
+// decisions on scans thinned to 1/4 (~30k points, a VLP-32's), 1/8 (~15k, a VLP-16's) and 1/40
+// (~3k, a LIO front end's sparse keyframe).
 TEST_F(KittiSamples, DecisionsHoldOnThinnedScans) {
     const Pair loops[] = {{"08", 209, 1684}, {"08", 720, 1500}, {"00", 94, 95}};
     const Pair others[] = {{"00", 94, 198}, {"08", 209, 720}, {"08", 1684, 1500}};
-    for (const std::size_t stride : {4, 8}) {
+    for (const std::size_t stride : {4, 8, 40}) {
         SCOPED_TRACE("every " + std::to_string(stride) + "th point");
         const auto run = [&](const Pair& pair) {
             return VerifyPair(Thinned(Scan(pair.sequence, pair.query), stride),
