@@ -132,8 +132,21 @@ TEST_F(MapRun, TheOptimisedMapClosesTheRevisitTheOdometryDoubles) {
 
     // The files: both maps read back with their sizes, the top view of both side by side.
     const std::filesystem::path out = request.out;
-    EXPECT_EQ(io::ReadPly(out / "map_odometry.ply").size(), outcome.maps.odometry_points);
-    EXPECT_EQ(io::ReadPly(out / "map_optimised.ply").size(), outcome.maps.optimised_points);
+    // map_optimised.ply is the map of every scan placed with the optimised poses, and
+    // map_odometry.ply the one with the odometry.
+    const auto all = app::BuildMaps(*dataset_, {odometry, Placed(odometry, outcome.result.poses)},
+                                    request.config.map);
+    const core::PointCloud odometry_map = io::ReadPly(out / "map_odometry.ply");
+    const core::PointCloud optimised_map = io::ReadPly(out / "map_optimised.ply");
+    ASSERT_EQ(odometry_map.size(), all.maps[0].points.size());
+    ASSERT_EQ(optimised_map.size(), all.maps[1].points.size());
+    EXPECT_EQ(optimised_map.size(), outcome.maps.optimised_points);
+    const std::size_t n = std::min(odometry_map.size(), optimised_map.size());
+    ASSERT_GT(n, 0u);
+    for (const std::size_t k : {std::size_t{0}, n / 2, n - 1}) {
+        EXPECT_EQ(optimised_map[k], all.maps[1].points[k].position.cast<float>()) << k;
+        EXPECT_EQ(odometry_map[k], all.maps[0].points[k].position.cast<float>()) << k;
+    }
     EXPECT_GT(outcome.maps.optimised_points, 10000u);
     EXPECT_DOUBLE_EQ(outcome.maps.voxel_m, 0.2);
     const auto [width, height] = PngSize(out / "map.png");
