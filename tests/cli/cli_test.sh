@@ -349,6 +349,9 @@ section_demo() {
         similarity_ndt.png config.yaml; do
         if [ -s "$work/demo/evaluation/$file" ]; then pass; else fail "demo did not write $file"; fi
     done
+    for file in map.png map_odometry.ply map_optimised.ply; do
+        if [ -s "$work/demo/optimised/$file" ]; then pass; else fail "demo did not write $file"; fi
+    done
     for stage in evaluation optimised; do
         if grep -q '"status": "complete"' "$work/demo/$stage/run.json"; then pass; else
             fail "demo's $stage/run.json does not say complete"
