@@ -12,6 +12,7 @@ void AddDetectCommand(CLI::App& app);
 void AddDistanceCommand(CLI::App& app);
 void AddDumpConfigCommand(CLI::App& app);
 void AddEvaluateCommand(CLI::App& app);
+void AddMapCommand(CLI::App& app);
 void AddOptimiseCommand(CLI::App& app);
 void AddSimulateCommand(CLI::App& app);
 void AddVerifyCommand(CLI::App& app);

@@ -4,11 +4,12 @@
 
 namespace lidarloop::cli {
 
-void DatasetOptions::AddTo(CLI::App& command, const std::string& format_flag) {
+void DatasetOptions::AddTo(CLI::App& command, const std::string& format_flag, bool with_poses) {
     command.add_option("DATASET", path_, "folder of scans (KITTI layout, scan files, Osnabrueck)")
         ->required();
     command.add_option(format_flag, format_, "dataset layout: auto | kitti | folder | osnabrueck")
         ->check(CLI::IsMember({"auto", "kitti", "folder", "osnabrueck"}));
+    if (!with_poses) return;
     command.add_option("--poses", poses_, "poses file (KITTI or TUM) instead of the usual one")
         ->check(CLI::ExistingFile);
     command.add_option("--calib", calib_, "KITTI calib.txt whose Tr converts the poses")

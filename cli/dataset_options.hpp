@@ -14,8 +14,10 @@ namespace lidarloop::cli {
 class DatasetOptions {
 public:
     /// Adds the DATASET positional and --format, --poses, --calib; `format_flag` renames
-    /// --format for a command whose --format means something else (optimise's pose format).
-    void AddTo(CLI::App& command, const std::string& format_flag = "--format");
+    /// --format for a command whose --format means something else (optimise's pose format);
+    /// without `with_poses` no --poses and --calib (a command whose --poses means another thing).
+    void AddTo(CLI::App& command, const std::string& format_flag = "--format",
+               bool with_poses = true);
     io::Dataset Open() const;
     /// The folder and the files given for it, which no output may lie inside or replace.
     std::vector<std::filesystem::path> Inputs() const { return {path_, poses_, calib_}; }

@@ -84,7 +84,8 @@ void RunDemoOptimisation(const io::Dataset& dataset, const DemoFlags& flags,
     std::cout << "loops closed: " << outcome.result.loops_used << " of " << outcome.loops.size()
               << " verified loops in the pose graph; ATE " << Fixed(outcome.odometry->ate_rmse_m, 2)
               << " m (odometry) -> " << Fixed(outcome.optimised->ate_rmse_m, 2)
-              << " m (optimised); top view: " << (request.out / "trajectory.png").string() << "\n";
+              << " m (optimised); top view: " << (request.out / "trajectory.png").string()
+              << ", maps before and after: " << (request.out / "map.png").string() << "\n";
 }
 
 void RunDemo(const DemoFlags& flags) {

@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
     lidarloop::cli::AddDetectCommand(app);
     lidarloop::cli::AddEvaluateCommand(app);
     lidarloop::cli::AddOptimiseCommand(app);
+    lidarloop::cli::AddMapCommand(app);
     lidarloop::cli::AddDistanceCommand(app);
     lidarloop::cli::AddDumpConfigCommand(app);
     lidarloop::cli::AddBenchCommand(app);

@@ -61,7 +61,7 @@ void PrintOutcome(const app::OptimiseRequest& request, const app::OptimiseOutcom
     for (const std::string& note : outcome.notes) std::cout << "  note: " << note << "\n";
     std::cout << "  results in " << request.out.string()
               << "/ (poses_optimised.txt, graph.g2o, loop_verdicts.csv, metrics.json, report.md, "
-                 "trajectory.png, config.yaml)\n";
+                 "trajectory.png, map_odometry.ply, map_optimised.ply, map.png, config.yaml)\n";
 }
 
 std::vector<std::filesystem::path> Inputs(const OptimiseFlags& flags) {

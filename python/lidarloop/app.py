@@ -1,13 +1,16 @@
-"""The run layer: detect, evaluate and optimise a dataset into a results folder, as the CLI does."""
+"""The run layer: detect, evaluate and optimise a dataset into a results folder, and build its map,
+as the CLI does."""
 
 from ._lidarloop import (
     DetectResult,
     EvaluateResult,
     MethodEvaluation,
     OptimiseResult,
+    build_map,
     detect,
     evaluate,
     optimise,
+    write_map,
 )
 
 __all__ = [
@@ -15,7 +18,9 @@ __all__ = [
     "EvaluateResult",
     "MethodEvaluation",
     "OptimiseResult",
+    "build_map",
     "detect",
     "evaluate",
     "optimise",
+    "write_map",
 ]

@@ -187,6 +187,9 @@ class OptimiseResult:
     @property
     def optimised_metrics(self) -> Optional[dict[str, float]]: ...
     @property
+    def maps(self) -> dict[str, float]:
+        """map_odometry.ply, map_optimised.ply: voxel_m, points_odometry, points_optimised, seconds."""
+    @property
     def notes(self) -> list[str]: ...
     @property
     def total_s(self) -> float: ...
@@ -213,12 +216,56 @@ def optimise(
 ) -> OptimiseResult:
     """`lidarloop optimise DATASET --odometry FILE --out OUT [--loops loops.csv]`."""
 
+def build_map(
+    dataset: Union[PathLike, Dataset],
+    *,
+    trajectory: Union[None, PathLike, npt.ArrayLike] = None,
+    voxel_m: Optional[float] = None,
+    max_points: Optional[int] = None,
+    config: Config = None,
+    scans: Sequence[int] = (),
+    skip_bad: bool = False,
+    progress: Optional[Progress] = None,
+    format: str = "auto",
+    poses: Optional[PathLike] = None,
+    calib: Optional[PathLike] = None,
+) -> dict[str, Any]:
+    """Every scan (or `scans`, in that order) placed with `trajectory` and averaged into voxels.
+
+    trajectory: None (the dataset's poses), a KITTI or TUM file (T_world_sensor, read as optimise
+    reads odometry), or an (N, 4, 4) array of T_world_sensor (times: the scan index). voxel_m and
+    max_points override the config's `map.voxel_m` (default 0.2) and `map.max_points` (2000000).
+    Returns points (M, 3) float64, times_s (M,), colors (M, 3) uint8 (viridis of the scan time),
+    voxel_m (coarser than asked when max_points capped it), scans, input_points, skipped.
+    """
+
+def write_map(
+    dataset: Union[PathLike, Dataset],
+    *,
+    out: PathLike,
+    trajectory: Optional[PathLike] = None,
+    voxel_m: Optional[float] = None,
+    max_points: Optional[int] = None,
+    config: Config = None,
+    overwrite: bool = False,
+    progress: Optional[Progress] = None,
+    format: str = "auto",
+    poses: Optional[PathLike] = None,
+    calib: Optional[PathLike] = None,
+) -> dict[str, Any]:
+    """`lidarloop map DATASET --poses TRAJECTORY --out OUT`: a binary PLY coloured by scan time.
+
+    Returns out, points, voxel_m, scans, input_points, notes, total_s.
+    """
+
 __all__ = [
     "DetectResult",
     "EvaluateResult",
     "MethodEvaluation",
     "OptimiseResult",
+    "build_map",
     "detect",
     "evaluate",
     "optimise",
+    "write_map",
 ]

@@ -17,12 +17,15 @@
 #include "conversions.hpp"
 #include "lidarloop/app/detection.hpp"
 #include "lidarloop/app/evaluation.hpp"
+#include "lidarloop/app/map_building.hpp"
 #include "lidarloop/app/metrics_json.hpp"
 #include "lidarloop/app/optimisation.hpp"
 #include "lidarloop/app/run_folder.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/core/min_gap.hpp"
+#include "lidarloop/io/colour_map.hpp"
 #include "lidarloop/io/dataset.hpp"
+#include "lidarloop/io/map_files.hpp"
 #include "lidarloop/pipeline/descriptor_method.hpp"
 #include "part2_helpers.hpp"
 
@@ -519,6 +522,18 @@ void BindOptimise(py::module_& m) {
         .def_property_readonly(
             "optimised_metrics",
             [](const OptimiseResult& r) { return TrajectoryMetricsOf(r.outcome.optimised); })
+        .def_property_readonly(
+            "maps",
+            [](const OptimiseResult& r) {
+                py::dict d;
+                d["voxel_m"] = r.outcome.maps.voxel_m;
+                d["points_odometry"] = r.outcome.maps.odometry_points;
+                d["points_optimised"] = r.outcome.maps.optimised_points;
+                d["seconds"] = r.outcome.maps.seconds;
+                return d;
+            },
+            "map_odometry.ply and map_optimised.ply: voxel_m, points_odometry, "
+            "points_optimised, seconds")
         .def_property_readonly("notes", [](const OptimiseResult& r) { return r.outcome.notes; })
         .def_property_readonly("total_s",
                                [](const OptimiseResult& r) { return r.outcome.total_s; });
@@ -571,9 +586,143 @@ void BindOptimise(py::module_& m) {
         "`lidarloop optimise DATASET --odometry FILE --out OUT`: reads the accepted loops "
         "(loops.csv of a verified detect) or detects them first (into out/detection), builds "
         "and optimises the pose graph and writes poses_optimised.txt (pose_format kitti | "
-        "tum), graph.g2o, loop_verdicts.csv, metrics.json, report.md and config.yaml into `out` "
+        "tum), graph.g2o, loop_verdicts.csv, metrics.json, report.md, config.yaml, "
+        "map_odometry.ply, map_optimised.ply and map.png into `out` "
         "(a results folder, as detect's: staged, run.json last, refused inside the dataset or "
         "when it holds other files unless overwrite).");
+}
+
+// ---- maps ----
+
+/// A map's settings: defaults < config (dict or YAML) < voxel_m, max_points.
+core::MapConfig MapConfigOf(const py::object& config, std::optional<double> voxel_m,
+                            std::optional<std::size_t> max_points) {
+    core::MapConfig map = RunConfigFrom(config).map;
+    map.voxel_m = voxel_m.value_or(map.voxel_m);
+    map.max_points = max_points.value_or(map.max_points);
+    map.Validate();
+    return map;
+}
+
+/// A trajectory argument: None (the dataset's poses), a KITTI or TUM file, or an (N, 4, 4) array
+/// of T_world_sensor (times: the scan index).
+std::vector<core::StampedPose> TrajectoryOf(const io::Dataset& data, const py::object& trajectory) {
+    if (trajectory.is_none()) return app::MapTrajectory(data, {});
+    if (py::isinstance<py::str>(trajectory) || py::hasattr(trajectory, "__fspath__"))
+        return app::MapTrajectory(data, trajectory.cast<fs::path>());
+    const std::vector<core::Transform> transforms = TransformsFromArray(trajectory, "trajectory");
+    std::vector<core::StampedPose> poses(transforms.size());
+    for (std::size_t i = 0; i < poses.size(); ++i)
+        poses[i] = {static_cast<double>(i), transforms[i]};
+    return poses;
+}
+
+py::dict MapCloudToPython(const core::MapCloud& map) {
+    const auto n = static_cast<py::ssize_t>(map.points.size());
+    py::array_t<double> points({n, py::ssize_t{3}});
+    py::array_t<double> times(n);
+    py::array_t<std::uint8_t> colors({n, py::ssize_t{3}});
+    auto p = points.mutable_unchecked<2>();
+    auto t = times.mutable_unchecked<1>();
+    auto c = colors.mutable_unchecked<2>();
+    for (py::ssize_t i = 0; i < n; ++i) {
+        const core::MapPoint& point = map.points[static_cast<std::size_t>(i)];
+        const io::Rgb rgb = io::Viridis(io::MapTimeFraction(map, point.time_s));
+        for (int k = 0; k < 3; ++k) {
+            p(i, k) = point.position[k];
+            c(i, k) = rgb[static_cast<std::size_t>(k)];
+        }
+        t(i) = point.time_s;
+    }
+    py::dict d;
+    d["points"] = points;
+    d["times_s"] = times;
+    d["colors"] = colors;
+    d["voxel_m"] = map.voxel_m;
+    d["scans"] = map.scans;
+    d["input_points"] = map.input_points;
+    return d;
+}
+
+void BindMap(py::module_& m) {
+    m.def(
+        "build_map",
+        [](const py::object& dataset, const py::object& trajectory, std::optional<double> voxel_m,
+           std::optional<std::size_t> max_points, const py::object& config,
+           const std::vector<std::size_t>& scans, bool skip_bad, const py::object& progress,
+           const std::string& format, const std::optional<fs::path>& poses,
+           const std::optional<fs::path>& calib) {
+            const io::Dataset data = DatasetOf(dataset, format, poses, calib);
+            const core::MapConfig map_config = MapConfigOf(config, voxel_m, max_points);
+            const std::vector<core::StampedPose> placed = TrajectoryOf(data, trajectory);
+            const PythonProgress python_progress(progress);
+            app::MapBuildOptions options;
+            options.scans = scans;
+            options.skip_bad = skip_bad;
+            options.progress = python_progress.Callback();
+            app::BuiltMaps built;
+            {
+                py::gil_scoped_release release;
+                built = app::BuildMaps(data, {placed}, map_config, options);
+            }
+            python_progress.Rethrow();
+            py::dict result = MapCloudToPython(built.maps.front());
+            result["skipped"] = built.skipped;
+            return result;
+        },
+        py::arg("dataset"), py::kw_only(), py::arg("trajectory") = py::none(),
+        py::arg("voxel_m") = py::none(), py::arg("max_points") = py::none(),
+        py::arg("config") = py::none(), py::arg("scans") = std::vector<std::size_t>{},
+        py::arg("skip_bad") = false, py::arg("progress") = py::none(), py::arg("format") = "auto",
+        py::arg("poses") = py::none(), py::arg("calib") = py::none(),
+        "Every scan of the dataset (or `scans`, in that order) placed with `trajectory` (None: "
+        "the dataset's poses; a KITTI or TUM file read as optimise reads odometry; or an (N, 4, "
+        "4) array of T_world_sensor, times the scan index) and averaged into voxels "
+        "(app::BuildMaps): a dict with points (M, 3) float64, times_s (M,), colors (M, 3) uint8 "
+        "(viridis of the scan time), voxel_m (coarser than asked when max_points capped it), "
+        "scans, input_points and skipped.");
+    m.def(
+        "write_map",
+        [](const py::object& dataset, const fs::path& out,
+           const std::optional<fs::path>& trajectory, std::optional<double> voxel_m,
+           std::optional<std::size_t> max_points, const py::object& config, bool overwrite,
+           const py::object& progress, const std::string& format,
+           const std::optional<fs::path>& poses, const std::optional<fs::path>& calib) {
+            const io::Dataset data = DatasetOf(dataset, format, poses, calib);
+            const PythonProgress python_progress(progress);
+            app::MapRequest request;
+            request.poses_file = trajectory.value_or(fs::path());
+            request.config = MapConfigOf(config, voxel_m, max_points);
+            request.out = out;
+            request.inputs = InputsOf(data, poses, calib);
+            request.overwrite = overwrite;
+            request.progress = python_progress.Callback();
+            app::MapOutcome outcome;
+            {
+                py::gil_scoped_release release;
+                outcome = app::RunMap(data, request);
+            }
+            python_progress.Rethrow();
+            py::dict result;
+            result["out"] = out;
+            result["points"] = outcome.points;
+            result["voxel_m"] = outcome.voxel_m;
+            result["scans"] = outcome.scans;
+            result["input_points"] = outcome.input_points;
+            result["notes"] = outcome.notes;
+            result["total_s"] = outcome.total_s;
+            return result;
+        },
+        py::arg("dataset"), py::kw_only(), py::arg("out"), py::arg("trajectory") = py::none(),
+        py::arg("voxel_m") = py::none(), py::arg("max_points") = py::none(),
+        py::arg("config") = py::none(), py::arg("overwrite") = false,
+        py::arg("progress") = py::none(), py::arg("format") = "auto", py::arg("poses") = py::none(),
+        py::arg("calib") = py::none(),
+        "`lidarloop map DATASET --poses TRAJECTORY --out OUT`: the map of the dataset placed "
+        "with `trajectory` (a KITTI or TUM file; None: the dataset's poses) written as a binary "
+        "PLY coloured by scan time (app::RunMap: `out` is refused inside an input, and replaced "
+        "only when lidarloop wrote it unless overwrite). A dict: out, points, voxel_m, scans, "
+        "input_points, notes, total_s.");
 }
 
 }  // namespace
@@ -583,6 +732,7 @@ void BindApp(py::module_& m) {
     BindMethodEvaluation(m);
     BindEvaluate(m);
     BindOptimise(m);
+    BindMap(m);
 }
 
 }  // namespace lidarloop::python

@@ -166,6 +166,39 @@ def test_optimise_matches_the_cli(cli, cli_verified, sequence, tmp_path):
     assert json.loads((tmp_path / "py" / "run.json").read_text())["status"] == "complete"
     with pytest.raises(lidarloop.WriteError):  # inside the dataset, as detect
         lidarloop.optimise(sequence, odometry=odometry, loops=loops, out=sequence / "opt")
+    for name in ("map_odometry.ply", "map_optimised.ply", "map.png"):
+        assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes()
+    assert result.maps["points_optimised"] == py_metrics["maps"]["points_optimised"] > 1000
+
+
+def test_map_matches_the_cli(cli, sequence, tmp_path):
+    odometry = sequence / "poses_odometry.txt"
+    run_cli(cli, "map", sequence, "--poses", odometry, "--voxel", "0.5", "--out",
+            tmp_path / "cli.ply")
+    written = lidarloop.write_map(sequence, trajectory=odometry, voxel_m=0.5,
+                                  out=tmp_path / "py.ply")
+    assert (tmp_path / "py.ply").read_bytes() == (tmp_path / "cli.ply").read_bytes()
+    built = lidarloop.build_map(sequence, trajectory=odometry, voxel_m=0.5)
+    assert built["points"].shape == (written["points"], 3) and written["scans"] == 80
+    assert built["colors"].dtype == np.uint8 and built["times_s"].shape == (written["points"],)
+    # The same trajectory as an array (times: the scan index, as poses_odometry.txt's).
+    kitti = np.loadtxt(odometry).reshape(-1, 3, 4)
+    transforms = np.tile(np.eye(4), (len(kitti), 1, 1))
+    transforms[:, :3, :] = kitti
+    from_array = lidarloop.build_map(sequence, trajectory=transforms, voxel_m=0.5)
+    np.testing.assert_allclose(from_array["points"], built["points"], atol=1e-9)
+    some = lidarloop.build_map(sequence, scans=[3, 4, 5], voxel_m=0.5)  # the ground truth
+    assert some["scans"] == 3 and 0 < len(some["points"]) < len(built["points"])
+    with pytest.raises(lidarloop.ConfigError, match="map.voxel_m"):
+        lidarloop.build_map(sequence, voxel_m=0.0)
+    with pytest.raises(lidarloop.ConfigError, match="holds 79 poses for 80 scans"):
+        lidarloop.build_map(sequence, trajectory=transforms[1:])
+    with pytest.raises(lidarloop.WriteError, match="lies inside the input"):
+        lidarloop.write_map(sequence, out=sequence / "map.ply")
+    (tmp_path / "mine.ply").write_text("my map")
+    with pytest.raises(lidarloop.WriteError, match="give --overwrite"):
+        lidarloop.write_map(sequence, out=tmp_path / "mine.ply")
+    assert (tmp_path / "mine.ply").read_text() == "my map"
 
 
 def test_results_folders_are_guarded(sequence, tmp_path):

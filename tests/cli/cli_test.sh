@@ -8,7 +8,7 @@
 # output; the last line is "cli <sections>: N passed, N failed".
 set -u
 sections=(describe distance ndt scancontext verify detect bench demo evaluate dump-config bad-input simulate
-    optimise results-folders errors loops path-gap)
+    optimise map results-folders errors loops path-gap)
 if [ "${1-}" = "--list" ]; then
     printf '%s\n' "${sections[@]}"
     exit 0
@@ -349,6 +349,9 @@ section_demo() {
         similarity_ndt.png config.yaml; do
         if [ -s "$work/demo/evaluation/$file" ]; then pass; else fail "demo did not write $file"; fi
     done
+    for file in map.png map_odometry.ply map_optimised.ply; do
+        if [ -s "$work/demo/optimised/$file" ]; then pass; else fail "demo did not write $file"; fi
+    done
     for stage in evaluation optimised; do
         if grep -q '"status": "complete"' "$work/demo/$stage/run.json"; then pass; else
             fail "demo's $stage/run.json does not say complete"
@@ -586,6 +589,55 @@ section_optimise() {
     expect_error "optimise non-finite odometry" "line 3: 'nan' is not a finite number" "$cli" \
         optimise "$work/seq" --odometry "$work/inf.txt" --loops "$work/loops.csv" \
         --out "$work/opt_bad"
+}
+
+# --- map: the scans placed with a trajectory, and optimise's maps ------------------------------
+section_map() {
+    "$cli" simulate --sensor vlp16 --route grid --scans 40 --horizontal-steps 90 --quiet \
+        --out "$work/seq" >/dev/null 2>&1
+    local odometry="$work/seq/poses_odometry.txt"
+    expect_ok "map" "40 scans" "$cli" map "$work/seq" --poses "$odometry" --out "$work/m/map.ply"
+    if head -c 200 "$work/m/map.ply" | grep -q "comment written by lidarloop" &&
+        head -c 400 "$work/m/map.ply" | grep -q "property uchar red"; then pass; else
+        fail "map wrote no coloured lidarloop PLY"
+    fi
+    expect_ok "map again over its own file" "voxels of 0.5 m" "$cli" map "$work/seq" --poses \
+        "$odometry" --voxel 0.5 --out "$work/m/map.ply"
+    expect_ok "map of the dataset's poses, capped" "map.max_points = 1000" "$cli" map \
+        "$work/seq" --max-points 1000 --out "$work/m/truth.ply"
+    echo "my map" >"$work/mine.ply"
+    expect_exit_1 "map onto a foreign file" "give --overwrite" "$cli" map "$work/seq" --out \
+        "$work/mine.ply"
+    if grep -q "my map" "$work/mine.ply"; then pass; else fail "map replaced mine.ply"; fi
+    expect_ok "map --overwrite" "40 scans" "$cli" map "$work/seq" --out "$work/mine.ply" \
+        --overwrite
+    expect_exit_1 "map into the dataset" "lies inside the input" "$cli" map "$work/seq" \
+        --out "$work/seq/map.ply"
+    head -n 39 "$odometry" >"$work/short.txt"
+    expect_exit_1 "map short poses" "short.txt: holds 39 poses but" "$cli" map "$work/seq" \
+        --poses "$work/short.txt" --out "$work/bad.ply"
+    sed '3s/^[^ ]*/nan/' "$odometry" >"$work/nan.txt"
+    expect_exit_1 "map non-finite pose" "line 3: 'nan' is not a finite number" "$cli" map \
+        "$work/seq" --poses "$work/nan.txt" --out "$work/bad.ply"
+    expect_exit_1 "map voxel 0" "voxel" "$cli" map "$work/seq" --voxel 0 --out "$work/bad.ply"
+    expect_exit_1 "map voxel nan" "map.voxel_m must be in" "$cli" map "$work/seq" --voxel nan \
+        --out "$work/bad.ply"
+    printf 'map:\n  voxel_m: -1\n' >"$work/bad.yaml"
+    expect_exit_1 "map negative voxel in a config" "map.voxel_m" "$cli" map "$work/seq" \
+        --config "$work/bad.yaml" --out "$work/bad.ply"
+    expect_exit_1 "map missing poses" "missing.txt" "$cli" map "$work/seq" --poses \
+        "$work/missing.txt" --out "$work/bad.ply"
+    if [ ! -e "$work/bad.ply" ]; then pass; else fail "a failed map left bad.ply"; fi
+    # optimise writes both maps and their top view, linked from its report.
+    local header="query,match,distance,second_ratio,accepted,rank,tx,ty,tz,qx,qy,qz,qw"
+    printf '%s\n%s\n' "$header" "35,2,0.001,,1,1,0,0,0,0,0,0,1" >"$work/loops.csv"
+    expect_ok "optimise with maps" "map.png" "$cli" optimise "$work/seq" --odometry "$odometry" \
+        --loops "$work/loops.csv" --out "$work/opt"
+    if [ -s "$work/opt/map_odometry.ply" ] && [ -s "$work/opt/map_optimised.ply" ] &&
+        [ "$(head -c 4 "$work/opt/map.png" | tail -c 3)" = "PNG" ] &&
+        grep -q "(map.png)" "$work/opt/report.md"; then pass; else
+        fail "optimise wrote no maps or map.png, or report.md does not link it"
+    fi
 }
 
 # expect_intact NAME FILE...: each file still exists and is not empty.

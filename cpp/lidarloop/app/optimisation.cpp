@@ -9,8 +9,12 @@
 #include <utility>
 
 #include "lidarloop/app/detection.hpp"
+#include "lidarloop/app/map_building.hpp"
 #include "lidarloop/app/optimisation_report.hpp"
 #include "lidarloop/app/results_folder.hpp"
+#include "lidarloop/io/map_files.hpp"
+#include "lidarloop/io/map_image.hpp"
+#include "lidarloop/io/png.hpp"
 #include "lidarloop/io/pose_graph_files.hpp"
 #include "lidarloop/io/poses.hpp"
 #include "lidarloop/io/read_error.hpp"
@@ -149,6 +153,36 @@ void WriteGraph(const std::filesystem::path& file, const posegraph::PoseGraph& g
     io::WriteG2o(file, result.poses, used, rejected);
 }
 
+// The scans placed with the odometry and with the optimised poses, in one pass over the scans.
+MapSummary WriteMaps(const io::Dataset& dataset, const OptimiseRequest& request,
+                     const std::filesystem::path& out,
+                     const std::vector<core::StampedPose>& odometry,
+                     const std::vector<core::Transform>& optimised,
+                     std::vector<std::string>& notes) {
+    const Stopwatch watch;
+    std::vector<core::StampedPose> placed = odometry;  // keeps the times
+    for (std::size_t i = 0; i < placed.size(); ++i) placed[i].T_world_sensor = optimised[i];
+    MapBuildOptions options;
+    options.skip_bad = request.skip_bad;
+    options.progress = request.progress;
+    const BuiltMaps built = BuildMaps(dataset, {odometry, placed}, request.config.map, options);
+    const core::MapCloud& before = built.maps[0];
+    const core::MapCloud& after = built.maps[1];
+    io::WriteMapPly(out / "map_odometry.ply", before);
+    io::WriteMapPly(out / "map_optimised.ply", after);
+    io::WritePng(out / "map.png", io::MapTopView({{"odometry", &before}, {"optimised", &after}}));
+    if (!built.skipped.empty()) {
+        notes.push_back("the maps leave out " + std::to_string(built.skipped.size()) +
+                        " unreadable scans (" + built.skipped.front() + ", ...)");
+    }
+    for (const core::MapCloud* map : {&before, &after}) {
+        const std::string note = CoarsenedMapNote(*map, request.config.map);
+        if (!note.empty()) notes.push_back(note);
+    }
+    return {before.points.size(), after.points.size(), std::max(before.voxel_m, after.voxel_m),
+            watch.Seconds()};
+}
+
 }  // namespace
 
 OptimiseOutcome RunOptimisation(const io::Dataset& dataset, const OptimiseRequest& request) {
@@ -177,6 +211,7 @@ OptimiseOutcome RunOptimisation(const io::Dataset& dataset, const OptimiseReques
     WritePoses(out / "poses_optimised.txt", request, odometry, outcome.result.poses);
     WriteGraph(out / "graph.g2o", graph, outcome.result);
     WriteLoopVerdicts(out / "loop_verdicts.csv", outcome);
+    outcome.maps = WriteMaps(dataset, request, out, odometry, outcome.result.poses, outcome.notes);
     const std::vector<core::Transform> truth =
         dataset.HasPoses() ? Transforms(dataset.poses()) : std::vector<core::Transform>{};
     if (const auto note = DrawTrajectoryPlot(out / "trajectory.png", graph.poses, truth, outcome))

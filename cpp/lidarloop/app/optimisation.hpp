@@ -39,6 +39,14 @@ struct TrajectoryMetrics {
     eval::TrajectoryRpe rpe;
 };
 
+/// The maps optimise writes: all scans placed with the odometry and with the optimised poses.
+struct MapSummary {
+    std::size_t odometry_points = 0;   ///< points of map_odometry.ply
+    std::size_t optimised_points = 0;  ///< points of map_optimised.ply
+    double voxel_m = 0.0;              ///< voxel edge used (map.voxel_m, or coarser when capped)
+    double seconds = 0.0;              ///< building and writing both maps and map.png
+};
+
 struct OptimiseOutcome {
     std::vector<posegraph::LoopConstraint> loops;  ///< the accepted loops, as read or detected
     posegraph::OptimisationResult result;
@@ -46,7 +54,8 @@ struct OptimiseOutcome {
     std::vector<bool> loop_is_true;
     std::optional<TrajectoryMetrics> odometry;   ///< with ground truth
     std::optional<TrajectoryMetrics> optimised;  ///< with ground truth
-    std::vector<std::string> notes;              ///< e.g. no loop, no ground truth, no gnuplot
+    MapSummary maps;
+    std::vector<std::string> notes;  ///< e.g. no loop, no ground truth, no gnuplot
     double total_s = 0.0;
 };
 
@@ -57,8 +66,10 @@ struct OptimiseOutcome {
 /// line; rows repeating an earlier row's two scans, in either order, are merged into it, with a
 /// note), or detects them, builds and optimises the pose graph, and writes into request.out:
 /// poses_optimised.txt, graph.g2o (optimised vertices, the odometry edges and the loops used;
-/// rejected loops commented), loop_verdicts.csv, metrics.json, report.md, config.yaml and,
-/// when gnuplot is installed, trajectory.png (top view).
+/// rejected loops commented), loop_verdicts.csv, metrics.json, report.md, config.yaml,
+/// map_odometry.ply and map_optimised.ply (every scan placed with each trajectory, config.map;
+/// io::WriteMapPly), map.png (their top views side by side, io::MapTopView) and, when gnuplot is
+/// installed, trajectory.png (top view of the trajectories).
 OptimiseOutcome RunOptimisation(const io::Dataset& dataset, const OptimiseRequest& request);
 
 }  // namespace lidarloop::app

@@ -160,6 +160,11 @@ nlohmann::json OptimisationMetricsJson(const io::Dataset& dataset, const Optimis
               {"initial_cost", r.initial_cost},
               {"final_cost", r.final_cost},
               {"seconds", r.seconds}}},
+            {"maps",
+             {{"voxel_m", outcome.maps.voxel_m},
+              {"points_odometry", outcome.maps.odometry_points},
+              {"points_optimised", outcome.maps.optimised_points},
+              {"seconds", outcome.maps.seconds}}},
             {"notes", outcome.notes},
             {"total_s", outcome.total_s}};
 }
@@ -206,6 +211,12 @@ void WriteOptimisationReport(const std::filesystem::path& file, const io::Datase
     if (std::filesystem::exists(file.parent_path() / "trajectory.png")) {
         out << "\n![top view](trajectory.png)\n";
     }
+    const MapSummary& maps = outcome.maps;
+    out << "\n## Maps\n\nEvery scan placed with the odometry (left; a revisit the odometry "
+           "drifted through shows doubled walls) and with the optimised poses (right), top view, "
+           "coloured by scan time: `map_odometry.ply` ("
+        << maps.odometry_points << " points) and `map_optimised.ply` (" << maps.optimised_points
+        << " points), voxels of " << Number(maps.voxel_m, 3) << " m.\n\n![maps](map.png)\n";
     if (!out) throw io::WriteError(file, "writing failed");
 }
 

@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "lidarloop/io/map_files.hpp"
 #include "lidarloop/io/read_error.hpp"
 
 namespace lidarloop::app {
@@ -338,16 +339,16 @@ void RunFolder::WriteManifest(RunStatus status, const std::vector<std::string>& 
     WriteFileAtomically(folder_ / io::kRunRecordName, json.dump(2) + "\n");
 }
 
-void WriteFileAtomically(const fs::path& file, const std::string& text) {
+void WriteFileAtomically(const fs::path& file,
+                         const std::function<void(const fs::path& temporary)>& write) {
     const fs::path temporary =
         file.parent_path() / ("." + file.filename().string() + ".tmp-" + UniqueSuffix());
-    std::ofstream out(temporary, std::ios::binary);
-    out << text;
-    out.close();
     std::error_code ec;
-    if (!out) {
+    try {
+        write(temporary);
+    } catch (...) {
         fs::remove(temporary, ec);
-        throw io::WriteError(file, "writing failed (disk full?)");
+        throw;
     }
     fs::rename(temporary, file, ec);
     if (ec) {
@@ -356,14 +357,23 @@ void WriteFileAtomically(const fs::path& file, const std::string& text) {
     }
 }
 
+void WriteFileAtomically(const fs::path& file, const std::string& text) {
+    WriteFileAtomically(file, [&](const fs::path& temporary) {
+        std::ofstream out(temporary, std::ios::binary);
+        out << text;
+        out.close();
+        if (!out) throw io::WriteError(file, "writing failed (disk full?)");
+    });
+}
+
 void CheckOutputFile(const fs::path& file, const std::vector<fs::path>& inputs, bool overwrite) {
     RefuseInputOverlap(file, inputs);
     std::error_code ec;
     if (fs::is_directory(file, ec)) throw io::WriteError(file, "is a folder, not a file");
-    if (fs::exists(file, ec) && !overwrite && !IsLidarloopJson(file)) {
+    if (fs::exists(file, ec) && !overwrite && !IsLidarloopJson(file) && !io::IsLidarloopPly(file)) {
         throw io::WriteError(file,
-                             "exists and is not a JSON file that lidarloop wrote; choose another "
-                             "file, or give --overwrite to replace it");
+                             "exists and is not a JSON or PLY file that lidarloop wrote; choose "
+                             "another file, or give --overwrite to replace it");
     }
 }
 

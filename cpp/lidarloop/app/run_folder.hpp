@@ -1,6 +1,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <mutex>
 #include <string>
 #include <utility>
@@ -99,10 +100,14 @@ std::filesystem::path AbandonActiveRun(RunStatus status, const std::string& mess
 /// Writes `text` to `file` beside it first and then renames it, so that `file` is whole or
 /// absent. Throws io::WriteError.
 void WriteFileAtomically(const std::filesystem::path& file, const std::string& text);
+/// The same for any writer: `write(temporary)` writes a file beside `file` (removed when `write`
+/// throws), which then replaces `file`.
+void WriteFileAtomically(const std::filesystem::path& file,
+                         const std::function<void(const std::filesystem::path& temporary)>& write);
 
 /// The results-folder rule for one output file: throws io::WriteError when `file` is or lies
-/// inside one of `inputs`, is a folder, or exists and is not a JSON file that lidarloop wrote
-/// (unless `overwrite`).
+/// inside one of `inputs`, is a folder, or exists and is not a JSON or PLY file that lidarloop
+/// wrote (unless `overwrite`).
 void CheckOutputFile(const std::filesystem::path& file,
                      const std::vector<std::filesystem::path>& inputs, bool overwrite);
 

@@ -215,6 +215,14 @@ void VisitFields(posegraph::PoseGraphConfig& c, Visitor& v) {
 }
 
 template <typename Visitor>
+void VisitFields(core::MapConfig& c, Visitor& v) {
+    v.Field("voxel_m", c.voxel_m,
+            "optimise, map: edge of the voxels a map's placed points are averaged into, m");
+    v.Field("max_points", c.max_points,
+            "most points of a map; a larger map gets a coarser voxel (doubled until it fits)");
+}
+
+template <typename Visitor>
 void VisitFields(OutputConfig& c, Visitor& v) {
     v.Field("similarity_matrix_mib", c.similarity_matrix_mib,
             "detect keeps the similarity matrix (similarity.bin, images) up to this size; 0 never");
@@ -229,6 +237,7 @@ void VisitFields(RunConfig& c, Visitor& v) {
     v.Section("detection", c.detection);
     v.Section("verification", c.detection.verification);
     v.Section("posegraph", c.posegraph);
+    v.Section("map", c.map);
     v.Section("output", c.output);
 }
 

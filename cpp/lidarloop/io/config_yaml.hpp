@@ -5,6 +5,7 @@
 #include <string>
 
 #include "lidarloop/core/descriptor_config.hpp"
+#include "lidarloop/core/point_map.hpp"
 #include "lidarloop/pipeline/loop_detector.hpp"
 #include "lidarloop/posegraph/pose_graph_config.hpp"
 
@@ -33,12 +34,14 @@ struct RunConfig {
     core::DescriptorConfig descriptor;   ///< keys `method`, `histogram.*`, `ndt.*`, `scancontext.*`
     pipeline::DetectorConfig detection;  ///< keys `detection.*`
     posegraph::PoseGraphConfig posegraph;  ///< keys `posegraph.*` (lidarloop optimise)
+    core::MapConfig map;                   ///< keys `map.*` (optimise's maps, lidarloop map)
     OutputConfig output;                   ///< keys `output.*`
 
     void Validate() const {
         descriptor.Validate();
         detection.Validate();
         posegraph.Validate();
+        map.Validate();
     }
 };
 

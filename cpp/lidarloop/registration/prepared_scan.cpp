@@ -4,27 +4,13 @@
 #include <cmath>
 #include <cstdint>
 #include <numbers>
-#include <unordered_map>
 
 #include <Eigen/Eigenvalues>
 
+#include "lidarloop/core/voxel_grid.hpp"
+
 namespace lidarloop::registration {
 namespace {
-
-// Per voxel: the sum of its points and their count.
-struct VoxelSum {
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    int count = 0;
-};
-
-std::uint64_t VoxelKey(const Eigen::Vector3f& point, double voxel_m) {
-    // 21 bits per axis: +-1e6 voxels, far beyond any max_range_m / voxel_m.
-    auto axis = [&](int i) {
-        const auto cell = static_cast<std::int64_t>(std::floor(point[i] / voxel_m));
-        return static_cast<std::uint64_t>(cell + (1 << 20)) & 0x1FFFFFu;
-    };
-    return axis(0) | (axis(1) << 21) | (axis(2) << 42);
-}
 
 bool Usable(const Eigen::Vector3f& point, const ScanReductionConfig& config) {
     if (!point.allFinite()) return false;
@@ -36,21 +22,17 @@ bool Usable(const Eigen::Vector3f& point, const ScanReductionConfig& config) {
 std::vector<Eigen::Vector3f> VoxelCentroids(const core::PointCloud& scan,
                                             const ScanReductionConfig& config,
                                             std::size_t& usable_points) {
-    std::unordered_map<std::uint64_t, std::uint32_t> slot_of;
-    std::vector<VoxelSum> sums;
-    slot_of.reserve(scan.size() / 4);
+    core::VoxelGrid grid(config.voxel_m);
+    grid.Reserve(scan.size() / 4);
     for (const auto& point : scan) {
         if (!Usable(point, config)) continue;
         ++usable_points;
-        const auto [it, inserted] = slot_of.try_emplace(VoxelKey(point, config.voxel_m),
-                                                        static_cast<std::uint32_t>(sums.size()));
-        if (inserted) sums.emplace_back();
-        sums[it->second].sum += point.cast<double>();
-        ++sums[it->second].count;
+        grid.Add(point.cast<double>());
     }
     std::vector<Eigen::Vector3f> centroids;
-    centroids.reserve(sums.size());
-    for (const auto& voxel : sums) centroids.push_back((voxel.sum / voxel.count).cast<float>());
+    centroids.reserve(grid.size());
+    for (const core::Voxel& voxel : grid.Voxels())
+        centroids.push_back(voxel.centroid.cast<float>());
     return centroids;
 }
 
