@@ -8,7 +8,7 @@
 
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/core/histogram.hpp"
-#include "lidarloop/core/ndt_config.hpp"
+#include "lidarloop/core/ndt/ndt_config.hpp"
 #include "lidarloop/core/scancontext/scancontext_config.hpp"
 
 namespace lidarloop::core {
