@@ -27,6 +27,7 @@
 #include "lidarloop/core/ndt/ndt_orientation_modes.hpp"
 #include "lidarloop/core/ndt/ndt_shape.hpp"
 #include "lidarloop/core/ndt/sphere_partition.hpp"
+#include "lidarloop/core/parameters.hpp"
 #include "lidarloop/core/point_cloud.hpp"
 #include "lidarloop/core/projection.hpp"
 #include "lidarloop/core/scancontext/scancontext.hpp"
