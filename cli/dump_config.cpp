@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "lidarloop/app/run_options.hpp"
 #include "lidarloop/io/config_yaml.hpp"
 
 namespace lidarloop::cli {
@@ -18,10 +19,16 @@ void AddDumpConfigCommand(CLI::App& app) {
     command->add_flag("--markdown", *markdown,
                       "print the registered methods' parameters as the Markdown table of "
                       "docs/cli.md instead (key, default, help, unit, range)");
-    command->callback([config_file, markdown] {
+    auto run_options = std::make_shared<bool>(false);
+    command->add_flag("--markdown-run-options", *run_options,
+                      "print the run options of detect, evaluate, optimise and bench as the "
+                      "Markdown table of docs/cli.md instead");
+    command->callback([config_file, markdown, run_options] {
         const io::RunConfig config =
             config_file->empty() ? io::RunConfig{} : io::LoadConfigYaml(*config_file);
-        std::cout << (*markdown ? io::DumpParametersMarkdown(config) : io::DumpConfigYaml(config));
+        std::cout << (*run_options ? app::RunOptionsMarkdown()
+                      : *markdown  ? io::DumpParametersMarkdown(config)
+                                   : io::DumpConfigYaml(config));
     });
 }
 

@@ -122,5 +122,6 @@
 #include "lidarloop/app/results_folder.hpp"
 #include "lidarloop/app/retrieval_evaluation.hpp"
 #include "lidarloop/app/run_folder.hpp"
+#include "lidarloop/app/run_options.hpp"
 #include "lidarloop/app/simulation.hpp"
 #include "lidarloop/app/verification_run.hpp"

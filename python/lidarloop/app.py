@@ -8,6 +8,7 @@ from ._lidarloop import (
     detect,
     evaluate,
     optimise,
+    run_options,
 )
 
 __all__ = [
@@ -18,4 +19,5 @@ __all__ = [
     "detect",
     "evaluate",
     "optimise",
+    "run_options",
 ]

@@ -516,7 +516,8 @@ private:
         bool code = std::is_same_v<T, std::string>;  // names in code, as in the docs
         if constexpr (std::is_same_v<T, std::optional<double>>) code = !value.has_value();
         out_ += "| `" + section_ + "." + std::string(info.key) + "` | " +
-                (code ? "`" + text + "`" : text) + " | " + std::string(info.help);
+                (code ? "`" + text + "`" : text) + " | ";
+        for (const char c : info.help) out_ += c == '|' ? std::string("\\|") : std::string(1, c);
         std::string limits;
         if (!info.unit.empty()) limits += std::string(info.unit);
         if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>) {
