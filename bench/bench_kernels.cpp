@@ -8,8 +8,8 @@
 #include <benchmark/benchmark.h>
 
 #include "lidarloop/core/histogram.hpp"
-#include "lidarloop/core/ndt_cells.hpp"
-#include "lidarloop/core/ndt_descriptor.hpp"
+#include "lidarloop/core/ndt/ndt_cells.hpp"
+#include "lidarloop/core/ndt/ndt_descriptor.hpp"
 #include "lidarloop/core/scancontext/scancontext.hpp"
 #include "lidarloop/core/scancontext/scancontext_distance.hpp"
 #include "lidarloop/core/wasserstein.hpp"

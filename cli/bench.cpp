@@ -8,11 +8,11 @@
 #include "commands.hpp"
 #include "dataset_options.hpp"
 #include "descriptor_options.hpp"
-#include "detection_options.hpp"
 #include "lidarloop/app/bench.hpp"
 #include "lidarloop/app/results_folder.hpp"
 #include "lidarloop/app/run_folder.hpp"
 #include "progress.hpp"
+#include "run_options.hpp"
 
 namespace lidarloop::cli {
 namespace {
@@ -20,7 +20,7 @@ namespace {
 struct BenchFlags {
     DatasetOptions dataset;
     DescriptorOptions descriptor;
-    DetectionOptions detection;
+    RunOptionFlags options;  // app/run_options.hpp: --threshold, --top-k, --min-gap, ...
     app::BenchRequest request;
     std::string json;
     bool overwrite = false;
@@ -96,7 +96,7 @@ void PrintSummary(const nlohmann::json& figures) {
 void RunBench(BenchFlags& flags) {
     ProgressPrinter progress(flags.quiet);
     flags.request.config = flags.descriptor.Resolve();
-    flags.detection.ApplyTo(flags.request.config);
+    flags.options.ApplyTo({&flags.request.config});
     flags.request.progress = progress.Callback();
     // The file is checked before the run, so that a refused --json costs no measurement.
     const bool json_to_stdout = flags.json == "-";
@@ -127,8 +127,7 @@ void AddBenchCommand(CLI::App& app) {
     command->add_option("--verify-queries", flags->request.verify_queries,
                         "query scans whose top-k candidates are verified and timed (default 50; "
                         "0: none)");
-    flags->detection.AddTo(*command, /*decides_loops=*/true,
-                           "S: candidates at least this far back");
+    flags->options.AddTo(*command, app::RunCommand::kBench);
     command->add_option("--json", flags->json,
                         "also write the figures as JSON to this file (replaced only when "
                         "lidarloop wrote it, or with --overwrite); '-': JSON to stdout instead of "

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <array>
+#include <deque>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -13,8 +14,10 @@ namespace lidarloop::cli {
 /// Precedence: built-in defaults < --config FILE < individual flags.
 class DescriptorOptions {
 public:
-    /// Adds --config, --method, and the histogram flags --bins, --min, --max, --up,
-    /// --sensor-height, --out-of-range (NDT parameters come from --config).
+    /// Adds --config, --method, the histogram flags --bins, --min, --max, --up,
+    /// --sensor-height, --out-of-range (NDT parameters come from --config), and a flag per
+    /// declared parameter of every registered method that has its own (--scancontext-rings ...;
+    /// docs/options.md).
     void AddTo(CLI::App& command, bool with_method = true);
 
     /// The effective configuration: `base` (default: the built-in defaults) with --config and
@@ -25,8 +28,18 @@ public:
     /// Whether --min or --max was given: they set the value range of one projection.
     bool GivesValueRange() const { return *min_option_ || *max_option_; }
 
+    /// A flag of a registered method's parameter, kept as given and applied through the YAML
+    /// reader, so that its value is read and checked exactly as the key in a file.
+    struct MethodFlag {
+        std::string section;  ///< the method's name
+        std::string key;      ///< the parameter's YAML key
+        std::string value;
+        CLI::Option* option = nullptr;
+    };
+
 private:
     void ApplyHistogramFlags(core::DescriptorConfig& descriptor) const;
+    void ApplyMethodFlags(io::RunConfig& config) const;
     /// --bins, --min, --max, --up, --sensor-height, --out-of-range.
     std::array<const CLI::Option*, 6> HistogramFlags() const {
         return {bins_option_, min_option_,           max_option_,
@@ -48,6 +61,7 @@ private:
     CLI::Option* sensor_height_option_ = nullptr;
     CLI::Option* up_option_ = nullptr;
     CLI::Option* out_of_range_option_ = nullptr;
+    std::deque<MethodFlag> method_flags_;  // a deque: CLI11 keeps the address of each value
 };
 
 }  // namespace lidarloop::cli

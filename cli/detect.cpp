@@ -10,11 +10,11 @@
 #include "commands.hpp"
 #include "dataset_options.hpp"
 #include "descriptor_options.hpp"
-#include "detection_options.hpp"
 #include "lidarloop/app/detection.hpp"
 #include "lidarloop/core/descriptor.hpp"
 #include "lidarloop/core/error.hpp"
 #include "progress.hpp"
+#include "run_options.hpp"
 #include "run_output.hpp"
 
 namespace lidarloop::cli {
@@ -23,11 +23,10 @@ namespace {
 struct DetectFlags {
     DatasetOptions dataset;
     DescriptorOptions descriptor;
-    DetectionOptions detection;
+    RunOptionFlags options;  // app/run_options.hpp: --threshold, --top-k, --skip-bad, ...
     std::string out;
     std::string map;       // a database.lldb to localise against (query-only mode)
     std::string odometry;  // poses the path is measured on (a gap in metres, path_m)
-    bool skip_bad = false;
     bool overwrite = false;
     bool quiet = false;
 };
@@ -38,7 +37,8 @@ io::RunConfig ResolveAgainstMap(const DetectFlags& flags, const app::LoadedMap& 
     io::RunConfig base;
     base.descriptor = map.database.config();
     io::RunConfig config = flags.descriptor.Resolve(base);
-    flags.detection.ApplyTo(config);
+    bool skip_bad = false;  // set again by RunDetect
+    flags.options.ApplyTo({&config, &skip_bad});
     if (config.descriptor != map.database.config()) {
         throw core::ConfigError(flags.descriptor.FirstGiven() +
                                 " changes how scans are described, but the map " + flags.map +
@@ -92,13 +92,13 @@ std::vector<std::filesystem::path> Inputs(const DetectFlags& flags) {
 void RunDetect(const DetectFlags& flags) {
     ProgressPrinter progress(flags.quiet);
     app::DetectRequest request;
-    request.skip_bad = flags.skip_bad;
     request.progress = progress.Callback();
     request.out = flags.out;
     request.odometry_file = flags.odometry;
     if (!flags.map.empty()) {
         app::LoadedMap map = app::LoadMap(flags.map);
         request.config = ResolveAgainstMap(flags, map);
+        flags.options.ApplyTo({&request.config, &request.skip_bad});
         const io::Dataset dataset = flags.dataset.Open();
         const app::DetectOutcome outcome = RunInFolder(
             flags.out, Inputs(flags), flags.overwrite, [&](const std::filesystem::path& staging) {
@@ -110,7 +110,7 @@ void RunDetect(const DetectFlags& flags) {
         return;
     }
     request.config = flags.descriptor.Resolve();
-    flags.detection.ApplyTo(request.config);
+    flags.options.ApplyTo({&request.config, &request.skip_bad});
     const io::Dataset dataset = flags.dataset.Open();
     const app::DetectOutcome outcome = RunInFolder(flags.out, Inputs(flags), flags.overwrite,
                                                    [&](const std::filesystem::path& staging) {
@@ -129,8 +129,7 @@ void AddDetectCommand(CLI::App& app) {
     auto flags = std::make_shared<DetectFlags>();
     flags->dataset.AddTo(*command);
     flags->descriptor.AddTo(*command);
-    flags->detection.AddTo(*command, /*decides_loops=*/true,
-                           "S: candidates at least this far back (default 30 scans)");
+    flags->options.AddTo(*command, app::RunCommand::kDetect);
     command->add_option("--out", flags->out, "folder for the results (created)")->required();
     command
         ->add_option("--map", flags->map,
@@ -142,8 +141,6 @@ void AddDetectCommand(CLI::App& app) {
                      "odometry poses, KITTI or TUM, one per scan: the path a gap in metres and "
                      "loops.csv's path_m are measured on (default: the dataset's poses)")
         ->check(CLI::ExistingFile);
-    command->add_flag("--skip-bad", flags->skip_bad,
-                      "skip unreadable scans (listed in skipped.txt) instead of stopping");
     command->add_flag("--overwrite", flags->overwrite,
                       "write into a non-empty folder that holds no earlier lidarloop run");
     command->add_flag("--quiet", flags->quiet, "no progress bar");

@@ -10,12 +10,12 @@
 #include "commands.hpp"
 #include "dataset_options.hpp"
 #include "descriptor_options.hpp"
-#include "detection_options.hpp"
 #include "lidarloop/app/evaluation.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/pipeline/descriptor_method.hpp"
 #include "progress.hpp"
 #include "retrieval_print.hpp"
+#include "run_options.hpp"
 #include "run_output.hpp"
 
 namespace lidarloop::cli {
@@ -24,19 +24,12 @@ namespace {
 struct EvaluateFlags {
     DatasetOptions dataset;
     DescriptorOptions descriptor;
-    DetectionOptions detection;
+    RunOptionFlags options;  // app/run_options.hpp: the ground truth, learning, detection keys
     std::vector<std::string> methods = pipeline::MethodNames();
     std::vector<std::string> results;
-    double distance_m = 10.0;
-    double max_heading_deg = 0.0;
-    double min_path_m = 0.0;
-    double train_fraction = 0.5;
-    std::string criterion = "mcc";
-    std::vector<double> fixed_thresholds;
     std::string train_on;
     std::string train_poses;
     std::string out;
-    bool skip_bad = false;
     bool overwrite = false;
     bool quiet = false;
 };
@@ -72,9 +65,7 @@ io::RunConfig ResolveConfig(const EvaluateFlags& flags, const std::vector<core::
         }
         base.descriptor.method = histograms.front();
     }
-    io::RunConfig config = flags.descriptor.Resolve(base);
-    flags.detection.ApplyTo(config);
-    return config;
+    return flags.descriptor.Resolve(base);
 }
 
 app::EvaluationRequest RequestOf(const EvaluateFlags& flags) {
@@ -82,14 +73,8 @@ app::EvaluationRequest RequestOf(const EvaluateFlags& flags) {
     for (const std::string& name : flags.methods)
         request.methods.push_back(pipeline::ParseMethod(name));
     request.config = ResolveConfig(flags, request.methods);
+    flags.options.ApplyTo({&request.config, &request.skip_bad, &request});
     request.results_files = flags.results;
-    request.distance_m = flags.distance_m;
-    request.max_heading_deg = flags.max_heading_deg;
-    request.min_path_m = flags.min_path_m;
-    request.learning.train_fraction = flags.train_fraction;
-    request.learning.criterion = eval::ParseCriterion(flags.criterion);
-    request.fixed_thresholds = flags.fixed_thresholds;
-    request.skip_bad = flags.skip_bad;
     request.out = flags.out;
     return request;
 }
@@ -142,21 +127,7 @@ void RunEvaluate(const EvaluateFlags& flags) {
     PrintOutcome(dataset, outcome, request.out);
 }
 
-void AddGroundTruthFlags(CLI::App& command, EvaluateFlags& flags) {
-    command.add_option("--distance", flags.distance_m,
-                       "same place when closer than this, metres (Roehling 10, Magnusson 3-10)");
-    command.add_option("--max-heading", flags.max_heading_deg,
-                       "and headings differ by less than this, degrees (0: any; Kvarntorp 20)");
-    command.add_option("--min-path", flags.min_path_m,
-                       "pairs not more than this much path apart (metres on the poses) are not "
-                       "evaluated, besides the gap (0: no path rule; SLAM revisits: 50)");
-    flags.detection.AddTo(command, /*decides_loops=*/true,
-                          "S: pairs closer in the sequence are not evaluated");
-}
-
-void AddLearningFlags(CLI::App& command, EvaluateFlags& flags) {
-    command.add_option("--train-fraction", flags.train_fraction,
-                       "share of the sequence a threshold is learnt on (default 0.5)");
+void AddTrainingFlags(CLI::App& command, EvaluateFlags& flags) {
     command
         .add_option("--train-on", flags.train_on,
                     "learn each method's threshold on all pairs of this dataset (same rule) "
@@ -164,12 +135,6 @@ void AddLearningFlags(CLI::App& command, EvaluateFlags& flags) {
         ->check(CLI::ExistingDirectory);
     command.add_option("--train-poses", flags.train_poses, "poses file of --train-on")
         ->check(CLI::ExistingFile);
-    command.add_option("--criterion", flags.criterion,
-                       "what the learnt threshold maximises: mcc | f1");
-    command
-        .add_option("--fixed-thresholds", flags.fixed_thresholds,
-                    "also report MCC and F1 at these thresholds (Roehling table II)")
-        ->delimiter(',');
 }
 
 }  // namespace
@@ -188,10 +153,9 @@ void AddEvaluateCommand(CLI::App& app) {
         ->add_option("--results", flags->results,
                      "also score another detector's CSV (query,match,distance); repeatable")
         ->check(CLI::ExistingFile);
-    AddGroundTruthFlags(*command, *flags);
-    AddLearningFlags(*command, *flags);
+    flags->options.AddTo(*command, app::RunCommand::kEvaluate);
+    AddTrainingFlags(*command, *flags);
     command->add_option("--out", flags->out, "folder for the results (created)")->required();
-    command->add_flag("--skip-bad", flags->skip_bad, "skip unreadable scans instead of stopping");
     command->add_flag("--overwrite", flags->overwrite,
                       "write into a non-empty folder that holds no earlier lidarloop run");
     command->add_flag("--quiet", flags->quiet, "no progress bar");

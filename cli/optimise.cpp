@@ -11,9 +11,9 @@
 #include "commands.hpp"
 #include "dataset_options.hpp"
 #include "descriptor_options.hpp"
-#include "detection_options.hpp"
 #include "lidarloop/app/optimisation.hpp"
 #include "progress.hpp"
+#include "run_options.hpp"
 #include "run_output.hpp"
 
 namespace lidarloop::cli {
@@ -22,13 +22,11 @@ namespace {
 struct OptimiseFlags {
     DatasetOptions dataset;
     DescriptorOptions descriptor;
-    DetectionOptions detection;
+    RunOptionFlags options;  // app/run_options.hpp: detection keys, --max-odometry-step, ...
     std::string odometry;
     std::string loops;
     std::string out;
     std::string format = "kitti";
-    std::optional<double> max_odometry_step_m;  // posegraph.max_odometry_step_m when given
-    bool skip_bad = false;
     bool overwrite = false;
     bool quiet = false;
 };
@@ -75,13 +73,10 @@ void RunOptimise(const OptimiseFlags& flags) {
     ProgressPrinter progress(flags.quiet);
     app::OptimiseRequest request;
     request.config = flags.descriptor.Resolve();
-    flags.detection.ApplyTo(request.config);
+    flags.options.ApplyTo({&request.config, &request.skip_bad});
     request.odometry_file = flags.odometry;
     request.loops_file = flags.loops;
     request.format = flags.format == "tum" ? app::PoseFormat::kTum : app::PoseFormat::kKitti;
-    if (flags.max_odometry_step_m)
-        request.config.posegraph.max_odometry_step_m = *flags.max_odometry_step_m;
-    request.skip_bad = flags.skip_bad;
     request.progress = progress.Callback();
     request.out = flags.out;
     const io::Dataset dataset = flags.dataset.Open();
@@ -112,16 +107,8 @@ void AddOptimiseCommand(CLI::App& app) {
     command->add_option("--format", flags->format, "poses_optimised.txt format: kitti | tum")
         ->check(CLI::IsMember({"kitti", "tum"}))
         ->capture_default_str();
-    command
-        ->add_option("--max-odometry-step", flags->max_odometry_step_m,
-                     "M: odometry moving farther between two scans is an error (a jump or "
-                     "reset); posegraph.max_odometry_step_m, default 100")
-        ->check(CLI::PositiveNumber);
     flags->descriptor.AddTo(*command);
-    flags->detection.AddTo(*command, /*decides_loops=*/true,
-                           "S: candidates at least this far back (default 30 scans)");
-    command->add_flag("--skip-bad", flags->skip_bad,
-                      "skip unreadable scans when detecting instead of stopping");
+    flags->options.AddTo(*command, app::RunCommand::kOptimise);
     command->add_flag("--overwrite", flags->overwrite,
                       "write into a non-empty folder that holds no lidarloop run.json");
     command->add_flag("--quiet", flags->quiet, "no progress bar");

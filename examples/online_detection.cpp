@@ -3,8 +3,7 @@
 #include <cstdio>
 #include <exception>
 
-#include "lidarloop/io/dataset.hpp"
-#include "lidarloop/pipeline/loop_detector.hpp"
+#include "lidarloop/lidarloop.hpp"  // every public header; link lidarloop::app
 
 namespace ll = lidarloop;
 

@@ -11,6 +11,7 @@ from ._lidarloop import (
     evaluate,
     optimise,
     write_map,
+    run_options,
 )
 
 __all__ = [
@@ -23,4 +24,5 @@ __all__ = [
     "evaluate",
     "optimise",
     "write_map",
+    "run_options",
 ]

@@ -61,18 +61,19 @@ def detect(
     out: PathLike,
     method: Optional[str] = None,
     config: Config = None,
-    verify: Optional[bool] = None,
-    threshold: Optional[float] = None,
-    top_k: Optional[int] = None,
-    min_gap: Optional[float] = None,
-    min_gap_unit: Optional[str] = None,
-    skip_bad: bool = False,
     overwrite: bool = False,
     progress: Optional[Progress] = None,
     format: str = "auto",
     poses: Optional[PathLike] = None,
     calib: Optional[PathLike] = None,
     odometry: Optional[PathLike] = None,
+    # The run options of detect (lidarloop.run_options("detect"); app/run_options.hpp).
+    threshold: Optional[float] = None,
+    min_gap: Optional[float] = None,
+    min_gap_unit: Optional[str] = None,
+    top_k: Optional[int] = None,
+    verify: Optional[bool] = None,
+    skip_bad: Optional[bool] = None,
 ) -> DetectResult:
     """`lidarloop detect DATASET --out OUT` (None keeps the config's value; verification is on
     by default). `out` is a results folder with run.json (refused inside the dataset, or when it
@@ -143,24 +144,25 @@ def evaluate(
     methods: Optional[Sequence[str]] = None,
     config: Config = None,
     results: Sequence[PathLike] = ...,
-    distance_m: Optional[float] = None,
-    max_heading_deg: Optional[float] = None,
-    min_path_m: Optional[float] = None,
-    train_fraction: Optional[float] = None,
-    criterion: Optional[str] = None,
-    fixed_thresholds: Sequence[float] = ...,
-    verify: Optional[bool] = None,
-    threshold: Optional[float] = None,
-    top_k: Optional[int] = None,
-    min_gap: Optional[float] = None,
-    min_gap_unit: Optional[str] = None,
-    skip_bad: bool = False,
     overwrite: bool = False,
     progress: Optional[Progress] = None,
     format: str = "auto",
     poses: Optional[PathLike] = None,
     calib: Optional[PathLike] = None,
     train_on: Union[None, PathLike, Dataset] = None,
+    # The run options of evaluate (lidarloop.run_options("evaluate")).
+    threshold: Optional[float] = None,
+    min_gap: Optional[float] = None,
+    min_gap_unit: Optional[str] = None,
+    top_k: Optional[int] = None,
+    verify: Optional[bool] = None,
+    skip_bad: Optional[bool] = None,
+    distance_m: Optional[float] = None,
+    max_heading_deg: Optional[float] = None,
+    min_path_m: Optional[float] = None,
+    train_fraction: Optional[float] = None,
+    criterion: Optional[str] = None,
+    fixed_thresholds: Optional[Sequence[float]] = None,
 ) -> EvaluateResult:
     """`lidarloop evaluate DATASET --out OUT`: every method (default all) on one ground truth
     (distance_m default 10 m, max_heading_deg 0: any, the config's min gap, min_path_m 0: no
@@ -203,16 +205,19 @@ def optimise(
     pose_format: str = "kitti",
     method: Optional[str] = None,
     config: Config = None,
-    threshold: Optional[float] = None,
-    top_k: Optional[int] = None,
-    min_gap: Optional[float] = None,
-    min_gap_unit: Optional[str] = None,
-    skip_bad: bool = False,
     overwrite: bool = False,
     progress: Optional[Progress] = None,
     format: str = "auto",
     poses: Optional[PathLike] = None,
     calib: Optional[PathLike] = None,
+    # The run options of optimise (lidarloop.run_options("optimise")).
+    threshold: Optional[float] = None,
+    min_gap: Optional[float] = None,
+    min_gap_unit: Optional[str] = None,
+    top_k: Optional[int] = None,
+    verify: Optional[bool] = None,
+    skip_bad: Optional[bool] = None,
+    max_odometry_step_m: Optional[float] = None,
 ) -> OptimiseResult:
     """`lidarloop optimise DATASET --odometry FILE --out OUT [--loops loops.csv]`."""
 
@@ -258,6 +263,10 @@ def write_map(
     Returns out, points, voxel_m, scans, input_points, notes, total_s.
     """
 
+def run_options(command: str) -> list[dict[str, str]]:
+    """The run options of detect, evaluate, optimise or bench as declared once: 'keyword',
+    'flag', 'value_name', 'type', 'help', 'sets', 'default'."""
+
 __all__ = [
     "DetectResult",
     "EvaluateResult",
@@ -268,4 +277,5 @@ __all__ = [
     "evaluate",
     "optimise",
     "write_map",
+    "run_options",
 ]

@@ -8,6 +8,7 @@ from ._lidarloop import (
     dump_config,
     is_match,
     method_names,
+    method_parameters,
     scancontext_match,
 )
 
@@ -19,5 +20,6 @@ __all__ = [
     "dump_config",
     "is_match",
     "method_names",
+    "method_parameters",
     "scancontext_match",
 ]

@@ -57,8 +57,11 @@ def describe(
     sensor_height: Optional[float] = None,
     out_of_range: Optional[str] = None,
     skip_non_finite: bool = False,
+    **parameters: Any,
 ) -> Descriptor:
-    """The descriptor of an (N, 3)/(N, 4) scan (sensor frame, metres) or a scan file."""
+    """The descriptor of an (N, 3)/(N, 4) scan (sensor frame, metres) or a scan file.
+
+    **parameters: the method's own parameters (method_parameters(method)), e.g. rings=30."""
 
 def distance(a: Descriptor, b: Descriptor) -> float:
     """W (histograms), sigma' (NDT) or d (Scan Context) between two descriptors of one method
@@ -66,6 +69,10 @@ def distance(a: Descriptor, b: Descriptor) -> float:
 
 def scancontext_match(query: Descriptor, candidate: Descriptor) -> dict[str, Any]:
     """Scan Context: {'distance', 'shift', 'yaw_rad' (of T_candidate_query)}."""
+
+def method_parameters(method: str) -> list[dict[str, Any]]:
+    """A method's own parameters as declared: 'key', 'type', 'default', 'min', 'max', 'unit',
+    'help'."""
 
 def method_names() -> list[str]: ...
 def default_threshold(method: str) -> float: ...
@@ -81,5 +88,6 @@ __all__ = [
     "dump_config",
     "is_match",
     "method_names",
+    "method_parameters",
     "scancontext_match",
 ]

@@ -28,6 +28,7 @@
 #include "lidarloop/io/map_files.hpp"
 #include "lidarloop/pipeline/descriptor_method.hpp"
 #include "part2_helpers.hpp"
+#include "run_keywords.hpp"
 
 namespace lidarloop::python {
 namespace {
@@ -76,32 +77,11 @@ io::Dataset DatasetOf(const py::object& dataset, const std::string& format,
     return OpenDatasetOf(dataset.cast<fs::path>(), format, poses, calib);
 }
 
-/// The detection keywords, as --threshold --min-gap --min-gap-unit --top-k --no-verify
-/// (cli/detection_options.cpp): each overrides its key when given.
-struct DetectionKeywords {
-    std::optional<double> threshold;
-    std::optional<double> min_gap;
-    std::optional<std::string> min_gap_unit;
-    std::optional<int> top_k;
-    std::optional<bool> verify;
-
-    void ApplyTo(io::RunConfig& config) const {
-        if (threshold) config.detection.threshold = *threshold;
-        if (min_gap) config.detection.min_gap.value = *min_gap;
-        if (min_gap_unit) config.detection.min_gap.unit = core::ParseMinGapUnit(*min_gap_unit);
-        if (top_k) config.detection.top_k = *top_k;
-        if (verify) config.detection.verify = *verify;
-    }
-};
-
-/// defaults < config (dict or YAML) < method < detection keywords, validated: the order of
-/// DescriptorOptions::Resolve and DetectionOptions::ApplyTo.
-io::RunConfig ResolveConfig(const py::object& config, const std::optional<std::string>& method,
-                            const DetectionKeywords& detection) {
+/// defaults < config (dict or YAML) < method, as DescriptorOptions::Resolve; the run options
+/// come next (ApplyRunKeywords).
+io::RunConfig ConfigOf(const py::object& config, const std::optional<std::string>& method) {
     io::RunConfig run = RunConfigFrom(config);
     if (method) run.descriptor.method = pipeline::ParseMethod(*method);
-    detection.ApplyTo(run);
-    run.Validate();
     return run;
 }
 
@@ -267,21 +247,17 @@ void BindDetect(py::module_& m) {
     m.def(
         "detect",
         [](const py::object& dataset, const fs::path& out, const std::optional<std::string>& method,
-           const py::object& config, std::optional<bool> verify, std::optional<double> threshold,
-           std::optional<int> top_k, std::optional<double> min_gap,
-           const std::optional<std::string>& min_gap_unit, bool skip_bad, bool overwrite,
-           const py::object& progress, const std::string& format,
-           const std::optional<fs::path>& poses, const std::optional<fs::path>& calib,
-           const std::optional<fs::path>& odometry) {
-            const py::dict given(py::arg("out") = out.string(), py::arg("method") = method,
-                                 py::arg("verify") = verify, py::arg("threshold") = threshold,
-                                 py::arg("top_k") = top_k, py::arg("min_gap") = min_gap,
-                                 py::arg("overwrite") = overwrite);
+           const py::object& config, bool overwrite, const py::object& progress,
+           const std::string& format, const std::optional<fs::path>& poses,
+           const std::optional<fs::path>& calib, const std::optional<fs::path>& odometry,
+           const py::kwargs& options) {
+            py::dict given(py::arg("out") = out.string(), py::arg("method") = method);
             const PythonProgress python_progress(progress);
             app::DetectRequest request;
-            request.config =
-                ResolveConfig(config, method, {threshold, min_gap, min_gap_unit, top_k, verify});
-            request.skip_bad = skip_bad;
+            request.config = ConfigOf(config, method);
+            ApplyRunKeywords(app::RunCommand::kDetect, options,
+                             {&request.config, &request.skip_bad}, given);
+            given["overwrite"] = overwrite;
             request.progress = python_progress.Callback();
             request.out = out;
             if (odometry) request.odometry_file = *odometry;
@@ -301,19 +277,18 @@ void BindDetect(py::module_& m) {
             return result;
         },
         py::arg("dataset"), py::kw_only(), py::arg("out"), py::arg("method") = py::none(),
-        py::arg("config") = py::none(), py::arg("verify") = py::none(),
-        py::arg("threshold") = py::none(), py::arg("top_k") = py::none(),
-        py::arg("min_gap") = py::none(), py::arg("min_gap_unit") = py::none(),
-        py::arg("skip_bad") = false, py::arg("overwrite") = false, py::arg("progress") = py::none(),
-        py::arg("format") = "auto", py::arg("poses") = py::none(), py::arg("calib") = py::none(),
-        py::arg("odometry") = py::none(),
-        "`lidarloop detect DATASET --out OUT` on a dataset folder (or a Dataset of "
-        "open_dataset): describes every scan, finds each scan's "
-        "candidates, verifies them (unless verify=False or the config says so) and writes "
-        "loops.csv, candidates.csv, the similarity matrix and images, database.lldb, "
-        "config.yaml, timings.json and run.json into `out` (a results folder: refused inside "
-        "the dataset or when it holds other files, unless overwrite=True). None keeps the "
-        "config's value. progress(stage, done, total) is called from worker threads.");
+        py::arg("config") = py::none(), py::arg("overwrite") = false,
+        py::arg("progress") = py::none(), py::arg("format") = "auto", py::arg("poses") = py::none(),
+        py::arg("calib") = py::none(), py::arg("odometry") = py::none(),
+        RunDoc(
+            app::RunCommand::kDetect,
+            "`lidarloop detect DATASET --out OUT` on a dataset folder (or a Dataset of "
+            "open_dataset): describes every scan, finds each scan's "
+            "candidates, verifies them (unless verify=False or the config says so) and writes "
+            "loops.csv, candidates.csv, the similarity matrix and images, database.lldb, "
+            "config.yaml, timings.json and run.json into `out` (a results folder: refused inside "
+            "the dataset or when it holds other files, unless overwrite=True). None keeps the "
+            "config's value. progress(stage, done, total) is called from worker threads."));
 }
 
 // ---- evaluate ----
@@ -411,33 +386,20 @@ void BindEvaluate(py::module_& m) {
         "evaluate",
         [](const py::object& dataset, const fs::path& out,
            const std::optional<std::vector<std::string>>& methods, const py::object& config,
-           const std::vector<fs::path>& results, std::optional<double> distance_m,
-           std::optional<double> max_heading_deg, std::optional<double> min_path_m,
-           std::optional<double> train_fraction, const std::optional<std::string>& criterion,
-           const std::vector<double>& fixed_thresholds, std::optional<bool> verify,
-           std::optional<double> threshold, std::optional<int> top_k, std::optional<double> min_gap,
-           const std::optional<std::string>& min_gap_unit, bool skip_bad, bool overwrite,
-           const py::object& progress, const std::string& format,
-           const std::optional<fs::path>& poses, const std::optional<fs::path>& calib,
-           const py::object& train_on) {
-            const py::dict given(py::arg("out") = out.string(), py::arg("methods") = methods,
-                                 py::arg("verify") = verify, py::arg("top_k") = top_k,
-                                 py::arg("min_gap") = min_gap, py::arg("overwrite") = overwrite);
+           const std::vector<fs::path>& results, bool overwrite, const py::object& progress,
+           const std::string& format, const std::optional<fs::path>& poses,
+           const std::optional<fs::path>& calib, const py::object& train_on,
+           const py::kwargs& options) {
+            py::dict given(py::arg("out") = out.string(), py::arg("methods") = methods);
             const PythonProgress python_progress(progress);
             app::EvaluationRequest request;
             for (const std::string& name : methods.value_or(pipeline::MethodNames()))
                 request.methods.push_back(pipeline::ParseMethod(name));
-            request.config = ResolveConfig(config, std::nullopt,
-                                           {threshold, min_gap, min_gap_unit, top_k, verify});
+            request.config = ConfigOf(config, std::nullopt);
+            ApplyRunKeywords(app::RunCommand::kEvaluate, options,
+                             {&request.config, &request.skip_bad, &request}, given);
+            given["overwrite"] = overwrite;
             for (const fs::path& file : results) request.results_files.push_back(file.string());
-            request.distance_m = distance_m.value_or(request.distance_m);
-            request.max_heading_deg = max_heading_deg.value_or(request.max_heading_deg);
-            request.min_path_m = min_path_m.value_or(request.min_path_m);
-            request.learning.train_fraction =
-                train_fraction.value_or(request.learning.train_fraction);
-            if (criterion) request.learning.criterion = eval::ParseCriterion(*criterion);
-            request.fixed_thresholds = fixed_thresholds;
-            request.skip_bad = skip_bad;
             request.progress = python_progress.Callback();
             request.out = out;
             const io::Dataset data = DatasetOf(dataset, format, poses, calib);
@@ -463,22 +425,18 @@ void BindEvaluate(py::module_& m) {
         },
         py::arg("dataset"), py::kw_only(), py::arg("out"), py::arg("methods") = py::none(),
         py::arg("config") = py::none(), py::arg("results") = std::vector<fs::path>{},
-        py::arg("distance_m") = py::none(), py::arg("max_heading_deg") = py::none(),
-        py::arg("min_path_m") = py::none(), py::arg("train_fraction") = py::none(),
-        py::arg("criterion") = py::none(), py::arg("fixed_thresholds") = std::vector<double>{},
-        py::arg("verify") = py::none(), py::arg("threshold") = py::none(),
-        py::arg("top_k") = py::none(), py::arg("min_gap") = py::none(),
-        py::arg("min_gap_unit") = py::none(), py::arg("skip_bad") = false,
         py::arg("overwrite") = false, py::arg("progress") = py::none(), py::arg("format") = "auto",
         py::arg("poses") = py::none(), py::arg("calib") = py::none(),
         py::arg("train_on") = py::none(),
-        "`lidarloop evaluate DATASET --out OUT`: scores every method (default all) and "
-        "results file on one ground truth from the dataset's poses (distance_m, "
-        "max_heading_deg, the config's min gap) and writes metrics.json, roc.csv, pr.csv, "
-        "images, report.md, config.yaml and run.json into `out` (a results folder, as "
-        "detect's). train_on (a folder or Dataset with poses) learns each method's threshold "
-        "there instead of on the first part. None keeps the default of app::EvaluationRequest "
-        "or the config.");
+        RunDoc(
+            app::RunCommand::kEvaluate,
+            "`lidarloop evaluate DATASET --out OUT`: scores every method (default all) and "
+            "results file on one ground truth from the dataset's poses (distance_m, "
+            "max_heading_deg, the config's min gap) and writes metrics.json, roc.csv, pr.csv, "
+            "images, report.md, config.yaml and run.json into `out` (a results folder, as "
+            "detect's). train_on (a folder or Dataset with poses) learns each method's threshold "
+            "there instead of on the first part. None keeps the default of app::EvaluationRequest "
+            "or the config."));
 }
 
 // ---- optimise ----
@@ -541,26 +499,24 @@ void BindOptimise(py::module_& m) {
         "optimise",
         [](const py::object& dataset, const fs::path& odometry, const fs::path& out,
            const std::optional<fs::path>& loops, const std::string& pose_format,
-           const std::optional<std::string>& method, const py::object& config,
-           std::optional<double> threshold, std::optional<int> top_k, std::optional<double> min_gap,
-           const std::optional<std::string>& min_gap_unit, bool skip_bad, bool overwrite,
+           const std::optional<std::string>& method, const py::object& config, bool overwrite,
            const py::object& progress, const std::string& format,
-           const std::optional<fs::path>& poses, const std::optional<fs::path>& calib) {
-            const py::dict given(py::arg("odometry") = odometry.string(),
-                                 py::arg("out") = out.string(), py::arg("method") = method,
-                                 py::arg("threshold") = threshold, py::arg("top_k") = top_k,
-                                 py::arg("min_gap") = min_gap, py::arg("overwrite") = overwrite);
+           const std::optional<fs::path>& poses, const std::optional<fs::path>& calib,
+           const py::kwargs& options) {
+            py::dict given(py::arg("odometry") = odometry.string(), py::arg("out") = out.string(),
+                           py::arg("method") = method);
             if (pose_format != "kitti" && pose_format != "tum")
                 throw core::ConfigError("pose_format must be kitti or tum, got '" + pose_format +
                                         "'");
             const PythonProgress python_progress(progress);
             app::OptimiseRequest request;
-            request.config = ResolveConfig(config, method,
-                                           {threshold, min_gap, min_gap_unit, top_k, std::nullopt});
+            request.config = ConfigOf(config, method);
+            ApplyRunKeywords(app::RunCommand::kOptimise, options,
+                             {&request.config, &request.skip_bad}, given);
+            given["overwrite"] = overwrite;
             request.odometry_file = odometry;
             request.loops_file = loops.value_or(fs::path());
             request.format = pose_format == "tum" ? app::PoseFormat::kTum : app::PoseFormat::kKitti;
-            request.skip_bad = skip_bad;
             request.progress = python_progress.Callback();
             request.out = out;
             const io::Dataset data = DatasetOf(dataset, format, poses, calib);
@@ -579,17 +535,17 @@ void BindOptimise(py::module_& m) {
         py::arg("dataset"), py::kw_only(), py::arg("odometry"), py::arg("out"),
         py::arg("loops") = py::none(), py::arg("pose_format") = "kitti",
         py::arg("method") = py::none(), py::arg("config") = py::none(),
-        py::arg("threshold") = py::none(), py::arg("top_k") = py::none(),
-        py::arg("min_gap") = py::none(), py::arg("min_gap_unit") = py::none(),
-        py::arg("skip_bad") = false, py::arg("overwrite") = false, py::arg("progress") = py::none(),
-        py::arg("format") = "auto", py::arg("poses") = py::none(), py::arg("calib") = py::none(),
-        "`lidarloop optimise DATASET --odometry FILE --out OUT`: reads the accepted loops "
-        "(loops.csv of a verified detect) or detects them first (into out/detection), builds "
-        "and optimises the pose graph and writes poses_optimised.txt (pose_format kitti | "
-        "tum), graph.g2o, loop_verdicts.csv, metrics.json, report.md, config.yaml, "
-        "map_odometry.ply, map_optimised.ply and map.png into `out` "
-        "(a results folder, as detect's: staged, run.json last, refused inside the dataset or "
-        "when it holds other files unless overwrite).");
+        py::arg("overwrite") = false, py::arg("progress") = py::none(), py::arg("format") = "auto",
+        py::arg("poses") = py::none(), py::arg("calib") = py::none(),
+        RunDoc(
+            app::RunCommand::kOptimise,
+            "`lidarloop optimise DATASET --odometry FILE --out OUT`: reads the accepted loops "
+            "(loops.csv of a verified detect) or detects them first (into out/detection), builds "
+            "and optimises the pose graph and writes poses_optimised.txt (pose_format kitti | "
+            "tum), graph.g2o, loop_verdicts.csv, metrics.json, report.md, config.yaml, "
+            "map_odometry.ply, map_optimised.ply and map.png into `out` "
+            "(a results folder, as detect's: staged, run.json last, refused inside the dataset or "
+            "when it holds other files unless overwrite)."));
 }
 
 // ---- maps ----
@@ -728,6 +684,7 @@ void BindMap(py::module_& m) {
 }  // namespace
 
 void BindApp(py::module_& m) {
+    BindRunOptions(m);
     BindDetect(m);
     BindMethodEvaluation(m);
     BindEvaluate(m);

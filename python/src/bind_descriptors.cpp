@@ -2,6 +2,7 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <cmath>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -11,6 +12,7 @@
 #include "lidarloop/app/describe_run.hpp"
 #include "lidarloop/app/descriptor_json.hpp"
 #include "lidarloop/core/descriptor.hpp"
+#include "lidarloop/core/parameters.hpp"
 #include "lidarloop/core/scancontext/scancontext.hpp"
 #include "lidarloop/pipeline/descriptor_method.hpp"
 #include "lidarloop/pipeline/scancontext_method.hpp"
@@ -104,10 +106,59 @@ Descriptor DescribeView(core::PointsView points, const core::DescriptorConfig& c
     return descriptor;
 }
 
+// The keywords of a method's own parameters (describe(scan, "scancontext", rings=30)) as the
+// keys of its section: read and checked by the YAML reader, like config={"scancontext": {...}}.
+void ApplyParameterKeywords(const py::kwargs& parameters, io::RunConfig& run) {
+    if (parameters.empty()) return;
+    const pipeline::DescriptorMethod& method = pipeline::MethodOf(run.descriptor.method);
+    if (!method.DefaultParameters()) {
+        throw py::type_error("describe() got keywords " +
+                             py::repr(parameters.attr("keys")()).cast<std::string>() +
+                             ", but method '" + method.name() +
+                             "' has no parameters of its own (lidarloop.method_parameters)");
+    }
+    py::dict section;
+    section[py::str(method.name())] = parameters;
+    const std::string text = py::module_::import("json").attr("dumps")(section).cast<std::string>();
+    io::ApplyConfigYaml(text, "keywords", run);
+}
+
+// One declared parameter as a dict: key, type, default, min, max (None: unbounded), unit, help.
+class ParameterDicts final : public core::ParameterVisitor {
+public:
+    void Visit(const core::ParameterInfo& i, bool& value) override { Add(i, value, "bool"); }
+    void Visit(const core::ParameterInfo& i, int& value) override { Add(i, value, "int"); }
+    void Visit(const core::ParameterInfo& i, std::size_t& value) override { Add(i, value, "int"); }
+    void Visit(const core::ParameterInfo& i, double& value) override { Add(i, value, "float"); }
+    void Visit(const core::ParameterInfo& i, std::optional<double>& value) override {
+        Add(i, value, "float | None");
+    }
+    void Visit(const core::ParameterInfo& i, std::vector<double>& value) override {
+        Add(i, value, "list[float]");
+    }
+    void Visit(const core::ParameterInfo& i, std::string& value) override { Add(i, value, "str"); }
+    py::list list;
+
+private:
+    template <typename T>
+    void Add(const core::ParameterInfo& info, const T& value, const char* type) {
+        py::dict d;
+        d["key"] = std::string(info.key);
+        d["type"] = type;
+        d["default"] = py::cast(value);
+        d["min"] = std::isfinite(info.min) ? py::cast(info.min) : py::none();
+        d["max"] = std::isfinite(info.max) ? py::cast(info.max) : py::none();
+        d["unit"] = std::string(info.unit);
+        d["help"] = std::string(info.help);
+        list.append(d);
+    }
+};
+
 Descriptor Describe(const py::object& points, const std::optional<std::string>& method,
                     const py::object& config, const HistogramKeywords& keywords,
-                    bool skip_non_finite) {
-    const io::RunConfig run = ResolveRunConfig(config, method, keywords);
+                    bool skip_non_finite, const py::kwargs& parameters) {
+    io::RunConfig run = ResolveRunConfig(config, method, keywords);
+    ApplyParameterKeywords(parameters, run);
     if (py::isinstance<py::str>(points) || py::hasattr(points, "__fspath__")) {
         const std::filesystem::path file = points.cast<std::filesystem::path>();
         py::gil_scoped_release release;
@@ -223,9 +274,9 @@ void BindDescriptors(py::module_& m) {
            const py::object& config, std::optional<int> bins, std::optional<double> min,
            std::optional<double> max, std::optional<std::string> up,
            std::optional<double> sensor_height, std::optional<std::string> out_of_range,
-           bool skip_non_finite) {
+           bool skip_non_finite, const py::kwargs& parameters) {
             const HistogramKeywords keywords{bins, min, max, up, sensor_height, out_of_range};
-            return Describe(points, method, config, keywords, skip_non_finite);
+            return Describe(points, method, config, keywords, skip_non_finite, parameters);
         },
         py::arg("points"), py::arg("method") = py::none(), py::kw_only(),
         py::arg("config") = py::none(), py::arg("bins") = py::none(), py::arg("min") = py::none(),
@@ -246,6 +297,9 @@ bins, min, max (metres, of the projection in use), up ('fixed' | 'pca') and sens
     `lidarloop describe`.
 skip_non_finite: False raises lidarloop.NonFiniteError for a NaN/Inf point; True lets the
     descriptor skip and count them (points_skipped), as it does for files.
+**parameters: the method's own parameters by key (lidarloop.method_parameters(method)), e.g.
+    describe(scan, 'scancontext', rings=30); they override `config`'s section of the method.
+    Unknown keys and invalid values raise lidarloop.ReadError, as in a config dict.
 
 Raises DtypeError, ShapeError, NonFiniteError, ConfigError, EmptyInputError (nothing usable),
 ReadError (files). Releases the GIL while describing.)doc");
@@ -268,6 +322,19 @@ ReadError (files). Releases the GIL while describing.)doc");
         "Two scancontext descriptors: {'distance': d (Kim eq. 5-6), 'shift': n (query column j "
         "meets candidate column j + n), 'yaw_rad': the yaw of T_candidate_query that shift "
         "implies, in (-pi, pi]}. lidarloop.ConfigError for other descriptors.");
+    m.def(
+        "method_parameters",
+        [](const std::string& method) {
+            ParameterDicts dicts;
+            const core::Method parsed = pipeline::ParseMethod(method);
+            if (auto p = pipeline::MethodOf(parsed).DefaultParameters()) p->Visit(dicts);
+            return dicts.list;
+        },
+        py::arg("method"),
+        "The parameters of a method's own section, as declared (docs/options.md): one dict per "
+        "parameter with 'key', 'type', 'default', 'min', 'max' (None: unbounded), 'unit' and "
+        "'help'; the keywords describe() takes for it. Empty for height, range and ndt, whose "
+        "parameters are the histogram keywords and config={'ndt': {...}}.");
     m.def("method_names", &pipeline::MethodNames,
           "The registered descriptor methods: height, range, ndt, then any registered in C++.");
     m.def(

@@ -117,6 +117,30 @@ def test_scancontext_match_gives_the_yaw_of_a_turned_scan(points):
         lidarloop.scancontext_match(lidarloop.describe(points, "range"), a)
 
 
+def test_a_methods_parameters_are_keywords_of_describe(cli, scan_file, points):
+    """Derived from the method's declaration (docs/options.md): the same keys as its YAML
+    section and its flags, read and checked like a config dict."""
+    keys = [p["key"] for p in lidarloop.method_parameters("scancontext")]
+    assert keys == ["rings", "sectors", "max_range_m", "sensor_height_m", "ring_key_candidates"]
+    rings = lidarloop.method_parameters("scancontext")[0]
+    assert rings == {"key": "rings", "type": "int", "default": 20, "min": 1.0, "max": 200.0,
+                     "unit": "", "help": "N_r, rings of equal width up to max_range_m"}
+    assert lidarloop.method_parameters("range") == []
+    d = lidarloop.describe(points, "scancontext", rings=10, max_range_m=40.0)
+    assert d.bins.shape == (10, 60)
+    assert d.to_dict() == lidarloop.describe(
+        points, "scancontext", config={"scancontext": {"rings": 10, "max_range_m": 40.0}}).to_dict()
+    flags = json.loads(run_cli(cli, "describe", scan_file, "--method", "scancontext",
+                               "--scancontext-rings", "10", "--scancontext-max-range-m", "40"))
+    assert d.to_dict() == flags
+    with pytest.raises(lidarloop.ReadError, match="key 'scancontext.ringz': unknown key"):
+        lidarloop.describe(points, "scancontext", ringz=10)
+    with pytest.raises(lidarloop.ReadError, match=r"scancontext.rings must be in \[1, 200\]"):
+        lidarloop.describe(points, "scancontext", rings=0)
+    with pytest.raises(TypeError, match="no parameters of its own"):
+        lidarloop.describe(points, "range", rings=10)
+
+
 @pytest.mark.parametrize(
     "bad, error",
     [

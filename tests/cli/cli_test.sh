@@ -190,6 +190,19 @@ section_scancontext() {
     expect_error "histogram flag with scancontext" "--bins applies to the height and range" \
         "$cli" describe --method scancontext --bins 10 "$samples/corner_a.bin"
     expect_ok "dump-config scancontext" "ring_key_candidates: 0" "$cli" dump-config
+    # A flag per declared parameter (docs/options.md), read and checked as its key in --config.
+    expect_ok "scancontext flags" '"sectors":30' "$cli" describe --method scancontext \
+        --scancontext-rings 10 --scancontext-sectors 30 "$samples/corner_a.bin"
+    expect_error "scancontext flag out of range" \
+        "--scancontext-rings: scancontext.rings must be in [1, 200], got 0" "$cli" describe \
+        --method scancontext --scancontext-rings 0 "$samples/corner_a.bin"
+    expect_error "scancontext flag not a number" "key 'scancontext.rings': expected an integer" \
+        "$cli" describe --method scancontext --scancontext-rings ten "$samples/corner_a.bin"
+    expect_error "scancontext flag with another method" \
+        "--scancontext-rings applies to the scancontext method" "$cli" describe --method range \
+        --scancontext-rings 10 "$samples/corner_a.bin"
+    expect_ok "scancontext flags in help" "--scancontext-ring-key-candidates" "$cli" detect --help
+    expect_ok "dump-config --markdown" '| `scancontext.rings` | 20 |' "$cli" dump-config --markdown
     seq="$work/seq"
     make_sequence "$seq"
     expect_ok "detect scancontext" "method scancontext" "$cli" detect "$seq" --method scancontext \

@@ -2,9 +2,7 @@
 // registry, their distance, and the run layer's JSON form of a descriptor.
 #include <cstdio>
 
-#include "lidarloop/app/descriptor_json.hpp"
-#include "lidarloop/io/config_yaml.hpp"
-#include "lidarloop/pipeline/descriptor_method.hpp"
+#include "lidarloop/lidarloop.hpp"  // the one header for library users
 
 int main() {
     namespace ll = lidarloop;

@@ -7,7 +7,7 @@
 #include "lidarloop/core/descriptor_config.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/core/histogram.hpp"
-#include "lidarloop/core/ndt_descriptor.hpp"
+#include "lidarloop/core/ndt/ndt_descriptor.hpp"
 
 namespace lidarloop::core {
 

@@ -219,108 +219,53 @@ Confusion ConfusionOf(std::uint64_t tp, std::uint64_t fp, std::uint64_t positive
     return {tp, fp, negatives - fp, positives - tp};
 }
 
-}  // namespace
+// The negatives' count, extremes and unscored pairs of one population (all, training, test).
+struct NegativeExtremes {
+    float min = 0.0f;
+    float max = 0.0f;
+    std::uint64_t min_count = 0;
+    std::uint64_t max_count = 0;
+    std::uint64_t unscored = 0;
+    std::uint64_t total = 0;
 
-struct StreamedPairwise::Shared {
-    const GroundTruth* truth = nullptr;
-    StreamedRequest request;
-    std::uint64_t positive_count = 0;
-    std::size_t first_test_scan = 0;  // the test part: pairs with j >= it
-    PositiveLevels all;
-    PositiveLevels train;
-    std::vector<double> ascending_thresholds;
-    std::vector<std::size_t> threshold_order;
-    std::unique_ptr<std::uint64_t, FreeDeleter> bitmap = NewBitmap();
-    int pass = 1;
-    // Merged counts. In the first pass the sinks add their located batches straight into the
-    // slots and the coarse histogram, under `counting`: one copy of the O(positives) slots, not
-    // one a thread.
-    mutable Sink merged;
-    mutable SlotCounts all_slots;    // negatives in the slots between all.keys
-    mutable SlotCounts train_slots;  // training negatives between train.keys
-    mutable std::mutex counting;
-    std::vector<std::int32_t> fine_of_bucket;  // pass 2: table of a coarse bucket, or -1
-    std::vector<RankQuery> queries;
-    std::optional<double> learnt_threshold;
-
-    explicit Shared(const GroundTruth& t) : truth(&t), merged(*this) {}
-    bool Learning() const { return request.learning.has_value(); }
-    bool InTest(std::size_t j) const { return j >= first_test_scan; }
-    // True when no pair had this distance before: fetch_or tells exactly one thread.
-    bool MarkDistinct(std::uint32_t key) const {
-        std::atomic_ref<std::uint64_t> word(bitmap.get()[key >> 6]);
-        const std::uint64_t bit = std::uint64_t{1} << (key & 63u);
-        if ((word.load(std::memory_order_relaxed) & bit) != 0) return false;
-        return (word.fetch_or(bit, std::memory_order_relaxed) & bit) == 0;
+    void Add(float distance) {
+        ++total;
+        if (!detail::IsScored(distance)) {
+            ++unscored;
+            return;
+        }
+        if (min_count == 0 || distance < min) {
+            min = distance;
+            min_count = 0;
+        }
+        if (max_count == 0 || distance > max) {
+            max = distance;
+            max_count = 0;
+        }
+        min_count += distance == min ? 1 : 0;
+        max_count += distance == max ? 1 : 0;
     }
-    struct Optima {
-        BestThreshold mcc;
-        BestThreshold f1;
-    };
-    Optima BestOf(const PositiveLevels& levels, const SlotCounts& slots,
-                  const Sink::Extremes& negatives) const;
-    void PrepareSecondPass();
-    void ResolveQueries();
-    void SweepAll(StreamedResult& result) const;
-    std::optional<ThresholdTransfer> Transfer() const;
+    void Merge(const NegativeExtremes& other) {
+        total += other.total;
+        unscored += other.unscored;
+        if (other.min_count > 0) {
+            if (min_count == 0 || other.min < min) {
+                min = other.min;
+                min_count = other.min_count;
+            } else if (other.min == min) {
+                min_count += other.min_count;
+            }
+        }
+        if (other.max_count > 0) {
+            if (max_count == 0 || other.max > max) {
+                max = other.max;
+                max_count = other.max_count;
+            } else if (other.max == max) {
+                max_count += other.max_count;
+            }
+        }
+    }
 };
-
-// ---- Sink -------------------------------------------------------------------------------------
-
-void StreamedPairwise::Sink::Extremes::Add(float distance) {
-    ++total;
-    if (!detail::IsScored(distance)) {
-        ++unscored;
-        return;
-    }
-    if (min_count == 0 || distance < min) {
-        min = distance;
-        min_count = 0;
-    }
-    if (max_count == 0 || distance > max) {
-        max = distance;
-        max_count = 0;
-    }
-    min_count += distance == min ? 1 : 0;
-    max_count += distance == max ? 1 : 0;
-}
-
-void StreamedPairwise::Sink::Extremes::Merge(const Extremes& other) {
-    total += other.total;
-    unscored += other.unscored;
-    if (other.min_count > 0) {
-        if (min_count == 0 || other.min < min) {
-            min = other.min;
-            min_count = other.min_count;
-        } else if (other.min == min) {
-            min_count += other.min_count;
-        }
-    }
-    if (other.max_count > 0) {
-        if (max_count == 0 || other.max > max) {
-            max = other.max;
-            max_count = other.max_count;
-        } else if (other.max == max) {
-            max_count += other.max_count;
-        }
-    }
-}
-
-StreamedPairwise::Sink::Sink(const Shared& shared) : shared_(&shared) {
-    const std::size_t n = shared.truth->size();
-    if (shared.pass == 1) {
-        best_.assign(n, BestMatch{});
-        pending_all_.reserve(kPending);
-        if (shared.Learning()) pending_train_.reserve(kPending);
-    } else {
-        std::size_t tables = 0;
-        for (const std::int32_t t : shared.fine_of_bucket) tables += t >= 0 ? 1 : 0;
-        fine_.assign(tables * kFineKeys, 0);
-        from_threshold_.assign(shared.ascending_thresholds.size() + 1, 0);
-    }
-}
-
-namespace {
 
 // Offers a candidate to a scan's best match as BestMatchesFromCondensed does, for candidates in
 // any order: the smallest distance wins, ties to the smaller scan.
@@ -344,76 +289,469 @@ void MergeBest(BestMatch& into, const BestMatch& from) {
     into.second_distance = std::min(into.second_distance, from.second_distance);
 }
 
+// What a first-pass sink holds besides its batches, and what the first pass merges them into.
+struct FirstPassTally {
+    std::vector<BestMatch> best;  // per scan
+    std::size_t distinct = 0;     // distances seen first by this tally's sinks
+    NegativeExtremes all;
+    NegativeExtremes train;
+    NegativeExtremes test;
+
+    explicit FirstPassTally(std::size_t scans) : best(scans, BestMatch{}) {}
+    void Merge(const FirstPassTally& other) {
+        for (std::size_t k = 0; k < best.size(); ++k) MergeBest(best[k], other.best[k]);
+        distinct += other.distinct;
+        all.Merge(other.all);
+        train.Merge(other.train);
+        test.Merge(other.test);
+    }
+};
+
+// What the second pass counts, per sink and merged.
+struct SecondPassTally {
+    std::vector<std::uint64_t> fine;            // negatives by key in the target buckets
+    std::vector<std::uint64_t> from_threshold;  // as in ConfusionsAt
+    std::uint64_t test_at_learnt = 0;           // test negatives <= the learnt threshold
+
+    void Merge(const SecondPassTally& other) {
+        for (std::size_t k = 0; k < fine.size(); ++k) fine[k] += other.fine[k];
+        for (std::size_t k = 0; k < from_threshold.size(); ++k)
+            from_threshold[k] += other.from_threshold[k];
+        test_at_learnt += other.test_at_learnt;
+    }
+};
+
 }  // namespace
 
-void StreamedPairwise::Sink::Add(std::size_t i, std::size_t j, float distance) {
-    const Shared& s = *shared_;
-    if (!s.truth->Comparable(i, j)) return;
-    CheckNotNan(i, j, distance);
-    const bool loop = s.truth->IsLoop(i, j);
-    if (s.pass == 1) {
-        Offer(best_[i], j, distance);
-        Offer(best_[j], i, distance);
-        // The negatives' distances are marked when their batch is counted (Flush).
-        if (loop && detail::IsScored(distance) && s.MarkDistinct(OrderKey(distance))) ++distinct_;
-    }
-    if (!loop) AddNegative(j, distance);
-}
+// ---- Fixed before the first pass ----------------------------------------------------------
 
-void StreamedPairwise::Sink::Flush() {
-    const Shared& s = *shared_;
-    RadixSort(pending_all_, scratch_);
-    RadixSort(pending_train_, scratch_);
-    // Sorting and locating outside the lock; under it only the additions, in ascending order.
-    located_coarse_.clear();
-    LocateSortedKeys(
-        pending_all_, s.all, located_all_, [&](std::uint32_t key, std::uint64_t count) {
-            const std::uint64_t bucket = key >> kFineBits;
-            if (!located_coarse_.empty() && (located_coarse_.back() >> kCountBits) == bucket) {
-                located_coarse_.back() += count;
-            } else {
-                located_coarse_.push_back((bucket << kCountBits) | count);
-            }
-            if (s.MarkDistinct(key)) ++distinct_;
-        });
-    LocateSortedKeys(pending_train_, s.train, located_train_, [](std::uint32_t, std::uint64_t) {});
-    {
-        const std::lock_guard<std::mutex> lock(s.counting);
-        AddLocated(located_all_, s.all_slots);
-        AddLocated(located_train_, s.train_slots);
-        for (const std::uint64_t entry : located_coarse_)
-            s.merged.coarse_[entry >> kCountBits] += entry & kCountMask;
-    }
-    pending_all_.clear();
-    pending_train_.clear();
-}
+struct StreamedPairwise::Context {
+    const GroundTruth* truth = nullptr;
+    StreamedRequest request;
+    std::uint64_t positive_count = 0;
+    std::size_t first_test_scan = 0;  // the test part: pairs with j >= it
+    PositiveLevels all;
+    PositiveLevels train;
+    std::vector<double> ascending_thresholds;
+    std::vector<std::size_t> threshold_order;
 
-void StreamedPairwise::Sink::AddNegative(std::size_t j, float distance) {
-    const Shared& s = *shared_;
-    const bool scored = detail::IsScored(distance);
-    const bool in_test = s.Learning() && s.InTest(j);
-    const std::uint32_t key = OrderKey(distance);
-    if (s.pass == 1) {
+    bool Learning() const { return request.learning.has_value(); }
+    bool InTest(std::size_t j) const { return j >= first_test_scan; }
+};
+
+// ---- The first pass -----------------------------------------------------------------------
+
+// All that the first pass found, handed whole (moved) to the second pass and from there to the
+// result: a field added here reaches both without a line that copies it.
+struct StreamedPairwise::FirstPassResult {
+    FirstPassTally tally;
+    std::vector<std::uint64_t> coarse;  // negatives by the top bits of their key
+    SlotCounts all_slots;               // negatives in the slots between all.keys
+    SlotCounts train_slots;             // training negatives between train.keys
+};
+
+// Counts every negative in its slot and coarse bucket, and keeps the best matches, the
+// extremes and the distinct distances. The sinks add their located batches straight into the
+// slots and the coarse histogram, under `counting_`: one copy of the O(positives) slots, not one
+// a thread; the rest they keep to themselves until Merge.
+class StreamedPairwise::FirstPass {
+public:
+    explicit FirstPass(const Context& context)
+        : context_(context), result_{FirstPassTally(context.truth->size()), {}, {}, {}} {
+        result_.coarse.assign(kCoarseBuckets, 0);
+        result_.all_slots.Assign(context.all.SlotCount());
+        if (context.Learning()) result_.train_slots.Assign(context.train.SlotCount());
+    }
+    const Context& context() const { return context_; }
+    // True when no pair had this distance before: fetch_or tells exactly one thread.
+    bool MarkDistinct(std::uint32_t key) const {
+        std::atomic_ref<std::uint64_t> word(bitmap_.get()[key >> 6]);
+        const std::uint64_t bit = std::uint64_t{1} << (key & 63u);
+        if ((word.load(std::memory_order_relaxed) & bit) != 0) return false;
+        return (word.fetch_or(bit, std::memory_order_relaxed) & bit) == 0;
+    }
+    // Adds located batches of a sink; thread-safe.
+    void AddBatches(const std::vector<std::uint64_t>& all, const std::vector<std::uint64_t>& train,
+                    const std::vector<std::uint64_t>& coarse) {
+        const std::lock_guard<std::mutex> lock(counting_);
+        AddLocated(all, result_.all_slots);
+        AddLocated(train, result_.train_slots);
+        for (const std::uint64_t entry : coarse)
+            result_.coarse[entry >> kCountBits] += entry & kCountMask;
+    }
+    void Merge(const FirstPassTally& tally) { result_.tally.Merge(tally); }
+    bool Empty() const { return context_.positive_count + result_.tally.all.total == 0; }
+    FirstPassResult Finish() && { return std::move(result_); }
+
+private:
+    const Context& context_;
+    std::unique_ptr<std::uint64_t, FreeDeleter> bitmap_ = NewBitmap();
+    std::mutex counting_;
+    FirstPassResult result_;
+};
+
+class StreamedPairwise::FirstSink {
+public:
+    explicit FirstSink(FirstPass& pass) : pass_(&pass), tally_(pass.context().truth->size()) {
+        pending_all_.reserve(kPending);
+        if (pass.context().Learning()) pending_train_.reserve(kPending);
+    }
+    void Add(std::size_t i, std::size_t j, float distance) {
+        const Context& c = pass_->context();
+        if (!c.truth->Comparable(i, j)) return;
+        CheckNotNan(i, j, distance);
+        Offer(tally_.best[i], j, distance);
+        Offer(tally_.best[j], i, distance);
+        if (!c.truth->IsLoop(i, j)) {
+            AddNegative(j, distance);
+        } else if (detail::IsScored(distance) && pass_->MarkDistinct(OrderKey(distance))) {
+            ++tally_.distinct;  // the negatives' distances are marked when counted (Flush)
+        }
+    }
+    // Counts what the sink still holds and hands its tally to the pass.
+    void MergeInto(FirstPass& pass) {
+        Flush();
+        pass.Merge(tally_);
+    }
+
+private:
+    void AddNegative(std::size_t j, float distance) {
+        const Context& c = pass_->context();
         // Counted in sorted batches: one random access a negative into the slots cost most of
         // the time when they outgrow the cache.
-        all_.Add(distance);
-        if (scored) pending_all_.push_back(key);
-        if (s.Learning()) {
-            (in_test ? test_ : train_).Add(distance);
-            if (scored && !in_test) pending_train_.push_back(key);
+        tally_.all.Add(distance);
+        const bool scored = detail::IsScored(distance);
+        if (scored) pending_all_.push_back(OrderKey(distance));
+        if (c.Learning()) {
+            const bool in_test = c.InTest(j);
+            (in_test ? tally_.test : tally_.train).Add(distance);
+            if (scored && !in_test) pending_train_.push_back(OrderKey(distance));
         }
         if (pending_all_.size() >= kPending || pending_train_.size() >= kPending) Flush();
-        return;
     }
-    if (!scored) return;
-    const std::int32_t table = s.fine_of_bucket[key >> kFineBits];
-    if (table >= 0) ++fine_[static_cast<std::size_t>(table) * kFineKeys + (key & (kFineKeys - 1))];
-    const auto first =
-        std::lower_bound(s.ascending_thresholds.begin(), s.ascending_thresholds.end(),
-                         static_cast<double>(distance));
-    ++from_threshold_[static_cast<std::size_t>(first - s.ascending_thresholds.begin())];
-    if (in_test && s.learnt_threshold && static_cast<double>(distance) <= *s.learnt_threshold)
-        ++test_at_learnt_;
+    void Flush() {
+        const Context& c = pass_->context();
+        RadixSort(pending_all_, scratch_);
+        RadixSort(pending_train_, scratch_);
+        // Sorting and locating outside the lock; under it only the additions, in ascending order.
+        located_coarse_.clear();
+        LocateSortedKeys(
+            pending_all_, c.all, located_all_, [&](std::uint32_t key, std::uint64_t count) {
+                const std::uint64_t bucket = key >> kFineBits;
+                if (!located_coarse_.empty() && (located_coarse_.back() >> kCountBits) == bucket) {
+                    located_coarse_.back() += count;
+                } else {
+                    located_coarse_.push_back((bucket << kCountBits) | count);
+                }
+                if (pass_->MarkDistinct(key)) ++tally_.distinct;
+            });
+        LocateSortedKeys(pending_train_, c.train, located_train_,
+                         [](std::uint32_t, std::uint64_t) {});
+        pass_->AddBatches(located_all_, located_train_, located_coarse_);
+        pending_all_.clear();
+        pending_train_.clear();
+    }
+
+    FirstPass* pass_;
+    FirstPassTally tally_;
+    std::vector<std::uint32_t> pending_all_;    // keys of negatives to count
+    std::vector<std::uint32_t> pending_train_;  // of training negatives
+    std::vector<std::uint32_t> scratch_;
+    // A sorted batch located outside the lock, (slot or bucket << kCountBits) | count.
+    std::vector<std::uint64_t> located_all_;
+    std::vector<std::uint64_t> located_train_;
+    std::vector<std::uint64_t> located_coarse_;
+};
+
+// ---- Between the passes, and after them ---------------------------------------------------
+
+namespace {
+
+// Walks the sweep's steps: for each D_k the run of negatives below it (slot 2k), then the
+// positives and negatives at it (slot 2k + 1); finally the run above all (slot 2U).
+template <class Run, class AtLevel>
+void ForEachStep(const PositiveLevels& levels, const SlotCounts& slots, Run run, AtLevel at_level) {
+    std::uint64_t tp = 0;
+    std::uint64_t fp = 0;
+    for (std::size_t k = 0; k <= levels.size(); ++k) {
+        const std::uint64_t below = slots[2 * k];
+        run(k, tp, fp, below);
+        fp += below;
+        if (k == levels.size()) break;
+        const std::uint64_t positives = levels.Count(k);
+        const std::uint64_t at = slots[2 * k + 1];
+        at_level(k, tp, fp, positives, at);
+        tp += positives;
+        fp += at;
+    }
+}
+
+// The smallest fp in [low, high] whose curve point lies in a bucket >= `bucket`; high when none.
+std::uint64_t FirstFpInBucket(const detail::CurveThinner& thinner, double bucket, std::uint64_t tp,
+                              std::uint64_t low, std::uint64_t high, std::uint64_t positives,
+                              std::uint64_t negatives) {
+    while (low < high) {
+        const std::uint64_t mid = low + (high - low) / 2;
+        const CurvePoint p = detail::MakePoint(0.0, ConfusionOf(tp, mid, positives, negatives));
+        if (thinner.Bucket(p) >= bucket) {
+            high = mid;
+        } else {
+            low = mid + 1;
+        }
+    }
+    return low;
+}
+
+struct Optima {
+    BestThreshold mcc;
+    BestThreshold f1;
+};
+
+// The optima over the sweep's points at the positives' distances and its first and last points:
+// see the top of this file for why the points between two positives' distances cannot win.
+Optima BestOf(const PositiveLevels& levels, const SlotCounts& slots,
+              const NegativeExtremes& negatives) {
+    const std::uint64_t positives_n = levels.total;
+    const std::uint64_t negatives_n = negatives.total;
+    const Confusion start = ConfusionOf(0, 0, positives_n, negatives_n);
+    const double minus_inf = -std::numeric_limits<double>::infinity();
+    Optima best{{minus_inf, Mcc(start), start}, {minus_inf, F1(start), start}};
+    bool have_mcc = false;
+    bool have_f1 = false;
+    const auto consider = [&](double threshold, std::uint64_t tp, std::uint64_t fp) {
+        const Confusion c = ConfusionOf(tp, fp, positives_n, negatives_n);
+        detail::KeepBest(best.mcc, have_mcc, Mcc(c), threshold, c);
+        detail::KeepBest(best.f1, have_f1, F1(c), threshold, c);
+    };
+    if (slots.front() > 0) consider(negatives.min, 0, negatives.min_count);
+    std::uint64_t scored_positives = 0;
+    ForEachStep(
+        levels, slots, [](std::size_t, std::uint64_t, std::uint64_t, std::uint64_t) {},
+        [&](std::size_t k, std::uint64_t tp, std::uint64_t fp, std::uint64_t pos,
+            std::uint64_t neg) {
+            consider(levels.Distance(k), tp + pos, fp + neg);
+            scored_positives = tp + pos;
+        });
+    if (slots.back() > 0)
+        consider(negatives.max, scored_positives, negatives_n - negatives.unscored);
+    return best;
+}
+
+}  // namespace
+
+// ---- The second pass ----------------------------------------------------------------------
+
+// Counts the negatives of the coarse buckets that hold a wanted rank key by key, the negatives
+// from each fixed threshold on, and the test negatives at the learnt threshold; then resolves
+// the ranks and computes the result from both passes' counts.
+class StreamedPairwise::SecondPass {
+public:
+    SecondPass(const Context& context, FirstPassResult first)
+        : context_(context), first_(std::move(first)) {
+        LocateRanks();
+        if (const auto t = Transfer(0)) learnt_threshold_ = t->threshold;
+        tally_ = NewTally();
+    }
+    const Context& context() const { return context_; }
+    SecondPassTally NewTally() const {
+        return {std::vector<std::uint64_t>(tables_ * kFineKeys, 0),
+                std::vector<std::uint64_t>(context_.ascending_thresholds.size() + 1, 0), 0};
+    }
+    void Count(SecondPassTally& tally, std::size_t j, float distance) const {
+        if (!detail::IsScored(distance)) return;
+        const std::uint32_t key = OrderKey(distance);
+        const std::int32_t table = fine_of_bucket_[key >> kFineBits];
+        if (table >= 0)
+            ++tally.fine[static_cast<std::size_t>(table) * kFineKeys + (key & (kFineKeys - 1))];
+        const std::vector<double>& thresholds = context_.ascending_thresholds;
+        const auto first =
+            std::lower_bound(thresholds.begin(), thresholds.end(), static_cast<double>(distance));
+        ++tally.from_threshold[static_cast<std::size_t>(first - thresholds.begin())];
+        if (context_.Learning() && context_.InTest(j) && learnt_threshold_ &&
+            static_cast<double>(distance) <= *learnt_threshold_)
+            ++tally.test_at_learnt;
+    }
+    void Merge(const SecondPassTally& tally) { tally_.Merge(tally); }
+    void ResolveQueries();
+    StreamedResult Result() const;
+
+private:
+    void LocateRanks();
+    void SweepAll(StreamedResult& result) const;
+    std::optional<ThresholdTransfer> Transfer(std::uint64_t test_at_learnt) const;
+
+    const Context& context_;
+    const FirstPassResult first_;
+    std::vector<std::int32_t> fine_of_bucket_;  // table of a coarse bucket, or -1
+    std::size_t tables_ = 0;
+    std::vector<RankQuery> queries_;
+    std::optional<double> learnt_threshold_;
+    SecondPassTally tally_;
+};
+
+class StreamedPairwise::SecondSink {
+public:
+    explicit SecondSink(const SecondPass& pass) : pass_(&pass), tally_(pass.NewTally()) {}
+    void Add(std::size_t i, std::size_t j, float distance) {
+        const Context& c = pass_->context();
+        if (!c.truth->Comparable(i, j)) return;
+        CheckNotNan(i, j, distance);
+        if (!c.truth->IsLoop(i, j)) pass_->Count(tally_, j, distance);
+    }
+    void MergeInto(SecondPass& pass) const { pass.Merge(tally_); }
+
+private:
+    const SecondPass* pass_;
+    SecondPassTally tally_;
+};
+
+void StreamedPairwise::SecondPass::LocateRanks() {
+    const std::uint64_t positives_n = context_.positive_count;
+    const std::uint64_t negatives_n = first_.tally.all.total;
+    const detail::CurveThinner thinner(context_.request.pairwise.max_curve_points);
+    std::vector<std::uint64_t> ranks;
+    // Every rank that can start a new bucket inside a run (see SweepAll).
+    ForEachStep(
+        context_.all, first_.all_slots,
+        [&](std::size_t, std::uint64_t tp, std::uint64_t fp, std::uint64_t count) {
+            if (count == 0) return;
+            const auto bucket_at = [&](std::uint64_t f) {
+                return thinner.Bucket(
+                    detail::MakePoint(0.0, ConfusionOf(tp, f, positives_n, negatives_n)));
+            };
+            for (double b = bucket_at(fp) + 1; b <= bucket_at(fp + count); ++b) {
+                ranks.push_back(
+                    FirstFpInBucket(thinner, b, tp, fp + 1, fp + count, positives_n, negatives_n));
+            }
+        },
+        [](std::size_t, std::uint64_t, std::uint64_t, std::uint64_t, std::uint64_t) {});
+    ranks.erase(std::unique(ranks.begin(), ranks.end()), ranks.end());
+    // Locate each rank's coarse bucket.
+    fine_of_bucket_.assign(kCoarseBuckets, -1);
+    std::uint64_t before = 0;
+    std::size_t next = 0;
+    for (std::size_t bucket = 0; bucket < kCoarseBuckets && next < ranks.size(); ++bucket) {
+        const std::uint64_t count = first_.coarse[bucket];
+        for (; next < ranks.size() && ranks[next] <= before + count; ++next) {
+            if (fine_of_bucket_[bucket] < 0)
+                fine_of_bucket_[bucket] = static_cast<std::int32_t>(tables_++);
+            queries_.push_back(
+                {ranks[next], static_cast<std::uint32_t>(bucket), ranks[next] - before, 0.0f, 0});
+        }
+        before += count;
+    }
+}
+
+void StreamedPairwise::SecondPass::ResolveQueries() {
+    std::uint64_t before = 0;
+    std::uint32_t summed_to = 0;  // coarse buckets [0, summed_to) are in `before`
+    for (RankQuery& q : queries_) {
+        for (; summed_to < q.bucket; ++summed_to) before += first_.coarse[summed_to];
+        const std::uint64_t* table =
+            tally_.fine.data() + static_cast<std::size_t>(fine_of_bucket_[q.bucket]) * kFineKeys;
+        std::uint64_t cumulative = 0;
+        std::size_t key = 0;
+        for (; key < kFineKeys; ++key) {
+            cumulative += table[key];
+            if (cumulative >= q.rank_in_bucket) break;
+        }
+        q.value = FromKey((q.bucket << kFineBits) | static_cast<std::uint32_t>(key));
+        q.at_most = before + cumulative;
+    }
+}
+
+void StreamedPairwise::SecondPass::SweepAll(StreamedResult& result) const {
+    PairwiseEvaluation& e = result.pairwise;
+    const PositiveLevels& all = context_.all;
+    const SlotCounts& all_slots = first_.all_slots;
+    const std::uint64_t positives_n = context_.positive_count;
+    const std::uint64_t negatives_n = first_.tally.all.total;
+    e.pairs = positives_n + negatives_n;
+    e.positives = positives_n;
+    e.negatives = negatives_n;
+    e.distinct_thresholds = first_.tally.distinct;
+    const auto point_at = [&](double threshold, std::uint64_t tp, std::uint64_t fp) {
+        return detail::MakePoint(threshold, ConfusionOf(tp, fp, positives_n, negatives_n));
+    };
+    e.curve.push_back(point_at(-std::numeric_limits<double>::infinity(), 0, 0));
+    detail::CurveThinner thinner(context_.request.pairwise.max_curve_points);
+    detail::AreaSum area;
+    const std::size_t levels = all.size();
+    const bool ends_in_run = all_slots.back() > 0;
+    std::size_t next_query = 0;
+    const auto run = [&](std::size_t k, std::uint64_t tp, std::uint64_t fp, std::uint64_t count) {
+        if (count == 0) return;
+        area.Step(count, tp, tp);
+        const std::uint64_t end = fp + count;
+        while (thinner.Bucket(point_at(0.0, tp, end)) > thinner.last_bucket()) {
+            const std::uint64_t rank = FirstFpInBucket(thinner, thinner.last_bucket() + 1, tp,
+                                                       fp + 1, end, positives_n, negatives_n);
+            while (next_query < queries_.size() && queries_[next_query].rank < rank) ++next_query;
+            if (next_query == queries_.size() || queries_[next_query].rank != rank)
+                throw core::Error("streamed evaluation: a curve point was not located");
+            const RankQuery& q = queries_[next_query];
+            if (k == levels && q.at_most == end) break;  // the last point, kept below
+            const CurvePoint point = point_at(q.value, tp, q.at_most);
+            thinner.Keep(point);
+            e.curve.push_back(point);
+            fp = q.at_most;
+        }
+        if (k == levels) e.curve.push_back(point_at(first_.tally.all.max, tp, end));
+    };
+    const auto at_level = [&](std::size_t k, std::uint64_t tp, std::uint64_t fp, std::uint64_t pos,
+                              std::uint64_t neg) {
+        area.Step(neg, tp, tp + pos);
+        const CurvePoint point = point_at(all.Distance(k), tp + pos, fp + neg);
+        const bool last = k + 1 == levels && !ends_in_run;
+        if (last || thinner.Keep(point)) e.curve.push_back(point);
+    };
+    ForEachStep(all, all_slots, run, at_level);
+    if (positives_n > 0 && negatives_n > 0) e.roc_auc = area.Area(positives_n, negatives_n);
+    const Optima best = BestOf(all, all_slots, first_.tally.all);
+    e.best_mcc = best.mcc;
+    e.best_f1 = best.f1;
+    result.optimum_exact = !(best.mcc.score < 0.0);
+}
+
+// The threshold learnt on the training part and its scores on the test part, whose negatives
+// at or below it are `test_at_learnt` (0 before the second pass, which counts them).
+std::optional<ThresholdTransfer> StreamedPairwise::SecondPass::Transfer(
+    std::uint64_t test_at_learnt) const {
+    if (!context_.Learning()) return std::nullopt;
+    const FirstPassTally& t = first_.tally;
+    const std::uint64_t test_positives = context_.positive_count - context_.train.total;
+    const std::uint64_t train_pairs = context_.train.total + t.train.total;
+    const std::uint64_t test_pairs = test_positives + t.test.total;
+    if (train_pairs == 0 || test_pairs == 0) return std::nullopt;
+    if (context_.train.size() == 0 && t.train.min_count == 0) return std::nullopt;
+    const Optima best = BestOf(context_.train, first_.train_slots, t.train);
+    const Criterion criterion = context_.request.learning->criterion;
+    const BestThreshold& chosen = criterion == Criterion::kMcc ? best.mcc : best.f1;
+    // The test part's positives are those of the whole sequence minus the training part's.
+    const std::uint64_t tp =
+        context_.all.AtMost(chosen.threshold) - context_.train.AtMost(chosen.threshold);
+    return TransferOf(criterion, chosen,
+                      ConfusionOf(tp, test_at_learnt, test_positives, t.test.total));
+}
+
+StreamedResult StreamedPairwise::SecondPass::Result() const {
+    StreamedResult result;
+    SweepAll(result);
+    result.learnt = Transfer(tally_.test_at_learnt);
+    result.best_matches = first_.tally.best;
+    // ConfusionsAt: positives directly, negatives from the second pass's counts.
+    const std::uint64_t negatives = first_.tally.all.total;
+    const std::uint64_t positives = context_.positive_count;
+    const std::vector<double>& thresholds = context_.ascending_thresholds;
+    result.at_thresholds.resize(thresholds.size());
+    std::uint64_t fp = 0;
+    for (std::size_t r = 0; r < thresholds.size(); ++r) {
+        fp += tally_.from_threshold[r];
+        const std::uint64_t tp = context_.all.AtMost(thresholds[r]);
+        result.at_thresholds[context_.threshold_order[r]] =
+            ConfusionOf(tp, fp, positives, negatives);
+    }
+    return result;
 }
 
 // ---- StreamedPairwise -------------------------------------------------------------------------
@@ -459,9 +797,22 @@ std::vector<float> TrainingPositives(const GroundTruth& truth, const std::vector
 
 }  // namespace
 
+StreamedPairwise::Sink::Sink(std::unique_ptr<FirstSink> first, std::unique_ptr<SecondSink> second)
+    : first_(std::move(first)), second_(std::move(second)) {}
+StreamedPairwise::Sink::Sink(Sink&&) noexcept = default;
+StreamedPairwise::Sink& StreamedPairwise::Sink::operator=(Sink&&) noexcept = default;
+StreamedPairwise::Sink::~Sink() = default;
+
+void StreamedPairwise::Sink::Add(std::size_t i, std::size_t j, float distance) {
+    if (first_) {
+        first_->Add(i, j, distance);
+    } else {
+        second_->Add(i, j, distance);
+    }
+}
+
 StreamedPairwise::StreamedPairwise(const GroundTruth& truth, std::vector<float> positives,
-                                   StreamedRequest request)
-    : shared_(nullptr) {
+                                   StreamedRequest request) {
     request.pairwise.Validate();
     if (request.pairwise.max_curve_points == 0) {
         throw core::ConfigError(
@@ -475,293 +826,65 @@ StreamedPairwise::StreamedPairwise(const GroundTruth& truth, std::vector<float> 
     if (truth.size() > std::numeric_limits<std::uint32_t>::max())
         throw core::Error("pair-wise evaluation: more than 2^32 scans");
     CheckPositives(truth, positives);
-    auto shared = std::make_unique<Shared>(truth);
-    Shared& s = *shared;
-    s.request = std::move(request);
-    s.positive_count = positives.size();
-    if (s.request.learning) {
-        s.first_test_scan = static_cast<std::size_t>(
-            std::llround(s.request.learning->train_fraction * static_cast<double>(truth.size())));
-        std::vector<float> train = TrainingPositives(truth, positives, s.first_test_scan);
-        s.train = LevelsOf(train);
+    auto context = std::make_unique<Context>();
+    Context& c = *context;
+    c.truth = &truth;
+    c.request = std::move(request);
+    c.positive_count = positives.size();
+    if (c.request.learning) {
+        c.first_test_scan = static_cast<std::size_t>(
+            std::llround(c.request.learning->train_fraction * static_cast<double>(truth.size())));
+        std::vector<float> train = TrainingPositives(truth, positives, c.first_test_scan);
+        c.train = LevelsOf(train);
     }
-    s.all = LevelsOf(positives);
+    c.all = LevelsOf(positives);
     positives = std::vector<float>();  // the levels hold what is needed of them
-    const std::vector<double>& thresholds = s.request.thresholds;
-    s.threshold_order.resize(thresholds.size());
-    for (std::size_t k = 0; k < thresholds.size(); ++k) s.threshold_order[k] = k;
-    std::sort(s.threshold_order.begin(), s.threshold_order.end(),
+    const std::vector<double>& thresholds = c.request.thresholds;
+    c.threshold_order.resize(thresholds.size());
+    for (std::size_t k = 0; k < thresholds.size(); ++k) c.threshold_order[k] = k;
+    std::sort(c.threshold_order.begin(), c.threshold_order.end(),
               [&](std::size_t a, std::size_t b) { return thresholds[a] < thresholds[b]; });
-    for (const std::size_t k : s.threshold_order) s.ascending_thresholds.push_back(thresholds[k]);
-    s.merged = Sink(s);
-    s.all_slots.Assign(s.all.SlotCount());
-    if (s.Learning()) s.train_slots.Assign(s.train.SlotCount());
-    s.merged.coarse_.assign(kCoarseBuckets, 0);
-    shared_ = std::move(shared);
+    for (const std::size_t k : c.threshold_order) c.ascending_thresholds.push_back(thresholds[k]);
+    context_ = std::move(context);
+    first_ = std::make_unique<FirstPass>(*context_);
 }
 
 StreamedPairwise::~StreamedPairwise() = default;
 
-int StreamedPairwise::pass() const { return shared_->pass; }
+int StreamedPairwise::pass() const { return first_ ? 1 : finished_ ? 3 : 2; }
 
-StreamedPairwise::Sink StreamedPairwise::NewSink() const { return Sink(*shared_); }
+StreamedPairwise::Sink StreamedPairwise::NewSink() const {
+    if (first_) return Sink(std::make_unique<FirstSink>(*first_), nullptr);
+    if (finished_) throw core::Error("streamed evaluation: NewSink() after both passes ended");
+    return Sink(nullptr, std::make_unique<SecondSink>(*second_));
+}
 
 void StreamedPairwise::Merge(Sink& sink) {
-    Sink& m = shared_->merged;
-    const auto add = [](std::vector<std::uint64_t>& into, const std::vector<std::uint64_t>& from) {
-        for (std::size_t k = 0; k < from.size(); ++k) into[k] += from[k];
-    };
-    if (shared_->pass == 1) {
-        sink.Flush();
-        for (std::size_t k = 0; k < m.best_.size(); ++k) MergeBest(m.best_[k], sink.best_[k]);
-        m.all_.Merge(sink.all_);
-        m.train_.Merge(sink.train_);
-        m.test_.Merge(sink.test_);
-        m.distinct_ += sink.distinct_;
+    if (first_ && sink.first_) {
+        sink.first_->MergeInto(*first_);
+    } else if (second_ && !finished_ && sink.second_) {
+        sink.second_->MergeInto(*second_);
     } else {
-        add(m.fine_, sink.fine_);
-        add(m.from_threshold_, sink.from_threshold_);
-        m.test_at_learnt_ += sink.test_at_learnt_;
+        throw core::Error("streamed evaluation: Merge() of a sink of another pass");
     }
 }
 
 void StreamedPairwise::EndPass() {
-    Shared& s = *shared_;
-    if (s.pass == 1) {
-        if (s.positive_count + s.merged.all_.total == 0)
+    if (first_) {
+        if (first_->Empty())
             throw core::EmptyInputError("pair-wise evaluation: no pairs to evaluate");
-        s.PrepareSecondPass();
-        // The second pass's sink keeps the first pass's merged counts.
-        Sink first = std::move(s.merged);
-        s.pass = 2;
-        s.merged = Sink(s);
-        s.merged.coarse_ = std::move(first.coarse_);
-        s.merged.best_ = std::move(first.best_);
-        s.merged.all_ = first.all_;
-        s.merged.train_ = first.train_;
-        s.merged.test_ = first.test_;
-        s.merged.distinct_ = first.distinct_;
-    } else if (s.pass == 2) {
-        s.ResolveQueries();
-        s.pass = 3;
+        // The first pass's findings move whole into the second.
+        second_ = std::make_unique<SecondPass>(*context_, std::move(*first_).Finish());
+        first_.reset();
+    } else if (!finished_) {
+        second_->ResolveQueries();
+        finished_ = true;
     }
 }
 
 StreamedResult StreamedPairwise::Result() const {
-    const Shared& s = *shared_;
-    if (s.pass != 3) throw core::Error("streamed evaluation: Result() before both passes ended");
-    StreamedResult result;
-    s.SweepAll(result);
-    result.learnt = s.Transfer();
-    result.best_matches = s.merged.best_;
-    // ConfusionsAt: positives directly, negatives from the second pass's slots.
-    const std::uint64_t negatives = s.merged.all_.total;
-    const std::uint64_t positives = s.positive_count;
-    result.at_thresholds.resize(s.ascending_thresholds.size());
-    std::uint64_t fp = 0;
-    for (std::size_t r = 0; r < s.ascending_thresholds.size(); ++r) {
-        fp += s.merged.from_threshold_[r];
-        const std::uint64_t tp = s.all.AtMost(s.ascending_thresholds[r]);
-        result.at_thresholds[s.threshold_order[r]] = ConfusionOf(tp, fp, positives, negatives);
-    }
-    return result;
-}
-
-// ---- Between the passes -----------------------------------------------------------------------
-
-namespace {
-
-// Walks the sweep's steps: for each D_k the run of negatives below it (slot 2k), then the
-// positives and negatives at it (slot 2k + 1); finally the run above all (slot 2U).
-template <class Run, class AtLevel>
-void ForEachStep(const PositiveLevels& levels, const SlotCounts& slots, Run run, AtLevel at_level) {
-    std::uint64_t tp = 0;
-    std::uint64_t fp = 0;
-    for (std::size_t k = 0; k <= levels.size(); ++k) {
-        const std::uint64_t below = slots[2 * k];
-        run(k, tp, fp, below);
-        fp += below;
-        if (k == levels.size()) break;
-        const std::uint64_t positives = levels.Count(k);
-        const std::uint64_t at = slots[2 * k + 1];
-        at_level(k, tp, fp, positives, at);
-        tp += positives;
-        fp += at;
-    }
-}
-
-// The smallest fp in [low, high] whose curve point lies in a bucket >= `bucket`; high when none.
-std::uint64_t FirstFpInBucket(const detail::CurveThinner& thinner, double bucket, std::uint64_t tp,
-                              std::uint64_t low, std::uint64_t high, std::uint64_t positives,
-                              std::uint64_t negatives) {
-    while (low < high) {
-        const std::uint64_t mid = low + (high - low) / 2;
-        const CurvePoint p = detail::MakePoint(0.0, ConfusionOf(tp, mid, positives, negatives));
-        if (thinner.Bucket(p) >= bucket) {
-            high = mid;
-        } else {
-            low = mid + 1;
-        }
-    }
-    return low;
-}
-
-}  // namespace
-
-void StreamedPairwise::Shared::PrepareSecondPass() {
-    const std::uint64_t positives_n = positive_count;
-    const std::uint64_t negatives_n = merged.all_.total;
-    const detail::CurveThinner thinner(request.pairwise.max_curve_points);
-    std::vector<std::uint64_t> ranks;
-    // Every rank that can start a new bucket inside a run (see SweepAll).
-    ForEachStep(
-        all, all_slots,
-        [&](std::size_t, std::uint64_t tp, std::uint64_t fp, std::uint64_t count) {
-            if (count == 0) return;
-            const auto bucket_at = [&](std::uint64_t f) {
-                return thinner.Bucket(
-                    detail::MakePoint(0.0, ConfusionOf(tp, f, positives_n, negatives_n)));
-            };
-            for (double b = bucket_at(fp) + 1; b <= bucket_at(fp + count); ++b) {
-                ranks.push_back(
-                    FirstFpInBucket(thinner, b, tp, fp + 1, fp + count, positives_n, negatives_n));
-            }
-        },
-        [](std::size_t, std::uint64_t, std::uint64_t, std::uint64_t, std::uint64_t) {});
-    ranks.erase(std::unique(ranks.begin(), ranks.end()), ranks.end());
-    // Locate each rank's coarse bucket.
-    fine_of_bucket.assign(kCoarseBuckets, -1);
-    std::int32_t tables = 0;
-    std::uint64_t before = 0;
-    std::size_t next = 0;
-    for (std::size_t bucket = 0; bucket < kCoarseBuckets && next < ranks.size(); ++bucket) {
-        const std::uint64_t count = merged.coarse_[bucket];
-        for (; next < ranks.size() && ranks[next] <= before + count; ++next) {
-            if (fine_of_bucket[bucket] < 0) fine_of_bucket[bucket] = tables++;
-            queries.push_back(
-                {ranks[next], static_cast<std::uint32_t>(bucket), ranks[next] - before, 0.0f, 0});
-        }
-        before += count;
-    }
-    learnt_threshold.reset();
-    if (const auto t = Transfer()) learnt_threshold = t->threshold;
-}
-
-void StreamedPairwise::Shared::ResolveQueries() {
-    std::uint64_t before = 0;
-    std::uint32_t summed_to = 0;  // coarse buckets [0, summed_to) are in `before`
-    for (RankQuery& q : queries) {
-        for (; summed_to < q.bucket; ++summed_to) before += merged.coarse_[summed_to];
-        const std::uint64_t* table =
-            merged.fine_.data() + static_cast<std::size_t>(fine_of_bucket[q.bucket]) * kFineKeys;
-        std::uint64_t cumulative = 0;
-        std::size_t key = 0;
-        for (; key < kFineKeys; ++key) {
-            cumulative += table[key];
-            if (cumulative >= q.rank_in_bucket) break;
-        }
-        q.value = FromKey((q.bucket << kFineBits) | static_cast<std::uint32_t>(key));
-        q.at_most = before + cumulative;
-    }
-}
-
-// ---- After the passes ---------------------------------------------------------------------
-
-// The optima over the sweep's points at the positives' distances and its first and last points:
-// see the top of this file for why the points between two positives' distances cannot win.
-StreamedPairwise::Shared::Optima StreamedPairwise::Shared::BestOf(
-    const PositiveLevels& levels, const SlotCounts& slots, const Sink::Extremes& negatives) const {
-    const std::uint64_t positives_n = levels.total;
-    const std::uint64_t negatives_n = negatives.total;
-    const Confusion start = ConfusionOf(0, 0, positives_n, negatives_n);
-    const double minus_inf = -std::numeric_limits<double>::infinity();
-    Optima best{{minus_inf, Mcc(start), start}, {minus_inf, F1(start), start}};
-    bool have_mcc = false;
-    bool have_f1 = false;
-    const auto consider = [&](double threshold, std::uint64_t tp, std::uint64_t fp) {
-        const Confusion c = ConfusionOf(tp, fp, positives_n, negatives_n);
-        detail::KeepBest(best.mcc, have_mcc, Mcc(c), threshold, c);
-        detail::KeepBest(best.f1, have_f1, F1(c), threshold, c);
-    };
-    if (slots.front() > 0) consider(negatives.min, 0, negatives.min_count);
-    std::uint64_t scored_positives = 0;
-    ForEachStep(
-        levels, slots, [](std::size_t, std::uint64_t, std::uint64_t, std::uint64_t) {},
-        [&](std::size_t k, std::uint64_t tp, std::uint64_t fp, std::uint64_t pos,
-            std::uint64_t neg) {
-            consider(levels.Distance(k), tp + pos, fp + neg);
-            scored_positives = tp + pos;
-        });
-    if (slots.back() > 0)
-        consider(negatives.max, scored_positives, negatives_n - negatives.unscored);
-    return best;
-}
-
-void StreamedPairwise::Shared::SweepAll(StreamedResult& result) const {
-    PairwiseEvaluation& e = result.pairwise;
-    const std::uint64_t positives_n = positive_count;
-    const std::uint64_t negatives_n = merged.all_.total;
-    e.pairs = positives_n + negatives_n;
-    e.positives = positives_n;
-    e.negatives = negatives_n;
-    e.distinct_thresholds = merged.distinct_;
-    const auto point_at = [&](double threshold, std::uint64_t tp, std::uint64_t fp) {
-        return detail::MakePoint(threshold, ConfusionOf(tp, fp, positives_n, negatives_n));
-    };
-    e.curve.push_back(point_at(-std::numeric_limits<double>::infinity(), 0, 0));
-    detail::CurveThinner thinner(request.pairwise.max_curve_points);
-    detail::AreaSum area;
-    const std::size_t levels = all.size();
-    const bool ends_in_run = all_slots.back() > 0;
-    std::size_t next_query = 0;
-    const auto run = [&](std::size_t k, std::uint64_t tp, std::uint64_t fp, std::uint64_t count) {
-        if (count == 0) return;
-        area.Step(count, tp, tp);
-        const std::uint64_t end = fp + count;
-        while (thinner.Bucket(point_at(0.0, tp, end)) > thinner.last_bucket()) {
-            const std::uint64_t rank = FirstFpInBucket(thinner, thinner.last_bucket() + 1, tp,
-                                                       fp + 1, end, positives_n, negatives_n);
-            while (next_query < queries.size() && queries[next_query].rank < rank) ++next_query;
-            if (next_query == queries.size() || queries[next_query].rank != rank)
-                throw core::Error("streamed evaluation: a curve point was not located");
-            const RankQuery& q = queries[next_query];
-            if (k == levels && q.at_most == end) break;  // the last point, kept below
-            const CurvePoint point = point_at(q.value, tp, q.at_most);
-            thinner.Keep(point);
-            e.curve.push_back(point);
-            fp = q.at_most;
-        }
-        if (k == levels) e.curve.push_back(point_at(merged.all_.max, tp, end));
-    };
-    const auto at_level = [&](std::size_t k, std::uint64_t tp, std::uint64_t fp, std::uint64_t pos,
-                              std::uint64_t neg) {
-        area.Step(neg, tp, tp + pos);
-        const CurvePoint point = point_at(all.Distance(k), tp + pos, fp + neg);
-        const bool last = k + 1 == levels && !ends_in_run;
-        if (last || thinner.Keep(point)) e.curve.push_back(point);
-    };
-    ForEachStep(all, all_slots, run, at_level);
-    if (positives_n > 0 && negatives_n > 0) e.roc_auc = area.Area(positives_n, negatives_n);
-    const Optima best = BestOf(all, all_slots, merged.all_);
-    e.best_mcc = best.mcc;
-    e.best_f1 = best.f1;
-    result.optimum_exact = !(best.mcc.score < 0.0);
-}
-
-std::optional<ThresholdTransfer> StreamedPairwise::Shared::Transfer() const {
-    if (!Learning()) return std::nullopt;
-    const std::uint64_t test_positives = positive_count - train.total;
-    const std::uint64_t train_pairs = train.total + merged.train_.total;
-    const std::uint64_t test_pairs = test_positives + merged.test_.total;
-    if (train_pairs == 0 || test_pairs == 0) return std::nullopt;
-    if (train.size() == 0 && merged.train_.min_count == 0) return std::nullopt;
-    const Optima best = BestOf(train, train_slots, merged.train_);
-    const Criterion criterion = request.learning->criterion;
-    const BestThreshold& chosen = criterion == Criterion::kMcc ? best.mcc : best.f1;
-    // The test part's positives are those of the whole sequence minus the training part's.
-    const std::uint64_t tp = all.AtMost(chosen.threshold) - train.AtMost(chosen.threshold);
-    return TransferOf(criterion, chosen,
-                      ConfusionOf(tp, merged.test_at_learnt_, test_positives, merged.test_.total));
+    if (!finished_) throw core::Error("streamed evaluation: Result() before both passes ended");
+    return second_->Result();
 }
 
 StreamedResult StreamSerially(StreamedPairwise& evaluation, std::size_t n,

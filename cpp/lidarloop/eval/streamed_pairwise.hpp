@@ -60,51 +60,34 @@ struct StreamedResult {
 /// constructing, the positives' distances (4 bytes each, sorted in place); per sink 24 bytes a scan
 /// and up to 7 MiB of batch; in the second pass 32 KiB per located curve point and sink; and a
 /// bitmap of the distinct distances (512 MiB of address space, of which only the pages of occurring
-/// distances become resident: 4 KiB per 32768 consecutive float values). Sinks sort their batches
-/// and locate them among the slots on their own, and add them to shared counters under a mutex.
+/// distances become resident: 4 KiB per 32768 consecutive float values; first pass only). Sinks
+/// sort their batches and locate them among the slots on their own, and add them to shared
+/// counters under a mutex.
 class StreamedPairwise {
+    struct Context;          // fixed before the first pass: the request, the positives' levels
+    struct FirstPassResult;  // what the first pass found, moved whole into the second
+    class FirstPass;         // counts the negatives in slots and coarse buckets
+    class FirstSink;
+    class SecondPass;  // counts the negatives near the wanted ranks; computes the result
+    class SecondSink;
+
 public:
-    struct Shared;
-    /// Per-thread accumulator of one pass; cheap to Add to, not thread-safe itself.
+    /// Per-thread accumulator of the pass that made it; cheap to Add to, not thread-safe itself.
+    /// Move-only.
     class Sink {
     public:
-        explicit Sink(const Shared& shared);
+        Sink(Sink&&) noexcept;
+        Sink& operator=(Sink&&) noexcept;
+        ~Sink();
         /// One pair i < j and its distance; pairs the ground truth does not compare are
         /// ignored. Throws core::Error for a NaN distance.
         void Add(std::size_t i, std::size_t j, float distance);
 
     private:
         friend class StreamedPairwise;
-        void AddNegative(std::size_t j, float distance);
-        void Flush();
-        const Shared* shared_;
-        std::vector<std::uint64_t> coarse_;       ///< pass 1: negatives by the top bits of the key
-        std::vector<std::uint32_t> pending_all_;  ///< pass 1: keys of negatives to count
-        std::vector<std::uint32_t> pending_train_;  ///< pass 1: of training negatives
-        std::vector<std::uint32_t> scratch_;
-        /// pass 1: a sorted batch located outside the lock, (slot or bucket << 20) | count
-        std::vector<std::uint64_t> located_all_;
-        std::vector<std::uint64_t> located_train_;
-        std::vector<std::uint64_t> located_coarse_;
-        std::vector<std::uint64_t> fine_;  ///< pass 2: negatives by key in the target buckets
-        std::vector<std::uint64_t> from_threshold_;  ///< pass 2: as in ConfusionsAt
-        std::uint64_t test_at_learnt_ = 0;           ///< pass 2: test negatives <= learnt tau
-        std::vector<BestMatch> best_;
-        std::size_t distinct_ = 0;  ///< pass 1: distances this sink saw first
-        struct Extremes {
-            float min = 0.0f;
-            float max = 0.0f;
-            std::uint64_t min_count = 0;
-            std::uint64_t max_count = 0;
-            std::uint64_t unscored = 0;
-            std::uint64_t total = 0;
-            void Add(float distance);
-            void Merge(const Extremes& other);
-        };
-        Extremes all_;
-        Extremes train_;
-        Extremes test_;
-        friend struct Shared;
+        Sink(std::unique_ptr<FirstSink> first, std::unique_ptr<SecondSink> second);
+        std::unique_ptr<FirstSink> first_;    ///< a sink of the first pass, or
+        std::unique_ptr<SecondSink> second_;  ///< of the second
     };
 
     /// `positives`: ScorePositives(truth, distance), one per truth.loop_count. Throws
@@ -121,8 +104,10 @@ public:
     int pass() const;
     /// Both passes are done: Result() is ready (stream while this is false).
     bool finished() const { return pass() > 2; }
+    /// A sink of the current pass; core::Error when both have ended.
     Sink NewSink() const;
-    /// Adds a sink's counts (after counting what it still holds).
+    /// Adds a sink's counts (after counting what it still holds); core::Error for a sink of
+    /// another pass. Not thread-safe.
     void Merge(Sink& sink);
     /// Ends a pass. Throws core::EmptyInputError after the first when there is no pair.
     void EndPass();
@@ -130,7 +115,10 @@ public:
     StreamedResult Result() const;
 
 private:
-    std::unique_ptr<Shared> shared_;
+    std::unique_ptr<const Context> context_;
+    std::unique_ptr<FirstPass> first_;    ///< during the first pass
+    std::unique_ptr<SecondPass> second_;  ///< from its end on
+    bool finished_ = false;
 };
 
 /// Streams every pair i < j of `n` scans through `evaluation` serially, both passes, and returns

@@ -74,15 +74,36 @@ void VisitFields(core::NdtConfig& c, Visitor& v) {
     v.Moved("threshold", "detection.threshold", kLegacyNdtThreshold);
 }
 
+// A registered method's parameters (core::MethodParameters): each declared parameter becomes a
+// Field of `visitor`, its key and help as declared.
 template <typename Visitor>
-void VisitFields(core::ScanContextConfig& c, Visitor& v) {
-    v.Field("rings", c.rings, "N_r, rings of equal width up to max_range_m");
-    v.Field("sectors", c.sectors, "N_s, sectors of equal azimuth");
-    v.Field("max_range_m", c.max_range_m, "L_max, farther points (planar range) are dropped");
-    v.Field("sensor_height_m", c.sensor_height_m,
-            "added to z, so that a bin holds max(0, z + this), metres");
-    v.Field("ring_key_candidates", c.ring_key_candidates,
-            "scans of nearest ring key ranked by the full distance; 0: compare every scan");
+class FieldAdapter final : public core::ParameterVisitor {
+public:
+    explicit FieldAdapter(Visitor& visitor) : visitor_(visitor) {}
+    void Visit(const core::ParameterInfo& i, bool& value) override { Forward(i, value); }
+    void Visit(const core::ParameterInfo& i, int& value) override { Forward(i, value); }
+    void Visit(const core::ParameterInfo& i, std::size_t& value) override { Forward(i, value); }
+    void Visit(const core::ParameterInfo& i, double& value) override { Forward(i, value); }
+    void Visit(const core::ParameterInfo& i, std::optional<double>& value) override {
+        Forward(i, value);
+    }
+    void Visit(const core::ParameterInfo& i, std::vector<double>& value) override {
+        Forward(i, value);
+    }
+    void Visit(const core::ParameterInfo& i, std::string& value) override { Forward(i, value); }
+
+private:
+    template <typename T>
+    void Forward(const core::ParameterInfo& info, T& value) {
+        visitor_.Field(std::string(info.key).c_str(), value, std::string(info.help));
+    }
+    Visitor& visitor_;
+};
+
+template <typename Visitor>
+void VisitFields(core::MethodParameters& c, Visitor& v) {
+    FieldAdapter<Visitor> adapter(v);
+    c.Visit(adapter);
 }
 
 template <typename Visitor>
@@ -233,7 +254,7 @@ void VisitFields(RunConfig& c, Visitor& v) {
     v.Field("method", c.descriptor.method, MethodHelp());
     v.Section("histogram", c.descriptor.histogram);
     v.Section("ndt", c.descriptor.ndt);
-    v.Section("scancontext", c.descriptor.scancontext);
+    v.MethodSections(c.descriptor);  // scancontext and any other registered method's
     v.Section("detection", c.detection);
     v.Section("verification", c.detection.verification);
     v.Section("posegraph", c.posegraph);
@@ -271,6 +292,8 @@ public:
             out_ << EnumName(value);
         } else if constexpr (std::is_same_v<T, bool>) {
             out_ << (value ? "true" : "false");
+        } else if constexpr (std::is_same_v<T, std::string>) {
+            out_ << value;
         } else if constexpr (std::is_same_v<T, std::vector<double>>) {
             out_ << "[";
             for (std::size_t i = 0; i < value.size(); ++i) {
@@ -291,6 +314,11 @@ public:
         out_.write(buffer, result.ptr - buffer);
     }
     void Moved(const char*, const char*, double) {}  // written under its new key only
+    // Every registered method's section, as held or with its defaults.
+    void MethodSections(const core::DescriptorConfig& descriptor) {
+        for (core::MethodParameters& p : pipeline::MethodParametersOf(descriptor))
+            Section(p.section().c_str(), p);
+    }
     template <typename Struct>
     void Section(const char* key, Struct& section) {
         out_ << indent_ << key << ":\n";
@@ -311,6 +339,7 @@ const char* ExpectedKind() {
     if constexpr (std::is_same_v<T, std::optional<double>>) return "a number or 'default'";
     if constexpr (std::is_same_v<T, bool>) return "true or false";
     if constexpr (std::is_same_v<T, std::vector<double>>) return "a list of numbers";
+    if constexpr (std::is_same_v<T, std::string>) return "a name";
     if constexpr (std::is_integral_v<T>) return "an integer";
     return "a number";
 }
@@ -394,6 +423,15 @@ public:
         VisitFields(section, reader);
         reader.RejectUnknownKeys();
     }
+    // The section of every registered method with parameters: read into what `descriptor`
+    // holds (or the defaults) and held from then on.
+    void MethodSections(core::DescriptorConfig& descriptor) {
+        for (core::MethodParameters& p : pipeline::MethodParametersOf(descriptor)) {
+            const std::string key = p.section();
+            Section(key.c_str(), p);
+            if (node_[key]) descriptor.methods.Set(std::move(p));
+        }
+    }
     // yaml-cpp 0.7 keeps both entries of a repeated key and node[key] finds the first, so the
     // second would be ignored silently. Checked before any value is read, so that the repeat is
     // what the message names.
@@ -457,6 +495,66 @@ std::string DumpConfigYaml(const RunConfig& config) {
     VisitFields(copy, writer);
     return "# lidarloop configuration; every key is optional and overrides the default.\n" +
            writer.str();
+}
+
+namespace {
+
+// One table row per declared parameter: key, default (as dump-config writes it), and the help
+// with the unit and the valid range.
+class MarkdownRows final : public core::ParameterVisitor {
+public:
+    explicit MarkdownRows(std::string section) : section_(std::move(section)) {}
+    void Visit(const core::ParameterInfo& i, bool& value) override { Row(i, value); }
+    void Visit(const core::ParameterInfo& i, int& value) override { Row(i, value); }
+    void Visit(const core::ParameterInfo& i, std::size_t& value) override { Row(i, value); }
+    void Visit(const core::ParameterInfo& i, double& value) override { Row(i, value); }
+    void Visit(const core::ParameterInfo& i, std::optional<double>& value) override {
+        Row(i, value);
+    }
+    void Visit(const core::ParameterInfo& i, std::vector<double>& value) override { Row(i, value); }
+    void Visit(const core::ParameterInfo& i, std::string& value) override { Row(i, value); }
+    std::string str() const { return out_; }
+
+private:
+    template <typename T>
+    void Row(const core::ParameterInfo& info, T& value) {
+        YamlWriter writer;  // the default exactly as dump-config writes it
+        writer.Field("k", value, "");
+        std::string text = writer.str();
+        text = text.substr(3, text.find("  #") - 3);
+        bool code = std::is_same_v<T, std::string>;  // names in code, as in the docs
+        if constexpr (std::is_same_v<T, std::optional<double>>) code = !value.has_value();
+        out_ += "| `" + section_ + "." + std::string(info.key) + "` | " +
+                (code ? "`" + text + "`" : text) + " | ";
+        for (const char c : info.help) out_ += c == '|' ? std::string("\\|") : std::string(1, c);
+        std::string limits;
+        if (!info.unit.empty()) limits += std::string(info.unit);
+        if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>) {
+            if (info.HasRange()) {
+                YamlWriter low;
+                YamlWriter high;
+                low.WriteNumber(static_cast<T>(info.min));
+                high.WriteNumber(static_cast<T>(info.max));
+                limits += (limits.empty() ? "" : ", ") + low.str() + " to " + high.str();
+            }
+        }
+        if (!limits.empty()) out_ += " (" + limits + ")";
+        out_ += " |\n";
+    }
+    std::string section_;
+    std::string out_;
+};
+
+}  // namespace
+
+std::string DumpParametersMarkdown(const RunConfig& config) {
+    std::string text = "| key | default | meaning |\n|---|---|---|\n";
+    for (core::MethodParameters& p : pipeline::MethodParametersOf(config.descriptor)) {
+        MarkdownRows rows(p.section());
+        p.Visit(rows);
+        text += rows.str();
+    }
+    return text;
 }
 
 void ApplyConfigYaml(const std::string& yaml_text, const std::string& source, RunConfig& config,

@@ -110,6 +110,18 @@ std::string MethodNamesText(std::string_view separator) {
     return text;
 }
 
+std::vector<core::MethodParameters> MethodParametersOf(const core::DescriptorConfig& config) {
+    std::vector<core::MethodParameters> all;
+    for (const std::string& name : MethodNames()) {
+        std::optional<core::MethodParameters> defaults =
+            MethodOf(ParseMethod(name)).DefaultParameters();
+        if (!defaults) continue;
+        const core::MethodParameters* held = config.methods.Find(defaults->section());
+        all.push_back(held != nullptr ? *held : std::move(*defaults));
+    }
+    return all;
+}
+
 core::Descriptor ComputeDescriptor(const core::PointCloud& cloud,
                                    const core::DescriptorConfig& config) {
     return MethodOf(config.method).Describe(cloud, config);

@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -121,6 +122,12 @@ public:
     virtual std::unique_ptr<DescriptorStore> MakeStore(
         const core::DescriptorConfig& config) const = 0;
 
+    /// The method's own parameters with their defaults, under its name as their section: YAML
+    /// `<name>:` and dump-config, flags --<name>-<key>, Python keywords of describe
+    /// (docs/options.md). Describe and MakeStore read them with
+    /// config.methods.Get<Config>(name()). nullopt (the default): no parameters of its own.
+    virtual std::optional<core::MethodParameters> DefaultParameters() const { return std::nullopt; }
+
     /// The default decision threshold (detection.threshold when it is not set).
     virtual double DefaultThreshold() const = 0;
     /// Whether `distance` says "same place" under `threshold` (default: distance <= threshold).
@@ -149,6 +156,10 @@ core::Method ParseMethod(std::string_view name);
 std::vector<std::string> MethodNames();
 /// MethodNames() joined by `separator` ("height | range | ndt"), for help texts and messages.
 std::string MethodNamesText(std::string_view separator);
+
+/// The parameters of every registered method that has any (DefaultParameters), as `config`
+/// holds them or else their defaults, in MethodNames() order. Thread-safe.
+std::vector<core::MethodParameters> MethodParametersOf(const core::DescriptorConfig& config);
 
 /// MethodOf(config.method).Describe(cloud, config): ConfigError for an invalid config,
 /// EmptyInputError for a scan with nothing usable. Thread-safe.

@@ -3,7 +3,7 @@
 #include <memory>
 #include <vector>
 
-#include "lidarloop/core/ndt_descriptor.hpp"
+#include "lidarloop/core/ndt/ndt_descriptor.hpp"
 #include "lidarloop/pipeline/descriptor_database.hpp"
 #include "lidarloop/pipeline/descriptor_method.hpp"
 

@@ -167,7 +167,7 @@ core::Descriptor ScanContextMethod::Describe(const core::PointCloud& cloud,
 
 core::Descriptor ScanContextMethod::DescribeView(core::PointsView points,
                                                  const core::DescriptorConfig& config) const {
-    return {method(), core::ComputeScanContext(points, config.scancontext)};
+    return {method(), core::ComputeScanContext(points, ConfigOf(config))};
 }
 
 double ScanContextMethod::Distance(const core::Descriptor& a, const core::Descriptor& b) const {
@@ -176,7 +176,15 @@ double ScanContextMethod::Distance(const core::Descriptor& a, const core::Descri
 
 std::unique_ptr<DescriptorStore> ScanContextMethod::MakeStore(
     const core::DescriptorConfig& config) const {
-    return std::make_unique<ScanContextStore>(config.scancontext);
+    return std::make_unique<ScanContextStore>(ConfigOf(config));
+}
+
+std::optional<core::MethodParameters> ScanContextMethod::DefaultParameters() const {
+    return core::MethodParameters(name(), core::ScanContextConfig{});
+}
+
+const core::ScanContextConfig& ScanContextMethod::ConfigOf(const core::DescriptorConfig& config) {
+    return config.methods.Get<core::ScanContextConfig>(kMethod.name());
 }
 
 void ScanContextMethod::ValidateThreshold(double threshold) const {

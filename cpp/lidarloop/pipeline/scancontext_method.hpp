@@ -26,6 +26,10 @@ public:
                                   const core::DescriptorConfig& config) const override;
     double Distance(const core::Descriptor& a, const core::Descriptor& b) const override;
     std::unique_ptr<DescriptorStore> MakeStore(const core::DescriptorConfig& config) const override;
+    /// core::ScanContextConfig under the section `scancontext`.
+    std::optional<core::MethodParameters> DefaultParameters() const override;
+    /// The parameters `config` holds for this method, or the defaults.
+    static const core::ScanContextConfig& ConfigOf(const core::DescriptorConfig& config);
     /// 0.13: the acceptance distance of the authors' implementation (0.1-0.2 across their
     /// papers). It depends on the sensor and the scene; learn yours.
     double DefaultThreshold() const override { return 0.13; }

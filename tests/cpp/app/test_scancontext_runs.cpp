@@ -91,10 +91,12 @@ TEST_F(ScanContextRuns, TheRingKeySearchRanksItsCandidatesByTheFullDistance) {
     exact.config.output.similarity_matrix_mib = 0;
     app::DetectRequest all = exact;
     all.out = dir_ / "all";
-    all.config.descriptor.scancontext.ring_key_candidates = 1000;
+    all.config.descriptor.methods.Mutable<core::ScanContextConfig>("scancontext")
+        .ring_key_candidates = 1000;
     app::DetectRequest few = exact;
     few.out = dir_ / "few";
-    few.config.descriptor.scancontext.ring_key_candidates = 8;
+    few.config.descriptor.methods.Mutable<core::ScanContextConfig>("scancontext")
+        .ring_key_candidates = 8;
     const app::DetectOutcome a = app::RunDetect(*dataset_, exact);
     const app::DetectOutcome b = app::RunDetect(*dataset_, all);
     const app::DetectOutcome c = app::RunDetect(*dataset_, few);

@@ -1,9 +1,12 @@
-// A third descriptor registered through the public interface only, then run end to end: online
+// A further descriptor registered through the public interface only, then run end to end: online
 // and offline detection, a saved map and localisation against it, and both papers' evaluation.
-// The method: the share of a scan's points in each 5 m range ring (a histogram of point counts
-// per ring), compared by the L1 distance of the shares.
+// The method: the share of a scan's points in each range ring (a histogram of point counts per
+// ring), compared by the L1 distance of the shares. Its two parameters are declared once
+// (RingParameters::Declare) and reach the YAML config, dump-config, validation and the keywords
+// without a line anywhere else (docs/options.md).
 #include <cmath>
 #include <fstream>
+#include <optional>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -13,6 +16,7 @@
 #include "lidarloop/app/detection.hpp"
 #include "lidarloop/app/evaluation.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/core/parameters.hpp"
 #include "lidarloop/io/config_yaml.hpp"
 #include "lidarloop/io/read_error.hpp"
 #include "lidarloop/pipeline/descriptor_method.hpp"
@@ -21,9 +25,22 @@
 namespace lidarloop {
 namespace {
 
-constexpr int kRings = 16;
-constexpr double kRingWidth_m = 5.0;
 using Shares = std::vector<double>;
+
+// The method's parameters: YAML section `rings`, as the method is named.
+struct RingParameters {
+    int ring_count = 16;
+    double ring_width_m = 5.0;
+
+    template <typename Self, typename Visit>
+    static void Declare(Self& c, Visit&& visit) {
+        visit(c.ring_count,
+              {"ring_count", "rings counted; the last takes all farther points", "", 1, 64});
+        visit(c.ring_width_m, {"ring_width_m", "width of a ring", "m", 0.1, 100.0});
+    }
+    void Validate() const { core::CheckDeclaredRanges("rings", *this); }
+    bool operator==(const RingParameters&) const = default;
+};
 
 double L1(const Shares& a, const Shares& b) {
     double sum = 0.0;
@@ -34,6 +51,7 @@ double L1(const Shares& a, const Shares& b) {
 // The store: the shares of every scan as they are.
 class RingStore : public pipeline::DescriptorStore {
 public:
+    explicit RingStore(int rings) : rings_(static_cast<std::size_t>(rings)) {}
     struct Query : pipeline::PreparedQuery {
         Shares shares;
     };
@@ -41,7 +59,7 @@ public:
         return std::make_unique<RingStore>(*this);
     }
     void Add(const core::Descriptor& d) override { rows_.push_back(d.As<Shares>()); }
-    void AddMissing() override { rows_.emplace_back(kRings, 0.0); }
+    void AddMissing() override { rows_.emplace_back(rings_, 0.0); }
     double Distance(std::size_t i, std::size_t j) const override { return L1(rows_[i], rows_[j]); }
     std::unique_ptr<pipeline::PreparedQuery> Prepare(const core::Descriptor& d) const override {
         auto query = std::make_unique<Query>();
@@ -60,12 +78,13 @@ public:
         out.PutArray(rows_[i].data(), rows_[i].size());
     }
     void Decode(core::ByteReader& in, bool) override {
-        Shares shares(kRings);
+        Shares shares(rings_);
         in.GetArray(shares.data(), shares.size(), "ring shares");
         rows_.push_back(std::move(shares));
     }
 
 private:
+    std::size_t rings_;
     std::vector<Shares> rows_;
 };
 
@@ -73,13 +92,15 @@ class RingCounts : public pipeline::DescriptorMethod {
 public:
     RingCounts() : DescriptorMethod(core::Method("rings")) {}
     core::Descriptor Describe(const core::PointCloud& cloud,
-                              const core::DescriptorConfig&) const override {
-        Shares shares(kRings, 0.0);
+                              const core::DescriptorConfig& config) const override {
+        const RingParameters& p = ParametersOf(config);
+        const int rings = p.ring_count;
+        Shares shares(static_cast<std::size_t>(rings), 0.0);
         double counted = 0.0;
-        for (const Eigen::Vector3f& p : cloud) {
-            if (!p.allFinite()) continue;
-            const auto ring = static_cast<int>(p.head<2>().norm() / kRingWidth_m);
-            shares[static_cast<std::size_t>(std::min(ring, kRings - 1))] += 1.0;
+        for (const Eigen::Vector3f& point : cloud) {
+            if (!point.allFinite()) continue;
+            const auto ring = static_cast<int>(point.head<2>().norm() / p.ring_width_m);
+            shares[static_cast<std::size_t>(std::min(ring, rings - 1))] += 1.0;
             counted += 1.0;
         }
         if (counted == 0.0) throw core::EmptyInputError("no finite point");
@@ -90,10 +111,16 @@ public:
         return L1(a.As<Shares>(), b.As<Shares>());
     }
     std::unique_ptr<pipeline::DescriptorStore> MakeStore(
-        const core::DescriptorConfig&) const override {
-        return std::make_unique<RingStore>();
+        const core::DescriptorConfig& config) const override {
+        return std::make_unique<RingStore>(ParametersOf(config).ring_count);
     }
     double DefaultThreshold() const override { return 0.1; }
+    std::optional<core::MethodParameters> DefaultParameters() const override {
+        return core::MethodParameters(name(), RingParameters{});
+    }
+    static const RingParameters& ParametersOf(const core::DescriptorConfig& config) {
+        return config.methods.Get<RingParameters>("rings");
+    }
 };
 
 // The one registration line, once per process.
@@ -196,6 +223,59 @@ TEST_F(ToyMethod, IsNamedInConfigsAndShownByName) {
     const core::Descriptor d =
         pipeline::ComputeDescriptor(dataset_->LoadScan(0), RingsConfig().descriptor);
     EXPECT_EQ(app::DescriptorJson(d), (nlohmann::json{{"method", "rings"}}));
+}
+
+}  // namespace
+}  // namespace lidarloop
+
+namespace lidarloop {
+namespace {
+
+std::string ConfigErrorOf(const std::string& yaml) {
+    io::RunConfig config;
+    try {
+        io::ApplyConfigYaml(yaml, "rings.yaml", config);
+    } catch (const io::ReadError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+// The declaration is all the method wrote: its YAML section, dump-config, validation, equality
+// with defaults and the keywords (Python sends describe()'s as this JSON) follow from it.
+TEST_F(ToyMethod, DeclaresItsParametersOnceForTheConfigAndTheKeywords) {
+    const std::string dump = io::DumpConfigYaml({});
+    EXPECT_NE(dump.find("rings:\n  ring_count: 16  # rings counted; the last takes all farther "
+                        "points\n  ring_width_m: 5  # width of a ring\n"),
+              std::string::npos)
+        << dump;
+    io::RunConfig config = RingsConfig();
+    io::ApplyConfigYaml("rings:\n  ring_width_m: 4\n", "rings.yaml", config);
+    EXPECT_EQ(RingCounts::ParametersOf(config.descriptor).ring_width_m, 4.0);
+    EXPECT_NE(io::DumpConfigYaml(config).find("  ring_width_m: 4  #"), std::string::npos);
+    io::ApplyConfigYaml(R"({"rings": {"ring_count": 8}})", "keywords", config);
+    const core::Descriptor d =
+        pipeline::ComputeDescriptor(dataset_->LoadScan(0), config.descriptor);
+    EXPECT_EQ(d.As<Shares>().size(), 8u);
+    EXPECT_NE(ConfigErrorOf("rings:\n  ring_cuont: 3\n")
+                  .find("key 'rings.ring_cuont': unknown key (valid here: ring_count, "
+                        "ring_width_m)"),
+              std::string::npos)
+        << ConfigErrorOf("rings:\n  ring_cuont: 3\n");
+    EXPECT_NE(ConfigErrorOf("rings:\n  ring_count: 0\n")
+                  .find("rings.ring_count must be in [1, 64], got 0"),
+              std::string::npos)
+        << ConfigErrorOf("rings:\n  ring_count: 0\n");
+    EXPECT_NE(ConfigErrorOf("rings:\n  ring_width_m: wide\n").find("expected a number"),
+              std::string::npos);
+    // Its defaults written out and read back equal a config that never named them.
+    io::RunConfig reloaded;
+    io::ApplyConfigYaml(dump, "dump", reloaded);
+    EXPECT_EQ(reloaded.descriptor, io::RunConfig{}.descriptor);
+    EXPECT_NE(io::DumpParametersMarkdown({}).find(
+                  "| `rings.ring_width_m` | 5 | width of a ring (m, 0.1 to 100) |"),
+              std::string::npos)
+        << io::DumpParametersMarkdown({});
 }
 
 }  // namespace

@@ -171,6 +171,34 @@ TEST(StreamedPairwise, PairsSpreadOverSinksInAnyOrderGiveTheSameResult) {
     ExpectEqualToPairsInMemory(c, s, evaluation.Result());
 }
 
+// The first pass's findings move whole into the second (no field copied by hand can be left
+// behind), and a sink counts for the pass that made it only.
+TEST(StreamedPairwise, ASinkBelongsToThePassThatMadeIt) {
+    const Case c{12, 60, 0, 0.0, 0.0, 30, Criterion::kMcc, 0.6};
+    const Sequence s = MakeSequence(c);
+    const std::size_t n = s.truth.size();
+    StreamedPairwise evaluation(s.truth, ScorePositives(s.truth, DistanceOf(s)), RequestOf(c));
+    const auto stream = [&](StreamedPairwise::Sink& sink) {
+        for (std::size_t i = 0; i < n; ++i) {
+            for (std::size_t j = i + 1; j < n; ++j) sink.Add(i, j, DistanceOf(s)(i, j));
+        }
+    };
+    StreamedPairwise::Sink first = evaluation.NewSink();
+    stream(first);
+    evaluation.Merge(first);
+    evaluation.EndPass();
+    EXPECT_EQ(evaluation.pass(), 2);
+    EXPECT_THROW(evaluation.Merge(first), core::Error);  // counted once, in its own pass
+    StreamedPairwise::Sink second = evaluation.NewSink();
+    stream(second);
+    evaluation.Merge(second);
+    evaluation.EndPass();
+    ASSERT_TRUE(evaluation.finished());
+    EXPECT_THROW(evaluation.NewSink(), core::Error);
+    EXPECT_THROW(evaluation.Merge(second), core::Error);
+    ExpectEqualToPairsInMemory(c, s, evaluation.Result());
+}
+
 TEST(StreamedPairwise, EveryPairUnscoredOrNoLoops) {
     Case c{21, 40, 0, 1.0, 0.0, 1000, Criterion::kMcc, 0.7};
     Sequence s = MakeSequence(c);

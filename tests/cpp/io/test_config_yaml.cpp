@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "lidarloop/core/scancontext/scancontext_config.hpp"
 #include "lidarloop/io/config_yaml.hpp"
 #include "lidarloop/io/read_error.hpp"
 #include "test_utils.hpp"
@@ -156,7 +157,8 @@ TEST(ConfigYaml, ScanContextSectionRoundTripsAndRejectsUnknownKeys) {
         "  sensor_height_m: 1.5\n  ring_key_candidates: 25\n",
         "sc.yaml", config);
     EXPECT_EQ(core::ToString(config.descriptor.method), "scancontext");
-    const core::ScanContextConfig& sc = config.descriptor.scancontext;
+    const core::ScanContextConfig& sc =
+        config.descriptor.methods.Get<core::ScanContextConfig>("scancontext");
     EXPECT_EQ(sc.rings, 10);
     EXPECT_EQ(sc.sectors, 90);
     EXPECT_EQ(sc.max_range_m, 40.0);

@@ -14,7 +14,7 @@ constexpr double kPi = 3.14159265358979323846;
 // float rounding of the unfolding (< 1e-6 rad), rounded up.
 constexpr double kAzimuthErrorRad = 0.002;
 
-// Function multi-versioning, as in ndt_shape.cpp: an AVX2 copy of the batch loop (8 floats per
+// Function multi-versioning, as in ndt/ndt_shape.cpp: an AVX2 copy of the batch loop (8 floats per
 // instruction instead of SSE2's 4), picked at load time. AVX2 has no FMA: both round alike.
 #if defined(__GNUC__) && defined(__x86_64__) && !defined(__SANITIZE_ADDRESS__)
 #define LIDARLOOP_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))

@@ -15,7 +15,7 @@ constexpr int kMaxSectors = 720;  // ScanContextConfig::Validate
 // distance is rounding of equal columns, and reads 0 (equal descriptors are at 0).
 constexpr double kRoundingDistance = 2e-6;
 
-// Function multi-versioning, as in ndt_shape.cpp: an AVX2 copy (8 floats per instruction
+// Function multi-versioning, as in ndt/ndt_shape.cpp: an AVX2 copy (8 floats per instruction
 // instead of SSE2's 4), picked at load time on CPUs that have it. AVX2 has no FMA, so both
 // copies round identically.
 #if defined(__GNUC__) && defined(__x86_64__) && !defined(__SANITIZE_ADDRESS__)

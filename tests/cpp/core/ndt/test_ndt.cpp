@@ -10,10 +10,10 @@
 
 #include "lidarloop/core/eigen3x3.hpp"
 #include "lidarloop/core/error.hpp"
-#include "lidarloop/core/ndt_cells.hpp"
-#include "lidarloop/core/ndt_descriptor.hpp"
-#include "lidarloop/core/ndt_shape.hpp"
-#include "lidarloop/core/sphere_partition.hpp"
+#include "lidarloop/core/ndt/ndt_cells.hpp"
+#include "lidarloop/core/ndt/ndt_descriptor.hpp"
+#include "lidarloop/core/ndt/ndt_shape.hpp"
+#include "lidarloop/core/ndt/sphere_partition.hpp"
 #include "ndt_reference.hpp"
 #include "test_utils.hpp"
 

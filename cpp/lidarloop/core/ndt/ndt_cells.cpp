@@ -1,4 +1,4 @@
-#include "lidarloop/core/ndt_cells.hpp"
+#include "lidarloop/core/ndt/ndt_cells.hpp"
 
 #include <algorithm>
 #include <array>

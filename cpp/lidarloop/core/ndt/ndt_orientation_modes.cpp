@@ -1,4 +1,4 @@
-#include "lidarloop/core/ndt_orientation_modes.hpp"
+#include "lidarloop/core/ndt/ndt_orientation_modes.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -11,7 +11,7 @@
 
 #include <Eigen/Core>
 
-#include "lidarloop/core/ndt_cells.hpp"
+#include "lidarloop/core/ndt/ndt_cells.hpp"
 #include "lidarloop/core/point_cloud.hpp"
 
 namespace lidarloop::core::test_reference {

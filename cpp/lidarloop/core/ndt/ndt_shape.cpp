@@ -1,7 +1,7 @@
 // Compiled with -fno-math-errno -fno-trapping-math (see CMakeLists.txt): without them GCC keeps
 // the branches of the selects and square roots below and does not vectorise the batch loop.
 // Neither flag changes a result: this code reads neither errno nor floating-point exceptions.
-#include "lidarloop/core/ndt_shape.hpp"
+#include "lidarloop/core/ndt/ndt_shape.hpp"
 
 #include <cmath>
 

@@ -6,7 +6,7 @@
 
 #include <Eigen/Core>
 
-#include "lidarloop/core/ndt_cells.hpp"
+#include "lidarloop/core/ndt/ndt_cells.hpp"
 
 namespace lidarloop::core {
 

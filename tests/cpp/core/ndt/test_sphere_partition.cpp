@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "lidarloop/core/error.hpp"
-#include "lidarloop/core/sphere_partition.hpp"
+#include "lidarloop/core/ndt/sphere_partition.hpp"
 #include "test_utils.hpp"
 
 namespace lidarloop::core {

@@ -14,8 +14,8 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
-#include "lidarloop/core/ndt_descriptor.hpp"
-#include "lidarloop/core/sphere_partition.hpp"
+#include "lidarloop/core/ndt/ndt_descriptor.hpp"
+#include "lidarloop/core/ndt/sphere_partition.hpp"
 #include "ndt_reference.hpp"
 
 namespace lidarloop::core {

@@ -27,11 +27,11 @@ struct NdtConfig {
     bool normalise_rotation = true;
     double ambiguity_ratio = 0.60;  ///< t_a, peaks >= t_a * the highest are ambiguous
     /// true: the peaks of eqs. (4)-(7) are the modes of the cells' normals (mean shift with a
-    /// 20-degree window, core/ndt_orientation_modes.hpp), counted by the cells within 20 degrees
-    /// of each; they turn with the scan, so a rotated scan gets the same peaks, and a surface is
-    /// never split in two by a class border. false: the peaks are the classes of the partition,
-    /// each aligned by its line P_i, as the paper writes; which surfaces share a class (~40
-    /// degrees wide for p = 9) then depends on how the scan is turned, and a rotated scan can
+    /// 20-degree window, core/ndt/ndt_orientation_modes.hpp), counted by the cells within 20
+    /// degrees of each; they turn with the scan, so a rotated scan gets the same peaks, and a
+    /// surface is never split in two by a class border. false: the peaks are the classes of the
+    /// partition, each aligned by its line P_i, as the paper writes; which surfaces share a class
+    /// (~40 degrees wide for p = 9) then depends on how the scan is turned, and a rotated scan can
     /// get other peaks and a different descriptor.
     bool align_to_mean_direction = true;
     /// false: count each rotation candidate by rotating the cells' axes (one grid per scan).

@@ -9,10 +9,10 @@
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
 
-#include "lidarloop/core/ndt_cells.hpp"
-#include "lidarloop/core/ndt_descriptor.hpp"
-#include "lidarloop/core/ndt_shape.hpp"
-#include "lidarloop/core/sphere_partition.hpp"
+#include "lidarloop/core/ndt/ndt_cells.hpp"
+#include "lidarloop/core/ndt/ndt_descriptor.hpp"
+#include "lidarloop/core/ndt/ndt_shape.hpp"
+#include "lidarloop/core/ndt/sphere_partition.hpp"
 #include "test_utils.hpp"
 
 namespace lidarloop::core {

@@ -5,9 +5,9 @@
 
 #include <Eigen/Core>
 
-#include "lidarloop/core/ndt_cells.hpp"
-#include "lidarloop/core/ndt_config.hpp"
-#include "lidarloop/core/ndt_shape.hpp"
+#include "lidarloop/core/ndt/ndt_cells.hpp"
+#include "lidarloop/core/ndt/ndt_config.hpp"
+#include "lidarloop/core/ndt/ndt_shape.hpp"
 #include "lidarloop/core/point_cloud.hpp"
 
 namespace lidarloop::core {

@@ -1,4 +1,4 @@
-#include "lidarloop/core/ndt_descriptor.hpp"
+#include "lidarloop/core/ndt/ndt_descriptor.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,8 +10,8 @@
 #include <Eigen/Geometry>
 
 #include "lidarloop/core/error.hpp"
-#include "lidarloop/core/ndt_orientation_modes.hpp"
-#include "lidarloop/core/sphere_partition.hpp"
+#include "lidarloop/core/ndt/ndt_orientation_modes.hpp"
+#include "lidarloop/core/ndt/sphere_partition.hpp"
 
 namespace lidarloop::core {
 namespace {

@@ -1,4 +1,4 @@
-#include "lidarloop/core/ndt_config.hpp"
+#include "lidarloop/core/ndt/ndt_config.hpp"
 
 #include <cmath>
 #include <string>

@@ -11,7 +11,7 @@
 #include <Eigen/Geometry>
 
 #include "lidarloop/core/error.hpp"
-#include "lidarloop/core/ndt_orientation_modes.hpp"
+#include "lidarloop/core/ndt/ndt_orientation_modes.hpp"
 #include "test_utils.hpp"
 
 namespace lidarloop::core {

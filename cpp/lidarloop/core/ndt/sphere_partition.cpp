@@ -1,4 +1,4 @@
-#include "lidarloop/core/sphere_partition.hpp"
+#include "lidarloop/core/ndt/sphere_partition.hpp"
 
 #include <algorithm>
 #include <cmath>
