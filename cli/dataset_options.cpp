@@ -5,7 +5,9 @@
 namespace lidarloop::cli {
 
 void DatasetOptions::AddTo(CLI::App& command, const std::string& format_flag) {
-    command.add_option("DATASET", path_, "folder of scans (KITTI layout, scan files, Osnabrueck)")
+    command
+        .add_option("DATASET", path_,
+                    "folder of scans (KITTI layout, scan files, Osnabrueck) or a ROS 1 bag (.bag)")
         ->required();
     command.add_option(format_flag, format_, "dataset layout: auto | kitti | folder | osnabrueck")
         ->check(CLI::IsMember({"auto", "kitti", "folder", "osnabrueck"}));
@@ -13,6 +15,8 @@ void DatasetOptions::AddTo(CLI::App& command, const std::string& format_flag) {
         ->check(CLI::ExistingFile);
     command.add_option("--calib", calib_, "KITTI calib.txt whose Tr converts the poses")
         ->check(CLI::ExistingFile);
+    command.add_option("--topic", topic_,
+                       "a bag's sensor_msgs/PointCloud2 topic (default: its only one)");
 }
 
 io::Dataset DatasetOptions::Open() const {
@@ -22,6 +26,7 @@ io::Dataset DatasetOptions::Open() const {
     if (format_ == "osnabrueck") options.format = io::DatasetFormat::kOsnabrueck;
     options.poses_file = poses_;
     options.calib_file = calib_;
+    options.topic = topic_;
     return io::OpenDataset(path_, options);
 }
 
