@@ -125,17 +125,24 @@ head -c 3000 "$work/run.bag" >"$work/truncated.bag"
 PHRASES="truncated.bag: "
 expect_error "truncated bag" "$cli" detect "$work/truncated.bag" --out "$work/x"
 expect_error "truncated bag, bag-info" "$cli" bag-info "$work/truncated.bag"
-# Damage where rosbag_storage notices it: the bag header, a chunk's header and its compression.
+# Damage to the record structure (the bag header, a chunk's header and its compression field),
+# which lidarloop checks before rosbag_storage trusts it, and to compressed data, which
+# rosbag_storage's decompression notices.
 for offset in 20 4121 4133; do
     cp "$work/run.bag" "$work/corrupt.bag"
     printf '\377\377\377\377\377\377\377\377' |
         dd of="$work/corrupt.bag" bs=1 seek="$offset" conv=notrunc status=none
-    PHRASES="corrupt.bag: not a readable ROS 1 bag ("
+    PHRASES="corrupt.bag: damaged bag at byte"
     expect_error "bag damaged at byte $offset" "$cli" detect "$work/corrupt.bag" --quiet \
         --out "$work/x"
 done
+cp "$work/runlz4.bag" "$work/corrupt.bag"
+printf '\377\377\377\377\377\377\377\377' |
+    dd of="$work/corrupt.bag" bs=1 seek=5133 conv=notrunc status=none
+PHRASES="corrupt.bag: topic '/points': not a readable ROS 1 bag (ROSLZ4_"
+expect_error "lz4 data damaged" "$cli" detect "$work/corrupt.bag" --quiet --out "$work/x"
 echo "not a bag" >"$work/text.bag"
-PHRASES="text.bag: not a readable ROS 1 bag (Error reading version line)"
+PHRASES="text.bag: not a ROS 1 bag of format 2.0 (it does not start with '#ROSBAG V2.0')"
 expect_error "text file named .bag" "$cli" bag-info "$work/text.bag"
 PHRASES="missing.bag: no such bag"
 expect_error "missing bag" "$cli" detect "$work/missing.bag" --out "$work/x"

@@ -19,6 +19,7 @@
 #include <Eigen/Geometry>
 
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/io/detail/bag_structure.hpp"
 #include "lidarloop/io/read_error.hpp"
 #include "lidarloop/io/ros_messages.hpp"
 
@@ -132,7 +133,10 @@ void OpenBag(rosbag::Bag& bag, const fs::path& file) {
     std::error_code ec;
     if (!fs::exists(file, ec)) throw ReadError(file, "no such bag");
     if (fs::is_directory(file, ec)) throw ReadError(file, "is a folder, not a bag");
-    Guarded(file, "", [&] { bag.open(file.string(), rosbag::bagmode::Read); });
+    Guarded(file, "", [&] {
+        detail::CheckBagStructure(file);  // what rosbag_storage trusts
+        bag.open(file.string(), rosbag::bagmode::Read);
+    });
 }
 
 // The topic to read: `wanted`, or the only topic of `type` when `wanted` is empty, checked to
