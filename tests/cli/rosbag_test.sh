@@ -106,7 +106,7 @@ done
 PHRASES="wrong-type.bag: topic '/points' holds 'nav_msgs/Odometry', not sensor_msgs/PointCloud2"
 expect_error "topic of the wrong type" "$cli" detect "$work/wrong-type.bag" --topic /points \
     --out "$work/x"
-PHRASES="no-xyz.bag: topic '/points' message 0: the cloud has no field z (fields: 'x y intensity_2 intensity')"
+PHRASES="no-xyz.bag: topic '/points' message |: the cloud has no field z (fields: 'x y intensity_2 intensity')"
 expect_error "cloud without z" "$cli" detect "$work/no-xyz.bag" --quiet --out "$work/x"
 PHRASES="no-clouds.bag: has 0 sensor_msgs/PointCloud2 topics (none)"
 expect_error "bag without clouds" "$cli" detect "$work/no-clouds.bag" --out "$work/x"
