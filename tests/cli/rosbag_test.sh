@@ -54,37 +54,37 @@ expect_same() {
 
 # --- the same scans from a folder and from bags give byte-identical results -------------------
 seq="$work/seq"
-"$cli" simulate --scene urban --route uturn --sensor vlp16 --scans 90 --horizontal-steps 450 \
+"$cli" simulate --scene urban --route uturn --sensor vlp16 --scans 60 --horizontal-steps 360 \
     --quiet --out "$seq" >/dev/null
 "${write_bag[@]}" from-kitti "$seq" "$work/run.bag" --odometry-topic /odom
 "${write_bag[@]}" from-kitti "$seq" "$work/run64.bag" --float64 --organised --compression bz2 \
     --topic /velodyne_points
 "${write_bag[@]}" from-kitti "$seq" "$work/runlz4.bag" --compression lz4
-expect_ok "detect folder" "90 scans (kitti)" "$cli" detect "$seq" --quiet --out "$work/folder"
+expect_ok "detect folder" "60 scans (kitti)" "$cli" detect "$seq" --quiet --out "$work/folder"
 if [ "$(awk -F, 'NR > 1 && $5 == 1' "$work/folder/loops.csv" | wc -l)" -ge 1 ]; then pass; else
     fail "the simulated sequence has no accepted loop: the comparison would prove little"
 fi
-expect_ok "detect bag" "90 scans (rosbag)" "$cli" detect "$work/run.bag" --poses "$seq/poses.txt" \
+expect_ok "detect bag" "60 scans (rosbag)" "$cli" detect "$work/run.bag" --poses "$seq/poses.txt" \
     --quiet --out "$work/bag"
 expect_same "loops.csv of folder and bag" "$work/folder/loops.csv" "$work/bag/loops.csv"
 expect_same "candidates.csv of folder and bag" "$work/folder/candidates.csv" \
     "$work/bag/candidates.csv"
-expect_ok "detect float64 organised bz2 bag" "90 scans (rosbag)" "$cli" detect "$work/run64.bag" \
+expect_ok "detect float64 organised bz2 bag" "60 scans (rosbag)" "$cli" detect "$work/run64.bag" \
     --poses "$seq/poses.txt" --quiet --out "$work/bag64"
 expect_same "loops.csv of folder and float64 bag" "$work/folder/loops.csv" "$work/bag64/loops.csv"
-expect_ok "detect lz4 bag" "90 scans (rosbag)" "$cli" detect "$work/runlz4.bag" --topic /points \
+expect_ok "detect lz4 bag" "60 scans (rosbag)" "$cli" detect "$work/runlz4.bag" --topic /points \
     --poses "$seq/poses.txt" --quiet --no-verify --out "$work/baglz4"
-expect_ok "detect folder without verification" "90 scans" "$cli" detect "$seq" --no-verify \
+expect_ok "detect folder without verification" "60 scans" "$cli" detect "$seq" --no-verify \
     --quiet --out "$work/folder_nv"
 expect_same "loops.csv of folder and lz4 bag" "$work/folder_nv/loops.csv" "$work/baglz4/loops.csv"
 
 # --- bag-info, scan references, odometry from the bag ------------------------------------------
-expect_ok "bag-info" "/odom    nav_msgs/Odometry        90" "$cli" bag-info "$work/run.bag"
-expect_ok "bag-info clouds" "/points  sensor_msgs/PointCloud2  90" "$cli" bag-info "$work/run.bag"
+expect_ok "bag-info" "/odom    nav_msgs/Odometry        60" "$cli" bag-info "$work/run.bag"
+expect_ok "bag-info clouds" "/points  sensor_msgs/PointCloud2  60" "$cli" bag-info "$work/run.bag"
 "$cli" describe "$seq/velodyne/000007.bin" >"$work/describe_file.json"
 "$cli" describe "$work/run64.bag:/velodyne_points:7" >"$work/describe_bag.json"
 expect_same "describe a scan of a bag" "$work/describe_file.json" "$work/describe_bag.json"
-expect_ok "verify scans of a bag" '"accepted"' "$cli" verify "$work/run.bag::80" "$work/run.bag::5"
+expect_ok "verify scans of a bag" '"accepted"' "$cli" verify "$work/run.bag::55" "$work/run.bag::5"
 expect_ok "optimise with the bag's odometry" "ATE RMSE: odometry" "$cli" optimise "$work/run.bag" \
     --poses "$seq/poses.txt" --odometry-topic /odom --loops "$work/bag/loops.csv" --out "$work/opt"
 if grep -qF "topic '/odom'" "$work/opt/report.md"; then pass; else
@@ -146,8 +146,8 @@ PHRASES="text.bag: not a ROS 1 bag of format 2.0 (it does not start with '#ROSBA
 expect_error "text file named .bag" "$cli" bag-info "$work/text.bag"
 PHRASES="missing.bag: no such bag"
 expect_error "missing bag" "$cli" detect "$work/missing.bag" --out "$work/x"
-PHRASES="run.bag: topic '/points' has 90 messages, no 90"
-expect_error "scan index past the topic" "$cli" describe "$work/run.bag:/points:90"
+PHRASES="run.bag: topic '/points' has 60 messages, no 60"
+expect_error "scan index past the topic" "$cli" describe "$work/run.bag:/points:60"
 PHRASES="INDEX 'seven' is no message number"
 expect_error "scan index not a number" "$cli" describe "$work/run.bag:/points:seven"
 PHRASES="is a folder; a topic ('/points') names the scans of a ROS bag"
