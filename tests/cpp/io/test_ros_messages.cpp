@@ -55,9 +55,10 @@ struct CloudSpec {
 std::vector<std::uint8_t> Serialise(const CloudSpec& spec) {
     const std::uint32_t row_step =
         spec.row_step != 0 ? spec.row_step : spec.width * spec.point_step;
-    // Room for every point even when row_step is too short for them (a layout under test).
+    // Room for every point even when row_step is too short for them, and 8 bytes more for a
+    // field placed past point_step (layouts under test).
     const std::size_t row_bytes = std::max<std::size_t>(row_step, spec.width * spec.point_step);
-    std::vector<std::uint8_t> data(spec.height * row_bytes, 0xAB);  // padding: garbage
+    std::vector<std::uint8_t> data(spec.height * row_bytes + 8, 0xAB);  // padding: garbage
 
     for (std::size_t i = 0; i < spec.points.size(); ++i) {
         const std::size_t row = i / spec.width;
