@@ -5,6 +5,7 @@
 namespace lidarloop::cli {
 
 // One function per subcommand; each lives in the file of the same name.
+void AddBagInfoCommand(CLI::App& app);
 void AddBenchCommand(CLI::App& app);
 void AddDemoCommand(CLI::App& app);
 void AddDescribeCommand(CLI::App& app);

@@ -13,7 +13,7 @@ namespace lidarloop::cli {
 /// DATASET and the flags that say how to open it, shared by the commands that read sequences.
 class DatasetOptions {
 public:
-    /// Adds the DATASET positional and --format, --poses, --calib; `format_flag` renames
+    /// Adds the DATASET positional and --format, --poses, --calib, --topic; `format_flag` renames
     /// --format for a command whose --format means something else (optimise's pose format);
     /// without `with_poses` no --poses and --calib (a command whose --poses means another thing).
     void AddTo(CLI::App& command, const std::string& format_flag = "--format",
@@ -28,6 +28,7 @@ private:
     std::string format_ = "auto";
     std::string poses_;
     std::string calib_;
+    std::string topic_;
 };
 
 }  // namespace lidarloop::cli

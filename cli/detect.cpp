@@ -25,8 +25,9 @@ struct DetectFlags {
     DescriptorOptions descriptor;
     RunOptionFlags options;  // app/run_options.hpp: --threshold, --top-k, --skip-bad, ...
     std::string out;
-    std::string map;       // a database.lldb to localise against (query-only mode)
-    std::string odometry;  // poses the path is measured on (a gap in metres, path_m)
+    std::string map;             // a database.lldb to localise against (query-only mode)
+    std::string odometry;        // poses the path is measured on (a gap in metres, path_m)
+    std::string odometry_topic;  // the same from a bag's nav_msgs/Odometry topic
     bool overwrite = false;
     bool quiet = false;
 };
@@ -95,6 +96,7 @@ void RunDetect(const DetectFlags& flags) {
     request.progress = progress.Callback();
     request.out = flags.out;
     request.odometry_file = flags.odometry;
+    request.odometry_topic = flags.odometry_topic;
     if (!flags.map.empty()) {
         app::LoadedMap map = app::LoadMap(flags.map);
         request.config = ResolveAgainstMap(flags, map);
@@ -136,11 +138,17 @@ void AddDetectCommand(CLI::App& app) {
                      "localise against this database.lldb (written by an earlier detect): "
                      "every scan is a query, none is added, the map's descriptor config is used")
         ->check(CLI::ExistingFile);
+    auto* odometry =
+        command
+            ->add_option("--odometry", flags->odometry,
+                         "odometry poses, KITTI or TUM, one per scan: the path a gap in metres and "
+                         "loops.csv's path_m are measured on (default: the dataset's poses)")
+            ->check(CLI::ExistingFile);
     command
-        ->add_option("--odometry", flags->odometry,
-                     "odometry poses, KITTI or TUM, one per scan: the path a gap in metres and "
-                     "loops.csv's path_m are measured on (default: the dataset's poses)")
-        ->check(CLI::ExistingFile);
+        ->add_option("--odometry-topic", flags->odometry_topic,
+                     "instead of --odometry, for a bag: its nav_msgs/Odometry topic, "
+                     "interpolated at the scans' stamps")
+        ->excludes(odometry);
     command->add_flag("--overwrite", flags->overwrite,
                       "write into a non-empty folder that holds no earlier lidarloop run");
     command->add_flag("--quiet", flags->quiet, "no progress bar");

@@ -15,7 +15,9 @@ void AddDistanceCommand(CLI::App& app) {
         "Print the distance between two scans: W (Roehling eq. 6) or sigma' (Magnusson eq. 9)");
     auto scans = std::make_shared<std::vector<std::string>>();
     auto options = std::make_shared<DescriptorOptions>();
-    command->add_option("SCAN_A SCAN_B", *scans, "two scan files")->required()->expected(2);
+    command->add_option("SCAN_A SCAN_B", *scans, "two scan files (or BAG:TOPIC:INDEX)")
+        ->required()
+        ->expected(2);
     options->AddTo(*command);
     command->callback([scans, options] {
         const io::RunConfig config = options->Resolve();

@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
     CLI::App app{"lidarloop: loop closure detection in sequences of 3-D LiDAR scans"};
     app.set_version_flag("--version", std::string("lidarloop ") + LIDARLOOP_VERSION);
     app.require_subcommand(1);
+    lidarloop::cli::AddBagInfoCommand(app);
     lidarloop::cli::AddDemoCommand(app);
     lidarloop::cli::AddDescribeCommand(app);
     lidarloop::cli::AddDetectCommand(app);

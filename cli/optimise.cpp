@@ -12,6 +12,7 @@
 #include "dataset_options.hpp"
 #include "descriptor_options.hpp"
 #include "lidarloop/app/optimisation.hpp"
+#include "lidarloop/core/error.hpp"
 #include "progress.hpp"
 #include "run_options.hpp"
 #include "run_output.hpp"
@@ -24,6 +25,7 @@ struct OptimiseFlags {
     DescriptorOptions descriptor;
     RunOptionFlags options;  // app/run_options.hpp: detection keys, --max-odometry-step, ...
     std::string odometry;
+    std::string odometry_topic;
     std::string loops;
     std::string out;
     std::string format = "kitti";
@@ -70,11 +72,17 @@ std::vector<std::filesystem::path> Inputs(const OptimiseFlags& flags) {
 }
 
 void RunOptimise(const OptimiseFlags& flags) {
+    if (flags.odometry.empty() && flags.odometry_topic.empty()) {
+        throw core::ConfigError(
+            "optimise needs the odometry: give --odometry FILE, or --odometry-topic TOPIC for a "
+            "bag");
+    }
     ProgressPrinter progress(flags.quiet);
     app::OptimiseRequest request;
     request.config = flags.descriptor.Resolve();
     flags.options.ApplyTo({&request.config, &request.skip_bad});
     request.odometry_file = flags.odometry;
+    request.odometry_topic = flags.odometry_topic;
     request.loops_file = flags.loops;
     request.format = flags.format == "tum" ? app::PoseFormat::kTum : app::PoseFormat::kKitti;
     request.progress = progress.Callback();
@@ -96,9 +104,15 @@ void AddOptimiseCommand(CLI::App& app) {
         "optimise", "Optimise the odometry with the accepted loops in a pose graph (Ceres)");
     auto flags = std::make_shared<OptimiseFlags>();
     flags->dataset.AddTo(*command, "--dataset-format");
-    command->add_option("--odometry", flags->odometry, "odometry poses, KITTI or TUM, one per scan")
-        ->required()
-        ->check(CLI::ExistingFile);
+    auto* odometry = command
+                         ->add_option("--odometry", flags->odometry,
+                                      "odometry poses, KITTI or TUM, one per scan")
+                         ->check(CLI::ExistingFile);
+    auto* odometry_topic =
+        command->add_option("--odometry-topic", flags->odometry_topic,
+                            "instead of --odometry, for a bag: its nav_msgs/Odometry topic, "
+                            "interpolated at the scans' stamps");
+    odometry->excludes(odometry_topic);
     command
         ->add_option("--loops", flags->loops,
                      "loops.csv of `detect` (with verification); default: detect them first")

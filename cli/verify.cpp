@@ -38,10 +38,11 @@ void AddVerifyCommand(CLI::App& app) {
         "Register QUERY_SCAN to MATCH_SCAN without a prior pose and print the verdict as JSON "
         "(accepted, T_match_query, overlap, rmse_m, reason)");
     auto flags = std::make_shared<VerifyFlags>();
-    command->add_option("QUERY_SCAN MATCH_SCAN", flags->scans, "two scan files")
+    command
+        ->add_option("QUERY_SCAN MATCH_SCAN", flags->scans,
+                     "two scan files, or scans of a ROS 1 bag as BAG:TOPIC:INDEX")
         ->required()
-        ->expected(2)
-        ->check(CLI::ExistingFile);
+        ->expected(2);
     command
         ->add_option("--config", flags->config_file,
                      "YAML file overriding the defaults it names (section verification)")

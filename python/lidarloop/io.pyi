@@ -7,9 +7,13 @@ import numpy.typing as npt
 PathLike = Union[str, os.PathLike]
 
 def read_scan(file: PathLike) -> npt.NDArray[np.float32]:
-    """One scan file as an (N, 3) float32 array: sensor frame, metres."""
+    """One scan file (or a bag's message, 'BAG:TOPIC:INDEX') as an (N, 3) float32 array: sensor
+    frame, metres."""
 
 def is_scan_file(file: PathLike) -> bool: ...
+def reads_bags() -> bool:
+    """Whether this lidarloop was built with ROS 1 bag support."""
+
 def read_poses(
     file: PathLike, calib: Optional[PathLike] = None, times: Optional[PathLike] = None
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
@@ -23,6 +27,10 @@ class Dataset:
     @property
     def root(self) -> os.PathLike: ...
     @property
+    def topic(self) -> str: ...
+    @property
+    def times(self) -> npt.NDArray[np.float64]: ...
+    @property
     def names(self) -> list[str]: ...
     @property
     def has_poses(self) -> bool: ...
@@ -34,6 +42,7 @@ def open_dataset(
     format: str = "auto",
     poses: Optional[PathLike] = None,
     calib: Optional[PathLike] = None,
+    topic: Optional[str] = None,
 ) -> Dataset: ...
 
-__all__ = ["Dataset", "is_scan_file", "open_dataset", "read_poses", "read_scan"]
+__all__ = ["Dataset", "is_scan_file", "open_dataset", "read_poses", "read_scan", "reads_bags"]

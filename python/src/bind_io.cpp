@@ -10,6 +10,7 @@
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/io/dataset.hpp"
 #include "lidarloop/io/poses.hpp"
+#include "lidarloop/io/rosbag.hpp"
 #include "lidarloop/io/scan_reader.hpp"
 
 namespace lidarloop::python {
@@ -22,8 +23,9 @@ io::DatasetFormat ParseDatasetFormat(const std::string& name) {
     if (name == "kitti") return io::DatasetFormat::kKitti;
     if (name == "folder") return io::DatasetFormat::kFolder;
     if (name == "osnabrueck") return io::DatasetFormat::kOsnabrueck;
-    throw core::ConfigError("format must be auto | kitti | folder | osnabrueck, got '" + name +
-                            "'");
+    if (name == "rosbag") return io::DatasetFormat::kRosbag;
+    throw core::ConfigError("format must be auto | kitti | folder | osnabrueck | rosbag, got '" +
+                            name + "'");
 }
 
 // Python's index rules: -1 is the last scan; IndexError (which ends a for loop) past the end.
@@ -60,11 +62,12 @@ py::tuple ReadPosesArrays(const path& file, const py::object& calib, const py::o
 }
 
 io::Dataset OpenDatasetAt(const path& folder, const std::string& format, const py::object& poses,
-                          const py::object& calib) {
+                          const py::object& calib, const py::object& topic) {
     io::DatasetOptions options;
     options.format = ParseDatasetFormat(format);
     if (!poses.is_none()) options.poses_file = poses.cast<path>();
     if (!calib.is_none()) options.calib_file = calib.cast<path>();
+    if (!topic.is_none()) options.topic = topic.cast<std::string>();
     py::gil_scoped_release release;
     return io::OpenDataset(folder, options);
 }
@@ -77,14 +80,33 @@ void BindDataset(py::module_& m) {
         .def(
             "__getitem__",
             [](const io::Dataset& dataset, py::ssize_t index) {
-                return ReadScanArray(dataset.ScanPath(ScanIndex(dataset, index)));
+                const std::size_t i = ScanIndex(dataset, index);
+                core::PointCloud cloud;
+                {
+                    py::gil_scoped_release release;
+                    cloud = dataset.LoadScan(i);
+                }
+                return PointsToArray(std::move(cloud));
             },
             py::arg("index"),
             "Scan `index` (negative counts from the end) as an (N, 3) float32 array: sensor "
-            "frame, metres. IndexError past the end; lidarloop.ReadError for a bad file.")
+            "frame, metres. IndexError past the end; lidarloop.ReadError for a bad file or "
+            "message.")
         .def_property_readonly("format", &io::Dataset::FormatName,
-                               "The layout: 'kitti', 'folder' or 'osnabrueck'.")
-        .def_property_readonly("root", &io::Dataset::root, "The folder it was opened from.")
+                               "The layout: 'kitti', 'folder', 'osnabrueck' or 'rosbag'.")
+        .def_property_readonly("root", &io::Dataset::root,
+                               "The folder it was opened from, or the bag file.")
+        .def_property_readonly("topic", &io::Dataset::Topic,
+                               "A bag's PointCloud2 topic ('' for a folder).")
+        .def_property_readonly(
+            "times",
+            [](const io::Dataset& dataset) {
+                std::vector<double> times(dataset.size());
+                for (std::size_t i = 0; i < times.size(); ++i) times[i] = dataset.ScanTime(i);
+                return py::array_t<double>(static_cast<py::ssize_t>(times.size()), times.data());
+            },
+            "(N,) float64 seconds: a bag message's header stamp, else the pose's time, else the "
+            "scan index.")
         .def_property_readonly(
             "names",
             [](const io::Dataset& dataset) {
@@ -94,7 +116,8 @@ void BindDataset(py::module_& m) {
                 }
                 return names;
             },
-            "The scan files in scan order (str paths).")
+            "The scan files in scan order (str paths); for a bag, 'BAG:TOPIC:INDEX' references, "
+            "which read_scan reads too.")
         .def_property_readonly("has_poses", &io::Dataset::HasPoses)
         .def_property_readonly(
             "poses", [](const io::Dataset& dataset) { return PosesToArrays(dataset.poses()); },
@@ -110,12 +133,15 @@ void BindDataset(py::module_& m) {
 
 void BindIo(py::module_& m) {
     m.def("read_scan", &ReadScanArray, py::arg("file"),
-          "Reads one scan file (.bin KITTI, .pcd, .ply, .xyz, .txt, .pts, .3d Osnabrueck) into "
+          "Reads one scan file (.bin KITTI, .pcd, .ply, .xyz, .txt, .pts, .3d Osnabrueck), or "
+          "a message of a ROS 1 bag named 'BAG:TOPIC:INDEX', into "
           "an (N, 3) float32 array: sensor frame, metres, x forward, z up. The array owns the "
           "C++ reader's memory (no copy); intensity and other fields are dropped, non-finite "
           "points kept. lidarloop.ReadError (.file) for a missing, unknown or damaged file.");
     m.def("is_scan_file", &io::IsScanFile, py::arg("file"),
           "Whether read_scan knows the file's extension.");
+    m.def("reads_bags", &io::RosbagSupported,
+          "Whether this lidarloop was built with ROS 1 bag support (LIDARLOOP_WITH_ROSBAG).");
     m.def("read_poses", &ReadPosesArrays, py::arg("file"), py::arg("calib") = py::none(),
           py::arg("times") = py::none(),
           "Reads a KITTI poses.txt (12 numbers a line) or TUM trajectory (8 numbers a line) "
@@ -124,10 +150,14 @@ void BindIo(py::module_& m) {
           "their times, else the line index. lidarloop.ReadError naming the bad line.");
     m.def("open_dataset", &OpenDatasetAt, py::arg("folder"), py::arg("format") = "auto",
           py::arg("poses") = py::none(), py::arg("calib") = py::none(),
+          py::arg("topic") = py::none(),
           "Opens a folder of scans: 'kitti' (velodyne/*.bin, poses.txt, calib.txt), 'folder' "
           "(scan files in natural name order) or 'osnabrueck' (scanNNN.3d); 'auto' detects it. "
+          "Or a ROS 1 bag (a .bag file, 'rosbag'): the sensor_msgs/PointCloud2 messages of "
+          "`topic` (default: the bag's only PointCloud2 topic), stamped by their headers. "
           "`poses` (KITTI or TUM file) and `calib` override the files beside the scans. "
-          "lidarloop.ReadError when the folder holds no scans or poses do not match them.");
+          "lidarloop.ReadError when the folder holds no scans, poses do not match them, or the "
+          "bag or topic cannot be read (naming the file and the topic).");
     BindDataset(m);
 }
 

@@ -13,9 +13,7 @@ pipeline::ScanSource SourceOf(const io::Dataset& dataset) {
     pipeline::ScanSource source;
     source.count = dataset.size();
     source.load = [&dataset](std::size_t i) { return dataset.LoadScan(i); };
-    source.time_s = [&dataset](std::size_t i) {
-        return dataset.HasPoses() ? dataset.poses()[i].time_s : static_cast<double>(i);
-    };
+    source.time_s = [&dataset](std::size_t i) { return dataset.ScanTime(i); };
     source.name = [&dataset](std::size_t i) { return dataset.ScanPath(i).string(); };
     return source;
 }

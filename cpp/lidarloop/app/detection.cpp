@@ -13,6 +13,7 @@
 #include "lidarloop/io/poses.hpp"
 #include "lidarloop/io/prepared_scans_file.hpp"
 #include "lidarloop/io/read_error.hpp"
+#include "lidarloop/io/rosbag.hpp"
 #include "lidarloop/io/similarity_file.hpp"
 #include "lidarloop/io/similarity_image.hpp"
 
@@ -20,7 +21,7 @@ namespace lidarloop::app {
 namespace {
 
 void RequireTimesForSeconds(const io::RunConfig& config, const io::Dataset& dataset) {
-    if (config.detection.min_gap.unit == core::MinGap::Unit::kSeconds && !dataset.HasPoses()) {
+    if (config.detection.min_gap.unit == core::MinGap::Unit::kSeconds && !dataset.HasTimes()) {
         throw core::ConfigError("a minimum gap in seconds needs scan times, and " +
                                 dataset.root().string() +
                                 " has no poses; give --poses or a gap in scans");
@@ -31,8 +32,9 @@ void RequireTimesForSeconds(const io::RunConfig& config, const io::Dataset& data
 // dataset's poses; empty when there are neither (ConfigError when the gap is in metres).
 std::vector<double> PathOfScans(const DetectRequest& request, const io::Dataset& dataset) {
     std::vector<double> path_m;
-    if (!request.odometry_file.empty()) {
-        path_m = core::CumulativePathM(ReadOdometry(request.odometry_file, dataset));
+    if (!request.odometry_file.empty() || !request.odometry_topic.empty()) {
+        path_m = core::CumulativePathM(
+            ReadOdometry(request.odometry_file, request.odometry_topic, dataset));
     } else if (dataset.HasPoses()) {
         path_m = core::CumulativePathM(dataset.poses());
     }
@@ -57,6 +59,30 @@ std::vector<core::StampedPose> ReadOdometry(const std::filesystem::path& file,
                                       " scans: odometry needs one pose per scan");
     }
     return odometry;
+}
+
+std::vector<core::StampedPose> ReadOdometry(const std::filesystem::path& file,
+                                            const std::string& topic, const io::Dataset& dataset,
+                                            double max_step_m) {
+    if (topic.empty()) return ReadOdometry(file, dataset, max_step_m);
+    if (!file.empty()) {
+        throw core::ConfigError("odometry from a file (" + file.string() + ") and from topic " +
+                                core::Quoted(topic) + ": give one");
+    }
+    if (dataset.format() != io::DatasetFormat::kRosbag) {
+        throw core::ConfigError("an odometry topic (" + core::Quoted(topic) +
+                                ") needs a bag, and " + dataset.root().string() +
+                                " is a folder; give an odometry file");
+    }
+    std::vector<double> times_s(dataset.size());
+    for (std::size_t i = 0; i < times_s.size(); ++i) times_s[i] = dataset.ScanTime(i);
+    return io::ReadBagOdometry(dataset.root(), topic, times_s, max_step_m);
+}
+
+std::string OdometryName(const std::filesystem::path& file, const std::string& topic,
+                         const io::Dataset& dataset) {
+    if (topic.empty()) return file.string();
+    return dataset.root().string() + " topic " + core::Quoted(topic);
 }
 
 namespace {

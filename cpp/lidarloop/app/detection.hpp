@@ -23,6 +23,9 @@ struct DetectRequest {
     /// Odometry, KITTI or TUM, one pose per scan (T_world_sensor): the path a gap in metres and
     /// loops.csv's path_m are measured on. Empty: the dataset's poses, when it has them.
     std::filesystem::path odometry_file;
+    /// Instead of odometry_file, for a bag: its nav_msgs/Odometry topic, matched to the scans by
+    /// their stamps (io::ReadBagOdometry).
+    std::string odometry_topic;
 };
 
 struct DetectOutcome {
@@ -53,6 +56,18 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
 std::vector<core::StampedPose> ReadOdometry(
     const std::filesystem::path& file, const io::Dataset& dataset,
     double max_step_m = std::numeric_limits<double>::infinity());
+
+/// The odometry of `dataset` from `file`, or, when `topic` is given, from the nav_msgs/Odometry
+/// messages of `topic` in the dataset's bag, interpolated at the scans' stamps
+/// (io::ReadBagOdometry: io::ReadError naming the bag and the topic when their times do not
+/// cover the scans). core::ConfigError for a topic with a dataset that is no bag, or both.
+std::vector<core::StampedPose> ReadOdometry(
+    const std::filesystem::path& file, const std::string& topic, const io::Dataset& dataset,
+    double max_step_m = std::numeric_limits<double>::infinity());
+
+/// How odometry was given, for reports: the file, or "BAG topic '/odom'".
+std::string OdometryName(const std::filesystem::path& file, const std::string& topic,
+                         const io::Dataset& dataset);
 
 /// A saved descriptor database to localise against.
 struct LoadedMap {

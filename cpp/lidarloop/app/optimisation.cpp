@@ -32,6 +32,7 @@ std::vector<posegraph::LoopConstraint> DetectLoops(const io::Dataset& dataset,
     detect.progress = request.progress;
     detect.out = request.out / "detection";
     detect.odometry_file = request.odometry_file;  // the path a gap in metres is measured on
+    detect.odometry_topic = request.odometry_topic;
     const DetectOutcome detected = RunDetect(dataset, detect);
     std::vector<posegraph::LoopConstraint> loops;
     for (const pipeline::LoopQuery& query : detected.queries) {
@@ -191,7 +192,8 @@ OptimiseOutcome RunOptimisation(const io::Dataset& dataset, const OptimiseReques
     const std::filesystem::path out = PrepareOutputFolder(request.out);
     io::WriteConfigYaml(out / "config.yaml", request.config);
     const std::vector<core::StampedPose> odometry =
-        ReadOdometry(request.odometry_file, dataset, request.config.posegraph.max_odometry_step_m);
+        ReadOdometry(request.odometry_file, request.odometry_topic, dataset,
+                     request.config.posegraph.max_odometry_step_m);
     OptimiseOutcome outcome;
     outcome.loops = LoadLoops(dataset, request, outcome.notes);
     const posegraph::PoseGraph graph =

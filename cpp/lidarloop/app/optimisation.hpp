@@ -20,6 +20,9 @@ enum class PoseFormat { kKitti, kTum };
 struct OptimiseRequest {
     io::RunConfig config;  ///< `posegraph`; without a loops file also how loops are detected
     std::filesystem::path odometry_file;  ///< KITTI or TUM, one pose per scan (T_world_sensor)
+    /// Instead of odometry_file, for a bag: its nav_msgs/Odometry topic, matched to the scans by
+    /// their stamps (ReadOdometry).
+    std::string odometry_topic;
     /// Accepted loops with their T_match_query (loops.csv of `detect` with verification). Empty:
     /// RunDetect with verification runs first, into out/detection.
     std::filesystem::path loops_file;

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <limits>
 
+#include "lidarloop/app/detection.hpp"
 #include "lidarloop/io/plot.hpp"
 #include "lidarloop/io/read_error.hpp"
 
@@ -145,7 +146,7 @@ nlohmann::json OptimisationMetricsJson(const io::Dataset& dataset, const Optimis
     }
     return {{"dataset", dataset.root().string()},
             {"scans", dataset.size()},
-            {"odometry", request.odometry_file.string()},
+            {"odometry", OdometryName(request.odometry_file, request.odometry_topic, dataset)},
             {"loops_file",
              request.loops_file.empty() ? "detection/loops.csv" : request.loops_file.string()},
             {"ate_rmse_m_odometry", Field(outcome.odometry, &TrajectoryMetrics::ate_rmse_m)},
@@ -175,7 +176,8 @@ void WriteOptimisationReport(const std::filesystem::path& file, const io::Datase
     std::ofstream out(file);
     out << "# Pose-graph optimisation\n\n"
         << "- dataset: `" << dataset.root().string() << "`, " << dataset.size() << " scans\n"
-        << "- odometry: `" << request.odometry_file.string() << "`\n"
+        << "- odometry: `" << OdometryName(request.odometry_file, request.odometry_topic, dataset)
+        << "`\n"
         << "- loops: " << outcome.loops.size() << " accepted ("
         << (request.loops_file.empty() ? "detected with verification, detection/"
                                        : "`" + request.loops_file.string() + "`")

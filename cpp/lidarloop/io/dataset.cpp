@@ -8,6 +8,7 @@
 #include "lidarloop/io/osnabrueck.hpp"
 #include "lidarloop/io/poses.hpp"
 #include "lidarloop/io/read_error.hpp"
+#include "lidarloop/io/rosbag.hpp"
 #include "lidarloop/io/run_record.hpp"
 #include "lidarloop/io/scan_reader.hpp"
 
@@ -140,6 +141,23 @@ Dataset OpenFolder(const fs::path& root, const DatasetOptions& options) {
     return {DatasetFormat::kFolder, root, std::move(scans), std::move(poses)};
 }
 
+// A bag's scans with the poses of `options.poses_file`: a KITTI file has no times, so its poses
+// take the scans' stamps; a TUM file keeps its own.
+Dataset OpenBag(const fs::path& bag, const DatasetOptions& options) {
+    std::shared_ptr<const BagScans> scans = BagScans::Open(bag, options.topic);
+    std::vector<core::StampedPose> poses;
+    if (!options.poses_file.empty()) {
+        const core::Transform T_cam0_velo = options.calib_file.empty()
+                                                ? core::Transform::Identity()
+                                                : ReadKittiCalibTr(options.calib_file);
+        poses = ReadPosesFile(options.poses_file, T_cam0_velo, {});
+        if (poses.size() == scans->size() && !IsTumPosesFile(options.poses_file)) {
+            for (std::size_t i = 0; i < poses.size(); ++i) poses[i].time_s = scans->times_s()[i];
+        }
+    }
+    return {std::move(scans), std::move(poses)};
+}
+
 DatasetFormat DetectFormat(const fs::path& root) {
     if (!ListFiles(root / "velodyne", IsKittiBin).empty()) return DatasetFormat::kKitti;
     if (!ListFiles(root, IsOsnabrueckScan).empty()) return DatasetFormat::kOsnabrueck;
@@ -158,6 +176,14 @@ Dataset::Dataset(DatasetFormat format, fs::path root, std::vector<fs::path> scan
       scan_files_(std::move(scan_files)),
       poses_(std::move(poses)) {}
 
+Dataset::Dataset(std::shared_ptr<const BagScans> bag, std::vector<core::StampedPose> poses)
+    : format_(DatasetFormat::kRosbag), root_(bag->file()), poses_(std::move(poses)) {
+    scan_files_.reserve(bag->size());
+    for (std::size_t i = 0; i < bag->size(); ++i)
+        scan_files_.emplace_back(ToString(BagScanReference{bag->file(), bag->topic(), i}));
+    bag_ = std::move(bag);
+}
+
 std::string Dataset::FormatName() const {
     switch (format_) {
         case DatasetFormat::kKitti:
@@ -166,6 +192,8 @@ std::string Dataset::FormatName() const {
             return "folder";
         case DatasetFormat::kOsnabrueck:
             return "osnabrueck";
+        case DatasetFormat::kRosbag:
+            return "rosbag";
         case DatasetFormat::kAuto:
             break;
     }
@@ -174,14 +202,43 @@ std::string Dataset::FormatName() const {
 
 const fs::path& Dataset::ScanPath(std::size_t index) const { return scan_files_.at(index); }
 
-core::PointCloud Dataset::LoadScan(std::size_t index) const { return ReadScan(ScanPath(index)); }
+core::PointCloud Dataset::LoadScan(std::size_t index) const {
+    if (bag_) return bag_->Load(index);
+    return ReadScan(ScanPath(index));
+}
+
+double Dataset::ScanTime(std::size_t index) const {
+    if (bag_) return bag_->times_s().at(index);
+    return HasPoses() ? poses_.at(index).time_s : static_cast<double>(index);
+}
+
+std::string Dataset::Topic() const { return bag_ ? bag_->topic() : std::string(); }
 
 Dataset OpenDataset(const fs::path& path, const DatasetOptions& options) {
     std::error_code ec;
-    if (!fs::exists(path, ec)) throw ReadError(path, "no such dataset folder");
-    if (!fs::is_directory(path, ec)) {
-        throw ReadError(path, "is a file; a dataset is a folder of scans");
+    if (!fs::exists(path, ec)) {
+        throw ReadError(path, IsBagFile(path) ? "no such bag" : "no such dataset folder");
     }
+    if (!fs::is_directory(path, ec) && IsBagFile(path)) {
+        if (options.format != DatasetFormat::kAuto && options.format != DatasetFormat::kRosbag)
+            throw ReadError(path, "is a ROS bag, not a folder of the layout asked for");
+        Dataset dataset = OpenBag(path, options);
+        if (dataset.HasPoses() && dataset.poses().size() != dataset.size()) {
+            throw ReadError(options.poses_file,
+                            "has " + std::to_string(dataset.poses().size()) + " poses but " +
+                                path.string() + " has " + std::to_string(dataset.size()) +
+                                " scans on topic " + core::Quoted(dataset.Topic()));
+        }
+        return dataset;
+    }
+    if (!fs::is_directory(path, ec)) {
+        throw ReadError(path, "is a file; a dataset is a folder of scans or a ROS bag (.bag)");
+    }
+    if (!options.topic.empty()) {
+        throw ReadError(path, "is a folder; a topic (" + core::Quoted(options.topic) +
+                                  ") names the scans of a ROS bag");
+    }
+    if (options.format == DatasetFormat::kRosbag) throw ReadError(path, "is a folder, not a bag");
     RefuseIncompleteDataset(path);
     const DatasetFormat format =
         options.format == DatasetFormat::kAuto ? DetectFormat(path) : options.format;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -14,29 +15,45 @@ enum class DatasetFormat {
     kKitti,       ///< KITTI odometry: velodyne/*.bin, optional poses.txt, calib.txt, times.txt
     kFolder,      ///< a folder of .pcd/.ply/.xyz/.txt/.pts/.bin files, sorted by name
     kOsnabrueck,  ///< Osnabrück repository: scanNNN.3d with scanNNN.pose or scanNNN.frames
+    kRosbag,      ///< a ROS 1 bag (.bag file): the sensor_msgs/PointCloud2 messages of one topic
 };
+
+class BagScans;
 
 /// How to open a dataset. Empty paths mean "look in the usual place".
 struct DatasetOptions {
     DatasetFormat format = DatasetFormat::kAuto;
     std::filesystem::path poses_file;  ///< KITTI poses.txt or TUM file (detected by its content)
     std::filesystem::path calib_file;  ///< KITTI calib.txt; default: calib.txt beside the scans
+    /// A bag's PointCloud2 topic; empty: the bag's only one. An error for a folder.
+    std::string topic;
 };
 
 /// An ordered sequence of scans with optional ground-truth poses. Scans are loaded on demand;
-/// LoadScan is thread-safe (it only reads files).
+/// LoadScan is thread-safe (it only reads files, or a bag under a lock).
 class Dataset {
 public:
     Dataset(DatasetFormat format, std::filesystem::path root,
             std::vector<std::filesystem::path> scan_files, std::vector<core::StampedPose> poses);
+    /// The scans of a bag's topic; `poses` one per scan or none.
+    Dataset(std::shared_ptr<const BagScans> bag, std::vector<core::StampedPose> poses);
 
     DatasetFormat format() const { return format_; }
     std::string FormatName() const;
+    /// The folder, or the bag file.
     const std::filesystem::path& root() const { return root_; }
     std::size_t size() const { return scan_files_.size(); }
+    /// The scan's file, or for a bag its reference "BAG:TOPIC:INDEX" (io::ReadScan reads both).
     const std::filesystem::path& ScanPath(std::size_t index) const;
     core::PointCloud LoadScan(std::size_t index) const;
     bool HasPoses() const { return !poses_.empty(); }
+    /// True when the scans have recording times: poses (with their times) or a bag's stamps.
+    bool HasTimes() const { return HasPoses() || bag_ != nullptr; }
+    /// Recording time of a scan, seconds: a bag message's header stamp, else its pose's time,
+    /// else its index.
+    double ScanTime(std::size_t index) const;
+    /// The bag's topic ("" for a folder).
+    std::string Topic() const;
     /// One pose per scan (T_world_sensor); empty when the dataset has none.
     const std::vector<core::StampedPose>& poses() const { return poses_; }
 
@@ -45,11 +62,14 @@ private:
     std::filesystem::path root_;
     std::vector<std::filesystem::path> scan_files_;
     std::vector<core::StampedPose> poses_;
+    std::shared_ptr<const BagScans> bag_;  ///< for kRosbag
 };
 
-/// Opens a dataset folder, detecting its format unless `options.format` names one. Throws
-/// ReadError when the path does not exist, holds no scans, the format cannot be told (the message
-/// says what was looked for), or the number of poses differs from the number of scans.
+/// Opens a dataset folder, detecting its format unless `options.format` names one, or a ROS 1 bag
+/// (a .bag file; BagScans::Open on `options.topic`; poses from `options.poses_file` only, a KITTI
+/// file's times being the scans' stamps). Throws ReadError when the path does not exist, holds
+/// no scans, the format cannot be told (the message says what was looked for), the number of
+/// poses differs from the number of scans, or a topic is given for a folder.
 Dataset OpenDataset(const std::filesystem::path& path, const DatasetOptions& options = {});
 
 }  // namespace lidarloop::io

@@ -205,6 +205,13 @@ std::vector<core::StampedPose> ReadTumPoses(const std::filesystem::path& file) {
     return ReadTumPosesBounded(file, std::numeric_limits<double>::infinity());
 }
 
+bool IsTumPosesFile(const std::filesystem::path& file) {
+    detail::LineReader reader(file);
+    std::string line;
+    Fields fields;
+    return NextDataLine(reader, line, fields) && fields.size() == 8;
+}
+
 std::vector<core::StampedPose> ReadPoses(const std::filesystem::path& file,
                                          const core::Transform& T_cam0_velo,
                                          const std::filesystem::path& times_file,

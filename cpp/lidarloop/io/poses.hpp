@@ -53,6 +53,10 @@ std::vector<core::StampedPose> ReadPoses(
     const std::filesystem::path& times_file = {},
     double max_step_m = std::numeric_limits<double>::infinity());
 
+/// True when the first data line of `file` has 8 numbers (TUM: poses with their times); ReadError
+/// when the file cannot be read.
+bool IsTumPosesFile(const std::filesystem::path& file);
+
 /// Writes poses in TUM format (full double precision).
 void WriteTumPoses(const std::filesystem::path& file, const std::vector<core::StampedPose>& poses);
 

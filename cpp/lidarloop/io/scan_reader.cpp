@@ -10,6 +10,7 @@
 #include "lidarloop/io/pcd.hpp"
 #include "lidarloop/io/ply.hpp"
 #include "lidarloop/io/read_error.hpp"
+#include "lidarloop/io/rosbag.hpp"
 #include "lidarloop/io/xyz.hpp"
 
 namespace lidarloop::io {
@@ -47,9 +48,16 @@ Reader FindReader(const std::filesystem::path& file) {
 bool IsScanFile(const std::filesystem::path& file) { return FindReader(file) != nullptr; }
 
 core::PointCloud ReadScan(const std::filesystem::path& file) {
+    if (const auto reference = ParseBagScanReference(file.string())) return ReadBagScan(*reference);
     // Before the extension: a folder has none, and "unknown scan format ''" would hide the cause.
     std::error_code ec;
     if (std::filesystem::is_directory(file, ec)) throw ReadError(file, "is a folder, not a file");
+    if (IsBagFile(file)) {
+        throw ReadError(file, "is a ROS bag; name one of its scans as BAG:TOPIC:INDEX (e.g. " +
+                                  file.string() +
+                                  ":/points:0; `lidarloop bag-info` lists the "
+                                  "topics)");
+    }
     const Reader reader = FindReader(file);
     if (reader == nullptr) {
         std::string known;

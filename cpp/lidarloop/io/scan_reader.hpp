@@ -10,8 +10,9 @@ namespace lidarloop::io {
 /// True when ReadScan knows the file's extension (.bin, .pcd, .ply, .xyz, .txt, .pts, .3d).
 bool IsScanFile(const std::filesystem::path& file);
 
-/// Reads one scan, choosing the reader by the file extension (case-insensitive). Throws ReadError
-/// for a missing file, an unknown extension (listing the known ones) or bad content.
+/// Reads one scan, choosing the reader by the file extension (case-insensitive), or the message a
+/// bag scan reference "BAG:TOPIC:INDEX" names (rosbag.hpp). Throws ReadError for a missing file,
+/// an unknown extension (listing the known ones) or bad content.
 core::PointCloud ReadScan(const std::filesystem::path& file);
 
 }  // namespace lidarloop::io

@@ -1,0 +1,22 @@
+# ROS 1 bag support of lidarloop::io (cpp/lidarloop/io/rosbag.cpp) through Debian's
+# librosbag-storage-dev. AUTO reads bags when the library is found, ON requires it, OFF builds
+# without (a bag is then an error saying so). Sets LIDARLOOP_HAS_ROSBAG.
+if(NOT LIDARLOOP_WITH_ROSBAG MATCHES "^(AUTO|ON|OFF)$")
+    message(FATAL_ERROR "LIDARLOOP_WITH_ROSBAG is '${LIDARLOOP_WITH_ROSBAG}': use AUTO, ON or OFF")
+endif()
+set(LIDARLOOP_HAS_ROSBAG OFF)
+if(LIDARLOOP_WITH_ROSBAG STREQUAL "OFF")
+    message(STATUS "ROS 1 bags: off (LIDARLOOP_WITH_ROSBAG=OFF)")
+    return()
+endif()
+if(LIDARLOOP_WITH_ROSBAG STREQUAL "ON")
+    find_package(RosbagStorage REQUIRED)
+else()
+    find_package(RosbagStorage QUIET)
+endif()
+if(NOT RosbagStorage_FOUND)
+    message(STATUS "ROS 1 bags: off (librosbag-storage-dev not found)")
+    return()
+endif()
+set(LIDARLOOP_HAS_ROSBAG ON)
+message(STATUS "ROS 1 bags: on (${RosbagStorage_LIBRARY})")
