@@ -107,6 +107,8 @@
 #include "lidarloop/io/prepared_scans_file.hpp"
 #include "lidarloop/io/read_error.hpp"
 #include "lidarloop/io/results_csv.hpp"
+#include "lidarloop/io/ros_messages.hpp"
+#include "lidarloop/io/rosbag.hpp"
 #include "lidarloop/io/run_record.hpp"
 #include "lidarloop/io/scan_reader.hpp"
 #include "lidarloop/io/similarity_file.hpp"
