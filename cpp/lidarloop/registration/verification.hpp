@@ -80,8 +80,9 @@ bool OverlapReaches(const PreparedScan& query, const PreparedScan& match,
                     const core::Transform& T_match_query, const AcceptanceConfig& config,
                     double min_overlap);
 
-/// The largest RMSE a pair may have: max_rmse_ratio times the scans' combined roughness
-/// (PreparedScan::structure_roughness_m), within [min_allowed_rmse_m, max_rmse_m].
+/// The largest RMSE a pair may have: max_rmse_ratio times the RMS of the two scans' roughness
+/// (PreparedScan::structure_roughness_m: how well each fits itself), within
+/// [min_allowed_rmse_m, max_rmse_m].
 double AllowedRmse(const PreparedScan& query, const PreparedScan& match,
                    const AcceptanceConfig& config);
 
