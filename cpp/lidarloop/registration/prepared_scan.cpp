@@ -76,12 +76,11 @@ bool OnLargePlane(const std::vector<Eigen::Vector3f>& centroids, const PointTree
     return total > 0.0 && eigenvalues(0) / total <= config.max_plane_variation;
 }
 
-// The overlap test's default gates (AcceptanceConfig), with which a scan is matched to itself.
+// The overlap test's gates at their defaults, with which a scan is matched to itself.
 struct SelfMatchGates {
-    float range_m = 40.0F;
-    float partner_m = 1.5F;
-    float plane_m = 0.3F;
-    float min_normal_cosine = 0.866F;  // 30 degrees
+    float range_m = static_cast<float>(AcceptanceConfig{}.overlap_range_m);
+    float partner_m = static_cast<float>(AcceptanceConfig{}.overlap_radius_m);
+    float plane_m = static_cast<float>(AcceptanceConfig{}.overlap_plane_m);
 };
 
 // Partners per probed point: the nearest lies along the scan line, closer than a second scan's
@@ -109,7 +108,7 @@ double SelfResidual(const SurfacePoints& structure) {
             const Eigen::Vector3f offset = point - structure.points()[partner];
             const float distance_m = partner_normal.dot(offset);
             if (offset.norm() > gates.partner_m || std::abs(distance_m) > gates.plane_m ||
-                std::abs(partner_normal.dot(structure.normals()[i])) < gates.min_normal_cosine) {
+                std::abs(partner_normal.dot(structure.normals()[i])) < kOverlapMinNormalCosine) {
                 continue;
             }
             squared_sum_m2 += static_cast<double>(distance_m) * distance_m;

@@ -13,10 +13,6 @@
 namespace lidarloop::registration {
 namespace {
 
-// Smallest angle cosine between matched normals (30 degrees): a wall point does not overlap a
-// pole that merely passes near it.
-constexpr float kMinNormalCosine = 0.866F;
-
 // Ground points a scan needs besides its structure: they fix height, roll and pitch.
 constexpr std::size_t kMinGroundPoints = 20;
 
@@ -38,7 +34,7 @@ SurfaceHit HitOnSurface(const Eigen::Vector3f& moved, const Eigen::Vector3f& mov
     hit.partner_normal = onto.normals()[partner];
     hit.distance_m = hit.partner_normal.dot(moved - onto.points()[partner]);
     hit.on_surface = std::abs(hit.distance_m) <= config.overlap_plane_m &&
-                     std::abs(hit.partner_normal.dot(moved_normal)) >= kMinNormalCosine;
+                     std::abs(hit.partner_normal.dot(moved_normal)) >= kOverlapMinNormalCosine;
     return hit;
 }
 

@@ -71,6 +71,11 @@ struct IcpConfig {
     bool operator==(const IcpConfig&) const = default;
 };
 
+/// Smallest |cosine| between the normals of two points that overlap (30 degrees): a wall point
+/// does not overlap a pole that merely passes near it. Shared by the overlap test and a scan's
+/// roughness (PreparedScan::structure_roughness_m), which must count pairs the same way.
+inline constexpr float kOverlapMinNormalCosine = 0.866F;
+
 /// When a registered candidate is accepted as a loop. Every value is physical: metres or a
 /// fraction of points; docs/verification.md explains the rule.
 struct AcceptanceConfig {
