@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <numbers>
 #include <optional>
 #include <random>
 #include <string>
@@ -22,6 +24,12 @@
 #include "lidarloop/core/point_cloud.hpp"
 
 namespace lidarloop::test {
+
+// Constants that many tests spell out: declared once, so that test files can share a unity batch.
+inline constexpr double kInf = std::numeric_limits<double>::infinity();
+inline constexpr float kInfFloat = std::numeric_limits<float>::infinity();
+inline constexpr float kNanFloat = std::numeric_limits<float>::quiet_NaN();
+inline constexpr double kDeg = std::numbers::pi / 180.0;  // radians per degree
 
 /// A fresh temporary folder per test, removed at the end of the test. Named after the test, the
 /// process and a count, so that the same test running in two build trees at once, or two

@@ -15,8 +15,6 @@
 namespace lidarloop {
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
-
 // Every pair of `matrix` as another detector's CSV (9 digits: floats read back exactly).
 void WriteAllPairs(const pipeline::SimilarityMatrix& matrix, const std::filesystem::path& file) {
     std::ofstream out(file);
@@ -65,8 +63,8 @@ TEST(EvaluationRun, MatrixOfResultsKeepsTheSmallestDistanceOfAPair) {
     test::WriteFile(dir / "r.csv", "query,match,distance\n3,1,0.5\n1,3,0.25\n2,2,0.1\n");
     const pipeline::SimilarityMatrix matrix = app::MatrixOfResults(dir / "r.csv", 4);
     EXPECT_EQ(matrix.at(1, 3), 0.25f);
-    EXPECT_EQ(matrix.at(0, 1), kInf);  // never listed: never detected
-    EXPECT_EQ(matrix.at(2, 3), kInf);
+    EXPECT_EQ(matrix.at(0, 1), test::kInfFloat);  // never listed: never detected
+    EXPECT_EQ(matrix.at(2, 3), test::kInfFloat);
 }
 
 TEST(EvaluationRun, AResultsPairBeyondTheDatasetIsAReadError) {

@@ -18,7 +18,7 @@
 namespace lidarloop {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using test::kInf;
 
 // Eight scans at three places 100 m apart: A = {0, 2, 4, 6}, B = {1, 3, 5}, C = {7}. Every pair
 // of distinct scans is evaluated (gap 0); the same place is a loop: 6 + 3 = 9 loops, 19 others.

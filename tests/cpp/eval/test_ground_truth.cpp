@@ -19,7 +19,7 @@ using core::MinGap;
 using test::MakePose;
 using test::RandomTrajectory;
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+using test::kDeg;
 
 // The O(n^2) reference: every pair, the rules written out again.
 struct BruteTruth {

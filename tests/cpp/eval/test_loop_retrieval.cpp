@@ -16,10 +16,10 @@
 namespace lidarloop::eval {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kDeg = std::numbers::pi / 180.0;
+using test::kDeg;
+using test::kInf;
 
-core::Transform Pose(double x, double y, double z, double yaw_deg, double pitch_deg = 0.0) {
+core::Transform PoseDeg(double x, double y, double z, double yaw_deg, double pitch_deg = 0.0) {
     core::Transform T = core::Transform::Identity();
     T.translation() = Eigen::Vector3d(x, y, z);
     T.linear() = (Eigen::AngleAxisd(yaw_deg * kDeg, Eigen::Vector3d::UnitZ()) *
@@ -55,7 +55,7 @@ core::Transform TrueMatchQuery(std::size_t match, std::size_t query) {
 }
 
 // Query 6's pose estimate is off by 10 deg of yaw and (3, 4, 0) m in the query frame.
-core::Transform OffPose() { return TrueMatchQuery(1, 6) * Pose(3, 4, 0, 10); }
+core::Transform OffPose() { return TrueMatchQuery(1, 6) * PoseDeg(3, 4, 0, 10); }
 
 std::vector<QueryCandidates> LineCandidates() {
     return {
@@ -197,48 +197,48 @@ TEST(LoopRetrieval, InfiniteScoresRankAtTheEnds) {
 }
 
 TEST(LoopRetrieval, PoseErrorOfKnownTransforms) {
-    const core::Transform T_true = Pose(10, -2, 0.5, 30);
+    const core::Transform T_true = PoseDeg(10, -2, 0.5, 30);
     const RelativePoseError exact = PoseError(T_true, T_true);
     EXPECT_NEAR(exact.translation_m, 0.0, 1e-12);
     EXPECT_NEAR(exact.rotation_deg, 0.0, 1e-12);
 
-    const RelativePoseError yaw = PoseError(T_true * Pose(0, 0, 0, 10), T_true);
+    const RelativePoseError yaw = PoseError(T_true * PoseDeg(0, 0, 0, 10), T_true);
     EXPECT_NEAR(yaw.yaw_deg, 10.0, 1e-9);
     EXPECT_NEAR(yaw.rotation_deg, 10.0, 1e-9);
     EXPECT_NEAR(yaw.translation_m, 0.0, 1e-9);
-    EXPECT_NEAR(PoseError(T_true * Pose(0, 0, 0, -170), T_true).yaw_deg, 170.0, 1e-9);
-    const RelativePoseError half_turn = PoseError(T_true * Pose(0, 0, 0, 180), T_true);
+    EXPECT_NEAR(PoseError(T_true * PoseDeg(0, 0, 0, -170), T_true).yaw_deg, 170.0, 1e-9);
+    const RelativePoseError half_turn = PoseError(T_true * PoseDeg(0, 0, 0, 180), T_true);
     EXPECT_NEAR(half_turn.yaw_deg, 180.0, 1e-9);
     EXPECT_NEAR(half_turn.rotation_deg, 180.0, 1e-9);
 
     // Tiny angles keep their precision (acos of the trace would give 0 here).
-    EXPECT_NEAR(PoseError(T_true * Pose(0, 0, 0, 1e-6), T_true).rotation_deg, 1e-6, 1e-12);
+    EXPECT_NEAR(PoseError(T_true * PoseDeg(0, 0, 0, 1e-6), T_true).rotation_deg, 1e-6, 1e-12);
 
-    const RelativePoseError shift = PoseError(T_true * Pose(3, 4, 12, 0), T_true);
+    const RelativePoseError shift = PoseError(T_true * PoseDeg(3, 4, 12, 0), T_true);
     EXPECT_NEAR(shift.translation_m, 13.0, 1e-9);
     EXPECT_NEAR(shift.planar_m, 5.0, 1e-9);
     EXPECT_NEAR(shift.yaw_deg, 0.0, 1e-9);
 
     // Yaw 10 deg then pitch 5 deg: yaw error 10, rotation angle from the trace of Rz Ry.
-    const RelativePoseError both = PoseError(T_true * Pose(0, 0, 0, 10, 5), T_true);
+    const RelativePoseError both = PoseError(T_true * PoseDeg(0, 0, 0, 10, 5), T_true);
     const double ca = std::cos(10 * kDeg), cb = std::cos(5 * kDeg);
     EXPECT_NEAR(both.yaw_deg, 10.0, 1e-9);
     EXPECT_NEAR(both.rotation_deg, std::acos((ca * cb + ca + cb - 1) / 2) / kDeg, 1e-6);
-    EXPECT_NEAR(PoseError(T_true * Pose(0, 0, 0, 0, 5), T_true).yaw_deg, 0.0, 1e-9);
+    EXPECT_NEAR(PoseError(T_true * PoseDeg(0, 0, 0, 0, 5), T_true).yaw_deg, 0.0, 1e-9);
 }
 
 TEST(LoopRetrieval, PoseErrorIsInTheQueryFrame) {
     // The query sensor is pitched 90 deg against the match sensor; the estimate is 1 m off
     // along the query's z axis, which is horizontal in the match frame: no planar error.
-    const core::Transform T_true = Pose(5, 0, 0, 0, 90);
-    const RelativePoseError error = PoseError(T_true * Pose(0, 0, 1, 0), T_true);
+    const core::Transform T_true = PoseDeg(5, 0, 0, 0, 90);
+    const RelativePoseError error = PoseError(T_true * PoseDeg(0, 0, 1, 0), T_true);
     EXPECT_NEAR(error.translation_m, 1.0, 1e-9);
     EXPECT_NEAR(error.planar_m, 0.0, 1e-9);
 }
 
 TEST(LoopRetrieval, TrueRelativePoseMapsQueryPointsIntoTheMatchFrame) {
-    const core::Transform T_world_match = Pose(10, 0, 0, 90);
-    const core::Transform T_world_query = Pose(10, 5, 0, 180);
+    const core::Transform T_world_match = PoseDeg(10, 0, 0, 90);
+    const core::Transform T_world_query = PoseDeg(10, 5, 0, 180);
     const core::Transform T_match_query = TrueRelativePose(T_world_match, T_world_query);
     // The query's origin is 5 m along the match's x axis (which points along world y).
     EXPECT_TRUE(T_match_query.translation().isApprox(Eigen::Vector3d(5, 0, 0), 1e-12));

@@ -10,11 +10,12 @@
 #include "eval/eval_test_utils.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/eval/pairwise.hpp"
+#include "test_utils.hpp"
 
 namespace lidarloop::eval {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using test::kInf;
 
 // `count` pairs, loops with probability `loop_rate`; distances quantised to `levels` values so
 // that ties occur; loops are shifted down by `separation` (0 = an uninformative detector).

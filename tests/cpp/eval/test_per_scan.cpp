@@ -10,14 +10,15 @@
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/eval/pairwise.hpp"
 #include "lidarloop/eval/per_scan.hpp"
+#include "test_utils.hpp"
 
 namespace lidarloop::eval {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using test::kInf;
 
 // Ten scans on a line; scan 5 revisits scan 0 (2 m away) and scan 7 revisits scan 3.
-GroundTruth LineTruth() {
+GroundTruth TenPoseLineTruth() {
     const double x[] = {0, 100, 200, 300, 400, 2, 500, 302, 600, 700};
     std::vector<core::StampedPose> poses;
     for (int i = 0; i < 10; ++i) poses.push_back(test::MakePose(i, x[i], 0.0));
@@ -44,7 +45,7 @@ std::vector<BestMatch> LineMatches() {
 }
 
 TEST(PerScan, HandMadeSequenceFollowsTableI) {
-    const GroundTruth truth = LineTruth();
+    const GroundTruth truth = TenPoseLineTruth();
     const auto matches = LineMatches();
     const auto labels = LabelScans(matches, truth, 1.0);
     using L = ScanLabel;
@@ -69,7 +70,7 @@ TEST(PerScan, HandMadeSequenceFollowsTableI) {
 }
 
 TEST(PerScan, ZeroErrorPointWithAndWithoutMismatches) {
-    const GroundTruth truth = LineTruth();
+    const GroundTruth truth = TenPoseLineTruth();
     const auto matches = LineMatches();
     const PerScanEvaluation strict = EvaluatePerScan(matches, truth);
     EXPECT_EQ(strict.overlapping, 4u);
@@ -190,7 +191,7 @@ TEST(PerScan, SweepEqualsLabellingAtEveryThreshold) {
 }
 
 TEST(PerScan, RejectsInconsistentInput) {
-    const GroundTruth truth = LineTruth();
+    const GroundTruth truth = TenPoseLineTruth();
     auto matches = LineMatches();
     EXPECT_THROW(LabelScans(matches, truth, std::numeric_limits<double>::quiet_NaN()), core::Error);
     matches[0].match = 1;  // inside the minimum gap of scan 0

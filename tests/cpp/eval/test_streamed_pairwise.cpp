@@ -16,11 +16,10 @@
 #include "lidarloop/eval/detail/slot_counts.hpp"
 #include "lidarloop/eval/pairwise.hpp"
 #include "lidarloop/eval/streamed_pairwise.hpp"
+#include "test_utils.hpp"
 
 namespace lidarloop::eval {
 namespace {
-
-constexpr float kInf = std::numeric_limits<float>::infinity();
 
 struct Case {
     unsigned seed = 1;
@@ -48,7 +47,7 @@ Sequence MakeSequence(const Case& c) {
         for (std::size_t j = i + 1; j < c.scans; ++j) {
             double d = unit(rng) + (s.truth.IsLoop(i, j) ? -c.informative : 0.0);
             if (c.levels > 0) d = std::round(d * c.levels) / c.levels;
-            s.condensed.push_back(unit(rng) < c.unscored ? kInf : static_cast<float>(d));
+            s.condensed.push_back(unit(rng) < c.unscored ? test::kInfFloat : static_cast<float>(d));
         }
     }
     return s;

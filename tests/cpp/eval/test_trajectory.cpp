@@ -8,11 +8,12 @@
 
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/eval/trajectory.hpp"
+#include "test_utils.hpp"
 
 namespace lidarloop::eval {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+using test::kDeg;
 
 core::Transform Pose(double x, double y, double z, double yaw, double pitch = 0.0) {
     core::Transform T = core::Transform::Identity();

@@ -44,8 +44,6 @@ using test::WriteFile;
 
 static_assert(std::endian::native == std::endian::little, "the byte builders assume it");
 
-constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
-
 template <typename T>
 void Append(std::string& bytes, T value) {
     char buffer[sizeof(T)];
@@ -111,7 +109,7 @@ TEST(PcdWriter, WritesTheV07HeaderAndLittleEndianFloats) {
 
 TEST(PcdWriter, AsciiUsesNineSignificantDigits) {
     TempDir dir;
-    WritePcd(dir / "one.pcd", {{0.1f, 1.5f, kNan}}, PcdEncoding::kAscii);
+    WritePcd(dir / "one.pcd", {{0.1f, 1.5f, test::kNanFloat}}, PcdEncoding::kAscii);
     const std::string text = ReadFile(dir / "one.pcd");
     EXPECT_NE(text.find("DATA ascii\n0.100000001 1.5 nan\n"), std::string::npos) << text;
 }
@@ -240,7 +238,10 @@ TEST(PcdRead, OrganisedCloudKeepsNanPoints) {
     text += "1 2 3\nnan nan nan\n4 5 6\nNaN NaN NaN\n";
     WriteFile(dir / "organised.pcd", text);
     ExpectSameCloud(ReadPcd(dir / "organised.pcd"),
-                    {{1, 2, 3}, {kNan, kNan, kNan}, {4, 5, 6}, {kNan, kNan, kNan}});
+                    {{1, 2, 3},
+                     {test::kNanFloat, test::kNanFloat, test::kNanFloat},
+                     {4, 5, 6},
+                     {test::kNanFloat, test::kNanFloat, test::kNanFloat}});
 }
 
 // ---------------------------------------------------------------------------------------------

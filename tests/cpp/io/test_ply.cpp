@@ -42,8 +42,6 @@ using test::WriteFile;
 
 static_assert(std::endian::native == std::endian::little, "the byte builders assume it");
 
-constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
-
 std::string FormatLine(PlyEncoding encoding) {
     switch (encoding) {
         case PlyEncoding::kAscii:
@@ -168,8 +166,10 @@ TEST(PlyWriter, LittleEndianFloat64Bytes) {
 
 TEST(PlyWriter, AsciiUsesMaxDigits10) {
     TempDir dir;
-    WritePly(dir / "f.ply", {{0.1f, 1.5f, kNan}}, PlyEncoding::kAscii, PlyScalar::kFloat32);
-    WritePly(dir / "d.ply", {{0.1f, 1.5f, kNan}}, PlyEncoding::kAscii, PlyScalar::kFloat64);
+    WritePly(dir / "f.ply", {{0.1f, 1.5f, test::kNanFloat}}, PlyEncoding::kAscii,
+             PlyScalar::kFloat32);
+    WritePly(dir / "d.ply", {{0.1f, 1.5f, test::kNanFloat}}, PlyEncoding::kAscii,
+             PlyScalar::kFloat64);
     EXPECT_NE(ReadFile(dir / "f.ply").find("end_header\n0.100000001 1.5 nan\n"), std::string::npos);
     EXPECT_NE(ReadFile(dir / "d.ply").find("end_header\n0.10000000149011612 1.5 nan\n"),
               std::string::npos);

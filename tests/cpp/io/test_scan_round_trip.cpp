@@ -15,8 +15,6 @@ using core::PointCloud;
 using test::ExpectSameCloud;
 using test::ScanRoundTrip;
 
-constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
-
 TEST_P(ScanRoundTrip, RandomCloudIsExact) {
     const PointCloud cloud = test::RandomCloud(2000, 7);
     ExpectSameCloud(RoundTrip(cloud), cloud);
@@ -24,7 +22,8 @@ TEST_P(ScanRoundTrip, RandomCloudIsExact) {
 
 TEST_P(ScanRoundTrip, NanPointsSurvive) {
     PointCloud cloud = test::RandomCloud(300, 8);
-    for (std::size_t i = 0; i < cloud.size(); i += 3) cloud[i] = {kNan, kNan, kNan};
+    for (std::size_t i = 0; i < cloud.size(); i += 3)
+        cloud[i] = {test::kNanFloat, test::kNanFloat, test::kNanFloat};
     const PointCloud read = RoundTrip(cloud);
     ExpectSameCloud(read, cloud);
     EXPECT_TRUE(std::isnan(read[0].x()));

@@ -11,18 +11,13 @@
 
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/sim/simulator.hpp"
+#include "sim/sim_test_utils.hpp"
 #include "test_utils.hpp"
 
 namespace lidarloop::sim {
 namespace {
 
 constexpr double kRadToDeg = 180.0 / std::numbers::pi;
-
-SensorSpec SpecOf(SensorModel model) {
-    SensorConfig config;
-    config.model = model;
-    return Resolve(config);
-}
 
 double ElevationDeg(const Eigen::Vector3d& d) { return std::asin(d.z() / d.norm()) * kRadToDeg; }
 double AzimuthDeg(const Eigen::Vector3d& d) { return std::atan2(d.y(), d.x()) * kRadToDeg; }
@@ -235,11 +230,6 @@ TEST(Sensors, LivoxAviaScansFollowTheirOwnScansRays) {
     const auto probes = EveryNth(point_directions, 24);
     EXPECT_GT(FractionSampledAgain(probes, simulator.ScanDirections(4), 0.01), 0.99);
     EXPECT_LT(FractionSampledAgain(probes, simulator.ScanDirections(3), 0.01), 0.02);
-}
-
-bool SameBytes(const core::PointCloud& a, const core::PointCloud& b) {
-    return a.size() == b.size() &&
-           std::memcmp(a.data(), b.data(), a.size() * sizeof(Eigen::Vector3f)) == 0;
 }
 
 // A front end's thinning keeps exactly points 0, N, 2N, ... of the full scan, dropouts and noise

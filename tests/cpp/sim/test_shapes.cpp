@@ -5,13 +5,10 @@
 
 #include "lidarloop/sim/shapes.hpp"
 #include "lidarloop/sim/terrain.hpp"
+#include "sim/sim_test_utils.hpp"
 
 namespace lidarloop::sim {
 namespace {
-
-Ray MakeRay(Eigen::Vector3d origin, Eigen::Vector3d direction) {
-    return {origin, direction.normalized()};
-}
 
 TEST(Shapes, BoxFaceHitAtAnalyticRange) {
     const Box box{{10.0, 0.0, 0.0}, {1.0, 2.0, 3.0}, 0.0};

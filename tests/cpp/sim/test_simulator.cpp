@@ -9,6 +9,7 @@
 #include "lidarloop/io/dataset.hpp"
 #include "lidarloop/io/kitti_sequence.hpp"
 #include "lidarloop/sim/simulator.hpp"
+#include "sim/sim_test_utils.hpp"
 #include "test_utils.hpp"
 
 namespace lidarloop::sim {
@@ -24,17 +25,6 @@ SimulationConfig SmallConfig(SceneType scene = SceneType::kUrban,
     config.scans = 40;
     config.seed = 3;
     return config;
-}
-
-SensorSpec SpecOf(SensorModel model) {
-    SensorConfig config;
-    config.model = model;
-    return Resolve(config);
-}
-
-bool SameBytes(const core::PointCloud& a, const core::PointCloud& b) {
-    return a.size() == b.size() &&
-           std::memcmp(a.data(), b.data(), a.size() * sizeof(Eigen::Vector3f)) == 0;
 }
 
 TEST(Sensor, BeamPatternsOfTheModels) {

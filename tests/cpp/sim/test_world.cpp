@@ -9,14 +9,11 @@
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/sim/scene.hpp"
 #include "lidarloop/sim/world.hpp"
+#include "sim/sim_test_utils.hpp"
 #include "test_utils.hpp"
 
 namespace lidarloop::sim {
 namespace {
-
-Ray MakeRay(Eigen::Vector3d origin, Eigen::Vector3d direction) {
-    return {origin, direction.normalized()};
-}
 
 TEST(World, RayHitsKnownBoxAndPlaneAtAnalyticRange) {
     // Ground z = 0, a 4 m x 6 m x 3 m box whose near face is 10 m ahead of a sensor at 1.73 m.

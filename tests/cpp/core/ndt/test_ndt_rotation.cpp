@@ -121,7 +121,7 @@ TEST(NdtRotation, PlaneOnAClassBorderGivesOneDescriptor) {
 }
 
 // A direction on the sphere: colatitude from +z and longitude from +x, degrees.
-Eigen::Vector3d Direction(double colatitude_deg, double longitude_deg) {
+Eigen::Vector3d UnitDirection(double colatitude_deg, double longitude_deg) {
     const double colatitude = colatitude_deg * std::numbers::pi / 180.0;
     return std::sin(colatitude) * Horizontal(longitude_deg) +
            std::cos(colatitude) * Eigen::Vector3d::UnitZ();
@@ -132,8 +132,8 @@ Eigen::Vector3d Direction(double colatitude_deg, double longitude_deg) {
 // yaw. R_z alone is used, the rotation about an axis perpendicular to both the first line and z.
 TEST(NdtRotation, SecondDirectionNearlyParallelToTheFirstSetsNoYaw) {
     const HalfSpherePartition partition(9);
-    const Eigen::Vector3d a = Direction(20.0, 22.5);
-    const Eigen::Vector3d b = Direction(36.0, 22.5);
+    const Eigen::Vector3d a = UnitDirection(20.0, 22.5);
+    const Eigen::Vector3d b = UnitDirection(36.0, 22.5);
     ASSERT_EQ(partition.NearestLine(a), 0);
     ASSERT_EQ(partition.NearestLine(b), 1);
     PointCloud cloud;

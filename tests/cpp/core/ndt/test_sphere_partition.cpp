@@ -16,8 +16,7 @@
 namespace lidarloop::core {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-constexpr double kTwoPi = 2.0 * kPi;
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 // Uniform on the whole sphere (normalised Gaussian vectors), so uniform over lines as well; this
 // sampler knows nothing of the z-uniformity the partition is built on.
@@ -109,7 +108,7 @@ TEST(HalfSpherePartition, ZonesTileTheHalfSphereInEqualAreasForEveryValidCount) 
         const auto& counts = partition.zone_region_counts();
         ASSERT_EQ(colatitudes.size(), counts.size() + 1) << n;
         ASSERT_EQ(colatitudes.front(), 0.0) << n;
-        ASSERT_EQ(colatitudes.back(), kPi / 2.0) << n;
+        ASSERT_EQ(colatitudes.back(), std::numbers::pi / 2.0) << n;
         for (std::size_t k = 0; k + 1 < colatitudes.size(); ++k) {
             ASSERT_LT(colatitudes[k], colatitudes[k + 1]) << n;
         }
@@ -286,16 +285,17 @@ TEST(HalfSpherePartition, NineRegionsAreACapAndOneCollarOfEight) {
     ASSERT_EQ(partition.zone_colatitudes().size(), 3U);
     EXPECT_EQ(partition.zone_colatitudes()[0], 0.0);
     EXPECT_NEAR(partition.zone_colatitudes()[1], std::acos(8.0 / 9.0), 1e-14);
-    EXPECT_EQ(partition.zone_colatitudes()[2], kPi / 2.0);
+    EXPECT_EQ(partition.zone_colatitudes()[2], std::numbers::pi / 2.0);
     EXPECT_EQ(partition.centres()[0], Eigen::Vector3d::UnitZ());
-    const double colatitude = (std::acos(8.0 / 9.0) + kPi / 2.0) / 2.0;
+    const double colatitude = (std::acos(8.0 / 9.0) + std::numbers::pi / 2.0) / 2.0;
     for (int j = 0; j < 8; ++j) {
-        const double longitude = (j + 0.5) * kPi / 4.0;
+        const double longitude = (j + 0.5) * std::numbers::pi / 4.0;
         const Eigen::Vector3d expected(std::sin(colatitude) * std::cos(longitude),
                                        std::sin(colatitude) * std::sin(longitude),
                                        std::cos(colatitude));
         EXPECT_LT((partition.centres()[1 + j] - expected).norm(), 1e-14) << j;
-        EXPECT_NEAR(partition.regions()[1 + j].longitude_min, j * kPi / 4.0, 1e-14) << j;
+        EXPECT_NEAR(partition.regions()[1 + j].longitude_min, j * std::numbers::pi / 4.0, 1e-14)
+            << j;
     }
 }
 
@@ -306,11 +306,11 @@ TEST(HalfSpherePartition, SmallCountsHaveTheExpectedZones) {
     // (a = -0.1355) and round(9.1355 - 0.1355) = 9.
     const HalfSpherePartition one(1);
     EXPECT_EQ(one.zone_region_counts(), (std::vector<int>{1}));
-    EXPECT_EQ(one.zone_colatitudes(), (std::vector<double>{0.0, kPi / 2.0}));
+    EXPECT_EQ(one.zone_colatitudes(), (std::vector<double>{0.0, std::numbers::pi / 2.0}));
     EXPECT_EQ(one.RegionOf(Eigen::Vector3d(1, 2, -3)), 0);
     const HalfSpherePartition two(2);
     EXPECT_EQ(two.zone_region_counts(), (std::vector<int>{1, 1}));
-    EXPECT_NEAR(two.zone_colatitudes()[1], kPi / 3.0, 1e-15);
+    EXPECT_NEAR(two.zone_colatitudes()[1], std::numbers::pi / 3.0, 1e-15);
     EXPECT_EQ(HalfSpherePartition(16).zone_region_counts(), (std::vector<int>{1, 6, 9}));
     EXPECT_EQ(HalfSpherePartition(50).zone_region_counts(), (std::vector<int>{1, 6, 11, 15, 17}));
     // n = 27, where the running discrepancy matters: 3 collars with ideal counts 5.4471, 9.2337

@@ -2,6 +2,7 @@
 // written here independently of the kernels: bins, ring key, column-shift distance and yaw.
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <random>
 #include <vector>
 
@@ -14,8 +15,6 @@
 namespace lidarloop::core {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 // Section III-A: ring from the planar range, sector from atan2, value the largest z + h.
 std::vector<float> BruteForceBins(const PointCloud& cloud, const ScanContextConfig& c) {
     std::vector<float> bins(static_cast<std::size_t>(c.rings * c.sectors), 0.0f);
@@ -24,9 +23,10 @@ std::vector<float> BruteForceBins(const PointCloud& cloud, const ScanContextConf
         const double range_m = std::hypot(double{p.x()}, double{p.y()});
         if (range_m >= c.max_range_m) continue;
         double azimuth_rad = std::atan2(double{p.y()}, double{p.x()});
-        if (azimuth_rad < 0.0) azimuth_rad += 2.0 * kPi;
+        if (azimuth_rad < 0.0) azimuth_rad += 2.0 * std::numbers::pi;
         const int ring = static_cast<int>(std::floor(range_m / (c.max_range_m / c.rings)));
-        const int sector = static_cast<int>(std::floor(azimuth_rad / (2.0 * kPi / c.sectors)));
+        const int sector =
+            static_cast<int>(std::floor(azimuth_rad / (2.0 * std::numbers::pi / c.sectors)));
         float& bin = bins[static_cast<std::size_t>(ring * c.sectors + sector)];
         bin = std::max(bin, p.z() + static_cast<float>(c.sensor_height_m));
     }
@@ -99,7 +99,7 @@ PointCloud PolarScene(unsigned seed, int sectors) {
     std::uniform_int_distribution<int> sector(0, sectors - 1);
     PointCloud cloud;
     for (int i = 0; i < 3000; ++i) {
-        const double azimuth_rad = (sector(rng) + inside(rng)) * 2.0 * kPi / sectors;
+        const double azimuth_rad = (sector(rng) + inside(rng)) * 2.0 * std::numbers::pi / sectors;
         const double r = range(rng);
         cloud.emplace_back(static_cast<float>(r * std::cos(azimuth_rad)),
                            static_cast<float>(r * std::sin(azimuth_rad)),
@@ -179,7 +179,7 @@ TEST(ScanContext, AScanTurnedByKSectorsMatchesAtShiftKWithItsYaw) {
     const PointCloud scene = PolarScene(6, config.sectors);
     const ScanContext original = ComputeScanContext(scene, config);
     for (int k : {0, 1, 7, 29, 30, 31, 45, 59}) {
-        const double sector_rad = 2.0 * kPi / config.sectors;
+        const double sector_rad = 2.0 * std::numbers::pi / config.sectors;
         const ScanContext turned = ComputeScanContext(TurnedBy(scene, k * sector_rad), config);
         EXPECT_EQ(turned.ring_key, original.ring_key) << k;  // the ring key ignores yaw
         const ScanContextMatch match = CompareScanContexts(original, turned);
