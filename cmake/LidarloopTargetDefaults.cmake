@@ -44,3 +44,12 @@ function(lidarloop_add_library name)
     install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/lidarloop/${name}
         FILES_MATCHING PATTERN "*.hpp" PATTERN "detail" EXCLUDE)
 endfunction()
+
+# lidarloop_unity_build(<target>): compile the target's files in batches of 8 (LIDARLOOP_UNITY_BUILD);
+# 8 keeps both cores busy and a batch's recompile short. Files with their own compile options or
+# definitions are left out by CMake. The libraries stay file by file: what they are is what ships.
+function(lidarloop_unity_build target)
+    if(LIDARLOOP_UNITY_BUILD)
+        set_target_properties(${target} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE 8)
+    endif()
+endfunction()
