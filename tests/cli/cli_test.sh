@@ -506,10 +506,10 @@ section_bad_input() {
     expect_error "unknown format" "unknown scan format '.las'" "$cli" describe "$work/scan.las"
     expect_error "unknown method" "unknown method 'sift'" "$cli" describe --method sift \
         "$samples/corner_a.bin"
-    expect_error "zero bins" "histogram.bins must be between" "$cli" describe --bins 0 \
-        "$samples/corner_a.bin"
-    expect_error "huge bins" "histogram.bins must be between" "$cli" describe --bins 999999999 \
-        "$samples/corner_a.bin"
+    expect_error "zero bins" "histogram.bins must be in [1, 1000000], got 0" "$cli" \
+        describe --bins 0 "$samples/corner_a.bin"
+    expect_error "huge bins" "histogram.bins must be in [1, 1000000]" "$cli" describe \
+        --bins 999999999 "$samples/corner_a.bin"
     expect_error "min above max" "must be smaller than" "$cli" describe --min 5 --max 1 \
         "$samples/corner_a.bin"
     expect_error "negative range" "range_min_m must be >= 0" "$cli" describe --method range \
