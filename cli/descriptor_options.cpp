@@ -4,6 +4,7 @@
 #include <charconv>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <vector>
 
@@ -43,15 +44,44 @@ const char* TypeName() {
     return "FLOAT";
 }
 
-// Adds --<section>-<key> for each declared parameter it visits (underscores become hyphens).
+// The histogram's flags predate the declarations and keep their short names. --min and --max
+// set the value range of the projection in use: the height's with --method height, else the
+// range's, whose keys therefore have no flag of their own. A histogram key not listed here gets
+// --histogram-<key>.
+struct ShortFlag {
+    std::string_view key;
+    std::string_view name;
+    std::string_view range_key;  // --min, --max: the key for the range projection
+    std::string_view help;       // "": the declared one
+    bool height_only;
+};
+constexpr ShortFlag kShortFlags[] = {
+    {"bins", "--bins", "", "", false},
+    {"up_vector", "--up", "", "", true},
+    {"sensor_height_m", "--sensor-height", "", "", true},
+    {"height_min_m", "--min", "range_min_m", "v_min of the projection in use", false},
+    {"height_max_m", "--max", "range_max_m", "v_max of the projection in use", false},
+    {"out_of_range", "--out-of-range", "", "", false},
+};
+
+// The short flag of histogram key `key`, or nullptr; `covered` is set for a key that --min or
+// --max sets.
+const ShortFlag* ShortFlagOf(std::string_view key, bool& covered) {
+    covered = false;
+    for (const ShortFlag& flag : kShortFlags) {
+        if (flag.key == key) return &flag;
+        covered = covered || flag.range_key == key;
+    }
+    return nullptr;
+}
+
+// Adds a flag for each declared parameter it visits: --<section>-<key> (underscores become
+// hyphens), or the histogram's short one.
 class FlagAdder final : public core::ParameterVisitor {
 public:
-    FlagAdder(CLI::App& command, std::string section, std::string group,
-              std::deque<DescriptorOptions::MethodFlag>& flags)
-        : command_(command),
-          section_(std::move(section)),
-          group_(std::move(group)),
-          flags_(flags) {}
+    FlagAdder(CLI::App& command, const pipeline::ParameterSection& section, std::string group,
+              std::deque<DescriptorOptions::ParameterFlag>& flags)
+        : command_(command), section_(section), group_(std::move(group)), flags_(flags) {}
     void Visit(const core::ParameterInfo& i, bool& value) override { Add(i, value); }
     void Visit(const core::ParameterInfo& i, int& value) override { Add(i, value); }
     void Visit(const core::ParameterInfo& i, std::size_t& value) override { Add(i, value); }
@@ -65,26 +95,43 @@ public:
 private:
     template <typename T>
     void Add(const core::ParameterInfo& info, const T& default_value) {
-        std::string name = "--" + section_ + "-" + std::string(info.key);
+        DescriptorOptions::ParameterFlag flag{
+            section_.name, section_.methods, std::string(info.key), "", "", nullptr};
+        std::string name = "--" + section_.name + "-" + flag.key;
         std::replace(name.begin() + 2, name.end(), '_', '-');
+        std::string help = Help(info, default_value);
+        bool covered = false;
+        const ShortFlag* short_flag = section_.name == core::HistogramConfig::kSection
+                                          ? ShortFlagOf(info.key, covered)
+                                          : nullptr;
+        if (covered) return;
+        if (short_flag != nullptr) {
+            name = short_flag->name;
+            if (short_flag->height_only) flag.methods = {core::Method::kHeight};
+            flag.range_key = short_flag->range_key;
+            if (!short_flag->help.empty()) {
+                help = std::string(short_flag->help) + " (histogram." + flag.key + " or " +
+                       flag.range_key + ", " + std::string(info.unit) + ")";
+            }
+        }
+        DescriptorOptions::ParameterFlag& added = flags_.emplace_back(std::move(flag));
+        added.option =
+            command_.add_option(name, added.value, help)->type_name(TypeName<T>())->group(group_);
+    }
+    // The declared help with the unit, the range and the default.
+    template <typename T>
+    static std::string Help(const core::ParameterInfo& info, const T& default_value) {
         std::string help = std::string(info.help) + " (";
         if (!info.unit.empty()) help += std::string(info.unit) + ", ";
         if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>) {
-            if (info.HasRange()) {
-                help += DefaultText(static_cast<T>(info.min)) + " to " +
-                        DefaultText(static_cast<T>(info.max)) + ", ";
-            }
+            if (info.HasRange()) help += core::RangeText<T>(info, " to ") + ", ";
         }
-        help += "default " + DefaultText(default_value) + ")";
-        DescriptorOptions::MethodFlag& flag = flags_.emplace_back(
-            DescriptorOptions::MethodFlag{section_, std::string(info.key), {}, nullptr});
-        flag.option =
-            command_.add_option(name, flag.value, help)->type_name(TypeName<T>())->group(group_);
+        return help + "default " + DefaultText(default_value) + ")";
     }
     CLI::App& command_;
-    std::string section_;
+    const pipeline::ParameterSection& section_;
     std::string group_;
-    std::deque<DescriptorOptions::MethodFlag>& flags_;
+    std::deque<DescriptorOptions::ParameterFlag>& flags_;
 };
 
 // A flag's value as a YAML scalar: quoted, so that no character of it is YAML syntax, except a
@@ -105,28 +152,30 @@ void DescriptorOptions::AddTo(CLI::App& command, bool with_method) {
     if (with_method) {
         command.add_option("--method", method_, "descriptor: " + pipeline::MethodNamesText(" | "));
     }
-    bins_option_ = command.add_option("--bins", bins_, "number of histogram buckets b");
-    min_option_ = command.add_option("--min", min_m_, "v_min of the chosen projection, metres");
-    max_option_ = command.add_option("--max", max_m_, "v_max of the chosen projection, metres");
-    up_option_ = command.add_option("--up", up_, "up vector of the height projection: fixed | pca");
-    sensor_height_option_ = command.add_option("--sensor-height", sensor_height_m_,
-                                               "sensor height above ground, metres");
-    out_of_range_option_ = command.add_option("--out-of-range", out_of_range_,
-                                              "values outside [min, max]: clamp | drop");
-    for (core::MethodParameters& p : pipeline::MethodParametersOf(core::DescriptorConfig{})) {
-        const std::string group = p.section() + " parameters" +
-                                  (with_method ? " (with --method " + p.section() + ")" : "");
-        FlagAdder adder(command, p.section(), group, method_flags_);
-        p.Visit(adder);
+    for (const pipeline::ParameterSection& section :
+         pipeline::ParameterSectionsOf(core::DescriptorConfig{})) {
+        AddSectionFlags(command, section);
     }
+    min_option_ = command.get_option("--min");
+    max_option_ = command.get_option("--max");
+}
+
+void DescriptorOptions::AddSectionFlags(CLI::App& command,
+                                        const pipeline::ParameterSection& section) {
+    std::string methods;
+    for (const core::Method& method : section.methods)
+        methods += (methods.empty() ? "" : " or ") + core::ToString(method);
+    const std::string group =
+        section.name + " parameters" + (with_method_ ? " (with --method " + methods + ")" : "");
+    FlagAdder adder(command, section, group, flags_);
+    section.visit(adder);
 }
 
 io::RunConfig DescriptorOptions::Resolve(io::RunConfig base) const {
     io::RunConfig config = std::move(base);
     if (!config_file_.empty()) config = io::LoadConfigYaml(config_file_, config);
     if (!method_.empty()) config.descriptor.method = pipeline::ParseMethod(method_);
-    ApplyHistogramFlags(config.descriptor);
-    ApplyMethodFlags(config);
+    ApplyFlags(config);
     config.Validate();
     return config;
 }
@@ -134,54 +183,45 @@ io::RunConfig DescriptorOptions::Resolve(io::RunConfig base) const {
 std::string DescriptorOptions::FirstGiven() const {
     if (!config_file_.empty()) return "--config";
     if (!method_.empty()) return "--method";
-    for (const CLI::Option* flag : HistogramFlags()) {
-        if (*flag) return flag->get_name();
-    }
-    for (const MethodFlag& flag : method_flags_) {
+    for (const ParameterFlag& flag : flags_) {
         if (*flag.option) return flag.option->get_name();
     }
     return "";
 }
 
-// Each given flag as the one key of a YAML text, in the order declared: read, checked and
-// validated exactly as that key in a --config file, the flag named as the source of an error.
-void DescriptorOptions::ApplyMethodFlags(io::RunConfig& config) const {
-    for (const MethodFlag& flag : method_flags_) {
-        if (!*flag.option) continue;
-        if (with_method_ && core::ToString(config.descriptor.method) != flag.section) {
-            throw core::ConfigError(flag.option->get_name() + " applies to the " + flag.section +
-                                    " method: add --method " + flag.section);
-        }
-        io::ApplyConfigYaml(flag.section + ":\n  " + flag.key + ": " + YamlValue(flag.value) + "\n",
-                            flag.option->get_name(), config);
+void DescriptorOptions::CheckApplies(const ParameterFlag& flag, const core::Method& method) const {
+    const std::string name = flag.option->get_name();
+    if (flag.section == core::HistogramConfig::kSection && !core::IsHistogramMethod(method)) {
+        throw core::ConfigError(name +
+                                " applies to the height and range methods; set the parameters "
+                                "of " +
+                                core::ToString(method) + " in its section of --config");
     }
+    const auto& methods = flag.methods;
+    if (!with_method_ || std::find(methods.begin(), methods.end(), method) != methods.end()) return;
+    const std::string wanted = core::ToString(methods.front());  // a section's other methods
+    throw core::ConfigError(name + " applies to the " + wanted + " method" +
+                            (flag.section != wanted ? " only" : "") + ": add --method " + wanted);
 }
 
-void DescriptorOptions::ApplyHistogramFlags(core::DescriptorConfig& descriptor) const {
-    for (const CLI::Option* flag : HistogramFlags()) {
-        if (*flag && !core::IsHistogramMethod(descriptor.method)) {
-            throw core::ConfigError(flag->get_name() +
-                                    " applies to the height and range methods; set the "
-                                    "parameters of " +
-                                    core::ToString(descriptor.method) +
-                                    " in its section of --config");
-        }
+// The given flags as the keys of one YAML text, in the order declared: read, checked and
+// validated exactly as those keys in a --config file (together, so that --min 8 --max 10 is
+// checked as a pair), the flags named as the source of an error.
+void DescriptorOptions::ApplyFlags(io::RunConfig& config) const {
+    const core::Method& method = config.descriptor.method;
+    std::string yaml;
+    std::string given;
+    const std::string* section = nullptr;
+    for (const ParameterFlag& flag : flags_) {
+        if (!*flag.option) continue;
+        CheckApplies(flag, method);
+        if (section == nullptr || *section != flag.section) yaml += flag.section + ":\n";
+        section = &flag.section;
+        const bool range = !flag.range_key.empty() && method != core::Method::kHeight;
+        yaml += "  " + (range ? flag.range_key : flag.key) + ": " + YamlValue(flag.value) + "\n";
+        given += (given.empty() ? "" : ", ") + flag.option->get_name();
     }
-    for (const CLI::Option* flag : {up_option_, sensor_height_option_}) {
-        if (*flag && with_method_ && descriptor.method != core::Method::kHeight) {
-            throw core::ConfigError(flag->get_name() +
-                                    " applies to the height method only: add --method height");
-        }
-    }
-    core::HistogramConfig& histogram = descriptor.histogram;
-    if (*bins_option_) histogram.bins = bins_;
-    if (*up_option_) histogram.up_vector = core::ParseUpVectorMode(up_);
-    if (*sensor_height_option_) histogram.sensor_height_m = sensor_height_m_;
-    if (*out_of_range_option_) histogram.out_of_range = core::ParseOutOfRangePolicy(out_of_range_);
-    // --min/--max set the value range of the projection in use.
-    const bool height = descriptor.method == core::Method::kHeight;
-    if (*min_option_) (height ? histogram.height_min_m : histogram.range_min_m) = min_m_;
-    if (*max_option_) (height ? histogram.height_max_m : histogram.range_max_m) = max_m_;
+    if (!given.empty()) io::ApplyConfigYaml(yaml, given, config);
 }
 
 }  // namespace lidarloop::cli

@@ -17,7 +17,7 @@ void AddDumpConfigCommand(CLI::App& app) {
         ->check(CLI::ExistingFile);
     auto markdown = std::make_shared<bool>(false);
     command->add_flag("--markdown", *markdown,
-                      "print the registered methods' parameters as the Markdown table of "
+                      "print the descriptor methods' parameters as the Markdown table of "
                       "docs/cli.md instead (key, default, help, unit, range)");
     auto run_options = std::make_shared<bool>(false);
     command->add_flag("--markdown-run-options", *run_options,

@@ -61,7 +61,8 @@ def describe(
 ) -> Descriptor:
     """The descriptor of an (N, 3)/(N, 4) scan (sensor frame, metres) or a scan file.
 
-    **parameters: the method's own parameters (method_parameters(method)), e.g. rings=30."""
+    **parameters: the keys of the method's section (method_parameters(method)), e.g. rings=30
+    (scancontext), cell_size_m=1.0 (ndt), height_max_m=5.0 (height)."""
 
 def distance(a: Descriptor, b: Descriptor) -> float:
     """W (histograms), sigma' (NDT) or d (Scan Context) between two descriptors of one method
@@ -71,8 +72,8 @@ def scancontext_match(query: Descriptor, candidate: Descriptor) -> dict[str, Any
     """Scan Context: {'distance', 'shift', 'yaw_rad' (of T_candidate_query)}."""
 
 def method_parameters(method: str) -> list[dict[str, Any]]:
-    """A method's own parameters as declared: 'key', 'type', 'default', 'min', 'max', 'unit',
-    'help'."""
+    """The parameters of a method's section (histogram for height and range) as declared: 'key',
+    'type', 'default', 'min', 'max', 'open', 'unit', 'help'."""
 
 def method_names() -> list[str]: ...
 def default_threshold(method: str) -> float: ...

@@ -106,19 +106,20 @@ Descriptor DescribeView(core::PointsView points, const core::DescriptorConfig& c
     return descriptor;
 }
 
-// The keywords of a method's own parameters (describe(scan, "scancontext", rings=30)) as the
-// keys of its section: read and checked by the YAML reader, like config={"scancontext": {...}}.
+// The keywords of a method's parameters (describe(scan, "ndt", cell_size_m=1.0)) as the keys of
+// its section: read and checked by the YAML reader, like config={"ndt": {...}}.
 void ApplyParameterKeywords(const py::kwargs& parameters, io::RunConfig& run) {
     if (parameters.empty()) return;
-    const pipeline::DescriptorMethod& method = pipeline::MethodOf(run.descriptor.method);
-    if (!method.DefaultParameters()) {
+    const auto sections = pipeline::ParameterSectionsOf(run.descriptor);
+    const pipeline::ParameterSection* own = pipeline::SectionOf(sections, run.descriptor.method);
+    if (own == nullptr) {
         throw py::type_error("describe() got keywords " +
                              py::repr(parameters.attr("keys")()).cast<std::string>() +
-                             ", but method '" + method.name() +
+                             ", but method '" + core::ToString(run.descriptor.method) +
                              "' has no parameters of its own (lidarloop.method_parameters)");
     }
     py::dict section;
-    section[py::str(method.name())] = parameters;
+    section[py::str(own->name)] = parameters;
     const std::string text = py::module_::import("json").attr("dumps")(section).cast<std::string>();
     io::ApplyConfigYaml(text, "keywords", run);
 }
@@ -148,6 +149,7 @@ private:
         d["default"] = py::cast(value);
         d["min"] = std::isfinite(info.min) ? py::cast(info.min) : py::none();
         d["max"] = std::isfinite(info.max) ? py::cast(info.max) : py::none();
+        d["open"] = info.open;
         d["unit"] = std::string(info.unit);
         d["help"] = std::string(info.help);
         list.append(d);
@@ -293,12 +295,13 @@ method: 'height', 'range', 'ndt' or any registered method (lidarloop.method_name
 config: None, a dict nested like the YAML config ({'ndt': {'cell_size_m': 1.0}}), or a YAML
     file path; unknown keys raise lidarloop.ReadError.
 bins, min, max (metres, of the projection in use), up ('fixed' | 'pca') and sensor_height
-    (metres; both height only), out_of_range ('clamp' | 'drop'): as the flags of
+    (metres; both height only), out_of_range ('clamp' | 'drop'): as the short flags of
     `lidarloop describe`.
 skip_non_finite: False raises lidarloop.NonFiniteError for a NaN/Inf point; True lets the
     descriptor skip and count them (points_skipped), as it does for files.
-**parameters: the method's own parameters by key (lidarloop.method_parameters(method)), e.g.
-    describe(scan, 'scancontext', rings=30); they override `config`'s section of the method.
+**parameters: the keys of the method's section by name (lidarloop.method_parameters(method)),
+    e.g. describe(scan, 'scancontext', rings=30), describe(scan, 'ndt', cell_size_m=1.0),
+    describe(scan, 'height', height_max_m=5.0); they override `config`'s section.
     Unknown keys and invalid values raise lidarloop.ReadError, as in a config dict.
 
 Raises DtypeError, ShapeError, NonFiniteError, ConfigError, EmptyInputError (nothing usable),
@@ -326,15 +329,16 @@ ReadError (files). Releases the GIL while describing.)doc");
         "method_parameters",
         [](const std::string& method) {
             ParameterDicts dicts;
-            const core::Method parsed = pipeline::ParseMethod(method);
-            if (auto p = pipeline::MethodOf(parsed).DefaultParameters()) p->Visit(dicts);
+            const auto sections = pipeline::ParameterSectionsOf({});
+            const auto* section = pipeline::SectionOf(sections, pipeline::ParseMethod(method));
+            if (section != nullptr) section->visit(dicts);
             return dicts.list;
         },
         py::arg("method"),
-        "The parameters of a method's own section, as declared (docs/options.md): one dict per "
-        "parameter with 'key', 'type', 'default', 'min', 'max' (None: unbounded), 'unit' and "
-        "'help'; the keywords describe() takes for it. Empty for height, range and ndt, whose "
-        "parameters are the histogram keywords and config={'ndt': {...}}.");
+        "The parameters of a method's section (histogram for height and range), as declared "
+        "(docs/options.md): one dict per parameter with 'key', 'type', 'default', 'min', 'max' "
+        "(None: unbounded), 'open' (whether min and max themselves are invalid), 'unit' and "
+        "'help'; the keywords describe() takes for it. Names (up_vector, ...) are of type str.");
     m.def("method_names", &pipeline::MethodNames,
           "The registered descriptor methods: height, range, ndt, then any registered in C++.");
     m.def(

@@ -33,9 +33,11 @@ struct HistogramKeywords {
 inline void ApplyHistogramKeywords(const HistogramKeywords& keywords,
                                    core::DescriptorConfig& descriptor) {
     if (keywords.any() && !core::IsHistogramMethod(descriptor.method)) {
+        const std::string method = core::ToString(descriptor.method);
         throw core::ConfigError(
             "bins, min, max, up, sensor_height and out_of_range apply to the height and range "
-            "methods; give NDT parameters in config={'ndt': {...}}");
+            "methods; give the parameters of " +
+            method + " as its keywords (lidarloop.method_parameters('" + method + "'))");
     }
     if ((keywords.up || keywords.sensor_height_m) && descriptor.method != core::Method::kHeight) {
         throw core::ConfigError(

@@ -124,8 +124,7 @@ def test_a_methods_parameters_are_keywords_of_describe(cli, scan_file, points):
     assert keys == ["rings", "sectors", "max_range_m", "sensor_height_m", "ring_key_candidates"]
     rings = lidarloop.method_parameters("scancontext")[0]
     assert rings == {"key": "rings", "type": "int", "default": 20, "min": 1.0, "max": 200.0,
-                     "unit": "", "help": "N_r, rings of equal width up to max_range_m"}
-    assert lidarloop.method_parameters("range") == []
+                     "open": False, "unit": "", "help": "N_r, rings of equal width up to max_range_m"}
     d = lidarloop.describe(points, "scancontext", rings=10, max_range_m=40.0)
     assert d.bins.shape == (10, 60)
     assert d.to_dict() == lidarloop.describe(
@@ -137,8 +136,38 @@ def test_a_methods_parameters_are_keywords_of_describe(cli, scan_file, points):
         lidarloop.describe(points, "scancontext", ringz=10)
     with pytest.raises(lidarloop.ReadError, match=r"scancontext.rings must be in \[1, 200\]"):
         lidarloop.describe(points, "scancontext", rings=0)
-    with pytest.raises(TypeError, match="no parameters of its own"):
+    with pytest.raises(lidarloop.ReadError, match="key 'histogram.rings': unknown key"):
         lidarloop.describe(points, "range", rings=10)
+
+
+def test_histogram_and_ndt_parameters_are_keywords_of_describe(cli, scan_file, points):
+    """Their sections are declared like scancontext's: method_parameters lists them (height and
+    range share the histogram section) and describe takes them as keywords."""
+    histogram = [p["key"] for p in lidarloop.method_parameters("height")]
+    assert histogram == ["bins", "up_vector", "sensor_height_m", "height_min_m", "height_max_m",
+                         "range_min_m", "range_max_m", "out_of_range"]
+    assert lidarloop.method_parameters("range") == lidarloop.method_parameters("height")
+    up = lidarloop.method_parameters("height")[1]
+    assert (up["type"], up["default"], up["min"]) == ("str", "fixed", None)
+    ndt = {p["key"]: p for p in lidarloop.method_parameters("ndt")}
+    assert list(ndt)[:3] == ["cell_size_m", "min_points_per_cell", "eigen_ratio_threshold"]
+    assert ndt["cell_size_m"] == {"key": "cell_size_m", "type": "float", "default": 0.5,
+                                  "min": 0.01, "max": 100.0, "open": False, "unit": "m",
+                                  "help": "q, side of an NDT cell; cells overlap by q/2"}
+    assert ndt["eigen_ratio_threshold"]["open"] is True
+    assert ndt["range_limits_m"]["default"] == [3.0, 6.0, 9.0, 15.0]
+    d = lidarloop.describe(points, "ndt", cell_size_m=1.0, planar_classes=4)
+    assert d.to_dict() == lidarloop.describe(
+        points, "ndt", config={"ndt": {"cell_size_m": 1.0, "planar_classes": 4}}).to_dict()
+    flags = json.loads(run_cli(cli, "describe", scan_file, "--method", "ndt",
+                               "--ndt-cell-size-m", "1", "--ndt-planar-classes", "4"))
+    assert lidarloop.describe(scan_file, "ndt", cell_size_m=1.0, planar_classes=4).to_dict() == flags
+    with pytest.raises(lidarloop.ReadError, match=r"ndt.cell_size_m must be in \[0.01, 100\]"):
+        lidarloop.describe(points, "ndt", cell_size_m=0.0)
+    h = lidarloop.describe(points, "height", height_min_m=8.0, height_max_m=10.0)
+    assert (h.min, h.max) == (8.0, 10.0)
+    with pytest.raises(lidarloop.ReadError, match="unknown up vector mode"):
+        lidarloop.describe(points, "height", up_vector="sideways")
 
 
 @pytest.mark.parametrize(

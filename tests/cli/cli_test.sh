@@ -163,6 +163,23 @@ section_ndt() {
         --config "$work/ndt_bad.yaml" "$samples/corner_a.bin"
     expect_error "histogram flag with ndt" "--bins applies to the height and range methods" \
         "$cli" describe --method ndt --bins 10 "$samples/corner_a.bin"
+    # The flags of the ndt section, derived from its declaration like --scancontext-*.
+    ndt_config="$("$cli" describe --config "$work/ndt.yaml" "$samples/corner_a.bin")"
+    ndt_flags="$("$cli" describe --method ndt --ndt-cell-size-m 1.0 --ndt-planar-classes 4 \
+        "$samples/corner_a.bin")"
+    if [ -n "$ndt_flags" ] && [ "$ndt_flags" = "$ndt_config" ]; then pass; else
+        fail "--ndt-cell-size-m 1.0 --ndt-planar-classes 4 differ from the same keys in --config"
+    fi
+    expect_error "ndt flag out of range" \
+        "--ndt-cell-size-m: ndt.cell_size_m must be in [0.01, 100], got 0" "$cli" describe \
+        --method ndt --ndt-cell-size-m 0 "$samples/corner_a.bin"
+    expect_error "ndt open range" "ndt.eigen_ratio_threshold must be in (0, 1), got 1" "$cli" \
+        describe --method ndt --ndt-eigen-ratio-threshold 1 "$samples/corner_a.bin"
+    expect_error "ndt flag with another method" "--ndt-cell-size-m applies to the ndt method" \
+        "$cli" describe --method range --ndt-cell-size-m 1 "$samples/corner_a.bin"
+    expect_ok "ndt flags in help" "--ndt-range-limits-m [FLOAT,...]" "$cli" describe --help
+    expect_ok "ndt in dump-config --markdown" '| `ndt.cell_size_m` | 0.5 |' "$cli" dump-config \
+        --markdown
     printf '1 2 3\n1 2 3\n' >"$work/two.xyz"
     expect_error "ndt too few points" "two.xyz: no NDT cell could be classified" "$cli" describe \
         --method ndt "$work/two.xyz"
@@ -510,12 +527,15 @@ section_bad_input() {
     expect_error "unknown format" "unknown scan format '.las'" "$cli" describe "$work/scan.las"
     expect_error "unknown method" "unknown method 'sift'" "$cli" describe --method sift \
         "$samples/corner_a.bin"
-    expect_error "zero bins" "histogram.bins must be between" "$cli" describe --bins 0 \
-        "$samples/corner_a.bin"
-    expect_error "huge bins" "histogram.bins must be between" "$cli" describe --bins 999999999 \
-        "$samples/corner_a.bin"
+    expect_error "zero bins" "--bins: histogram.bins must be in [1, 1000000], got 0" "$cli" \
+        describe --bins 0 "$samples/corner_a.bin"
+    expect_error "huge bins" "histogram.bins must be in [1, 1000000]" "$cli" describe \
+        --bins 999999999 "$samples/corner_a.bin"
     expect_error "min above max" "must be smaller than" "$cli" describe --min 5 --max 1 \
         "$samples/corner_a.bin"
+    # Checked as a pair: --min 8 alone would be above the default height_max_m 7.
+    expect_ok "min and max above the defaults" '"min":8' "$cli" describe --method height \
+        --min 8 --max 10 "$samples/corner_a.bin"
     expect_error "negative range" "range_min_m must be >= 0" "$cli" describe --method range \
         --min -1 "$samples/corner_a.bin"
     expect_error "bad up" "unknown up vector mode" "$cli" describe --method height --up sideways \

@@ -22,10 +22,8 @@ void RequireFinite(double value, const char* field) {
     }
 }
 
-void RequireRange(double min_value, double max_value, const char* min_field,
-                  const char* max_field) {
-    RequireFinite(min_value, min_field);
-    RequireFinite(max_value, max_field);
+void RequireOrdered(double min_value, double max_value, const char* min_field,
+                    const char* max_field) {
     if (!(min_value < max_value)) {
         throw ConfigError(std::string("histogram.") + min_field + " (" + std::to_string(min_value) +
                           ") must be smaller than histogram." + max_field + " (" +
@@ -158,14 +156,15 @@ OutOfRangePolicy ParseOutOfRangePolicy(std::string_view name) {
 }
 
 void HistogramConfig::Validate() const {
-    if (bins < 1 || bins > 1'000'000) {
-        throw ConfigError("histogram.bins must be between 1 and 1000000, got " +
-                          std::to_string(bins));
-    }
+    // Finite first, so that a NaN is named as such rather than as outside a range.
     RequireFinite(sensor_height_m, "sensor_height_m");
-    RequireRange(height_min_m, height_max_m, "height_min_m", "height_max_m");
-    RequireRange(range_min_m, range_max_m, "range_min_m", "range_max_m");
-    if (range_min_m < 0.0) throw ConfigError("histogram.range_min_m must be >= 0 (a range)");
+    RequireFinite(height_min_m, "height_min_m");
+    RequireFinite(height_max_m, "height_max_m");
+    RequireFinite(range_min_m, "range_min_m");
+    RequireFinite(range_max_m, "range_max_m");
+    CheckDeclaredRanges(kSection, *this);
+    RequireOrdered(height_min_m, height_max_m, "height_min_m", "height_max_m");
+    RequireOrdered(range_min_m, range_max_m, "range_min_m", "range_max_m");
 }
 
 Histogram ComputeHistogram(PointsView cloud, Projection projection, const HistogramConfig& config) {

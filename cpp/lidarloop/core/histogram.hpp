@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 
+#include "lidarloop/core/parameters.hpp"
 #include "lidarloop/core/point_cloud.hpp"
 #include "lidarloop/core/projection.hpp"
 
@@ -30,7 +31,9 @@ OutOfRangePolicy ParseOutOfRangePolicy(std::string_view name);
 /// descriptor parameter (detection.threshold); it depends on b and on the value range, so learn it
 /// on your data (`lidarloop evaluate`) when you change them.
 struct HistogramConfig {
-    int bins = 100;                                 ///< b, number of buckets, 1..1'000'000
+    static constexpr char kSection[] = "histogram";  ///< YAML section, shared by height and range
+
+    int bins = 100;                                 ///< b, number of buckets
     UpVectorMode up_vector = UpVectorMode::kFixed;  ///< up vector of the height projection
     /// Added to <p, u> so that 0 is the ground (Röhling footnote 1: the plane of the height
     /// projection passes through the sensor). 0 keeps heights relative to the sensor.
@@ -41,6 +44,20 @@ struct HistogramConfig {
     double range_max_m = 80.0;   ///< v_max of the range projection
     OutOfRangePolicy out_of_range = OutOfRangePolicy::kClamp;
 
+    /// Every parameter, declared once (core/parameters.hpp): key, help, unit, valid range. The
+    /// value ranges need only be finite and ordered (Validate), so they declare no bounds.
+    template <typename Self, typename Visit>
+    static void Declare(Self& c, Visit&& visit) {
+        visit(c.bins, {"bins", "b, number of buckets", "", 1, 1'000'000});
+        visit(c.up_vector, {"up_vector", "height projection up vector: fixed (0,0,1) | pca", ""});
+        visit(c.sensor_height_m,
+              {"sensor_height_m", "added to heights so that 0 is the ground", "m"});
+        visit(c.height_min_m, {"height_min_m", "v_min of the height histogram", "m"});
+        visit(c.height_max_m, {"height_max_m", "v_max of the height histogram", "m"});
+        visit(c.range_min_m, {"range_min_m", "v_min of the range histogram", "m", 0.0});
+        visit(c.range_max_m, {"range_max_m", "v_max of the range histogram", "m"});
+        visit(c.out_of_range, {"out_of_range", "values outside [v_min, v_max]: clamp | drop", ""});
+    }
     /// Throws ConfigError naming the first invalid field.
     void Validate() const;
     bool operator==(const HistogramConfig&) const = default;

@@ -8,6 +8,7 @@
 // from it. MethodParameters carries such a struct type-erased, so that a registered method's
 // parameters reach all of these without any of them naming its type.
 
+#include <charconv>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -32,9 +33,40 @@ struct ParameterInfo {
     std::string_view unit;  ///< "m", "deg", ...; empty for counts, ratios, names and switches
     double min = -std::numeric_limits<double>::infinity();  ///< valid range, inclusive (numbers)
     double max = std::numeric_limits<double>::infinity();
+    bool open = false;  ///< the bounds themselves are invalid: (min, max)
 
     bool HasRange() const { return std::isfinite(min) || std::isfinite(max); }
 };
+
+namespace detail {
+
+// A bound as T writes it: the shortest text that reads back (0.01, not 0.0100000000000000002).
+template <typename T>
+std::string BoundText(double bound) {
+    char buffer[64];
+    const auto result = std::to_chars(buffer, buffer + sizeof(buffer), static_cast<T>(bound));
+    return std::string(buffer, result.ptr);
+}
+
+}  // namespace detail
+
+/// The declared range of a number parameter of type T: "[1, 200]", "(0, 1)" (open), ">= 0" or
+/// "<= 5" (one bound); "" when it has none. `to` joins two bounds as help and tables show them:
+/// RangeText<int>(info, " to ") is "1 to 200" (an open range adds ", exclusive").
+template <typename T>
+std::string RangeText(const ParameterInfo& info, std::string_view to = {}) {
+    const bool has_min = std::isfinite(info.min);
+    const bool has_max = std::isfinite(info.max);
+    if (has_min && has_max) {
+        const std::string low = detail::BoundText<T>(info.min);
+        const std::string high = detail::BoundText<T>(info.max);
+        if (!to.empty()) return low + std::string(to) + high + (info.open ? ", exclusive" : "");
+        return (info.open ? "(" : "[") + low + ", " + high + (info.open ? ")" : "]");
+    }
+    if (has_min) return (info.open ? "> " : ">= ") + detail::BoundText<T>(info.min);
+    if (has_max) return (info.open ? "< " : "<= ") + detail::BoundText<T>(info.max);
+    return "";
+}
 
 /// The value types a parameter of a registered method may have (MethodParameters); the built-in
 /// sections also use enums, which the io layer reads by name.
@@ -50,22 +82,21 @@ public:
     virtual void Visit(const ParameterInfo& info, std::string& value) = 0;
 };
 
-/// ConfigError "<section>.<key> must be in [min, max], got <value>" unless `value` (a number)
-/// lies in the declared range; a NaN fails. The bounds are printed as the value's type.
+/// ConfigError "<section>.<key> must be in [min, max], got <value>" (or "in (min, max)",
+/// "must be >= min", ...: RangeText) unless `value` (a number) lies in the declared range; a NaN
+/// fails. The bounds are printed as the value's type.
 template <typename T>
 void CheckDeclaredRange(std::string_view section, const ParameterInfo& info, const T& value) {
     if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>) {
         if (!info.HasRange()) return;
         const auto v = static_cast<double>(value);
-        if (v >= info.min && v <= info.max) return;
+        const bool inside =
+            info.open ? v > info.min && v < info.max : v >= info.min && v <= info.max;
+        if (inside) return;
+        const std::string range = RangeText<T>(info);
         std::ostringstream message;
-        message << section << "." << info.key << " must be in [";
-        if constexpr (std::is_integral_v<T>) {
-            message << static_cast<long long>(info.min) << ", " << static_cast<long long>(info.max);
-        } else {
-            message << info.min << ", " << info.max;
-        }
-        message << "], got " << value;
+        message << section << "." << info.key << " must be "
+                << (range[0] == '[' || range[0] == '(' ? "in " : "") << range << ", got " << value;
         throw ConfigError(message.str());
     }
 }
@@ -76,6 +107,23 @@ template <typename Config>
 void CheckDeclaredRanges(std::string_view section, const Config& config) {
     Config::Declare(config, [&](const auto& value, const ParameterInfo& info) {
         CheckDeclaredRange(section, info, value);
+    });
+}
+
+/// Visits a copy of every parameter of `config` (Config::Declare) in declaration order, for
+/// flags, keywords and tables: what `visitor` changes is not kept. An enum is visited as its
+/// name (ToString, found by argument-dependent lookup), so sections with enums fit the visitor.
+template <typename Config>
+void VisitCopies(const Config& config, ParameterVisitor& visitor) {
+    Config::Declare(config, [&](const auto& value, const ParameterInfo& info) {
+        using T = std::decay_t<decltype(value)>;
+        if constexpr (std::is_enum_v<T>) {
+            std::string name = ToString(value);
+            visitor.Visit(info, name);
+        } else {
+            T copy = value;
+            visitor.Visit(info, copy);
+        }
     });
 }
 

@@ -43,34 +43,25 @@ std::string MethodHelp() { return "descriptor: " + pipeline::MethodNamesText(" |
 // The one list of keys. Both the writer and the reader walk it, so a key cannot exist in one and
 // be missing in the other. `visitor.Field(key, value, help)`, `visitor.Section(key, struct)`,
 // `visitor.Moved(key, new_key, legacy_default)` for a key that moved elsewhere.
+
+// A struct that declares its parameters (core/parameters.hpp): each is a Field, its key and
+// help as declared.
+template <typename Config, typename Visitor>
+void VisitDeclared(Config& c, Visitor& v) {
+    Config::Declare(c, [&](auto& value, const core::ParameterInfo& info) {
+        v.Field(std::string(info.key).c_str(), value, std::string(info.help));
+    });
+}
+
 template <typename Visitor>
 void VisitFields(core::HistogramConfig& c, Visitor& v) {
-    v.Field("bins", c.bins, "b, number of buckets");
-    v.Field("up_vector", c.up_vector, "height projection up vector: fixed (0,0,1) | pca");
-    v.Field("sensor_height_m", c.sensor_height_m, "added to heights so that 0 is the ground");
-    v.Field("height_min_m", c.height_min_m, "v_min of the height histogram");
-    v.Field("height_max_m", c.height_max_m, "v_max of the height histogram");
-    v.Field("range_min_m", c.range_min_m, "v_min of the range histogram");
-    v.Field("range_max_m", c.range_max_m, "v_max of the range histogram");
-    v.Field("out_of_range", c.out_of_range, "values outside [v_min, v_max]: clamp | drop");
+    VisitDeclared(c, v);
     v.Moved("threshold", "detection.threshold", kLegacyHistogramThreshold);
 }
 
 template <typename Visitor>
 void VisitFields(core::NdtConfig& c, Visitor& v) {
-    v.Field("cell_size_m", c.cell_size_m, "q, side of an NDT cell; cells overlap by q/2");
-    v.Field("min_points_per_cell", c.min_points_per_cell, "sparser cells are not classified");
-    v.Field("eigen_ratio_threshold", c.eigen_ratio_threshold, "t_e of the shape classes");
-    v.Field("spherical_classes", c.spherical_classes, "s, sub-classes by l2/l1");
-    v.Field("planar_classes", c.planar_classes, "p, sub-classes by normal orientation");
-    v.Field("linear_classes", c.linear_classes, "l, sub-classes by axis orientation");
-    v.Field("range_limits_m", c.range_limits_m, "borders of the range intervals");
-    v.Field("normalise_rotation", c.normalise_rotation, "align dominant planes (section II-C)");
-    v.Field("ambiguity_ratio", c.ambiguity_ratio, "t_a, peaks this close are ambiguous");
-    v.Field("align_to_mean_direction", c.align_to_mean_direction,
-            "peaks are modes of the cells' normals (true) or partition classes, lines P_i (false)");
-    v.Field("regrid_rotations", c.regrid_rotations,
-            "new grid per rotation (paper) vs rotated cells");
+    VisitDeclared(c, v);
     v.Moved("threshold", "detection.threshold", kLegacyNdtThreshold);
 }
 
@@ -252,8 +243,8 @@ void VisitFields(OutputConfig& c, Visitor& v) {
 template <typename Visitor>
 void VisitFields(RunConfig& c, Visitor& v) {
     v.Field("method", c.descriptor.method, MethodHelp());
-    v.Section("histogram", c.descriptor.histogram);
-    v.Section("ndt", c.descriptor.ndt);
+    v.Section(core::HistogramConfig::kSection, c.descriptor.histogram);
+    v.Section(core::NdtConfig::kSection, c.descriptor.ndt);
     v.MethodSections(c.descriptor);  // scancontext and any other registered method's
     v.Section("detection", c.detection);
     v.Section("verification", c.detection.verification);
@@ -530,13 +521,8 @@ private:
         std::string limits;
         if (!info.unit.empty()) limits += std::string(info.unit);
         if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>) {
-            if (info.HasRange()) {
-                YamlWriter low;
-                YamlWriter high;
-                low.WriteNumber(static_cast<T>(info.min));
-                high.WriteNumber(static_cast<T>(info.max));
-                limits += (limits.empty() ? "" : ", ") + low.str() + " to " + high.str();
-            }
+            if (info.HasRange())
+                limits += (limits.empty() ? "" : ", ") + core::RangeText<T>(info, " to ");
         }
         if (!limits.empty()) out_ += " (" + limits + ")";
         out_ += " |\n";
@@ -549,9 +535,10 @@ private:
 
 std::string DumpParametersMarkdown(const RunConfig& config) {
     std::string text = "| key | default | meaning |\n|---|---|---|\n";
-    for (core::MethodParameters& p : pipeline::MethodParametersOf(config.descriptor)) {
-        MarkdownRows rows(p.section());
-        p.Visit(rows);
+    for (const pipeline::ParameterSection& section :
+         pipeline::ParameterSectionsOf(config.descriptor)) {
+        MarkdownRows rows(section.name);
+        section.visit(rows);
         text += rows.str();
     }
     return text;

@@ -48,9 +48,10 @@ struct RunConfig {
 /// The whole configuration as YAML, every key present, with a comment line per key.
 std::string DumpConfigYaml(const RunConfig& config);
 
-/// The parameters of the registered methods (scancontext, ...) as a Markdown table, one row per
-/// parameter: `section.key`, its value in `config` (as DumpConfigYaml writes it) and its help
-/// with unit and valid range, as declared (docs/options.md). docs/cli.md holds its output.
+/// The declared parameters of the descriptor methods (histogram, ndt, scancontext, ...;
+/// pipeline::ParameterSectionsOf) as a Markdown table, one row per parameter: `section.key`, its
+/// value in `config` (as DumpConfigYaml writes it) and its help with unit and valid range, as
+/// declared (docs/options.md). docs/cli.md holds its output.
 std::string DumpParametersMarkdown(const RunConfig& config);
 
 /// Keys of lidarloop 0.1 that moved: `histogram.threshold` and `ndt.threshold` are now

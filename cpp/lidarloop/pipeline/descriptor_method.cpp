@@ -1,5 +1,6 @@
 #include "lidarloop/pipeline/descriptor_method.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <mutex>
 
@@ -120,6 +121,38 @@ std::vector<core::MethodParameters> MethodParametersOf(const core::DescriptorCon
         all.push_back(held != nullptr ? *held : std::move(*defaults));
     }
     return all;
+}
+
+std::vector<ParameterSection> ParameterSectionsOf(const core::DescriptorConfig& config) {
+    using core::HistogramConfig;
+    using core::NdtConfig;
+    std::vector<ParameterSection> sections;
+    sections.push_back(
+        {HistogramConfig::kSection,
+         {core::Method::kHeight, core::Method::kRange},
+         [c = config.histogram](core::ParameterVisitor& v) { core::VisitCopies(c, v); }});
+    sections.push_back({NdtConfig::kSection,
+                        {core::Method::kNdt},
+                        [c = config.ndt](core::ParameterVisitor& v) { core::VisitCopies(c, v); }});
+    for (core::MethodParameters& p : MethodParametersOf(config)) {
+        const core::Method method = ParseMethod(p.section());
+        sections.push_back({p.section(), {method}, [p](core::ParameterVisitor& v) {
+                                core::MethodParameters copy = p;
+                                copy.Visit(v);
+                            }});
+    }
+    return sections;
+}
+
+const ParameterSection* SectionOf(const std::vector<ParameterSection>& sections,
+                                  const core::Method& method) {
+    for (const ParameterSection& section : sections) {
+        if (std::find(section.methods.begin(), section.methods.end(), method) !=
+            section.methods.end()) {
+            return &section;
+        }
+    }
+    return nullptr;
 }
 
 core::Descriptor ComputeDescriptor(const core::PointCloud& cloud,

@@ -161,6 +161,22 @@ std::string MethodNamesText(std::string_view separator);
 /// holds them or else their defaults, in MethodNames() order. Thread-safe.
 std::vector<core::MethodParameters> MethodParametersOf(const core::DescriptorConfig& config);
 
+/// A section of declared descriptor parameters (docs/options.md) and the methods it configures.
+struct ParameterSection {
+    std::string name;                   ///< YAML section
+    std::vector<core::Method> methods;  ///< the methods that read it
+    /// Visits copies of its parameters as the config held them (core::VisitCopies).
+    std::function<void(core::ParameterVisitor&)> visit;
+};
+
+/// Every section of declared parameters, as `config` holds them, in dump-config's order:
+/// histogram (height, range), ndt, then MethodParametersOf(config). Thread-safe.
+std::vector<ParameterSection> ParameterSectionsOf(const core::DescriptorConfig& config);
+
+/// The section of `sections` that `method` reads, or nullptr when it has none.
+const ParameterSection* SectionOf(const std::vector<ParameterSection>& sections,
+                                  const core::Method& method);
+
 /// MethodOf(config.method).Describe(cloud, config): ConfigError for an invalid config,
 /// EmptyInputError for a scan with nothing usable. Thread-safe.
 core::Descriptor ComputeDescriptor(const core::PointCloud& cloud,

@@ -82,7 +82,10 @@ TEST(ConfigYaml, BadInputNamesFileKeyAndProblem) {
     expect_error("detection:\n  threshold: -0.1\n", "detection.threshold must be a finite");
     expect_error("histogram: 5\n", "expected a section");
     expect_error("method: sift\n", "unknown method 'sift'");
-    expect_error("histogram:\n  bins: 0\n", "histogram.bins must be between");
+    expect_error("histogram:\n  bins: 0\n", "histogram.bins must be in [1, 1000000], got 0");
+    expect_error("ndt:\n  eigen_ratio_threshold: 1\n",
+                 "ndt.eigen_ratio_threshold must be in (0, 1), got 1");
+    expect_error("histogram:\n  up_vector: up\n", "key 'histogram.up_vector': unknown up vector");
     expect_error("histogram:\n  height_min_m: 10\n", "must be smaller than");
     expect_error("histogram: {bins: 3\n", "line");
     expect_error("- a\n- b\n", "expected a map");
@@ -177,6 +180,27 @@ TEST(ConfigYaml, ScanContextSectionRoundTripsAndRejectsUnknownKeys) {
     EXPECT_NE(ErrorOf("scancontext:\n  rings: 0\n").find("scancontext.rings must be in [1, 200]"),
               std::string::npos)
         << ErrorOf("scancontext:\n  rings: 0\n");
+}
+
+// docs/cli.md's table of descriptor parameters: each row from a declaration, with its default,
+// unit and range; names (enums) in code like strings.
+TEST(ConfigYaml, ParametersMarkdownHasTheHistogramAndNdtDeclarations) {
+    const std::string table = DumpParametersMarkdown({});
+    for (const char* row :
+         {"| `histogram.bins` | 100 | b, number of buckets (1 to 1000000) |\n",
+          "| `histogram.up_vector` | `fixed` | height projection up vector: fixed (0,0,1) \\| pca "
+          "|\n",
+          "| `histogram.range_min_m` | 0 | v_min of the range histogram (m, >= 0) |\n",
+          "| `ndt.cell_size_m` | 0.5 | q, side of an NDT cell; cells overlap by q/2 (m, 0.01 to "
+          "100) "
+          "|\n",
+          "| `ndt.eigen_ratio_threshold` | 0.1 | t_e of the shape classes (0 to 1, exclusive) |\n",
+          "| `ndt.range_limits_m` | [3, 6, 9, 15] | borders of the range intervals (m) |\n",
+          "| `scancontext.rings` | 20 |"}) {
+        EXPECT_NE(table.find(row), std::string::npos) << row << " missing in\n" << table;
+    }
+    EXPECT_LT(table.find("histogram.out_of_range"), table.find("ndt.cell_size_m"));
+    EXPECT_LT(table.find("ndt.regrid_rotations"), table.find("scancontext.rings"));
 }
 
 TEST(ConfigYaml, FailedApplyLeavesConfigUnchanged) {

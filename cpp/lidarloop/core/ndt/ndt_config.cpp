@@ -15,17 +15,7 @@ void Require(bool condition, const std::string& message) {
 }  // namespace
 
 void NdtConfig::Validate() const {
-    Require(cell_size_m >= 0.01 && cell_size_m <= 100.0, "ndt.cell_size_m must be in [0.01, 100]");
-    Require(min_points_per_cell >= 3 && min_points_per_cell <= 1'000'000,
-            "ndt.min_points_per_cell must be in [3, 1000000] (a shape needs 3 points)");
-    Require(eigen_ratio_threshold > 0.0 && eigen_ratio_threshold < 1.0,
-            "ndt.eigen_ratio_threshold (t_e) must be in (0, 1)");
-    Require(spherical_classes >= 0 && spherical_classes <= 100,
-            "ndt.spherical_classes must be in [0, 100]");
-    Require(planar_classes >= 0 && planar_classes <= 10'000,
-            "ndt.planar_classes must be in [0, 10000]");
-    Require(linear_classes >= 0 && linear_classes <= 10'000,
-            "ndt.linear_classes must be in [0, 10000]");
+    CheckDeclaredRanges(kSection, *this);
     Require(FeatureCount() >= 1,
             "ndt: at least one of spherical, planar, linear classes is needed");
     Require(range_limits_m.size() <= 64, "ndt.range_limits_m holds at most 64 borders");
@@ -35,8 +25,6 @@ void NdtConfig::Validate() const {
         Require(i == 0 || range_limits_m[i] > range_limits_m[i - 1],
                 "ndt.range_limits_m must be strictly increasing");
     }
-    Require(ambiguity_ratio >= 0.0 && ambiguity_ratio <= 1.0,
-            "ndt.ambiguity_ratio (t_a) must be in [0, 1]");
 }
 
 }  // namespace lidarloop::core

@@ -2,12 +2,16 @@
 
 #include <vector>
 
+#include "lidarloop/core/parameters.hpp"
+
 namespace lidarloop::core {
 
 /// Parameters of the NDT appearance descriptor (Magnusson et al. 2009, section II-E). Defaults
 /// are the paper's, except where a comment says otherwise. The decision threshold t_d is not a
 /// descriptor parameter (detection.threshold).
 struct NdtConfig {
+    static constexpr char kSection[] = "ndt";  ///< YAML section
+
     double cell_size_m = 0.5;  ///< q, side of an NDT cell; cell corners are q/2 apart
     /// Cells with fewer points are not classified. The paper does not state its minimum; 5 is
     /// the smallest count whose 3x3 covariance is not dominated by sampling noise for planes.
@@ -41,6 +45,35 @@ struct NdtConfig {
     /// (about that of a translation by a fraction of a cell), not zero.
     bool regrid_rotations = false;
 
+    /// Every parameter, declared once (core/parameters.hpp): key, help, unit, valid range.
+    /// range_limits_m and the total of classes are checked by Validate.
+    template <typename Self, typename Visit>
+    static void Declare(Self& c, Visit&& visit) {
+        visit(c.cell_size_m,
+              {"cell_size_m", "q, side of an NDT cell; cells overlap by q/2", "m", 0.01, 100.0});
+        // A cell's shape needs at least 3 points.
+        visit(c.min_points_per_cell,
+              {"min_points_per_cell", "sparser cells are not classified", "", 3, 1'000'000});
+        visit(c.eigen_ratio_threshold,
+              {"eigen_ratio_threshold", "t_e of the shape classes", "", 0.0, 1.0, true});
+        visit(c.spherical_classes, {"spherical_classes", "s, sub-classes by l2/l1", "", 0, 100});
+        visit(c.planar_classes,
+              {"planar_classes", "p, sub-classes by normal orientation", "", 0, 10'000});
+        visit(c.linear_classes,
+              {"linear_classes", "l, sub-classes by axis orientation", "", 0, 10'000});
+        visit(c.range_limits_m, {"range_limits_m", "borders of the range intervals", "m"});
+        visit(c.normalise_rotation,
+              {"normalise_rotation", "align dominant planes (section II-C)", ""});
+        visit(c.ambiguity_ratio,
+              {"ambiguity_ratio", "t_a, peaks this close are ambiguous", "", 0.0, 1.0});
+        visit(c.align_to_mean_direction,
+              {"align_to_mean_direction",
+               "peaks are modes of the cells' normals (true) or partition classes, lines P_i "
+               "(false)",
+               ""});
+        visit(c.regrid_rotations,
+              {"regrid_rotations", "new grid per rotation (paper) vs rotated cells", ""});
+    }
     int FeatureCount() const { return spherical_classes + planar_classes + linear_classes; }
     int RangeCount() const { return static_cast<int>(range_limits_m.size()) + 1; }
     /// Throws ConfigError naming the first invalid field.
