@@ -192,10 +192,9 @@ std::string DescriptorOptions::FirstGiven() const {
 void DescriptorOptions::CheckApplies(const ParameterFlag& flag, const core::Method& method) const {
     const std::string name = flag.option->get_name();
     if (flag.section == core::HistogramConfig::kSection && !core::IsHistogramMethod(method)) {
-        throw core::ConfigError(name +
-                                " applies to the height and range methods; set the parameters "
-                                "of " +
-                                core::ToString(method) + " in its section of --config");
+        throw core::ConfigError(name + " applies to the height and range methods, not " +
+                                core::ToString(method) + ": its parameters have flags --" +
+                                core::ToString(method) + "-... (--help)");
     }
     const auto& methods = flag.methods;
     if (!with_method_ || std::find(methods.begin(), methods.end(), method) != methods.end()) return;

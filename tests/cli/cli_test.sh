@@ -161,7 +161,8 @@ section_ndt() {
     printf 'ndt:\n  cell_size_m: 0\n' >"$work/ndt_bad.yaml"
     expect_error "ndt absurd cell size" "ndt.cell_size_m must be in" "$cli" describe --method ndt \
         --config "$work/ndt_bad.yaml" "$samples/corner_a.bin"
-    expect_error "histogram flag with ndt" "--bins applies to the height and range methods" \
+    expect_error "histogram flag with ndt" \
+        "--bins applies to the height and range methods, not ndt: its parameters have flags --ndt-" \
         "$cli" describe --method ndt --bins 10 "$samples/corner_a.bin"
     # The flags of the ndt section, derived from its declaration like --scancontext-*.
     ndt_config="$("$cli" describe --config "$work/ndt.yaml" "$samples/corner_a.bin")"
