@@ -31,6 +31,16 @@ inline constexpr float kInfFloat = std::numeric_limits<float>::infinity();
 inline constexpr float kNanFloat = std::numeric_limits<float>::quiet_NaN();
 inline constexpr double kDeg = std::numbers::pi / 180.0;  // radians per degree
 
+/// Skips the test in a build with AddressSanitizer (scripts/test's first pass, the dev preset): for
+/// run-scale tests that register hundreds of scan pairs, a minute or more there and seconds in the
+/// release suite, which runs them. Lighter tests cover the same code under the sanitizers.
+#if defined(__SANITIZE_ADDRESS__)
+#define LIDARLOOP_RELEASE_SUITE_ONLY() \
+    GTEST_SKIP() << "run-scale: the release suite runs it (minutes under the sanitizers)"
+#else
+#define LIDARLOOP_RELEASE_SUITE_ONLY() static_cast<void>(0)
+#endif
+
 /// A fresh temporary folder per test, removed at the end of the test. Named after the test, the
 /// process and a count, so that the same test running in two build trees at once, or two
 /// folders of one test, never share a folder.

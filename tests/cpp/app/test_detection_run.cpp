@@ -304,6 +304,9 @@ registration::Verification VerifyAsKept(const core::PointCloud& query,
 // Verification inside detect gives what registering each candidate on its own gives, and the
 // same verdicts and poses within a centimetre as the scans at full precision.
 TEST_F(DetectionRun, VerifiesEveryCandidateAsRegisteringThePairAlone) {
+    // Each sampled pair is registered twice more; detection's verification runs under the
+    // sanitizers in ReportsProgressOfEveryScanAndEndsTheStage and the loops reader's test.
+    LIDARLOOP_RELEASE_SUITE_ONLY();
     const app::DetectRequest request = Request("verified", core::Method::kRange);
     const app::DetectOutcome outcome = app::RunDetect(*dataset_, request);
     const registration::VerificationConfig& config = request.config.detection.verification;
