@@ -10,9 +10,9 @@
 // coarse score, occupied image cells, overlaps, ICP iterations, time, both scans' point counts
 // and roughness, overlapping points, RMSE and the RMSE allowed, the degeneracy measures, the
 // coarse search's time alone, its best score, hypothesis count and the 2nd and 3rd's score over it,
-// and the rank of the hypothesis the registered pose came from) and, with --poses (KITTI or TUM,
-// T_world_sensor, one per scan), the true distance, the overlap at the true pose and the registered
-// pose's error against it (metres, degrees).
+// the hypotheses ICP refined, and the rank of the hypothesis the registered pose came from) and,
+// with --poses (KITTI or TUM, T_world_sensor, one per scan), the true distance, the overlap at the
+// true pose and the registered pose's error against it (metres, degrees).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -190,6 +190,7 @@ void WritePair(std::ofstream& out, const Candidate& candidate,
         << now.T_match_query.translation().norm() << ',' << coarse_ms << ','
         << (hypotheses.empty() ? 0.0 : hypotheses.front().score) << ',' << hypotheses.size() << ','
         << ScoreRatio(hypotheses, 1) << ',' << ScoreRatio(hypotheses, 2) << ','
+        << now.registered_hypotheses << ','
         << (now.overlap.query_overlapping == 0 ? -2
                                                : HypothesisRankOf(hypotheses, now.T_match_query))
         << '\n';
@@ -228,7 +229,8 @@ void Replay(const std::filesystem::path& run, const registration::VerificationCo
                  "m_ground,m_roughness_m,q_overlapping,m_overlapping,rmse_m,"
                  "allowed_rmse_m,"
                  "shifted_ratio,constraining,registered_distance_m,coarse_ms,top_coarse_score,"
-                 "hypotheses,second_score_ratio,third_score_ratio,result_hypothesis\n";
+                 "hypotheses,second_score_ratio,third_score_ratio,registered_hypotheses,"
+                 "result_hypothesis\n";
     }
     io::StoredPreparedScans stored = io::LoadPreparedScans(run / "database.scans");
     const ScanSource scans(std::move(stored.scans), compact);
