@@ -8,9 +8,11 @@
 // --config verifies with another configuration, --compact with the scans kept compact (the
 // match expanded in the timed step, as detect does), --pairs-csv writes one line per pair (verdict,
 // coarse score, occupied image cells, overlaps, ICP iterations, time, both scans' point counts
-// and roughness, overlapping points, RMSE and the RMSE allowed, the degeneracy measures) and,
-// with --poses (KITTI or TUM, T_world_sensor, one per scan), the true distance, the overlap at
-// the true pose and the registered pose's error against it (metres, degrees).
+// and roughness, overlapping points, RMSE and the RMSE allowed, the degeneracy measures, the
+// coarse search's time alone, its best score, hypothesis count and the 2nd and 3rd's score over it,
+// the hypotheses ICP refined, and the rank of the hypothesis the registered pose came from) and,
+// with --poses (KITTI or TUM, T_world_sensor, one per scan), the true distance, the overlap at the
+// true pose and the registered pose's error against it (metres, degrees).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -117,6 +119,26 @@ int CoarseRankOfTruth(const registration::PreparedScan& query,
     return -1;
 }
 
+// The rank (0: best) of the coarse hypothesis the registered pose came from: the first within 2 m
+// and 10 degrees of it (-1 when none is; ICP moved it farther). Which peaks the verdicts need.
+int HypothesisRankOf(const std::vector<registration::PlanarHypothesis>& hypotheses,
+                     const core::Transform& T_registered) {
+    const double yaw_rad = std::atan2(T_registered.linear()(1, 0), T_registered.linear()(0, 0));
+    for (std::size_t rank = 0; rank < hypotheses.size(); ++rank) {
+        const double yaw_error_rad =
+            std::abs(std::remainder(hypotheses[rank].yaw_rad - yaw_rad, 2.0 * M_PI));
+        const double offset_m =
+            (hypotheses[rank].translation_m - T_registered.translation().head<2>()).norm();
+        if (offset_m < 2.0 && yaw_error_rad < 10.0 * M_PI / 180.0) return static_cast<int>(rank);
+    }
+    return -1;
+}
+
+// Coarse score of hypothesis `rank` over the best's, 0 when there is none.
+double ScoreRatio(const std::vector<registration::PlanarHypothesis>& hypotheses, std::size_t rank) {
+    return rank < hypotheses.size() ? hypotheses[rank].score / hypotheses.front().score : 0.0;
+}
+
 // With ground-truth poses: the sensors' distance and the overlap at the true relative pose (what
 // the pair can show at best), as CSV fields; empty fields without poses.
 std::string TruthFields(const std::vector<core::StampedPose>& poses, const Candidate& candidate,
@@ -153,7 +175,8 @@ void WritePair(std::ofstream& out, const Candidate& candidate,
                const registration::Verification& now, const registration::PreparedScan& query,
                const registration::PreparedScan& match,
                const registration::VerificationConfig& config, double ms,
-               const std::vector<core::StampedPose>& poses) {
+               const std::vector<core::StampedPose>& poses,
+               const std::vector<registration::PlanarHypothesis>& hypotheses, double coarse_ms) {
     out << candidate.query << ',' << candidate.match << ',' << (now.accepted ? 1 : 0) << ','
         << registration::ToString(now.reason) << ',' << now.coarse_score << ','
         << OccupiedCells(*query.structure, config.coarse) << ','
@@ -164,7 +187,13 @@ void WritePair(std::ofstream& out, const Candidate& candidate,
         << ',' << now.overlap.match_overlapping << ',' << now.overlap.rmse_m << ','
         << registration::AllowedRmse(query, match, config.acceptance) << ','
         << now.overlap.shifted_overlap_ratio << ',' << now.overlap.constraining_points << ','
-        << now.T_match_query.translation().norm() << '\n';
+        << now.T_match_query.translation().norm() << ',' << coarse_ms << ','
+        << (hypotheses.empty() ? 0.0 : hypotheses.front().score) << ',' << hypotheses.size() << ','
+        << ScoreRatio(hypotheses, 1) << ',' << ScoreRatio(hypotheses, 2) << ','
+        << now.registered_hypotheses << ','
+        << (now.overlap.query_overlapping == 0 ? -2
+                                               : HypothesisRankOf(hypotheses, now.T_match_query))
+        << '\n';
 }
 
 // The run's scans as a run keeps them: as loaded, or (--compact) encoded as
@@ -199,7 +228,9 @@ void Replay(const std::filesystem::path& run, const registration::VerificationCo
                  "q_structure,q_distinctive,q_ground,q_roughness_m,m_structure,m_distinctive,"
                  "m_ground,m_roughness_m,q_overlapping,m_overlapping,rmse_m,"
                  "allowed_rmse_m,"
-                 "shifted_ratio,constraining,registered_distance_m\n";
+                 "shifted_ratio,constraining,registered_distance_m,coarse_ms,top_coarse_score,"
+                 "hypotheses,second_score_ratio,third_score_ratio,registered_hypotheses,"
+                 "result_hypothesis\n";
     }
     io::StoredPreparedScans stored = io::LoadPreparedScans(run / "database.scans");
     const ScanSource scans(std::move(stored.scans), compact);
@@ -223,8 +254,14 @@ void Replay(const std::filesystem::path& run, const registration::VerificationCo
         if (!query.structure || !match.structure) continue;
         const registration::Verification now = registration::Verify(query, *coarse, match, config);
         tally.pair_ms.push_back(1e3 * clock.Seconds());
-        if (pairs.is_open())
-            WritePair(pairs, candidate, now, query, match, config, tally.pair_ms.back(), poses);
+        if (pairs.is_open()) {
+            // The coarse search alone, timed again (Verify above includes it).
+            const app::ThreadCpuStopwatch coarse_clock;
+            const auto hypotheses = registration::CoarseAlign(*coarse, *match.structure);
+            const double coarse_ms = 1e3 * coarse_clock.Seconds();
+            WritePair(pairs, candidate, now, query, match, config, tally.pair_ms.back(), poses,
+                      hypotheses, coarse_ms);
+        }
         ++tally.pairs;
         tally.accepted_before += candidate.accepted ? 1 : 0;
         tally.accepted_now += now.accepted ? 1 : 0;

@@ -83,6 +83,7 @@ void BindVerification(py::module_& m) {
             "None when not registered")
         .def_readonly("coarse_score", &Verification::coarse_score)
         .def_readonly("icp_iterations", &Verification::icp_iterations)
+        .def_readonly("registered_hypotheses", &Verification::registered_hypotheses)
         .def_property_readonly("score", &Verification::score,
                                "confidence for ranking accepted loops: the smaller overlap")
         .def("to_dict", &VerdictDict,

@@ -130,6 +130,8 @@ void VisitFields(registration::CoarseConfig& c, Visitor& v) {
     v.Field("yaw_step_deg", c.yaw_step_deg, "yaw search step over the full circle");
     v.Field("max_translation_m", c.max_translation_m, "largest planar offset searched");
     v.Field("hypotheses", c.hypotheses, "best coarse poses refined by ICP");
+    v.Field("min_hypothesis_score_ratio", c.min_hypothesis_score_ratio,
+            "a coarse pose after the best is refined only with this share of its score");
     v.Field("rival_hypotheses", c.rival_hypotheses,
             "further coarse poses the ambiguity test registers after an acceptance");
     v.Field("peaks_per_yaw", c.peaks_per_yaw, "translation peaks kept per yaw");

@@ -301,11 +301,15 @@ Verification Verify(const PreparedScan& query, const CoarseQuery& coarse, const 
         return best;
     }
     // Hypotheses in order of coarse score; the first that passes is the answer unless another
-    // fits about as well, else the one that overlapped best explains the rejection.
+    // fits about as well, else the one that overlapped best explains the rejection. A peak well
+    // below the best is not refined (CoarseConfig::min_hypothesis_score_ratio).
     const auto tried =
         std::min(hypotheses.size(), static_cast<std::size_t>(config.coarse.hypotheses));
+    const double min_score = config.coarse.min_hypothesis_score_ratio * hypotheses.front().score;
     for (std::size_t i = 0; i < tried; ++i) {
+        if (i > 0 && hypotheses[i].score < min_score) break;  // scores descend
         Verification trial = RegisterFrom(query, match, hypotheses[i], config);
+        trial.registered_hypotheses = static_cast<int>(i) + 1;
         if (trial.accepted) {
             if (trial.T_match_query.translation().norm() > config.acceptance.max_loop_distance_m) {
                 trial.accepted = false;
@@ -317,6 +321,7 @@ Verification Verify(const PreparedScan& query, const CoarseQuery& coarse, const 
             return trial;
         }
         if (i == 0 || trial.overlap.Min() > best.overlap.Min()) best = trial;
+        best.registered_hypotheses = trial.registered_hypotheses;
     }
     return best;
 }

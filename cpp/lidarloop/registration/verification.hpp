@@ -64,6 +64,9 @@ struct Verification {
     double shifted_overlap_ratio = std::numeric_limits<double>::quiet_NaN();
     double coarse_score = 0.0;  ///< the coarse correlation of the chosen hypothesis
     int icp_iterations = 0;
+    /// Coarse hypotheses ICP refined before the verdict (CoarseConfig::hypotheses at most, fewer
+    /// after an acceptance or below min_hypothesis_score_ratio), rival poses not counted.
+    int registered_hypotheses = 0;
     /// Confidence for ranking accepted loops: the smaller overlap fraction (0 when rejected
     /// before registration).
     double score() const { return overlap.Min(); }

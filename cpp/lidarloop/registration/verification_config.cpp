@@ -47,6 +47,7 @@ void CoarseConfig::Validate() const {
     RequireIn(yaw_step_deg, 0.1, 45.0, "coarse.yaw_step_deg");
     RequireIn(max_translation_m, 0.1, 1000.0, "coarse.max_translation_m");
     RequireIn(hypotheses, 1, 16, "coarse.hypotheses");
+    RequireIn(min_hypothesis_score_ratio, 0.0, 1.0, "coarse.min_hypothesis_score_ratio");
     RequireIn(rival_hypotheses, 0, 32, "coarse.rival_hypotheses");
     RequireIn(peaks_per_yaw, 1, 8, "coarse.peaks_per_yaw");
 }

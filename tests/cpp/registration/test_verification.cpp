@@ -110,6 +110,49 @@ TEST(Verification, MirroredPlaceIsRejected) {
     EXPECT_NE(v.reason, RejectReason::kNone);
 }
 
+// A place and its mirror image (the same parts, arranged differently): every coarse peak is
+// refined and rejected, except the peaks after the best whose score is under
+// min_hypothesis_score_ratio of the best's, which are not refined.
+TEST(Verification, PeaksFarBelowTheBestAreNotRefined) {
+    VerificationConfig config;
+    const core::PointCloud place = test::SyntheticPlace();
+    core::PointCloud mirrored = place;
+    for (auto& p : mirrored) p.y() = -p.y();
+    const PreparedScan query = PrepareScan(mirrored, config.reduction);
+    const PreparedScan match = PrepareScan(place, config.reduction);
+    const CoarseQuery coarse(*query.structure, config.coarse);
+    const auto hypotheses = CoarseAlign(coarse, *match.structure);
+    ASSERT_GE(hypotheses.size(), 3u);
+    for (const double ratio : {0.0, 0.5, 0.8, 0.9, 0.95, 1.0}) {
+        config.coarse.min_hypothesis_score_ratio = ratio;
+        int expected = 1;  // the best is always refined
+        while (expected < config.coarse.hypotheses &&
+               hypotheses[static_cast<std::size_t>(expected)].score >=
+                   ratio * hypotheses.front().score) {
+            ++expected;
+        }
+        const Verification v = Verify(query, coarse, match, config);
+        EXPECT_FALSE(v.accepted) << ratio;
+        EXPECT_EQ(v.registered_hypotheses, expected) << ratio;
+    }
+    config.coarse.min_hypothesis_score_ratio = 0.0;
+    EXPECT_EQ(Verify(query, coarse, match, config).registered_hypotheses, config.coarse.hypotheses);
+}
+
+// A right pose from the best peak: accepted at once, whatever the ratio.
+TEST(Verification, ScoreRatioKeepsAPoseFromTheBestPeak) {
+    const core::PointCloud match = test::SyntheticPlace();
+    const core::Transform truth = test::PlanarTransform(2.0, -1.0, 120.0);
+    VerificationConfig config;
+    for (const double ratio : {0.0, 0.8, 1.0}) {
+        config.coarse.min_hypothesis_score_ratio = ratio;
+        const Verification v = VerifyPair(QueryOf(match, truth), match, config);
+        EXPECT_TRUE(v.accepted) << ratio << " " << ToString(v.reason);
+        EXPECT_EQ(v.registered_hypotheses, 1) << ratio;
+        EXPECT_LT((v.T_match_query.translation() - truth.translation()).norm(), 0.1) << ratio;
+    }
+}
+
 // Two long parallel walls and a floor: every shift along the corridor fits as well.
 core::PointCloud Corridor() {
     core::PointCloud cloud;
@@ -212,6 +255,7 @@ TEST(Verification, InvalidConfigIsAConfigError) {
     expect_error([](auto& c) { c.reduction.voxel_m = std::nan(""); });
     expect_error([](auto& c) { c.coarse.grid_cells = 100; });
     expect_error([](auto& c) { c.coarse.yaw_step_deg = 0.0; });
+    expect_error([](auto& c) { c.coarse.min_hypothesis_score_ratio = 1.5; });
     expect_error(
         [](auto& c) { c.icp.final_correspondence_m = 2 * c.icp.initial_correspondence_m; });
     expect_error([](auto& c) { c.acceptance.min_overlap = 1.5; });
