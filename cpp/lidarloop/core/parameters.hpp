@@ -31,7 +31,7 @@ struct ParameterInfo {
     std::string_view key;   ///< YAML key in its section ("rings"); flags and keywords follow it
     std::string_view help;  ///< one line: the YAML comment, the flag's and the keyword's help
     std::string_view unit;  ///< "m", "deg", ...; empty for counts, ratios, names and switches
-    double min = -std::numeric_limits<double>::infinity();  ///< valid range, inclusive (numbers)
+    double min = -std::numeric_limits<double>::infinity();  ///< valid range, inclusive unless open
     double max = std::numeric_limits<double>::infinity();
     bool open = false;  ///< the bounds themselves are invalid: (min, max)
 
