@@ -19,7 +19,10 @@ namespace {
 
 constexpr char kVersionLine[] = "#ROSBAG V2.0\n";
 constexpr std::uint64_t kVersionBytes = sizeof(kVersionLine) - 1;
-constexpr std::uint32_t kMaxChunkBytes = 1U << 30;
+// rosbag_storage allocates a compressed chunk's declared size before decompressing it. Writers
+// close a chunk at 768 kB by default, after one message at most: 128 MiB is ten times the
+// largest LiDAR scan message (Ouster 128 x 2048 points), and under libFuzzer's 512 MiB limit.
+constexpr std::uint32_t kMaxChunkBytes = 1U << 27;
 constexpr std::uint32_t kMaxHeaderBytes = 1U << 20;  // record headers hold a few short fields
 constexpr std::uint8_t kOpMessage = 0x02, kOpBagHeader = 0x03, kOpIndex = 0x04, kOpChunk = 0x05,
                        kOpChunkInfo = 0x06;
@@ -136,7 +139,7 @@ Chunk CheckChunk(BagFile& bag, const Record& record) {
     Chunk chunk{record.data_at, Field32(bag, record, "size"), name != "none"};
     if (chunk.size > kMaxChunkBytes) {
         bag.Fail(record.at,
-                 "a chunk claims " + std::to_string(chunk.size) + " bytes, more than 1 GiB");
+                 "a chunk claims " + std::to_string(chunk.size) + " bytes, more than 128 MiB");
     }
     if (!chunk.compressed && chunk.size != record.data_len)
         bag.Fail(record.at, "an uncompressed chunk whose size is not its data length");
