@@ -101,24 +101,6 @@ std::size_t OccupiedCells(const registration::SurfacePoints& structure,
     return static_cast<std::size_t>(std::count(image.begin(), image.end(), 1.0F));
 }
 
-// The rank (0: best) of the first coarse hypothesis within 2 m and 10 degrees of the true planar
-// pose, -1 when none is: whether the coarse search or ICP lost a pair.
-int CoarseRankOfTruth(const registration::PreparedScan& query,
-                      const registration::PreparedScan& match, const core::Transform& T_truth,
-                      const registration::VerificationConfig& config) {
-    const registration::CoarseQuery coarse(*query.structure, config.coarse);
-    const auto hypotheses = registration::CoarseAlign(coarse, *match.structure);
-    const double true_yaw_rad = std::atan2(T_truth.linear()(1, 0), T_truth.linear()(0, 0));
-    for (std::size_t rank = 0; rank < hypotheses.size(); ++rank) {
-        const double yaw_error_rad =
-            std::abs(std::remainder(hypotheses[rank].yaw_rad - true_yaw_rad, 2.0 * M_PI));
-        const double offset_m =
-            (hypotheses[rank].translation_m - T_truth.translation().head<2>()).norm();
-        if (offset_m < 2.0 && yaw_error_rad < 10.0 * M_PI / 180.0) return static_cast<int>(rank);
-    }
-    return -1;
-}
-
 // The rank (0: best) of the coarse hypothesis the registered pose came from: the first within 2 m
 // and 10 degrees of it (-1 when none is; ICP moved it farther). Which peaks the verdicts need.
 int HypothesisRankOf(const std::vector<registration::PlanarHypothesis>& hypotheses,
@@ -132,6 +114,15 @@ int HypothesisRankOf(const std::vector<registration::PlanarHypothesis>& hypothes
         if (offset_m < 2.0 && yaw_error_rad < 10.0 * M_PI / 180.0) return static_cast<int>(rank);
     }
     return -1;
+}
+
+// The rank (0: best) of the first coarse hypothesis within 2 m and 10 degrees of the true planar
+// pose, -1 when none is: whether the coarse search or ICP lost a pair.
+int CoarseRankOfTruth(const registration::PreparedScan& query,
+                      const registration::PreparedScan& match, const core::Transform& T_truth,
+                      const registration::VerificationConfig& config) {
+    const registration::CoarseQuery coarse(*query.structure, config.coarse);
+    return HypothesisRankOf(registration::CoarseAlign(coarse, *match.structure), T_truth);
 }
 
 // Coarse score of hypothesis `rank` over the best's, 0 when there is none.
