@@ -35,6 +35,8 @@ protected:
 };
 
 TEST_F(ScanContextRuns, DetectionVerifiesItsCandidatesLikeAnyMethods) {
+    // Verification does not depend on the method; it runs under the sanitizers in DetectionRun.
+    LIDARLOOP_RELEASE_SUITE_ONLY();
     const app::DetectRequest request = Request("verified");
     ASSERT_TRUE(request.config.detection.verify);
     const app::DetectOutcome outcome = app::RunDetect(*dataset_, request);
