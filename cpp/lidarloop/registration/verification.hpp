@@ -78,10 +78,11 @@ Overlap MeasureOverlap(const PreparedScan& query, const PreparedScan& match,
 
 /// MeasureOverlap(query, match, T_match_query, config).Min() >= min_overlap, computed without
 /// the degeneracy test and without the match side when the query side already falls short (the
-/// check that abandons an ICP hypothesis). Thread-safe.
+/// check that abandons an ICP hypothesis). With `stride` > 1 it counts every stride-th structure
+/// point of each side only: an estimate, cheaper by that factor. Thread-safe.
 bool OverlapReaches(const PreparedScan& query, const PreparedScan& match,
                     const core::Transform& T_match_query, const AcceptanceConfig& config,
-                    double min_overlap);
+                    double min_overlap, std::size_t stride = 1);
 
 /// The largest RMSE a pair may have: max_rmse_ratio times the RMS of the two scans' roughness
 /// (PreparedScan::structure_roughness_m: how well each fits itself), within

@@ -101,6 +101,35 @@ TEST(Verification, OverlapReachesAgreesWithMeasureOverlap) {
     EXPECT_GT(missed, 20);
 }
 
+// On every 4th point (what ICP's abandonment check reads) the check decides as the full measure
+// wherever the overlap is not within 0.05 of the bar.
+TEST(Verification, OverlapReachesOnASubsampleDecidesAsTheFullMeasureAwayFromTheBar) {
+    const core::PointCloud match = test::SyntheticPlace();
+    const core::Transform truth = test::PlanarTransform(3.0, -1.0, 12.0);
+    const VerificationConfig config;
+    const PreparedScan q = PrepareScan(QueryOf(match, truth), config.reduction);
+    const PreparedScan t = PrepareScan(match, config.reduction);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> offset_m(-4.0, 4.0), yaw_deg(-30.0, 30.0);
+    int compared = 0;
+    for (int trial = 0; trial < 40; ++trial) {
+        const double scale = trial / 40.0;
+        const core::Transform pose =
+            test::PlanarTransform(scale * offset_m(rng), scale * offset_m(rng),
+                                  scale * yaw_deg(rng)) *
+            truth;
+        const double overlap = MeasureOverlap(q, t, pose, config.acceptance).Min();
+        for (const double threshold : {0.05, 0.15, 0.3, 0.5, 0.7}) {
+            if (std::abs(overlap - threshold) <= 0.05) continue;
+            EXPECT_EQ(OverlapReaches(q, t, pose, config.acceptance, threshold, 4),
+                      overlap >= threshold)
+                << trial << " " << threshold << " " << overlap;
+            ++compared;
+        }
+    }
+    EXPECT_GT(compared, 150);
+}
+
 TEST(Verification, MirroredPlaceIsRejected) {
     const core::PointCloud match = test::SyntheticPlace();
     core::PointCloud mirrored = match;
