@@ -45,16 +45,20 @@ double ParabolicOffset(double before, double at, double after) {
     return std::clamp(0.5 * (before - after) / curvature, -0.5, 0.5);
 }
 
-// The peak at `cell` of one correlation grid (the real or imaginary part of `grid`), refined to
-// sub-cell precision.
-template <class Part>
-PlanarHypothesis PeakAt(const std::vector<std::complex<float>>& grid, Part part, std::uint32_t cell,
+// A correlation of a 0/1 query image with a 0/0.5/1 match image is a multiple of 0.5. Rounded to
+// it, the FFT's rounding error is gone: equal correlations tie exactly (the first searched cell
+// wins), so the hypotheses do not depend on how the FFT computed them.
+double Correlation(const std::vector<float>& plane, std::size_t cell) {
+    return std::round(2.0 * static_cast<double>(plane[cell])) / 2.0;
+}
+
+// The peak at `cell` of one correlation plane, refined to sub-cell precision.
+PlanarHypothesis PeakAt(const std::vector<float>& plane, std::uint32_t cell,
                         const CoarseQuery& query, double yaw_rad) {
     const int n = query.config().grid_cells;
     const int x = static_cast<int>(cell) % n, y = static_cast<int>(cell) / n;
     auto at = [&](int cx, int cy) {
-        return static_cast<double>(
-            part(grid[static_cast<std::size_t>(((cy + n) % n) * n + (cx + n) % n)]));
+        return Correlation(plane, static_cast<std::size_t>(((cy + n) % n) * n + (cx + n) % n));
     };
     const double score = at(x, y);
     const double fx = ParabolicOffset(at(x - 1, y), score, at(x + 1, y));
@@ -76,16 +80,15 @@ int CellDistance(std::uint32_t a, std::uint32_t b, int n) {
 // test needs them all.
 constexpr int kPeakSeparationCells = 3;
 
-template <class Part>
-void AddPeaks(const std::vector<std::complex<float>>& grid, Part part, const CoarseQuery& query,
-              double yaw_rad, int count, std::vector<PlanarHypothesis>& peaks) {
+void AddPeaks(const std::vector<float>& plane, const CoarseQuery& query, double yaw_rad, int count,
+              std::vector<PlanarHypothesis>& peaks) {
     const int n = query.config().grid_cells;
     std::vector<std::uint32_t> taken;
     for (int k = 0; k < count; ++k) {
         double best_score = 0.0;
         std::optional<std::uint32_t> best;
         for (const std::uint32_t cell : query.search_cells()) {
-            const double value = part(grid[cell]);
+            const double value = Correlation(plane, cell);
             if (value <= best_score) continue;
             const bool apart = std::all_of(taken.begin(), taken.end(), [&](std::uint32_t t) {
                 return CellDistance(cell, t, n) > kPeakSeparationCells;
@@ -94,7 +97,7 @@ void AddPeaks(const std::vector<std::complex<float>>& grid, Part part, const Coa
         }
         if (!best) return;
         taken.push_back(*best);
-        peaks.push_back(PeakAt(grid, part, *best, query, yaw_rad));
+        peaks.push_back(PeakAt(plane, *best, query, yaw_rad));
     }
 }
 
@@ -191,23 +194,24 @@ std::vector<PlanarHypothesis> CoarseAlign(const CoarseQuery& query,
     const Spectrum match =
         ToSpectrum(Spread(OccupancyImage(match_structure.points(), 0.0, config), n), n);
     std::vector<PlanarHypothesis> peaks;
-    Spectrum product(match.size());
+    detail::SplitGrid product{std::vector<float>(match.size()), std::vector<float>(match.size())};
     const auto rows = RowsWithNeighbors(query.search_rows(), n);
-    auto real = [](std::complex<float> value) { return value.real(); };
-    auto imaginary = [](std::complex<float> value) { return value.imag(); };
-    // Two yaws per inverse FFT: both correlations are real, so one rides in the imaginary part.
+    // Two yaws per inverse FFT: both correlations are real, so yaw b rides in the imaginary part:
+    // product = qa m + i qb m (written out: std::complex's product checks for NaN and does not
+    // vectorise).
     for (int a = 0; a < query.yaw_count(); a += 2) {
         const int b = std::min(a + 1, query.yaw_count() - 1);
         const Spectrum& qa = query.spectrum(a);
         const Spectrum& qb = query.spectrum(b);
-        for (std::size_t i = 0; i < product.size(); ++i) {
-            const std::complex<float> m = match[i];
-            product[i] = qa[i] * m + std::complex<float>(0.0F, 1.0F) * (qb[i] * m);
+        for (std::size_t i = 0; i < match.size(); ++i) {
+            const float mr = match[i].real(), mi = match[i].imag();
+            const float ar = qa[i].real(), ai = qa[i].imag(), br = qb[i].real(), bi = qb[i].imag();
+            product.re[i] = (ar * mr - ai * mi) - (br * mi + bi * mr);
+            product.im[i] = (ar * mi + ai * mr) + (br * mr - bi * mi);
         }
         detail::Fft2dInverseRows(product, n, rows);
-        AddPeaks(product, real, query, query.YawOf(a), config.peaks_per_yaw, peaks);
-        if (b != a)
-            AddPeaks(product, imaginary, query, query.YawOf(b), config.peaks_per_yaw, peaks);
+        AddPeaks(product.re, query, query.YawOf(a), config.peaks_per_yaw, peaks);
+        if (b != a) AddPeaks(product.im, query, query.YawOf(b), config.peaks_per_yaw, peaks);
     }
     return Distinct(std::move(peaks), config);
 }

@@ -1,11 +1,13 @@
 // Kernels of registration against brute force: the float k-d tree, the 2-D FFT, scan reduction.
 #include <algorithm>
+#include <cmath>
 #include <complex>
 #include <limits>
 #include <random>
 #include <utility>
 
 #include <gtest/gtest.h>
+#include <unsupported/Eigen/FFT>
 
 #include "lidarloop/registration/coarse_alignment.hpp"
 #include "lidarloop/registration/detail/fft2d.hpp"
@@ -93,11 +95,47 @@ TEST(Fft2d, MatchesTheDefinitionAndInverts) {
     detail::Fft2dInverse(back, n);
     for (int i = 0; i < n * n; ++i) EXPECT_NEAR(std::abs(back[i] - grid[i]), 0.0, 1e-5);
     // Only the listed rows are final in the partial inverse; they equal the full one.
-    auto rows = spectrum;
+    detail::SplitGrid rows;
+    for (const auto& v : spectrum) rows.re.push_back(v.real()), rows.im.push_back(v.imag());
     detail::Fft2dInverseRows(rows, n, {1, 5});
-    for (const int row : {1, 5})
-        for (int x = 0; x < n; ++x)
-            EXPECT_NEAR(std::abs(rows[row * n + x] - grid[row * n + x]), 0.0, 1e-5);
+    for (const int row : {1, 5}) {
+        for (int x = 0; x < n; ++x) {
+            EXPECT_NEAR(rows.re[row * n + x], grid[row * n + x].real(), 1e-5);
+            EXPECT_NEAR(rows.im[row * n + x], grid[row * n + x].imag(), 1e-5);
+        }
+    }
+}
+
+// The batched kernel against Eigen's FFT, one 1-D transform at a time, at the sizes the coarse
+// search allows.
+TEST(Fft2d, EqualsEigensFftOnRowsThenColumns) {
+    for (const int n : {16, 64, 256}) {
+        std::mt19937_64 rng(static_cast<unsigned>(n));
+        std::uniform_real_distribution<float> u(-1.0F, 1.0F);
+        std::vector<std::complex<float>> grid(static_cast<std::size_t>(n * n));
+        for (auto& v : grid) v = {u(rng), u(rng)};
+        for (const bool inverse : {false, true}) {
+            std::vector<std::complex<float>> expected = grid, in(n), out(n);
+            Eigen::FFT<float> fft;
+            const auto run = [&] { inverse ? fft.inv(out, in) : fft.fwd(out, in); };
+            for (int row = 0; row < n; ++row) {
+                std::copy_n(expected.begin() + row * n, n, in.begin());
+                run();
+                std::copy(out.begin(), out.end(), expected.begin() + row * n);
+            }
+            for (int col = 0; col < n; ++col) {
+                for (int row = 0; row < n; ++row) in[row] = expected[row * n + col];
+                run();
+                for (int row = 0; row < n; ++row) expected[row * n + col] = out[row];
+            }
+            auto actual = grid;
+            inverse ? detail::Fft2dInverse(actual, n) : detail::Fft2dForward(actual, n);
+            const float tolerance = (inverse ? 1e-5F : 1e-3F) * static_cast<float>(n) / 16.0F;
+            for (std::size_t i = 0; i < grid.size(); ++i)
+                ASSERT_NEAR(std::abs(actual[i] - expected[i]), 0.0F, tolerance)
+                    << "n " << n << " inverse " << inverse << " at " << i;
+        }
+    }
 }
 
 TEST(Fft2d, ARealPairSplitsIntoTheSpectraOfEachImage) {
@@ -133,6 +171,22 @@ TEST(CoarseQuery, HoldsTheConjugateSpectrumOfTheRotatedImageAtEveryYaw) {
             ASSERT_NEAR(std::abs(query.spectrum(i)[k] - std::conj(expected[k])), 0.0, 1e-2)
                 << "yaw " << i << " frequency " << k;
     }
+}
+
+// Correlations of 0/1 with 0/0.5/1 images are multiples of 0.5: the peaks' scores are exactly
+// that, without the FFT's rounding error, so equal peaks tie whatever computed the transform.
+TEST(CoarseAlign, ScoresAreExactMultiplesOfAHalf) {
+    ScanReductionConfig reduction;
+    const PreparedScan scan = PrepareScan(test::SyntheticPlace(), reduction);
+    const CoarseQuery query(*scan.structure, CoarseConfig{});
+    const auto hypotheses = CoarseAlign(query, *scan.structure);
+    ASSERT_FALSE(hypotheses.empty());
+    for (const PlanarHypothesis& h : hypotheses) {
+        EXPECT_GT(h.score, 0.0);
+        EXPECT_EQ(h.score * 2.0, std::round(h.score * 2.0)) << h.score;
+    }
+    EXPECT_NEAR(hypotheses.front().translation_m.norm(), 0.0, 0.2);  // the scan onto itself
+    EXPECT_NEAR(hypotheses.front().yaw_rad, 0.0, 1e-9);
 }
 
 TEST(PrepareScan, SplitsWallsFromGroundWithUnitNormalsFacingTheSensor) {

@@ -5,8 +5,14 @@
 
 namespace lidarloop::registration::detail {
 
-/// In-place 2-D discrete Fourier transform of an n x n row-major grid (Eigen's FFT on rows, then
-/// columns). The inverse is scaled by 1 / n^2, so Inverse(Forward(x)) == x. Thread-safe.
+/// An n x n grid of complex numbers as two row-major planes, the real and the imaginary parts.
+struct SplitGrid {
+    std::vector<float> re, im;
+};
+
+/// In-place 2-D discrete Fourier transform of an n x n row-major grid, n a power of two (columns,
+/// then rows; a batched radix-2 kernel checked against Eigen's FFT in the tests). The inverse is
+/// scaled by 1 / n^2, so Inverse(Forward(x)) == x. Thread-safe.
 void Fft2dForward(std::vector<std::complex<float>>& grid, int n);
 void Fft2dInverse(std::vector<std::complex<float>>& grid, int n);
 /// The forward transforms of two real n x n images at the cost of one complex transform: `a` is
@@ -17,6 +23,6 @@ void Fft2dForwardRealPair(const std::vector<float>& a, const std::vector<float>&
                           std::vector<std::complex<float>>& spectrum_b);
 /// The inverse transform computed only for the rows listed in `rows` (columns first, then those
 /// rows); the other rows hold partial results. For correlations read in a band of rows.
-void Fft2dInverseRows(std::vector<std::complex<float>>& grid, int n, const std::vector<int>& rows);
+void Fft2dInverseRows(SplitGrid& grid, int n, const std::vector<int>& rows);
 
 }  // namespace lidarloop::registration::detail
