@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 #include <Eigen/Cholesky>
 
@@ -22,15 +24,20 @@ struct NormalEquations {
 };
 
 // Pairs every stride-th point of `from` (an even subsample of at most `cap` points).
+// `partners` holds each paired point's partner of the previous iteration (-1: none), the hint
+// that makes the nearest-neighbour search cheap once the pose moves little; updated here.
 void Accumulate(const SurfacePoints& from, const SurfacePoints& onto, const Eigen::Isometry3f& T,
-                float max_distance_m, int cap, float inlier_m, NormalEquations& equations) {
+                float max_distance_m, int cap, float inlier_m, std::vector<std::int64_t>& partners,
+                NormalEquations& equations) {
     const double scale_m = max_distance_m / 3.0;
     const std::size_t stride = std::max<std::size_t>(1, (from.size() + cap - 1) / cap);
-    for (std::size_t i = 0; i < from.size(); i += stride) {
+    partners.resize((from.size() + stride - 1) / stride, -1);
+    for (std::size_t i = 0, k = 0; i < from.size(); i += stride, ++k) {
         const Eigen::Vector3f& point = from.points()[i];
         ++equations.paired;
         const Eigen::Vector3f moved = T * point;
-        const auto index = onto.tree().Nearest(moved, max_distance_m);
+        const auto index = onto.tree().Nearest(moved, max_distance_m, partners[k]);
+        partners[k] = index;
         if (index < 0) continue;
         const Eigen::Vector3d normal =
             onto.normals()[static_cast<std::size_t>(index)].cast<double>();
@@ -59,21 +66,26 @@ core::Transform Increment(const Vector6d& step) {
     return increment;
 }
 
+// Each paired query point's partner in the last iteration, structure and ground.
+struct Partners {
+    std::vector<std::int64_t> structure, ground;
+};
+
 // One stage at a fixed correspondence distance; returns true when it settled.
 bool RunStage(const PreparedScan& query, const PreparedScan& match, float max_distance_m,
-              const IcpConfig& config, IcpResult& result) {
+              const IcpConfig& config, Partners& partners, IcpResult& result) {
     for (int iteration = 0; iteration < config.max_iterations_per_stage; ++iteration) {
         NormalEquations equations;
         const Eigen::Isometry3f T = result.T_match_query.cast<float>();
         const auto inlier_m = static_cast<float>(config.final_correspondence_m);
         Accumulate(*query.structure, *match.structure, T, max_distance_m,
-                   config.max_structure_points, inlier_m, equations);
+                   config.max_structure_points, inlier_m, partners.structure, equations);
         result.structure_inliers =
             equations.paired == 0
                 ? 0.0
                 : static_cast<double>(equations.inliers) / static_cast<double>(equations.paired);
         Accumulate(*query.ground, *match.ground, T, max_distance_m, config.max_ground_points,
-                   inlier_m, equations);
+                   inlier_m, partners.ground, equations);
         ++result.iterations;
         result.correspondences = equations.count;
         if (equations.count < 6) return false;
@@ -93,8 +105,10 @@ IcpResult RefinePointToPlane(const PreparedScan& query, const PreparedScan& matc
     IcpResult result;
     result.T_match_query = T_initial;
     double distance_m = config.initial_correspondence_m;
+    Partners partners;
     while (true) {
-        result.converged = RunStage(query, match, static_cast<float>(distance_m), config, result);
+        result.converged =
+            RunStage(query, match, static_cast<float>(distance_m), config, partners, result);
         if (distance_m <= config.final_correspondence_m) break;
         if (distance_m == config.initial_correspondence_m && keep_going &&
             !keep_going(result.T_match_query)) {

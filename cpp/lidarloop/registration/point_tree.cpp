@@ -28,7 +28,8 @@ public:
     using DistanceType = float;
     using IndexType = std::uint32_t;
 
-    explicit NearestWithin(float max_squared_m2) : best_squared_m2_(max_squared_m2) {}
+    explicit NearestWithin(float max_squared_m2, std::int64_t start_index = -1)
+        : best_squared_m2_(max_squared_m2), best_index_(start_index) {}
 
     bool full() const { return true; }
     float worstDist() const { return best_squared_m2_; }
@@ -43,7 +44,7 @@ public:
 
 private:
     float best_squared_m2_;
-    std::int64_t best_index_ = -1;
+    std::int64_t best_index_;
 };
 
 }  // namespace
@@ -64,8 +65,20 @@ PointTree::PointTree(PointTree&&) noexcept = default;
 PointTree& PointTree::operator=(PointTree&&) noexcept = default;
 
 std::int64_t PointTree::Nearest(const Eigen::Vector3f& query, float max_distance_m) const {
-    if (impl_->adaptor.points->empty()) return -1;
-    NearestWithin result(max_distance_m * max_distance_m);
+    return Nearest(query, max_distance_m, -1);
+}
+
+std::int64_t PointTree::Nearest(const Eigen::Vector3f& query, float max_distance_m,
+                                std::int64_t hint) const {
+    const std::vector<Eigen::Vector3f>& points = *impl_->adaptor.points;
+    if (points.empty()) return -1;
+    float bound_m2 = max_distance_m * max_distance_m;
+    std::int64_t start = -1;
+    if (hint >= 0 && static_cast<std::size_t>(hint) < points.size()) {
+        const float hint_m2 = (points[static_cast<std::size_t>(hint)] - query).squaredNorm();
+        if (hint_m2 < bound_m2) bound_m2 = hint_m2, start = hint;
+    }
+    NearestWithin result(bound_m2, start);
     impl_->index.findNeighbors(result, query.data(), nanoflann::SearchParams(10));
     return result.best_index();
 }

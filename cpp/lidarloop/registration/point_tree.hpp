@@ -24,6 +24,11 @@ public:
 
     /// Index of the point nearest to `query` when it is closer than `max_distance_m`, else -1.
     std::int64_t Nearest(const Eigen::Vector3f& query, float max_distance_m) const;
+    /// The same, given a point `hint` (an index, or -1) likely to be near: the search only looks
+    /// for points closer than the hint, which prunes most of the tree when the hint is good (the
+    /// previous correspondence of an ICP iteration). Returns the hint when nothing is closer.
+    std::int64_t Nearest(const Eigen::Vector3f& query, float max_distance_m,
+                         std::int64_t hint) const;
     /// The indices of the `k` nearest points (fewer when the tree is smaller), nearest first.
     void Knn(const Eigen::Vector3f& query, int k, std::vector<std::uint32_t>& indices) const;
 

@@ -48,6 +48,38 @@ TEST(PointTree, NearestMatchesBruteForceWithinTheBound) {
     }
 }
 
+// A hint (ICP's partner of the previous iteration) only prunes: good, bad, far, absent or out of
+// range, the answer is the brute-force nearest within the bound.
+TEST(PointTree, NearestWithAnyHintMatchesBruteForce) {
+    const auto points = RandomPoints(2000, 5, 20.0F);
+    const PointTree tree(&points);
+    std::mt19937_64 rng(6);
+    std::uniform_int_distribution<std::int64_t> any(0, 1999);
+    for (const auto& query : RandomPoints(300, 7, 22.0F)) {
+        std::int64_t best = -1, farther = -1;  // farther: in the bound, not the nearest
+        float best_m2 = 1.5F * 1.5F;
+        for (std::size_t i = 0; i < points.size(); ++i) {
+            const float d2 = (points[i] - query).squaredNorm();
+            if (d2 < 1.5F * 1.5F && best >= 0)
+                farther = d2 < best_m2 ? best : static_cast<std::int64_t>(i);
+            if (d2 < best_m2) best_m2 = d2, best = static_cast<std::int64_t>(i);
+        }
+        const std::vector<std::int64_t> hints = {-1,      any(rng), best,
+                                                 farther, 2000,     std::int64_t{1} << 40};
+        for (const std::int64_t hint : hints) {
+            const auto found = tree.Nearest(query, 1.5F, hint);
+            if (best < 0) {
+                EXPECT_EQ(found, -1) << hint;
+            } else {
+                ASSERT_GE(found, 0) << hint;
+                EXPECT_FLOAT_EQ((points[static_cast<std::size_t>(found)] - query).squaredNorm(),
+                                best_m2)
+                    << hint;
+            }
+        }
+    }
+}
+
 TEST(PointTree, KnnMatchesBruteForce) {
     const auto points = RandomPoints(1000, 3, 10.0F);
     const PointTree tree(&points);
