@@ -11,6 +11,7 @@
 #include "lidarloop/app/results_folder.hpp"
 #include "lidarloop/app/verification_run.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/pipeline/expanded_scans.hpp"
 #include "lidarloop/pipeline/histogram_index.hpp"
 #include "lidarloop/pipeline/histogram_method.hpp"
 #include "lidarloop/pipeline/similarity_matrix.hpp"
@@ -132,6 +133,7 @@ nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
     std::size_t accepted = 0;
     const std::size_t step =
         std::max<std::size_t>(1, all.size() / std::max<std::size_t>(1, queries));
+    pipeline::ExpandedScans expanded;  // as the online detector keeps its candidates
     for (std::size_t q = 0; q < all.size() && coarse_times.wall_ms.size() < queries; q += step) {
         const registration::PreparedScan query = prepared.scans[all[q].query].Expand();
         if (!query.structure) continue;
@@ -142,8 +144,8 @@ nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
         double verification_cpu_ms = coarse_times.cpu_ms.back();
         for (const pipeline::Neighbor& candidate : all[q].candidates) {
             const registration::Verification verdict = pair_times.Time([&] {
-                return registration::Verify(query, *coarse,
-                                            prepared.scans[candidate.index].Expand(), verification);
+                return registration::Verify(
+                    query, *coarse, expanded.Get(prepared.scans, candidate.index), verification);
             });
             verification_cpu_ms += pair_times.cpu_ms.back();
             accepted += verdict.accepted ? 1 : 0;

@@ -6,6 +6,7 @@
 #include <tbb/parallel_for.h>
 
 #include "lidarloop/pipeline/descriptor_method.hpp"
+#include "lidarloop/pipeline/expanded_scans.hpp"
 
 namespace lidarloop::pipeline {
 namespace {
@@ -108,7 +109,8 @@ VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
                                 Execution execution,
                                 const std::function<void(std::size_t, std::size_t)>& progress,
                                 VerificationCache* cache) {
-    const auto scan_of = [&scans](std::size_t i) { return scans.at(i).Expand(); };
+    ExpandedScans expanded;
+    const auto scan_of = [&](std::size_t i) { return expanded.Get(scans, i); };
     std::vector<VerificationTimes> per_query(queries.size());
     std::atomic<std::size_t> done{0};
     const auto run = [&](std::size_t i) {

@@ -201,8 +201,8 @@ void LoopDetector::Verify(LoopQuery& result, const registration::CompactPrepared
     if (!detector_.verify || !scan.prepared()) return;
     // The query as it is stored: online, offline and localisation see the same scans.
     VerifyQuery(
-        result, scan.Expand(), [this](std::size_t j) { return scans_[j].Expand(); }, detector_,
-        database_.method());
+        result, scan.Expand(), [this](std::size_t j) { return expanded_.Get(scans_, j); },
+        detector_, database_.method());
 }
 
 std::size_t LoopDetector::prepared_bytes() const {

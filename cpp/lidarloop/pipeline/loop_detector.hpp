@@ -11,6 +11,7 @@
 #include "lidarloop/core/min_gap.hpp"
 #include "lidarloop/pipeline/descriptor_database.hpp"
 #include "lidarloop/pipeline/descriptor_method.hpp"
+#include "lidarloop/pipeline/expanded_scans.hpp"
 #include "lidarloop/pipeline/similarity_matrix.hpp"
 #include "lidarloop/registration/compact_prepared_scan.hpp"
 #include "lidarloop/registration/verification.hpp"
@@ -136,6 +137,7 @@ private:
     std::unique_ptr<NeighborIndex> index_;  // nullptr: compare every eligible scan
     // By database index, for verification; compact (about 36 kB a scan instead of 140 kB).
     std::vector<registration::CompactPreparedScan> scans_;
+    mutable ExpandedScans expanded_;  // the candidates verified lately (thread-safe)
 };
 
 /// Localisation of a whole sequence against a map: LoopDetector::Query for every scan of
