@@ -1,9 +1,13 @@
 #include "lidarloop/app/verification_run.hpp"
 
+#include <atomic>
 #include <cmath>
+
+#include <tbb/parallel_for.h>
 
 #include "lidarloop/app/results_folder.hpp"
 #include "lidarloop/io/scan_reader.hpp"
+#include "lidarloop/registration/submap.hpp"
 
 namespace lidarloop::app {
 
@@ -25,6 +29,44 @@ std::vector<double> PreparedScans::BytesPerScan() const {
         if (scan.prepared()) bytes.push_back(static_cast<double>(scan.MemoryBytes()));
     }
     return bytes;
+}
+
+void PrepareSubmaps(const io::Dataset& dataset, const std::vector<core::StampedPose>& poses,
+                    const registration::ScanReductionConfig& reduction, PreparedScans& prepared,
+                    const Progress& progress) {
+    const std::vector<double> path_m = registration::SubmapPathM(poses);
+    // A scan skipped while describing could not be read: it adds nothing to its neighbours.
+    const auto load = [&](std::size_t k) {
+        return prepared.scans.at(k).prepared() ? dataset.LoadScan(k) : core::PointCloud{};
+    };
+    std::vector<registration::CompactPreparedScan> submaps(prepared.scans.size());
+    std::atomic<std::size_t> done{0};
+    tbb::parallel_for(std::size_t{0}, submaps.size(), [&](std::size_t i) {
+        if (prepared.scans[i].prepared()) {
+            const Stopwatch clock;
+            const ThreadCpuStopwatch cpu_clock;
+            submaps[i] = registration::CompactPreparedScan(
+                registration::PrepareSubmap(i, poses, path_m, load, reduction));
+            prepared.prepare_seconds[i] += clock.Seconds();
+            prepared.prepare_cpu_seconds[i] += cpu_clock.Seconds();
+        }
+        const std::size_t finished = ++done;
+        if (progress) progress("submaps", finished, submaps.size());
+    });
+    prepared.scans = std::move(submaps);
+}
+
+bool SubmapsApply(const registration::ScanReductionConfig& reduction,
+                  const std::vector<core::StampedPose>& poses, std::size_t scans,
+                  std::string& note) {
+    if (reduction.submap_path_m <= 0.0 || reduction.submap_max_scans == 0) return false;
+    if (poses.size() != scans) {
+        note =
+            "no submaps (verification.reduction.submap_path_m): the scans have no poses; "
+            "give --odometry FILE to register against a scan and its neighbours";
+        return false;
+    }
+    return true;
 }
 
 pipeline::VerificationTimes VerifyAll(std::vector<pipeline::LoopQuery>& queries,

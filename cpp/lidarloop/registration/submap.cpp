@@ -77,4 +77,21 @@ core::PointCloud MergeIntoFrame(const std::vector<core::PointCloud>& scans,
     return merged;
 }
 
+PreparedScan PrepareSubmap(std::size_t centre, const std::vector<core::StampedPose>& poses,
+                           const std::vector<double>& path_m,
+                           const std::function<core::PointCloud(std::size_t)>& load,
+                           const ScanReductionConfig& config) {
+    const SubmapWindow window{config.submap_path_m, config.submap_max_scans, false};
+    const std::vector<std::size_t> members = SubmapMembers(path_m, centre, window);
+    if (members.size() == 1) return PrepareScan(load(centre), config);
+    std::vector<core::PointCloud> scans;
+    std::vector<core::Transform> T_world_scans;
+    for (const std::size_t k : members) {
+        scans.push_back(load(k));
+        T_world_scans.push_back(poses.at(k).T_world_sensor);
+    }
+    return PrepareScan(
+        MergeIntoFrame(scans, T_world_scans, poses.at(centre).T_world_sensor, config), config);
+}
+
 }  // namespace lidarloop::registration

@@ -1,9 +1,11 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <vector>
 
 #include "lidarloop/core/point_cloud.hpp"
+#include "lidarloop/registration/prepared_scan.hpp"
 #include "lidarloop/registration/verification_config.hpp"
 
 namespace lidarloop::registration {
@@ -36,5 +38,15 @@ core::PointCloud MergeIntoFrame(const std::vector<core::PointCloud>& scans,
                                 const std::vector<core::Transform>& T_world_scans,
                                 const core::Transform& T_world_centre,
                                 const ScanReductionConfig& config);
+
+/// Scan `centre` prepared for registration together with its neighbours (PrepareScan of
+/// MergeIntoFrame over SubmapMembers, window from config.submap_path_m and submap_max_scans),
+/// in centre's sensor frame, so that a registration against it is still the pose between the
+/// two scans' frames. `path_m` from SubmapPathM(poses); `load(k)` reads scan k (an empty cloud
+/// for one that cannot be read). Only the scan itself when the window is 0 or it has no pose.
+PreparedScan PrepareSubmap(std::size_t centre, const std::vector<core::StampedPose>& poses,
+                           const std::vector<double>& path_m,
+                           const std::function<core::PointCloud(std::size_t)>& load,
+                           const ScanReductionConfig& config);
 
 }  // namespace lidarloop::registration
