@@ -36,24 +36,25 @@ void PrepareSubmaps(const io::Dataset& dataset, const std::vector<core::StampedP
                     const Progress& progress) {
     const std::vector<double> path_m = registration::SubmapPathM(poses);
     // A scan skipped while describing could not be read: it adds nothing to its neighbours.
+    // Noted before the scans are replaced in place (one copy of the store, not two).
+    std::vector<char> readable(prepared.scans.size());
+    for (std::size_t k = 0; k < readable.size(); ++k) readable[k] = prepared.scans[k].prepared();
     const auto load = [&](std::size_t k) {
-        return prepared.scans.at(k).prepared() ? dataset.LoadScan(k) : core::PointCloud{};
+        return readable.at(k) != 0 ? dataset.LoadScan(k) : core::PointCloud{};
     };
-    std::vector<registration::CompactPreparedScan> submaps(prepared.scans.size());
     std::atomic<std::size_t> done{0};
-    tbb::parallel_for(std::size_t{0}, submaps.size(), [&](std::size_t i) {
-        if (prepared.scans[i].prepared()) {
+    tbb::parallel_for(std::size_t{0}, readable.size(), [&](std::size_t i) {
+        if (readable[i] != 0) {
             const Stopwatch clock;
             const ThreadCpuStopwatch cpu_clock;
-            submaps[i] = registration::CompactPreparedScan(
+            prepared.scans[i] = registration::CompactPreparedScan(
                 registration::PrepareSubmap(i, poses, path_m, load, reduction));
             prepared.prepare_seconds[i] += clock.Seconds();
             prepared.prepare_cpu_seconds[i] += cpu_clock.Seconds();
         }
         const std::size_t finished = ++done;
-        if (progress) progress("submaps", finished, submaps.size());
+        if (progress) progress("submaps", finished, readable.size());
     });
-    prepared.scans = std::move(submaps);
 }
 
 bool SubmapsApply(const registration::ScanReductionConfig& reduction,
