@@ -182,7 +182,10 @@ pipeline::SequenceDescriptors DescribeAndPrepare(const io::Dataset& dataset,
     DescribeRun run{
         "describing", request.skip_bad, pipeline::Execution::kParallel, request.progress, {}};
     if (config.detection.verify) {
-        run.with_cloud = prepared.Collector(config.detection.verification.reduction);
+        // With submaps a scan alone is never verified: only which scans were read matters.
+        const auto& reduction = config.detection.verification.reduction;
+        run.with_cloud =
+            reduction.submap_path_m > 0.0 ? prepared.ReadMarker() : prepared.Collector(reduction);
     }
     return DescribeDataset(dataset, config.descriptor, run);
 }

@@ -20,7 +20,12 @@ std::function<void(std::size_t, const core::PointCloud&)> PreparedScans::Collect
             registration::CompactPreparedScan(registration::PrepareScan(cloud, reduction));
         prepare_seconds.at(i) = clock.Seconds();
         prepare_cpu_seconds.at(i) = cpu_clock.Seconds();
+        readable.at(i) = 1;
     };
+}
+
+std::function<void(std::size_t, const core::PointCloud&)> PreparedScans::ReadMarker() {
+    return [this](std::size_t i, const core::PointCloud&) { readable.at(i) = 1; };
 }
 
 std::vector<double> PreparedScans::BytesPerScan() const {
@@ -36,9 +41,7 @@ void PrepareSubmaps(const io::Dataset& dataset, const std::vector<core::StampedP
                     const Progress& progress) {
     const std::vector<double> path_m = registration::SubmapPathM(poses);
     // A scan skipped while describing could not be read: it adds nothing to its neighbours.
-    // Noted before the scans are replaced in place (one copy of the store, not two).
-    std::vector<char> readable(prepared.scans.size());
-    for (std::size_t k = 0; k < readable.size(); ++k) readable[k] = prepared.scans[k].prepared();
+    const std::vector<char>& readable = prepared.readable;
     const auto load = [&](std::size_t k) {
         return readable.at(k) != 0 ? dataset.LoadScan(k) : core::PointCloud{};
     };

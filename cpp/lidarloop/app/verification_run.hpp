@@ -24,21 +24,28 @@ struct PreparedScans {
     std::vector<registration::CompactPreparedScan> scans;
     std::vector<double> prepare_seconds;      ///< per scan, wall time
     std::vector<double> prepare_cpu_seconds;  ///< per scan, thread CPU time
+    std::vector<char> readable;               ///< per scan, 1 when it was read
 
     explicit PreparedScans(std::size_t count)
-        : scans(count), prepare_seconds(count, 0.0), prepare_cpu_seconds(count, 0.0) {}
+        : scans(count),
+          prepare_seconds(count, 0.0),
+          prepare_cpu_seconds(count, 0.0),
+          readable(count, 0) {}
 
     /// A DescribeRun::with_cloud callback that prepares scan i into scans[i] (thread-safe for
     /// distinct scans). The callback refers to this object and `reduction`.
     std::function<void(std::size_t, const core::PointCloud&)> Collector(
         const registration::ScanReductionConfig& reduction);
+    /// One that only notes which scans were read: with submaps (PrepareSubmaps) a scan alone is
+    /// never verified, so it is not prepared alone first.
+    std::function<void(std::size_t, const core::PointCloud&)> ReadMarker();
     /// Heap bytes of the prepared scans, per scan (skipped scans excluded).
     std::vector<double> BytesPerScan() const;
 };
 
 /// Prepares every scan again as its submap (registration::PrepareSubmap with `reduction`'s
 /// window) from the scans of `dataset` placed by `poses` (one per scan), in parallel, telling
-/// `progress` as stage "submaps". Scans skipped while describing (not prepared) stay empty and
+/// `progress` as stage "submaps". Scans skipped while describing (not `readable`) stay empty and
 /// join no submap. The pair times of verification then include the larger scans.
 void PrepareSubmaps(const io::Dataset& dataset, const std::vector<core::StampedPose>& poses,
                     const registration::ScanReductionConfig& reduction, PreparedScans& prepared,
