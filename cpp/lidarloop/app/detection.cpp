@@ -31,7 +31,10 @@ void RequireTimesForSeconds(const io::RunConfig& config, const io::Dataset& data
 // The poses of the scans: the odometry when given, else the dataset's poses; empty when there
 // are neither. The path a gap in metres is measured on, and what places submaps.
 std::vector<core::StampedPose> PosesOfScans(const DetectRequest& request,
-                                            const io::Dataset& dataset);
+                                            const io::Dataset& dataset) {
+    if (request.odometry_file.empty() && request.odometry_topic.empty()) return dataset.poses();
+    return ReadOdometry(request.odometry_file, request.odometry_topic, dataset);
+}
 
 // Per scan, the path travelled along `poses` (core::CumulativePathM); empty when there are none
 // (ConfigError when the gap is in metres).
@@ -80,12 +83,6 @@ std::vector<core::StampedPose> ReadOdometry(const std::filesystem::path& file,
 }
 
 namespace {
-
-std::vector<core::StampedPose> PosesOfScans(const DetectRequest& request,
-                                            const io::Dataset& dataset) {
-    if (request.odometry_file.empty() && request.odometry_topic.empty()) return dataset.poses();
-    return ReadOdometry(request.odometry_file, request.odometry_topic, dataset);
-}
 
 // The configuration a run applies: without poses no submaps, said in `notes` (and config.yaml
 // and database.scans record the scans as prepared alone).
