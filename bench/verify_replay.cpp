@@ -4,6 +4,9 @@
 // (docs/BENCHMARK.md): same decisions and poses, time per pair. Run:
 //   taskset -c 1 ./build/bench/verify_replay RUN [--config FILE] [--compact]
 //                                            [--pairs-csv FILE [--poses FILE]]
+//                                            [--submap-scans DIR --submap-poses FILE
+//                                             --submap-window-m M [--submap-max-scans N]
+//                                             [--submap-query past|full]]
 // RUN_FOLDER holds database.scans, candidates.csv and config.yaml (detect with verification on);
 // --config verifies with another configuration, --compact with the scans kept compact (the
 // match expanded in the timed step, as detect does), --pairs-csv writes one line per pair (verdict,
@@ -13,6 +16,11 @@
 // the hypotheses ICP refined, and the rank of the hypothesis the registered pose came from) and,
 // with --poses (KITTI or TUM, T_world_sensor, one per scan), the true distance, the overlap at the
 // true pose and the registered pose's error against it (metres, degrees).
+// --submap-*: each match is the scan merged with its neighbours within M metres of path (at most
+// N a side), placed by the poses given (odometry: the ground truth is for scoring only) and
+// prepared as one scan from the raw scans in DIR; --submap-query merges the query's past alike
+// (past) or both sides as the match (full: offline, all scans exist).
+// The question of issue 24: whether a denser match side closes the sparse revisits.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -28,9 +36,11 @@
 
 #include "lidarloop/app/results_folder.hpp"
 #include "lidarloop/io/config_yaml.hpp"
+#include "lidarloop/io/dataset.hpp"
 #include "lidarloop/io/poses.hpp"
 #include "lidarloop/io/prepared_scans_file.hpp"
 #include "lidarloop/registration/compact_prepared_scan.hpp"
+#include "lidarloop/registration/submap.hpp"
 #include "lidarloop/registration/verification.hpp"
 
 namespace {
@@ -207,9 +217,74 @@ private:
     std::vector<registration::CompactPreparedScan> compact_;
 };
 
+// Scans prepared from their submaps (see the header), each once, and the time that took.
+class SubmapSource {
+public:
+    SubmapSource(const std::filesystem::path& scans, const std::filesystem::path& poses,
+                 const registration::SubmapWindow& window,
+                 const registration::ScanReductionConfig& reduction)
+        : dataset_(io::OpenDataset(scans)),
+          poses_(io::ReadPoses(poses)),
+          path_m_(registration::SubmapPathM(poses_)),
+          window_(window),
+          reduction_(reduction) {
+        if (poses_.size() != dataset_.size())
+            throw std::runtime_error("--submap-poses: not one pose per scan");
+    }
+    registration::PreparedScan At(std::size_t i, bool past_only) {
+        auto& cache = past_only ? past_ : both_;
+        if (const auto it = cache.find(i); it != cache.end()) return it->second;
+        const app::ThreadCpuStopwatch clock;
+        registration::SubmapWindow window = window_;
+        window.past_only = past_only;
+        std::vector<core::PointCloud> scans;
+        std::vector<core::Transform> T_world_scans;
+        for (const std::size_t k : registration::SubmapMembers(path_m_, i, window)) {
+            scans.push_back(dataset_.LoadScan(k));
+            T_world_scans.push_back(poses_[k].T_world_sensor);
+        }
+        members_.push_back(static_cast<double>(scans.size()));
+        const registration::PreparedScan prepared = registration::PrepareScan(
+            scans.size() == 1 ? scans.front()
+                              : registration::MergeIntoFrame(scans, T_world_scans,
+                                                             poses_[i].T_world_sensor, reduction_),
+            reduction_);
+        prepare_ms_.push_back(1e3 * clock.Seconds());
+        return cache.emplace(i, prepared).first->second;
+    }
+    void Report() const {
+        std::printf(
+            "  submaps: %zu prepared, scans per submap median %.0f, prepare median %.1f ms\n",
+            prepare_ms_.size(), app::Quantile(members_, 0.5), app::Quantile(prepare_ms_, 0.5));
+    }
+
+private:
+    io::Dataset dataset_;
+    std::vector<core::StampedPose> poses_;
+    std::vector<double> path_m_;
+    registration::SubmapWindow window_;
+    registration::ScanReductionConfig reduction_;
+    std::map<std::size_t, registration::PreparedScan> both_, past_;
+    std::vector<double> members_, prepare_ms_;
+};
+
+// Where the replay takes a scan from: the run's stored scans, or a submap.
+struct Sources {
+    const ScanSource& stored;
+    SubmapSource* submaps = nullptr;  // nullptr: stored scans only
+    bool query_submap = false;
+    bool query_past_only = true;
+    registration::PreparedScan Query(std::size_t i) const {
+        return submaps != nullptr && query_submap ? submaps->At(i, query_past_only) : stored.At(i);
+    }
+    registration::PreparedScan Match(std::size_t j) const {
+        return submaps != nullptr ? submaps->At(j, false) : stored.At(j);
+    }
+};
+
 void Replay(const std::filesystem::path& run, const registration::VerificationConfig& config,
             const std::filesystem::path& pairs_csv, const std::vector<core::StampedPose>& poses,
-            bool compact) {
+            bool compact, SubmapSource* submaps, bool query_submap, bool query_past_only) {
     std::ofstream pairs;
     if (!pairs_csv.empty()) {
         pairs.open(pairs_csv);
@@ -224,7 +299,8 @@ void Replay(const std::filesystem::path& run, const registration::VerificationCo
                  "result_hypothesis\n";
     }
     io::StoredPreparedScans stored = io::LoadPreparedScans(run / "database.scans");
-    const ScanSource scans(std::move(stored.scans), compact);
+    const ScanSource stored_scans(std::move(stored.scans), compact);
+    const Sources scans{stored_scans, submaps, query_submap, query_past_only};
     if (!(stored.reduction == config.reduction))
         std::printf("note: the scans were reduced with another configuration than --config's\n");
     const std::vector<Candidate> candidates = ReadCandidates(run / "candidates.csv");
@@ -235,13 +311,13 @@ void Replay(const std::filesystem::path& run, const registration::VerificationCo
     for (const Candidate& candidate : candidates) {
         if (query_index != candidate.query) {
             const app::ThreadCpuStopwatch clock;
-            query = scans.At(candidate.query);
+            query = scans.Query(candidate.query);
             if (query.structure) coarse.emplace(*query.structure, config.coarse);
             tally.query_ms.push_back(1e3 * clock.Seconds());
             query_index = candidate.query;
         }
         const app::ThreadCpuStopwatch clock;
-        const registration::PreparedScan match = scans.At(candidate.match);
+        const registration::PreparedScan match = scans.Match(candidate.match);
         if (!query.structure || !match.structure) continue;
         const registration::Verification now = registration::Verify(query, *coarse, match, config);
         tally.pair_ms.push_back(1e3 * clock.Seconds());
@@ -280,13 +356,15 @@ void Replay(const std::filesystem::path& run, const registration::VerificationCo
         "images per query median %.3f ms\n",
         app::Quantile(tally.pair_ms, 0.5), app::Quantile(tally.pair_ms, 0.95), Mean(tally.pair_ms),
         app::Quantile(tally.query_ms, 0.5));
+    if (submaps != nullptr) submaps->Report();
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-    std::filesystem::path run, config_file, pairs_csv, poses_file;
-    bool compact = false;
+    std::filesystem::path run, config_file, pairs_csv, poses_file, submap_scans, submap_poses;
+    registration::SubmapWindow window{0.0, 1000, false};
+    bool compact = false, query_submap = false, query_past_only = true;
     for (int i = 1; i < argc; ++i) {
         const std::string argument = argv[i];
         if (argument == "--compact") {
@@ -297,6 +375,18 @@ int main(int argc, char** argv) {
             pairs_csv = argv[++i];
         } else if (argument == "--poses" && i + 1 < argc) {
             poses_file = argv[++i];
+        } else if (argument == "--submap-scans" && i + 1 < argc) {
+            submap_scans = argv[++i];
+        } else if (argument == "--submap-poses" && i + 1 < argc) {
+            submap_poses = argv[++i];
+        } else if (argument == "--submap-window-m" && i + 1 < argc) {
+            window.path_m = std::stod(argv[++i]);
+        } else if (argument == "--submap-max-scans" && i + 1 < argc) {
+            window.max_scans = std::stoi(argv[++i]);
+        } else if (argument == "--submap-query" && i + 1 < argc) {
+            // past: the query's past only (online); full: both sides, as the match (offline).
+            query_submap = true;
+            query_past_only = std::string(argv[++i]) != "full";
         } else if (run.empty() && argument.rfind("--", 0) != 0) {
             run = argument;
         } else {
@@ -307,7 +397,9 @@ int main(int argc, char** argv) {
     if (run.empty()) {
         std::fprintf(
             stderr,
-            "usage: %s RUN_FOLDER [--config FILE] [--compact] [--pairs-csv FILE [--poses FILE]]\n",
+            "usage: %s RUN_FOLDER [--config FILE] [--compact] [--pairs-csv FILE [--poses FILE]]\n"
+            "       [--submap-scans DIR --submap-poses FILE --submap-window-m M\n"
+            "        [--submap-max-scans N] [--submap-query past|full]]\n",
             argv[0]);
         return 2;
     }
@@ -316,7 +408,13 @@ int main(int argc, char** argv) {
             io::LoadConfigYaml(config_file.empty() ? run / "config.yaml" : config_file);
         const std::vector<core::StampedPose> poses =
             poses_file.empty() ? std::vector<core::StampedPose>{} : io::ReadPoses(poses_file);
-        Replay(run, config.detection.verification, pairs_csv, poses, compact);
+        std::optional<SubmapSource> submaps;
+        if (!submap_scans.empty()) {
+            submaps.emplace(submap_scans, submap_poses, window,
+                            config.detection.verification.reduction);
+        }
+        Replay(run, config.detection.verification, pairs_csv, poses, compact,
+               submaps ? &*submaps : nullptr, query_submap, query_past_only);
     } catch (const std::exception& error) {
         std::fprintf(stderr, "verify_replay: %s\n", error.what());
         return 1;

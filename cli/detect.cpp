@@ -80,6 +80,7 @@ void PrintOutcome(const io::Dataset& dataset, const app::DetectRequest& request,
                                : "(loops.csv, candidates.csv, database.lldb, config.yaml, "
                                  "timings.json; no similarity matrix: it would exceed "
                                  "output.similarity_matrix_mib)\n");
+    for (const std::string& note : outcome.notes) std::cerr << "lidarloop detect: " << note << '\n';
 }
 
 // The map and its database.scans beside it are inputs too.

@@ -43,6 +43,7 @@
 #include "lidarloop/registration/icp.hpp"
 #include "lidarloop/registration/point_tree.hpp"
 #include "lidarloop/registration/prepared_scan.hpp"
+#include "lidarloop/registration/submap.hpp"
 #include "lidarloop/registration/verification.hpp"
 #include "lidarloop/registration/verification_config.hpp"
 

@@ -28,16 +28,19 @@ void RequireTimesForSeconds(const io::RunConfig& config, const io::Dataset& data
     }
 }
 
-// Per scan, the path travelled (core::CumulativePathM): on the odometry when given, else on the
-// dataset's poses; empty when there are neither (ConfigError when the gap is in metres).
-std::vector<double> PathOfScans(const DetectRequest& request, const io::Dataset& dataset) {
-    std::vector<double> path_m;
-    if (!request.odometry_file.empty() || !request.odometry_topic.empty()) {
-        path_m = core::CumulativePathM(
-            ReadOdometry(request.odometry_file, request.odometry_topic, dataset));
-    } else if (dataset.HasPoses()) {
-        path_m = core::CumulativePathM(dataset.poses());
-    }
+// The poses of the scans: the odometry when given, else the dataset's poses; empty when there
+// are neither. The path a gap in metres is measured on, and what places submaps.
+std::vector<core::StampedPose> PosesOfScans(const DetectRequest& request,
+                                            const io::Dataset& dataset) {
+    if (request.odometry_file.empty() && request.odometry_topic.empty()) return dataset.poses();
+    return ReadOdometry(request.odometry_file, request.odometry_topic, dataset);
+}
+
+// Per scan, the path travelled along `poses` (core::CumulativePathM); empty when there are none
+// (ConfigError when the gap is in metres).
+std::vector<double> PathOfScans(const DetectRequest& request, const io::Dataset& dataset,
+                                const std::vector<core::StampedPose>& poses) {
+    std::vector<double> path_m = core::CumulativePathM(poses);
     if (path_m.empty() && request.config.detection.min_gap.unit == core::MinGap::Unit::kMetres) {
         throw core::ConfigError("a minimum gap in metres needs the path travelled, and " +
                                 dataset.root().string() +
@@ -78,6 +81,34 @@ std::vector<core::StampedPose> ReadOdometry(const std::filesystem::path& file,
     for (std::size_t i = 0; i < times_s.size(); ++i) times_s[i] = dataset.ScanTime(i);
     return io::ReadBagOdometry(dataset.root(), topic, times_s, max_step_m);
 }
+
+namespace {
+
+// The configuration a run applies: without poses no submaps, said in `notes` (and config.yaml
+// and database.scans record the scans as prepared alone).
+io::RunConfig EffectiveConfig(const io::RunConfig& config, const io::Dataset& dataset,
+                              const std::vector<core::StampedPose>& poses,
+                              std::vector<std::string>& notes) {
+    io::RunConfig effective = config;
+    std::string note;
+    auto& reduction = effective.detection.verification.reduction;
+    if (effective.detection.verify && !SubmapsApply(reduction, poses, dataset.size(), note)) {
+        if (!note.empty()) notes.push_back(note);
+        reduction.submap_path_m = 0.0;
+    }
+    return effective;
+}
+
+// With submaps, replaces each prepared scan by its submap.
+void PrepareSubmapsIfAsked(const io::Dataset& dataset, const io::RunConfig& config,
+                           const std::vector<core::StampedPose>& poses,
+                           const DetectRequest& request, PreparedScans& prepared) {
+    const auto& reduction = config.detection.verification.reduction;
+    if (!config.detection.verify || reduction.submap_path_m <= 0.0) return;
+    PrepareSubmaps(dataset, poses, reduction, prepared, request.progress);
+}
+
+}  // namespace
 
 std::string OdometryName(const std::filesystem::path& file, const std::string& topic,
                          const io::Dataset& dataset) {
@@ -121,7 +152,12 @@ std::vector<registration::PreparedScan> MapScansFor(LoadedMap& map,
                                 "detect` (which verifies by default), or localise with "
                                 "--no-verify");
     }
-    if (map.scans->reduction != detection.verification.reduction) {
+    // Whether the map's scans are submaps is the map's affair: the queries are prepared as
+    // submaps when their own poses allow, and a scan registers to a submap in its frame.
+    registration::ScanReductionConfig reduction = detection.verification.reduction;
+    reduction.submap_path_m = map.scans->reduction.submap_path_m;
+    reduction.submap_max_scans = map.scans->reduction.submap_max_scans;
+    if (map.scans->reduction != reduction) {
         throw core::ConfigError("verification.reduction differs from the one " +
                                 scans_file.string() +
                                 " was made with; localise with the map's (its config.yaml)");
@@ -143,7 +179,10 @@ pipeline::SequenceDescriptors DescribeAndPrepare(const io::Dataset& dataset,
     DescribeRun run{
         "describing", request.skip_bad, pipeline::Execution::kParallel, request.progress, {}};
     if (config.detection.verify) {
-        run.with_cloud = prepared.Collector(config.detection.verification.reduction);
+        // With submaps a scan alone is never verified: only which scans were read matters.
+        const auto& reduction = config.detection.verification.reduction;
+        run.with_cloud =
+            reduction.submap_path_m > 0.0 ? prepared.ReadMarker() : prepared.Collector(reduction);
     }
     return DescribeDataset(dataset, config.descriptor, run);
 }
@@ -151,12 +190,14 @@ pipeline::SequenceDescriptors DescribeAndPrepare(const io::Dataset& dataset,
 }  // namespace
 
 DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request) {
-    const io::RunConfig& config = request.config;
-    config.Validate();
+    request.config.Validate();
+    const std::vector<core::StampedPose> poses = PosesOfScans(request, dataset);
+    DetectOutcome outcome;
+    const io::RunConfig config = EffectiveConfig(request.config, dataset, poses, outcome.notes);
     const double threshold = config.detection.ThresholdFor(config.descriptor.method);
     pipeline::MethodOf(config.descriptor.method).ValidateThreshold(threshold);
     RequireTimesForSeconds(config, dataset);
-    const std::vector<double> path_m = PathOfScans(request, dataset);
+    const std::vector<double> path_m = PathOfScans(request, dataset, poses);
     const std::filesystem::path out_dir = PrepareOutputFolder(request.out);
     io::WriteConfigYaml(out_dir / "config.yaml", config);
 
@@ -166,12 +207,12 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     PreparedScans prepared(verify ? dataset.size() : 0);
     const pipeline::SequenceDescriptors described =
         DescribeAndPrepare(dataset, config, request, prepared);
+    PrepareSubmapsIfAsked(dataset, config, poses, request, prepared);
     const double describe_s = describe_clock.Seconds();
 
     // All pairs either way; the matrix only when it fits the budget (same results without).
     Stopwatch matrix_clock;
     std::optional<pipeline::SimilarityMatrix> matrix;
-    DetectOutcome outcome;
     outcome.threshold = threshold;
     outcome.path_m = path_m;
     if (config.output.KeepsSimilarityMatrix(dataset.size())) {
@@ -221,7 +262,9 @@ LoadedMap LoadMap(const std::filesystem::path& file) {
 
 DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const DetectRequest& request) {
     Stopwatch total;
-    io::RunConfig config = request.config;
+    const std::vector<core::StampedPose> poses = PosesOfScans(request, dataset);
+    DetectOutcome outcome;
+    io::RunConfig config = EffectiveConfig(request.config, dataset, poses, outcome.notes);
     if (!config.detection.threshold) config.detection.threshold = map.detection.threshold;
     config.Validate();
     if (config.descriptor != map.database.config()) {
@@ -238,8 +281,8 @@ DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const Detec
     PreparedScans prepared(verify ? dataset.size() : 0);
     const pipeline::SequenceDescriptors described =
         DescribeAndPrepare(dataset, config, request, prepared);
+    PrepareSubmapsIfAsked(dataset, config, poses, request, prepared);
     Stopwatch query_clock;
-    DetectOutcome outcome;
     outcome.queries = pipeline::LocaliseSequence(detector, described.database,
                                                  pipeline::Execution::kParallel, prepared.scans);
     const double query_s = query_clock.Seconds();

@@ -37,6 +37,8 @@ struct DetectOutcome {
     /// Per scan, the path travelled (core::CumulativePathM of the odometry or the poses), which
     /// loops.csv's path_m is taken from; empty when neither is known and when localising.
     std::vector<double> path_m;
+    /// What the run could not do as configured, e.g. submaps without poses.
+    std::vector<std::string> notes;
     double total_s = 0.0;
 };
 

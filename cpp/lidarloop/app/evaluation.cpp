@@ -196,6 +196,20 @@ std::optional<LearntThreshold> TrainingThresholdOf(const EvaluationRequest& requ
         criterion == eval::Criterion::kMcc ? result.pairwise.best_mcc : result.pairwise.best_f1};
 }
 
+// The configuration evaluate applies: each scan verified alone. Submaps would be placed by the
+// dataset's poses, which are the ground truth scored against here, and would flatter the
+// verified recall; detect and optimise build them from odometry (--odometry).
+io::RunConfig WithoutSubmaps(io::RunConfig config, std::vector<std::string>& notes) {
+    auto& reduction = config.detection.verification.reduction;
+    if (config.detection.verify && reduction.submap_path_m > 0.0) {
+        notes.push_back(
+            "verification without submaps (verification.reduction.submap_path_m): the poses are "
+            "the ground truth; `lidarloop detect --odometry FILE` verifies with them");
+    }
+    reduction.submap_path_m = 0.0;
+    return config;
+}
+
 // Scans prepared for verification once per evaluation: while the first method describes them.
 struct VerificationState {
     std::optional<PreparedScans> prepared;
@@ -277,7 +291,8 @@ void WriteEvaluationResults(const std::filesystem::path& out_dir, const io::Data
     WriteJson(out_dir / "metrics.json",
               EvaluationMetricsJson(dataset.root().string(), dataset.size(), outcome));
     WriteCurveCsvs(out_dir, outcome.methods);
-    outcome.notes = WriteFigures(out_dir, truth, outcome.methods);
+    std::vector<std::string> notes = WriteFigures(out_dir, truth, outcome.methods);
+    outcome.notes.insert(outcome.notes.begin(), notes.begin(), notes.end());
     for (const MethodEvaluation& e : outcome.methods) {
         if (e.optimum_exact) continue;
         outcome.notes.push_back(
@@ -419,7 +434,7 @@ EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequ
     EvaluationOutcome outcome{
         eval::BuildGroundTruth(dataset.poses(), GroundTruthRule(request)), {}, {}};
     const std::filesystem::path out_dir = PrepareOutputFolder(request.out);
-    io::WriteConfigYaml(out_dir / "config.yaml", request.config);
+    io::WriteConfigYaml(out_dir / "config.yaml", WithoutSubmaps(request.config, outcome.notes));
     VerificationState verification;
     if (request.config.detection.verify) verification.prepared.emplace(dataset.size());
     for (core::Method method : request.methods) {

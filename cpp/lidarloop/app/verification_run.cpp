@@ -1,9 +1,13 @@
 #include "lidarloop/app/verification_run.hpp"
 
+#include <atomic>
 #include <cmath>
+
+#include <tbb/parallel_for.h>
 
 #include "lidarloop/app/results_folder.hpp"
 #include "lidarloop/io/scan_reader.hpp"
+#include "lidarloop/registration/submap.hpp"
 
 namespace lidarloop::app {
 
@@ -16,7 +20,12 @@ std::function<void(std::size_t, const core::PointCloud&)> PreparedScans::Collect
             registration::CompactPreparedScan(registration::PrepareScan(cloud, reduction));
         prepare_seconds.at(i) = clock.Seconds();
         prepare_cpu_seconds.at(i) = cpu_clock.Seconds();
+        readable.at(i) = 1;
     };
+}
+
+std::function<void(std::size_t, const core::PointCloud&)> PreparedScans::ReadMarker() {
+    return [this](std::size_t i, const core::PointCloud&) { readable.at(i) = 1; };
 }
 
 std::vector<double> PreparedScans::BytesPerScan() const {
@@ -25,6 +34,43 @@ std::vector<double> PreparedScans::BytesPerScan() const {
         if (scan.prepared()) bytes.push_back(static_cast<double>(scan.MemoryBytes()));
     }
     return bytes;
+}
+
+void PrepareSubmaps(const io::Dataset& dataset, const std::vector<core::StampedPose>& poses,
+                    const registration::ScanReductionConfig& reduction, PreparedScans& prepared,
+                    const Progress& progress) {
+    const std::vector<double> path_m = registration::SubmapPathM(poses);
+    // A scan skipped while describing could not be read: it adds nothing to its neighbours.
+    const std::vector<char>& readable = prepared.readable;
+    const auto load = [&](std::size_t k) {
+        return readable.at(k) != 0 ? dataset.LoadScan(k) : core::PointCloud{};
+    };
+    std::atomic<std::size_t> done{0};
+    tbb::parallel_for(std::size_t{0}, readable.size(), [&](std::size_t i) {
+        if (readable[i] != 0) {
+            const Stopwatch clock;
+            const ThreadCpuStopwatch cpu_clock;
+            prepared.scans[i] = registration::CompactPreparedScan(
+                registration::PrepareSubmap(i, poses, path_m, load, reduction));
+            prepared.prepare_seconds[i] += clock.Seconds();
+            prepared.prepare_cpu_seconds[i] += cpu_clock.Seconds();
+        }
+        const std::size_t finished = ++done;
+        if (progress) progress("submaps", finished, readable.size());
+    });
+}
+
+bool SubmapsApply(const registration::ScanReductionConfig& reduction,
+                  const std::vector<core::StampedPose>& poses, std::size_t scans,
+                  std::string& note) {
+    if (reduction.submap_path_m <= 0.0 || reduction.submap_max_scans == 0) return false;
+    if (poses.size() != scans) {
+        note =
+            "no submaps (verification.reduction.submap_path_m): the scans have no poses; "
+            "give --odometry FILE to register against a scan and its neighbours";
+        return false;
+    }
+    return true;
 }
 
 pipeline::VerificationTimes VerifyAll(std::vector<pipeline::LoopQuery>& queries,

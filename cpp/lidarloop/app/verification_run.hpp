@@ -3,12 +3,14 @@
 #include <cstddef>
 #include <filesystem>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "lidarloop/app/progress.hpp"
 #include "lidarloop/core/point_cloud.hpp"
+#include "lidarloop/io/dataset.hpp"
 #include "lidarloop/pipeline/candidate_verification.hpp"
 #include "lidarloop/registration/compact_prepared_scan.hpp"
 #include "lidarloop/registration/prepared_scan.hpp"
@@ -22,17 +24,38 @@ struct PreparedScans {
     std::vector<registration::CompactPreparedScan> scans;
     std::vector<double> prepare_seconds;      ///< per scan, wall time
     std::vector<double> prepare_cpu_seconds;  ///< per scan, thread CPU time
+    std::vector<char> readable;               ///< per scan, 1 when it was read
 
     explicit PreparedScans(std::size_t count)
-        : scans(count), prepare_seconds(count, 0.0), prepare_cpu_seconds(count, 0.0) {}
+        : scans(count),
+          prepare_seconds(count, 0.0),
+          prepare_cpu_seconds(count, 0.0),
+          readable(count, 0) {}
 
     /// A DescribeRun::with_cloud callback that prepares scan i into scans[i] (thread-safe for
     /// distinct scans). The callback refers to this object and `reduction`.
     std::function<void(std::size_t, const core::PointCloud&)> Collector(
         const registration::ScanReductionConfig& reduction);
+    /// One that only notes which scans were read: with submaps (PrepareSubmaps) a scan alone is
+    /// never verified, so it is not prepared alone first.
+    std::function<void(std::size_t, const core::PointCloud&)> ReadMarker();
     /// Heap bytes of the prepared scans, per scan (skipped scans excluded).
     std::vector<double> BytesPerScan() const;
 };
+
+/// Prepares every scan again as its submap (registration::PrepareSubmap with `reduction`'s
+/// window) from the scans of `dataset` placed by `poses` (one per scan), in parallel, telling
+/// `progress` as stage "submaps". Scans skipped while describing (not `readable`) stay empty and
+/// join no submap. The pair times of verification then include the larger scans.
+void PrepareSubmaps(const io::Dataset& dataset, const std::vector<core::StampedPose>& poses,
+                    const registration::ScanReductionConfig& reduction, PreparedScans& prepared,
+                    const Progress& progress);
+
+/// Whether scans are prepared as submaps: the config asks for them and `poses` has one finite
+/// position per scan or more (odometry or the dataset's). `note` tells why not when asked for.
+bool SubmapsApply(const registration::ScanReductionConfig& reduction,
+                  const std::vector<core::StampedPose>& poses, std::size_t scans,
+                  std::string& note);
 
 /// pipeline::VerifyQueries over `queries`, telling `progress` as stage "verifying".
 pipeline::VerificationTimes VerifyAll(std::vector<pipeline::LoopQuery>& queries,

@@ -121,6 +121,9 @@ void VisitFields(registration::ScanReductionConfig& c, Visitor& v) {
     v.Field("max_plane_variation", c.max_plane_variation, "largest surface variation of a plane");
     v.Field("max_structure_points", c.max_structure_points, "structure points kept per scan");
     v.Field("max_ground_points", c.max_ground_points, "other (ground) points kept per scan");
+    v.Field("submap_path_m", c.submap_path_m,
+            "with poses: a scan merged with its neighbours this much path either side (0: off)");
+    v.Field("submap_max_scans", c.submap_max_scans, "neighbours merged per side, at most");
 }
 
 template <typename Visitor>

@@ -36,6 +36,8 @@ void ScanReductionConfig::Validate() const {
     RequireIn(max_plane_variation, 0.0, 1.0 / 3.0, "reduction.max_plane_variation");
     RequireIn(max_structure_points, 10, 1'000'000, "reduction.max_structure_points");
     RequireIn(max_ground_points, 10, 1'000'000, "reduction.max_ground_points");
+    RequireIn(submap_path_m, 0.0, 100.0, "reduction.submap_path_m");
+    RequireIn(submap_max_scans, 0, 1000, "reduction.submap_max_scans");
 }
 
 void CoarseConfig::Validate() const {

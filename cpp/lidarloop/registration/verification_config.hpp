@@ -21,6 +21,14 @@ struct ScanReductionConfig {
     int max_structure_points = 3000;
     /// Other points (mostly ground; they fix z, roll and pitch) kept at most.
     int max_ground_points = 600;
+    /// Submaps, when the scans' poses are known (odometry or the dataset's; offline runs only):
+    /// a scan is prepared merged with its neighbours within this much path on each side, metres,
+    /// placed by the poses in its own frame (registration::PrepareSubmap); 0: each scan alone.
+    /// One sparse scan holds too little structure to pin a pose; a few neighbours, which the
+    /// odometry places with little drift, give it (docs/verification.md, "Submaps"). [0, 100]
+    double submap_path_m = 5.0;
+    /// Neighbours per side at most, 0..1000: bounds the merge on a slow or standing platform.
+    int submap_max_scans = 30;
 
     /// Throws core::ConfigError naming the first invalid field (prefix "verification.").
     void Validate() const;

@@ -15,6 +15,7 @@
 #include "lidarloop/app/describe_run.hpp"
 #include "lidarloop/app/detection.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/io/config_yaml.hpp"
 #include "lidarloop/io/kitti_bin.hpp"
 #include "lidarloop/io/pose_graph_files.hpp"
 #include "lidarloop/io/poses.hpp"
@@ -23,6 +24,7 @@
 #include "lidarloop/io/results_csv.hpp"
 #include "lidarloop/pipeline/scancontext_method.hpp"
 #include "lidarloop/registration/compact_prepared_scan.hpp"
+#include "lidarloop/registration/submap.hpp"
 #include "lidarloop/registration/verification.hpp"
 #include "test_utils.hpp"
 
@@ -307,7 +309,8 @@ TEST_F(DetectionRun, VerifiesEveryCandidateAsRegisteringThePairAlone) {
     // Each sampled pair is registered twice more; detection's verification runs under the
     // sanitizers in ReportsProgressOfEveryScanAndEndsTheStage and the loops reader's test.
     LIDARLOOP_RELEASE_SUITE_ONLY();
-    const app::DetectRequest request = Request("verified", core::Method::kRange);
+    app::DetectRequest request = Request("verified", core::Method::kRange);
+    request.config.detection.verification.reduction.submap_path_m = 0.0;  // each scan alone
     const app::DetectOutcome outcome = app::RunDetect(*dataset_, request);
     const registration::VerificationConfig& config = request.config.detection.verification;
     std::size_t checked = 0, accepted = 0;
@@ -377,7 +380,7 @@ TEST_F(DetectionRun, ReportsProgressOfEveryScanAndEndsTheStage) {
         seen.insert(done);
     };
     app::RunDetect(*dataset_, request);
-    EXPECT_EQ(stages, (std::set<std::string>{"describing", "verifying"}));
+    EXPECT_EQ(stages, (std::set<std::string>{"describing", "submaps", "verifying"}));
     EXPECT_EQ(seen.size(), dataset_->size());
     EXPECT_EQ(*seen.rbegin(), dataset_->size());
 }
@@ -477,6 +480,44 @@ TEST_F(DetectionRun, AGapInMetresWithoutPosesOrOdometryIsAClearError) {
         EXPECT_EQ(rows[r].size(), rows.front().size());
         EXPECT_EQ(rows[r].back(), "");
     }
+}
+
+// With poses every stored scan is its submap, placed by them; without, each scan is alone, the
+// run says so, and config.yaml and database.scans record it.
+TEST_F(DetectionRun, ScansAreSubmapsWhenThePosesAreKnown) {
+    app::DetectRequest request = Request("submaps", core::Method::kRange);
+    request.config.detection.top_k = 1;
+    const registration::ScanReductionConfig& reduction =
+        request.config.detection.verification.reduction;
+    const app::DetectOutcome outcome = app::RunDetect(*dataset_, request);
+    EXPECT_TRUE(outcome.notes.empty());
+    const io::StoredPreparedScans stored = io::LoadPreparedScans(request.out / "database.scans");
+    EXPECT_EQ(stored.reduction.submap_path_m, reduction.submap_path_m);
+    const std::vector<core::StampedPose>& poses = dataset_->poses();
+    const auto load = [this](std::size_t k) { return dataset_->LoadScan(k); };
+    for (const std::size_t i : {std::size_t{0}, std::size_t{77}, poses.size() - 1}) {
+        const registration::PreparedScan expected =
+            registration::CompactPreparedScan(
+                registration::PrepareSubmap(i, poses, registration::SubmapPathM(poses), load,
+                                            reduction))
+                .Expand();
+        const registration::PreparedScan kept = stored.scans.at(i);
+        EXPECT_EQ(kept.structure->size(), expected.structure->size()) << i;
+        EXPECT_EQ(kept.usable_points, expected.usable_points) << i;
+    }
+    EXPECT_GT(stored.scans.at(77).usable_points,
+              registration::PrepareScan(dataset_->LoadScan(77), reduction).usable_points);
+
+    std::filesystem::create_directories(dir_ / "bare" / "velodyne");
+    std::filesystem::copy(dir_ / "sequence" / "velodyne", dir_ / "bare" / "velodyne");
+    request.out = dir_ / "alone";
+    const app::DetectOutcome alone = app::RunDetect(io::OpenDataset(dir_ / "bare"), request);
+    ASSERT_EQ(alone.notes.size(), 1u);
+    EXPECT_TRUE(test::Contains(alone.notes.front(), "--odometry")) << alone.notes.front();
+    EXPECT_EQ(io::LoadPreparedScans(request.out / "database.scans").reduction.submap_path_m, 0.0);
+    EXPECT_EQ(io::LoadConfigYaml(request.out / "config.yaml")
+                  .detection.verification.reduction.submap_path_m,
+              0.0);
 }
 
 // optimise --loops reads a verified loops.csv with path_m, and one written before it existed.
