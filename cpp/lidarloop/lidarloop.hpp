@@ -57,6 +57,7 @@
 #include "lidarloop/pipeline/cumulative_histograms.hpp"
 #include "lidarloop/pipeline/descriptor_database.hpp"
 #include "lidarloop/pipeline/descriptor_method.hpp"
+#include "lidarloop/pipeline/expanded_scans.hpp"
 #include "lidarloop/pipeline/histogram_index.hpp"
 #include "lidarloop/pipeline/histogram_method.hpp"
 #include "lidarloop/pipeline/loop_detector.hpp"
