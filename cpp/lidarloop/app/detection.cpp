@@ -28,19 +28,22 @@ void RequireTimesForSeconds(const io::RunConfig& config, const io::Dataset& data
     }
 }
 
-// The poses of the scans: the odometry when given, else the dataset's poses; empty when there
-// are neither. The path a gap in metres is measured on, and what places submaps.
-std::vector<core::StampedPose> PosesOfScans(const DetectRequest& request,
-                                            const io::Dataset& dataset) {
-    if (request.odometry_file.empty() && request.odometry_topic.empty()) return dataset.poses();
+// The odometry of the scans when given (--odometry, --odometry-topic), else empty: what places
+// a scan's neighbours in its submap. Never the dataset's poses: in KITTI layout they are the
+// ground truth, and submaps placed by them would let the truth into the verification that is
+// then scored against it.
+std::vector<core::StampedPose> OdometryOfScans(const DetectRequest& request,
+                                               const io::Dataset& dataset) {
+    if (request.odometry_file.empty() && request.odometry_topic.empty()) return {};
     return ReadOdometry(request.odometry_file, request.odometry_topic, dataset);
 }
 
-// Per scan, the path travelled along `poses` (core::CumulativePathM); empty when there are none
-// (ConfigError when the gap is in metres).
+// Per scan, the path travelled (core::CumulativePathM): on the odometry when given, else on the
+// dataset's poses; empty when there are neither (ConfigError when the gap is in metres).
 std::vector<double> PathOfScans(const DetectRequest& request, const io::Dataset& dataset,
-                                const std::vector<core::StampedPose>& poses) {
-    std::vector<double> path_m = core::CumulativePathM(poses);
+                                const std::vector<core::StampedPose>& odometry) {
+    std::vector<double> path_m =
+        core::CumulativePathM(odometry.empty() && dataset.HasPoses() ? dataset.poses() : odometry);
     if (path_m.empty() && request.config.detection.min_gap.unit == core::MinGap::Unit::kMetres) {
         throw core::ConfigError("a minimum gap in metres needs the path travelled, and " +
                                 dataset.root().string() +
@@ -191,7 +194,7 @@ pipeline::SequenceDescriptors DescribeAndPrepare(const io::Dataset& dataset,
 
 DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request) {
     request.config.Validate();
-    const std::vector<core::StampedPose> poses = PosesOfScans(request, dataset);
+    const std::vector<core::StampedPose> poses = OdometryOfScans(request, dataset);
     DetectOutcome outcome;
     const io::RunConfig config = EffectiveConfig(request.config, dataset, poses, outcome.notes);
     const double threshold = config.detection.ThresholdFor(config.descriptor.method);
@@ -262,7 +265,7 @@ LoadedMap LoadMap(const std::filesystem::path& file) {
 
 DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const DetectRequest& request) {
     Stopwatch total;
-    const std::vector<core::StampedPose> poses = PosesOfScans(request, dataset);
+    const std::vector<core::StampedPose> poses = OdometryOfScans(request, dataset);
     DetectOutcome outcome;
     io::RunConfig config = EffectiveConfig(request.config, dataset, poses, outcome.notes);
     if (!config.detection.threshold) config.detection.threshold = map.detection.threshold;

@@ -66,8 +66,9 @@ bool SubmapsApply(const registration::ScanReductionConfig& reduction,
     if (reduction.submap_path_m <= 0.0 || reduction.submap_max_scans == 0) return false;
     if (poses.size() != scans) {
         note =
-            "no submaps (verification.reduction.submap_path_m): the scans have no poses; "
-            "give --odometry FILE to register against a scan and its neighbours";
+            "no submaps (verification.reduction.submap_path_m): they need the scans' odometry; "
+            "give --odometry FILE (or --odometry-topic) to register against a scan and its "
+            "neighbours (a dataset's own poses are taken as its ground truth)";
         return false;
     }
     return true;

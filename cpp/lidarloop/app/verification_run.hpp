@@ -51,8 +51,8 @@ void PrepareSubmaps(const io::Dataset& dataset, const std::vector<core::StampedP
                     const registration::ScanReductionConfig& reduction, PreparedScans& prepared,
                     const Progress& progress);
 
-/// Whether scans are prepared as submaps: the config asks for them and `poses` has one finite
-/// position per scan or more (odometry or the dataset's). `note` tells why not when asked for.
+/// Whether scans are prepared as submaps: the config asks for them and `poses` (the odometry,
+/// never a dataset's ground truth) has one per scan. `note` tells why not when asked for.
 bool SubmapsApply(const registration::ScanReductionConfig& reduction,
                   const std::vector<core::StampedPose>& poses, std::size_t scans,
                   std::string& note);

@@ -21,7 +21,8 @@ struct ScanReductionConfig {
     int max_structure_points = 3000;
     /// Other points (mostly ground; they fix z, roll and pitch) kept at most.
     int max_ground_points = 600;
-    /// Submaps, when the scans' poses are known (odometry or the dataset's; offline runs only):
+    /// Submaps, when the scans' odometry is given (never a dataset's own poses, which may be its
+    /// ground truth; offline runs only):
     /// a scan is prepared merged with its neighbours within this much path on each side, metres,
     /// placed by the poses in its own frame (registration::PrepareSubmap); 0: each scan alone.
     /// One sparse scan holds too little structure to pin a pose; a few neighbours, which the

@@ -484,16 +484,18 @@ TEST_F(DetectionRun, AGapInMetresWithoutPosesOrOdometryIsAClearError) {
 
 // With poses every stored scan is its submap, placed by them; without, each scan is alone, the
 // run says so, and config.yaml and database.scans record it.
-TEST_F(DetectionRun, ScansAreSubmapsWhenThePosesAreKnown) {
+TEST_F(DetectionRun, ScansAreSubmapsWhenTheOdometryIsKnown) {
     app::DetectRequest request = Request("submaps", core::Method::kRange);
     request.config.detection.top_k = 1;
+    request.odometry_file = dir_ / "sequence" / "poses_odometry.txt";
     const registration::ScanReductionConfig& reduction =
         request.config.detection.verification.reduction;
     const app::DetectOutcome outcome = app::RunDetect(*dataset_, request);
     EXPECT_TRUE(outcome.notes.empty());
     const io::StoredPreparedScans stored = io::LoadPreparedScans(request.out / "database.scans");
     EXPECT_EQ(stored.reduction.submap_path_m, reduction.submap_path_m);
-    const std::vector<core::StampedPose>& poses = dataset_->poses();
+    const std::vector<core::StampedPose> poses =
+        app::ReadOdometry(request.odometry_file, "", *dataset_);
     const auto load = [this](std::size_t k) { return dataset_->LoadScan(k); };
     for (const std::size_t i : {std::size_t{0}, std::size_t{77}, poses.size() - 1}) {
         const registration::PreparedScan expected =
@@ -508,16 +510,20 @@ TEST_F(DetectionRun, ScansAreSubmapsWhenThePosesAreKnown) {
     EXPECT_GT(stored.scans.at(77).usable_points,
               registration::PrepareScan(dataset_->LoadScan(77), reduction).usable_points);
 
-    std::filesystem::create_directories(dir_ / "bare" / "velodyne");
-    std::filesystem::copy(dir_ / "sequence" / "velodyne", dir_ / "bare" / "velodyne");
+    // Without odometry each scan is verified alone, also where the dataset has poses: in KITTI
+    // layout they are the ground truth the loops are scored against.
+    request.odometry_file.clear();
     request.out = dir_ / "alone";
-    const app::DetectOutcome alone = app::RunDetect(io::OpenDataset(dir_ / "bare"), request);
+    const app::DetectOutcome alone = app::RunDetect(*dataset_, request);
+    ASSERT_TRUE(dataset_->HasPoses());
     ASSERT_EQ(alone.notes.size(), 1u);
     EXPECT_TRUE(test::Contains(alone.notes.front(), "--odometry")) << alone.notes.front();
     EXPECT_EQ(io::LoadPreparedScans(request.out / "database.scans").reduction.submap_path_m, 0.0);
     EXPECT_EQ(io::LoadConfigYaml(request.out / "config.yaml")
                   .detection.verification.reduction.submap_path_m,
               0.0);
+    EXPECT_EQ(io::LoadPreparedScans(request.out / "database.scans").scans.at(77).usable_points,
+              registration::PrepareScan(dataset_->LoadScan(77), reduction).usable_points);
 }
 
 // optimise --loops reads a verified loops.csv with path_m, and one written before it existed.
