@@ -143,7 +143,9 @@ void AddDetectCommand(CLI::App& app) {
         command
             ->add_option("--odometry", flags->odometry,
                          "odometry poses, KITTI or TUM, one per scan: the path a gap in metres and "
-                         "loops.csv's path_m are measured on (default: the dataset's poses)")
+                         "loops.csv's path_m are measured on (default: the dataset's poses), and "
+                         "what places each scan's neighbours in its submap (without it: no "
+                         "submaps)")
             ->check(CLI::ExistingFile);
     command
         ->add_option("--odometry-topic", flags->odometry_topic,
