@@ -370,6 +370,7 @@ TEST(DescribeDataset, AnEmptiedScanFileIsNamedInTheSkipMessage) {
 TEST_F(DetectionRun, ReportsProgressOfEveryScanAndEndsTheStage) {
     app::DetectRequest request = Request("detect", core::Method::kHeight);
     request.config.detection.top_k = 1;
+    request.odometry_file = dir_ / "sequence" / "poses_odometry.txt";  // with the submaps stage
     std::mutex mutex;
     std::set<std::size_t> seen;
     std::set<std::string> stages;
