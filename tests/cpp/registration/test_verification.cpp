@@ -73,27 +73,41 @@ INSTANTIATE_TEST_SUITE_P(Motions, KnownMotion,
                                            Motion{-6.0, 4.0, 180.0}, Motion{8.0, 2.5, -150.0},
                                            Motion{1.0, 7.0, 91.0}));
 
+// A query of the synthetic place 3 m and 12 degrees off, and 40 poses from the true one to 4 m
+// and 30 degrees off, with the overlap each reaches.
+struct PosesAroundTheTruth {
+    VerificationConfig config;
+    PreparedScan query, match;
+    std::vector<std::pair<core::Transform, double>> poses;  // pose, MeasureOverlap(...).Min()
+
+    explicit PosesAroundTheTruth(unsigned seed) {
+        const core::PointCloud place = test::SyntheticPlace();
+        const core::Transform truth = test::PlanarTransform(3.0, -1.0, 12.0);
+        query = PrepareScan(QueryOf(place, truth), config.reduction);
+        match = PrepareScan(place, config.reduction);
+        std::mt19937 rng(seed);
+        std::uniform_real_distribution<double> offset_m(-4.0, 4.0), yaw_deg(-30.0, 30.0);
+        for (int trial = 0; trial < 40; ++trial) {
+            const double scale = trial / 40.0;
+            const core::Transform pose =
+                test::PlanarTransform(scale * offset_m(rng), scale * offset_m(rng),
+                                      scale * yaw_deg(rng)) *
+                truth;
+            poses.emplace_back(pose, MeasureOverlap(query, match, pose, config.acceptance).Min());
+        }
+    }
+};
+
 // The cheap check that abandons a hypothesis decides as the full measure does, at poses from
 // right to far off and at thresholds around the overlaps they reach.
 TEST(Verification, OverlapReachesAgreesWithMeasureOverlap) {
-    const core::PointCloud match = test::SyntheticPlace();
-    const core::Transform truth = test::PlanarTransform(3.0, -1.0, 12.0);
-    const VerificationConfig config;
-    const PreparedScan q = PrepareScan(QueryOf(match, truth), config.reduction);
-    const PreparedScan t = PrepareScan(match, config.reduction);
-    std::mt19937 rng(3);
-    std::uniform_real_distribution<double> offset_m(-4.0, 4.0), yaw_deg(-30.0, 30.0);
+    const PosesAroundTheTruth around(3);
     int reached = 0, missed = 0;
-    for (int trial = 0; trial < 40; ++trial) {
-        const double scale = trial / 40.0;  // from the truth to 4 m and 30 degrees off
-        const core::Transform pose =
-            test::PlanarTransform(scale * offset_m(rng), scale * offset_m(rng),
-                                  scale * yaw_deg(rng)) *
-            truth;
-        const double overlap = MeasureOverlap(q, t, pose, config.acceptance).Min();
+    for (const auto& [pose, overlap] : around.poses) {
         for (const double threshold : {0.05, 0.15, 0.3, 0.5, 0.7, overlap}) {
-            const bool reaches = OverlapReaches(q, t, pose, config.acceptance, threshold);
-            EXPECT_EQ(reaches, overlap >= threshold) << trial << " " << threshold;
+            const bool reaches = OverlapReaches(around.query, around.match, pose,
+                                                around.config.acceptance, threshold);
+            EXPECT_EQ(reaches, overlap >= threshold) << overlap << " " << threshold;
             (reaches ? reached : missed)++;
         }
     }
@@ -104,26 +118,15 @@ TEST(Verification, OverlapReachesAgreesWithMeasureOverlap) {
 // On every 4th point (what ICP's abandonment check reads) the check decides as the full measure
 // wherever the overlap is not within 0.05 of the bar.
 TEST(Verification, OverlapReachesOnASubsampleDecidesAsTheFullMeasureAwayFromTheBar) {
-    const core::PointCloud match = test::SyntheticPlace();
-    const core::Transform truth = test::PlanarTransform(3.0, -1.0, 12.0);
-    const VerificationConfig config;
-    const PreparedScan q = PrepareScan(QueryOf(match, truth), config.reduction);
-    const PreparedScan t = PrepareScan(match, config.reduction);
-    std::mt19937 rng(5);
-    std::uniform_real_distribution<double> offset_m(-4.0, 4.0), yaw_deg(-30.0, 30.0);
+    const PosesAroundTheTruth around(5);
     int compared = 0;
-    for (int trial = 0; trial < 40; ++trial) {
-        const double scale = trial / 40.0;
-        const core::Transform pose =
-            test::PlanarTransform(scale * offset_m(rng), scale * offset_m(rng),
-                                  scale * yaw_deg(rng)) *
-            truth;
-        const double overlap = MeasureOverlap(q, t, pose, config.acceptance).Min();
+    for (const auto& [pose, overlap] : around.poses) {
         for (const double threshold : {0.05, 0.15, 0.3, 0.5, 0.7}) {
             if (std::abs(overlap - threshold) <= 0.05) continue;
-            EXPECT_EQ(OverlapReaches(q, t, pose, config.acceptance, threshold, 4),
+            EXPECT_EQ(OverlapReaches(around.query, around.match, pose, around.config.acceptance,
+                                     threshold, 4),
                       overlap >= threshold)
-                << trial << " " << threshold << " " << overlap;
+                << overlap << " " << threshold;
             ++compared;
         }
     }
