@@ -9,6 +9,7 @@
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/registration/verification.hpp"
 #include "lidarloop/sim/simulator.hpp"
+#include "sparse_keyframes.hpp"
 
 namespace lidarloop::registration {
 namespace {
@@ -155,16 +156,7 @@ TEST(Submap, ConfigRangesAreValidated) {
 // surfaces); merged with the neighbours within 5 m of path, placed by the drifting odometry,
 // the two overlap 0.9 at the true pose (bench/verify_replay, docs/verification.md "Submaps").
 TEST(Submap, SparseRuralRevisitNeedsTheSubmap) {
-    sim::SimulationConfig simulation;
-    simulation.scene = sim::SceneType::kRural;
-    simulation.route.type = sim::RouteType::kUTurn;
-    simulation.route.spacing_min_m = 1.0;
-    simulation.route.spacing_max_m = 2.0;
-    simulation.sensor.model = sim::SensorModel::kHdl32;
-    simulation.front_end.keep_every = 10;
-    simulation.scans = 300;
-    simulation.seed = 3;
-    const sim::Simulator simulator(simulation);
+    const sim::Simulator simulator(test::SparseUTurnKeyframes(sim::SceneType::kRural, 10));
     const std::vector<core::StampedPose> odometry = simulator.OdometryPoses(0, simulator.size());
     const auto load = [&simulator](std::size_t k) { return simulator.Scan(k); };
     const std::size_t query = 294, match = 87;

@@ -12,6 +12,7 @@
 #include "lidarloop/registration/verification.hpp"
 #include "lidarloop/sim/simulator.hpp"
 #include "registration_test_utils.hpp"
+#include "sparse_keyframes.hpp"
 
 namespace lidarloop::registration {
 namespace {
@@ -373,16 +374,7 @@ INSTANTIATE_TEST_SUITE_P(Sensors, SimulatedRevisit,
 class SparseUrbanKeyframes : public ::testing::Test {
 protected:
     static sim::SimulationConfig Config(std::int64_t keep_every) {
-        sim::SimulationConfig config;
-        config.scene = sim::SceneType::kUrban;
-        config.route.type = sim::RouteType::kUTurn;
-        config.route.spacing_min_m = 1.0;
-        config.route.spacing_max_m = 2.0;
-        config.sensor.model = sim::SensorModel::kHdl32;
-        config.front_end.keep_every = keep_every;
-        config.scans = 300;
-        config.seed = 3;
-        return config;
+        return test::SparseUTurnKeyframes(sim::SceneType::kUrban, keep_every);
     }
     static PreparedScan Prepared(const sim::Simulator& simulator, std::size_t index) {
         return PrepareScan(simulator.Scan(index), VerificationConfig{}.reduction);
