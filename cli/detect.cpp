@@ -145,7 +145,8 @@ void AddDetectCommand(CLI::App& app) {
                          "odometry poses, KITTI or TUM, one per scan: the path a gap in metres and "
                          "loops.csv's path_m are measured on (default: the dataset's poses), and "
                          "what places each scan's neighbours in its submap (without it: no "
-                         "submaps)")
+                         "submaps), and what a registered loop must agree with (reason "
+                         "odometry_mismatch)")
             ->check(CLI::ExistingFile);
     command
         ->add_option("--odometry-topic", flags->odometry_topic,

@@ -16,8 +16,8 @@ class Verification:
     @property
     def reason(self) -> str:
         """'none' when accepted, else 'too_few_points', 'no_alignment', 'not_converged',
-        'low_overlap', 'high_rmse', 'degenerate', 'ambiguous', 'too_far' or
-        'pruned'."""
+        'low_overlap', 'high_rmse', 'degenerate', 'ambiguous', 'too_far',
+        'pruned' or 'odometry_mismatch' (detect with odometry)."""
     @property
     def T_match_query(self) -> npt.NDArray[np.float64]:
         """(4, 4): maps query-frame points into the match scan's frame, metres."""

@@ -233,6 +233,17 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     if (verify) {
         verification_times = VerifyAll(outcome.queries, prepared, config.detection,
                                        config.descriptor.method, request.progress);
+        if (!poses.empty()) {
+            const std::size_t rejected =
+                RejectLoopsAgainstOdometry(outcome.queries, poses, path_m, config.posegraph);
+            if (rejected > 0) {
+                outcome.notes.push_back(
+                    std::to_string(rejected) +
+                    " registered candidates rejected: the odometry contradicts their pose "
+                    "beyond its drift (reason odometry_mismatch in candidates.csv; the gate of "
+                    "posegraph.robust)");
+            }
+        }
     }
     const double verify_s = verify_clock.Seconds();
     outcome.accepted = CountAccepted(outcome.queries);

@@ -7,6 +7,7 @@
 
 #include "lidarloop/app/results_folder.hpp"
 #include "lidarloop/io/scan_reader.hpp"
+#include "lidarloop/posegraph/optimiser.hpp"
 #include "lidarloop/registration/submap.hpp"
 
 namespace lidarloop::app {
@@ -84,6 +85,39 @@ pipeline::VerificationTimes VerifyAll(std::vector<pipeline::LoopQuery>& queries,
         tell = [&progress](std::size_t done, std::size_t n) { progress("verifying", done, n); };
     return pipeline::VerifyQueries(queries, prepared.scans, detector, method,
                                    pipeline::Execution::kParallel, tell, cache);
+}
+
+std::size_t RejectLoopsAgainstOdometry(std::vector<pipeline::LoopQuery>& queries,
+                                       const std::vector<core::StampedPose>& odometry,
+                                       const std::vector<double>& path_m,
+                                       const posegraph::PoseGraphConfig& config) {
+    const auto require_pose = [&](std::size_t scan) {
+        if (scan >= odometry.size() || scan >= path_m.size()) {
+            throw core::ConfigError("scan " + std::to_string(scan) + " has no odometry (" +
+                                    std::to_string(odometry.size()) + " poses)");
+        }
+    };
+    std::size_t rejected = 0;
+    for (pipeline::LoopQuery& query : queries) {
+        for (std::size_t c = 0; c < query.verifications.size(); ++c) {
+            registration::Verification& verdict = query.verifications[c];
+            if (!verdict.accepted) continue;
+            const std::size_t match = query.candidates[c].index;
+            require_pose(query.query);
+            require_pose(match);
+            const core::Transform T_match_query_odometry =
+                odometry[match].T_world_sensor.inverse() * odometry[query.query].T_world_sensor;
+            const posegraph::LoopResult gate = posegraph::GateAgainstOdometry(
+                verdict.T_match_query, T_match_query_odometry,
+                std::abs(path_m[query.query] - path_m[match]), config);
+            if (gate.verdict != posegraph::LoopVerdict::kRejectedByOdometry) continue;
+            verdict.accepted = false;
+            verdict.reason = registration::RejectReason::kOdometryMismatch;
+            ++rejected;
+        }
+        query.accepted = query.loop().has_value();
+    }
+    return rejected;
 }
 
 nlohmann::json VerificationTimingsJson(const PreparedScans& prepared,

@@ -12,6 +12,7 @@
 #include "lidarloop/core/point_cloud.hpp"
 #include "lidarloop/io/dataset.hpp"
 #include "lidarloop/pipeline/candidate_verification.hpp"
+#include "lidarloop/posegraph/pose_graph_config.hpp"
 #include "lidarloop/registration/compact_prepared_scan.hpp"
 #include "lidarloop/registration/prepared_scan.hpp"
 #include "lidarloop/registration/verification.hpp"
@@ -63,6 +64,18 @@ pipeline::VerificationTimes VerifyAll(std::vector<pipeline::LoopQuery>& queries,
                                       const pipeline::DetectorConfig& detector,
                                       const core::Method& method, const Progress& progress,
                                       pipeline::VerificationCache* cache = nullptr);
+
+/// Rejects (RejectReason::kOdometryMismatch) every accepted candidate whose registered pose the
+/// odometry contradicts beyond its drift (posegraph::GateAgainstOdometry with `posegraph`'s gate)
+/// and chooses each query's loop again among the rest: a place that repeats itself (a street
+/// with a period of 45 m) registers well at the wrong place, and the odometry knows better over
+/// a short path. `odometry`: T_world_sensor of each scan; `path_m`: its cumulative path, one per
+/// scan. Returns how many it rejected. Throws core::ConfigError when a query or candidate has
+/// no odometry.
+std::size_t RejectLoopsAgainstOdometry(std::vector<pipeline::LoopQuery>& queries,
+                                       const std::vector<core::StampedPose>& odometry,
+                                       const std::vector<double>& path_m,
+                                       const posegraph::PoseGraphConfig& config);
 
 /// The figures of a verification run for timings.json: per scan preparation (ms) and memory
 /// (bytes), per query coarse images (ms), per candidate pair (ms), counts.

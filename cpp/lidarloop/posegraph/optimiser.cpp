@@ -116,33 +116,13 @@ std::vector<double> PathLengths(const std::vector<core::Transform>& poses) {
     return path;
 }
 
-// The odometry gate: the loop against the odometry's relative pose of its scans, with the drift
-// the information model allows over the path between them (a random walk in position and
-// heading; the heading's walk moves the position by about a_r * sqrt(d^3 / 3)).
+// The odometry gate of one edge (GateAgainstOdometry).
 LoopResult GateLoop(const Edge& edge, const PoseGraph& graph, const std::vector<double>& path,
                     const PoseGraphConfig& config) {
-    LoopResult result;
-    result.loop = edge.loop;
-    result.path_m = std::abs(path[edge.to] - path[edge.from]);
     const core::Transform T_odometry = graph.poses[edge.from].inverse() * graph.poses[edge.to];
-    const core::Transform discrepancy = edge.T_from_to.inverse() * T_odometry;
-    result.odometry_translation_error_m = discrepancy.translation().norm();
-    result.odometry_rotation_error_deg =
-        Eigen::AngleAxisd(discrepancy.linear()).angle() / kRadPerDeg;
-    const InformationConfig& info = config.information;
-    const RobustConfig& robust = config.robust;
-    const double d = result.path_m;
-    const double a_t = info.odometry_translation_sigma_m_per_sqrt_m;
-    const double a_r = info.odometry_rotation_sigma_deg_per_sqrt_m * kRadPerDeg;
-    const double sigma_t = std::sqrt(a_t * a_t * d + a_r * a_r * d * d * d / 3.0);
-    const double sigma_r_deg = info.odometry_rotation_sigma_deg_per_sqrt_m * std::sqrt(d);
-    result.gate_translation_m = robust.gate_sigmas * sigma_t + robust.gate_min_translation_m +
-                                robust.gate_translation_percent / 100.0 * d;
-    result.gate_rotation_deg = robust.gate_sigmas * sigma_r_deg + robust.gate_min_rotation_deg +
-                               robust.gate_rotation_deg_per_100m / 100.0 * d;
-    const bool passes = result.odometry_translation_error_m <= result.gate_translation_m &&
-                        result.odometry_rotation_error_deg <= result.gate_rotation_deg;
-    if (!passes) result.verdict = LoopVerdict::kRejectedByOdometry;
+    LoopResult result = GateAgainstOdometry(edge.T_from_to, T_odometry,
+                                            std::abs(path[edge.to] - path[edge.from]), config);
+    result.loop = edge.loop;
     return result;
 }
 
@@ -370,6 +350,34 @@ void RejectAndResolve(const PoseGraph& graph, LoopSet& loops, const PoseGraphCon
 }
 
 }  // namespace
+
+// The drift the information model allows over the path: a random walk in position and heading
+// (the heading's walk moves the position by about a_r * sqrt(d^3 / 3)).
+LoopResult GateAgainstOdometry(const core::Transform& T_from_to_loop,
+                               const core::Transform& T_from_to_odometry, double path_m,
+                               const PoseGraphConfig& config) {
+    LoopResult result;
+    result.path_m = path_m;
+    const core::Transform discrepancy = T_from_to_loop.inverse() * T_from_to_odometry;
+    result.odometry_translation_error_m = discrepancy.translation().norm();
+    result.odometry_rotation_error_deg =
+        Eigen::AngleAxisd(discrepancy.linear()).angle() / kRadPerDeg;
+    const InformationConfig& info = config.information;
+    const RobustConfig& robust = config.robust;
+    const double d = path_m;
+    const double a_t = info.odometry_translation_sigma_m_per_sqrt_m;
+    const double a_r = info.odometry_rotation_sigma_deg_per_sqrt_m * kRadPerDeg;
+    const double sigma_t = std::sqrt(a_t * a_t * d + a_r * a_r * d * d * d / 3.0);
+    const double sigma_r_deg = info.odometry_rotation_sigma_deg_per_sqrt_m * std::sqrt(d);
+    result.gate_translation_m = robust.gate_sigmas * sigma_t + robust.gate_min_translation_m +
+                                robust.gate_translation_percent / 100.0 * d;
+    result.gate_rotation_deg = robust.gate_sigmas * sigma_r_deg + robust.gate_min_rotation_deg +
+                               robust.gate_rotation_deg_per_100m / 100.0 * d;
+    const bool passes = result.odometry_translation_error_m <= result.gate_translation_m &&
+                        result.odometry_rotation_error_deg <= result.gate_rotation_deg;
+    if (!passes) result.verdict = LoopVerdict::kRejectedByOdometry;
+    return result;
+}
 
 OptimisationResult Optimise(const PoseGraph& graph, const PoseGraphConfig& config) {
     const auto start = std::chrono::steady_clock::now();

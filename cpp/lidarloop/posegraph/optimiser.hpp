@@ -57,6 +57,15 @@ struct OptimisationResult {
     std::string note;  ///< e.g. why the odometry came back unchanged; empty otherwise
 };
 
+/// The odometry gate (RobustConfig) for one loop: `T_from_to_loop`, the loop's transform between
+/// two scans, against `T_from_to_odometry`, the odometry's relative pose of the same scans, with
+/// the drift the information model allows over `path_m` of path between them. Fills path_m, the
+/// errors and tolerances; verdict kRejectedByOdometry when an error exceeds its tolerance, else
+/// kUsed. Optimise applies it to every loop first; `detect --odometry` to every accepted loop.
+LoopResult GateAgainstOdometry(const core::Transform& T_from_to_loop,
+                               const core::Transform& T_from_to_odometry, double path_m,
+                               const PoseGraphConfig& config);
+
 /// Optimises the graph with Ceres (trust region with Powell's dogleg, sparse Cholesky): every pose
 /// is a position in R^3 and a unit quaternion (Ceres' ProductManifold of EuclideanManifold<3> and
 /// EigenQuaternionManifold), pose 0 is fixed, and

@@ -253,6 +253,8 @@ std::string ToString(RejectReason reason) {
             return "too_far";
         case RejectReason::kPruned:
             return "pruned";
+        case RejectReason::kOdometryMismatch:
+            return "odometry_mismatch";
     }
     return "unknown";
 }

@@ -23,11 +23,14 @@ enum class RejectReason {
     kAmbiguous,     ///< another, distinct pose fits about as well (periodic structure)
     kTooFar,        ///< registered, but the sensors are farther apart than one place
     kPruned,        ///< not registered: the descriptor distance failed the threshold set
+    /// registered, but the odometry puts the two scans elsewhere beyond its drift (detect with
+    /// odometry: the pose graph's gate, posegraph::GateAgainstOdometry)
+    kOdometryMismatch,
 };
 
 /// "none", "too_few_points", "no_alignment", "not_converged", "low_overlap", "high_rmse",
-/// "degenerate", "ambiguous", "too_far", "pruned": the spelling of loops.csv and `lidarloop
-/// verify`.
+/// "degenerate", "ambiguous", "too_far", "pruned", "odometry_mismatch": the spelling of loops.csv
+/// and `lidarloop verify`.
 std::string ToString(RejectReason reason);
 
 /// How well a query sits on a match at a pose (registration::MeasureOverlap).

@@ -14,6 +14,7 @@
 #include "app_test_utils.hpp"
 #include "lidarloop/app/describe_run.hpp"
 #include "lidarloop/app/detection.hpp"
+#include "lidarloop/app/verification_run.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/io/config_yaml.hpp"
 #include "lidarloop/io/kitti_bin.hpp"
@@ -36,6 +37,66 @@ std::size_t CsvRows(const std::filesystem::path& file) {
     std::size_t lines = 0;
     for (std::string line; std::getline(in, line);) ++lines;
     return lines - 1;  // header
+}
+
+// An accepted candidate at its place (per the odometry) with the given overlap.
+registration::Verification AcceptedAt(const core::Transform& T_match_query, double overlap) {
+    registration::Verification verdict;
+    verdict.accepted = true;
+    verdict.T_match_query = T_match_query;
+    verdict.overlap.query_fraction = overlap;
+    verdict.overlap.match_fraction = overlap;
+    return verdict;
+}
+
+TEST(RejectLoopsAgainstOdometry, RejectsThePoseTheOdometryContradictsAndChoosesAgain) {
+    // A straight drive, a scan every metre; the path is the odometry's.
+    std::vector<core::StampedPose> odometry(100);
+    std::vector<double> path_m(100);
+    for (std::size_t i = 0; i < odometry.size(); ++i) {
+        odometry[i].T_world_sensor.translation().x() = static_cast<double>(i);
+        path_m[i] = static_cast<double>(i);
+    }
+    const auto T_match_query = [&](std::size_t match, std::size_t query) {
+        return odometry[match].T_world_sensor.inverse() * odometry[query].T_world_sensor;
+    };
+    core::Transform period_off = core::Transform::Identity();
+    period_off.translation().x() = 45.0;  // a street that repeats itself every 45 m
+
+    pipeline::LoopQuery two_loops;  // the wrong pose overlaps better: it was the loop
+    two_loops.query = 99;
+    two_loops.candidates = {{40, 0.1}, {45, 0.2}, {50, 0.3}};
+    two_loops.verifications = {AcceptedAt(T_match_query(40, 99), 0.4),
+                               AcceptedAt(T_match_query(45, 99) * period_off, 0.6),
+                               registration::Verification{}};
+    two_loops.verifications[2].reason = registration::RejectReason::kLowOverlap;
+    two_loops.accepted = true;
+    ASSERT_EQ(two_loops.loop(), 1u);
+    pipeline::LoopQuery one_wrong_loop = two_loops;
+    one_wrong_loop.query = 98;
+    one_wrong_loop.candidates.resize(1);
+    one_wrong_loop.verifications = {AcceptedAt(T_match_query(40, 98) * period_off, 0.5)};
+
+    std::vector<pipeline::LoopQuery> queries{two_loops, one_wrong_loop};
+    EXPECT_EQ(app::RejectLoopsAgainstOdometry(queries, odometry, path_m, {}), 2u);
+    EXPECT_EQ(queries[0].loop(), 0u);
+    EXPECT_TRUE(queries[0].accepted);
+    EXPECT_EQ(queries[0].verifications[1].reason, registration::RejectReason::kOdometryMismatch);
+    EXPECT_FALSE(queries[0].verifications[1].accepted);
+    EXPECT_EQ(queries[0].verifications[2].reason, registration::RejectReason::kLowOverlap);
+    EXPECT_FALSE(queries[1].accepted);
+    EXPECT_EQ(queries[1].loop(), std::nullopt);
+    EXPECT_EQ(registration::ToString(registration::RejectReason::kOdometryMismatch),
+              "odometry_mismatch");
+
+    // Loops the odometry agrees with stay; a scan without odometry is an error.
+    std::vector<pipeline::LoopQuery> consistent{two_loops};
+    consistent[0].verifications[1] = AcceptedAt(T_match_query(45, 99), 0.6);
+    EXPECT_EQ(app::RejectLoopsAgainstOdometry(consistent, odometry, path_m, {}), 0u);
+    EXPECT_EQ(consistent[0].loop(), 1u);
+    odometry.resize(60);
+    EXPECT_THROW(app::RejectLoopsAgainstOdometry(consistent, odometry, path_m, {}),
+                 core::ConfigError);
 }
 
 class DetectionRun : public ::testing::Test {

@@ -187,6 +187,34 @@ TEST(Optimise, GateRejectsALoopTheOdometryCannotExplain) {
     EXPECT_LT(MaxPositionError(result.poses, truth), 1e-12);
 }
 
+// The tolerance at the defaults over d = 100 m: 5 sigma_t + 3 m + 3 % of d, with
+// sigma_t^2 = 0.1^2 d + (0.03 deg in rad)^2 d^3 / 3; and 5 * 0.03 * sqrt(d) + 10 + 1 deg.
+TEST(GateAgainstOdometry, ToleranceGrowsWithThePathAsTheInformationModelSays) {
+    const double d = 100.0;
+    const double a_r = 0.03 * std::numbers::pi / 180.0;
+    const double sigma_t = std::sqrt(0.01 * d + a_r * a_r * d * d * d / 3.0);
+    const double tolerance_m = 5.0 * sigma_t + 3.0 + 0.03 * d;
+    const core::Transform T_odometry = PlanarPose(30.0, -4.0, 0.3);
+    const auto shifted_by = [&](double x_m) {
+        return GateAgainstOdometry(T_odometry * PlanarPose(x_m, 0.0, 0.0), T_odometry, d, {});
+    };
+    const LoopResult inside = shifted_by(tolerance_m - 0.01);
+    EXPECT_EQ(inside.verdict, LoopVerdict::kUsed);
+    EXPECT_NEAR(inside.gate_translation_m, tolerance_m, 1e-9);
+    EXPECT_NEAR(inside.odometry_translation_error_m, tolerance_m - 0.01, 1e-9);
+    EXPECT_NEAR(inside.gate_rotation_deg, 5.0 * 0.03 * 10.0 + 10.0 + 1.0, 1e-9);
+    EXPECT_EQ(inside.path_m, d);
+    EXPECT_EQ(shifted_by(tolerance_m + 0.01).verdict, LoopVerdict::kRejectedByOdometry);
+    // A street that repeats itself every 45 m: registered a period off, 54 m of path apart.
+    EXPECT_EQ(
+        GateAgainstOdometry(T_odometry * PlanarPose(45.0, 0.0, 0.0), T_odometry, 54.0, {}).verdict,
+        LoopVerdict::kRejectedByOdometry);
+    const LoopResult turned =
+        GateAgainstOdometry(T_odometry * PlanarPose(0.0, 0.0, 0.25), T_odometry, d, {});
+    EXPECT_NEAR(turned.odometry_rotation_error_deg, 0.25 * 180.0 / std::numbers::pi, 1e-9);
+    EXPECT_EQ(turned.verdict, LoopVerdict::kRejectedByOdometry);  // 14.3 deg > 12.5 deg
+}
+
 TEST(Optimise, WithoutLoopsTheOdometryComesBackUnchangedWithANote) {
     const std::vector<core::Transform> truth = EllipseLaps(1);
     const std::vector<core::Transform> odometry = DriftingOdometry(truth, 3);
