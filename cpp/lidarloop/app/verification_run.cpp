@@ -1,7 +1,9 @@
 #include "lidarloop/app/verification_run.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <map>
 
 #include <tbb/parallel_for.h>
 
@@ -37,28 +39,84 @@ std::vector<double> PreparedScans::BytesPerScan() const {
     return bytes;
 }
 
+namespace {
+
+// Centres per block of PrepareSubmapsInOrder: enough to keep both cores busy between reads,
+// few enough that a block's scans (at most this plus two windows of submap_max_scans) fit in
+// memory even for dense scans.
+constexpr std::size_t kSubmapBlock = 32;
+
+// The scans the submaps of `centres` need, each once, in sequence order.
+std::vector<std::size_t> BlockMembers(const std::vector<double>& path_m,
+                                      const std::vector<std::size_t>& centres,
+                                      const registration::SubmapWindow& window) {
+    std::vector<std::size_t> members;
+    for (const std::size_t centre : centres) {
+        for (const std::size_t k : registration::SubmapMembers(path_m, centre, window))
+            members.push_back(k);
+    }
+    std::sort(members.begin(), members.end());
+    members.erase(std::unique(members.begin(), members.end()), members.end());
+    return members;
+}
+
+}  // namespace
+
+void PrepareSubmapsInOrder(const std::vector<core::StampedPose>& poses,
+                           const registration::ScanReductionConfig& reduction,
+                           const std::function<core::PointCloud(std::size_t)>& load,
+                           const std::function<bool(std::size_t)>& wanted, const SubmapSink& take) {
+    const std::vector<double> path_m = registration::SubmapPathM(poses);
+    const registration::SubmapWindow window{reduction.submap_path_m, reduction.submap_max_scans,
+                                            false};
+    std::map<std::size_t, core::PointCloud> loaded;  // the scans the current block needs
+    for (std::size_t start = 0; start < poses.size(); start += kSubmapBlock) {
+        std::vector<std::size_t> centres;
+        for (std::size_t i = start; i < std::min(start + kSubmapBlock, poses.size()); ++i) {
+            if (wanted(i)) centres.push_back(i);
+        }
+        if (centres.empty()) continue;
+        const std::vector<std::size_t> members = BlockMembers(path_m, centres, window);
+        // Scans no later block needs go; the window only moves forward along the path.
+        loaded.erase(loaded.begin(), loaded.lower_bound(members.front()));
+        std::vector<std::size_t> missing;
+        for (const std::size_t k : members) {
+            if (!loaded.contains(k)) missing.push_back(k);
+        }
+        const Stopwatch read_clock;
+        std::vector<core::PointCloud> read(missing.size());
+        tbb::parallel_for(std::size_t{0}, missing.size(),
+                          [&](std::size_t m) { read[m] = load(missing[m]); });
+        for (std::size_t m = 0; m < missing.size(); ++m) loaded[missing[m]] = std::move(read[m]);
+        const double read_seconds_per_centre =
+            read_clock.Seconds() / static_cast<double>(centres.size());
+        const auto from_memory = [&loaded](std::size_t k) { return loaded.at(k); };
+        tbb::parallel_for(std::size_t{0}, centres.size(), [&](std::size_t c) {
+            const Stopwatch clock;
+            registration::PreparedScan submap =
+                registration::PrepareSubmap(centres[c], poses, path_m, from_memory, reduction);
+            take(centres[c], std::move(submap), clock.Seconds() + read_seconds_per_centre);
+        });
+    }
+}
+
 void PrepareSubmaps(const io::Dataset& dataset, const std::vector<core::StampedPose>& poses,
                     const registration::ScanReductionConfig& reduction, PreparedScans& prepared,
                     const Progress& progress) {
-    const std::vector<double> path_m = registration::SubmapPathM(poses);
     // A scan skipped while describing could not be read: it adds nothing to its neighbours.
     const std::vector<char>& readable = prepared.readable;
     const auto load = [&](std::size_t k) {
         return readable.at(k) != 0 ? dataset.LoadScan(k) : core::PointCloud{};
     };
+    const auto wanted = [&readable](std::size_t i) { return readable.at(i) != 0; };
     std::atomic<std::size_t> done{0};
-    tbb::parallel_for(std::size_t{0}, readable.size(), [&](std::size_t i) {
-        if (readable[i] != 0) {
-            const Stopwatch clock;
-            const ThreadCpuStopwatch cpu_clock;
-            prepared.scans[i] = registration::CompactPreparedScan(
-                registration::PrepareSubmap(i, poses, path_m, load, reduction));
-            prepared.prepare_seconds[i] += clock.Seconds();
-            prepared.prepare_cpu_seconds[i] += cpu_clock.Seconds();
-        }
-        const std::size_t finished = ++done;
-        if (progress) progress("submaps", finished, readable.size());
-    });
+    PrepareSubmapsInOrder(poses, reduction, load, wanted,
+                          [&](std::size_t i, registration::PreparedScan submap, double seconds) {
+                              prepared.scans[i] = registration::CompactPreparedScan(submap);
+                              prepared.prepare_seconds[i] += seconds;
+                              const std::size_t finished = ++done;
+                              if (progress) progress("submaps", finished, readable.size());
+                          });
 }
 
 bool SubmapsApply(const registration::ScanReductionConfig& reduction,

@@ -44,6 +44,21 @@ struct PreparedScans {
     std::vector<double> BytesPerScan() const;
 };
 
+/// Receives scan i's submap and the seconds it took (its share of the block's reads included),
+/// from worker threads.
+using SubmapSink = std::function<void(std::size_t, registration::PreparedScan, double)>;
+
+/// Prepares scan i as its submap (registration::PrepareSubmap with `reduction`'s window, `poses`
+/// one per scan) for every i with `wanted(i)`, reading each scan once (`load`, as
+/// PrepareSubmap's) where reading every submap's members would read each scan about twice the
+/// window's member count: the centres go in blocks of consecutive scans, a block's members are
+/// read in parallel and kept while the next block needs them, and its submaps are prepared in
+/// parallel. Memory: the scans of one block and its two windows.
+void PrepareSubmapsInOrder(const std::vector<core::StampedPose>& poses,
+                           const registration::ScanReductionConfig& reduction,
+                           const std::function<core::PointCloud(std::size_t)>& load,
+                           const std::function<bool(std::size_t)>& wanted, const SubmapSink& take);
+
 /// Prepares every scan again as its submap (registration::PrepareSubmap with `reduction`'s
 /// window) from the scans of `dataset` placed by `poses` (one per scan), in parallel, telling
 /// `progress` as stage "submaps". Scans skipped while describing (not `readable`) stay empty and

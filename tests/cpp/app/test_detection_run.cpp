@@ -1,11 +1,13 @@
 // The detect and localise runs: what they return equals what the pipeline gives for the same
 // descriptors, and the results folder holds what the outcome says.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <fstream>
 #include <limits>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -546,6 +548,42 @@ TEST_F(DetectionRun, AGapInMetresWithoutPosesOrOdometryIsAClearError) {
 
 // With poses every stored scan is its submap, placed by them; without, each scan is alone, the
 // run says so, and config.yaml and database.scans record it.
+TEST_F(DetectionRun, SubmapsInOrderReadEachScanOnceAndEqualEachSubmapAlone) {
+    std::vector<core::StampedPose> poses =
+        app::ReadOdometry(dir_ / "sequence" / "poses_odometry.txt", "", *dataset_);
+    poses.resize(70);  // three blocks of centres
+    registration::ScanReductionConfig reduction;
+    reduction.submap_path_m = 6.0;
+    std::vector<std::atomic<int>> reads(poses.size());
+    const auto load = [&](std::size_t k) {
+        ++reads.at(k);
+        return dataset_->LoadScan(k);
+    };
+    const auto wanted = [](std::size_t i) { return i != 5 && i != 40; };
+    std::vector<std::optional<registration::PreparedScan>> submaps(poses.size());
+    app::PrepareSubmapsInOrder(poses, reduction, load, wanted,
+                               [&](std::size_t i, registration::PreparedScan submap, double) {
+                                   submaps.at(i) = std::move(submap);
+                               });
+    const auto load_again = [this](std::size_t k) { return dataset_->LoadScan(k); };
+    const std::vector<double> path_m = registration::SubmapPathM(poses);
+    std::size_t largest_submap = 0;
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+        EXPECT_EQ(reads[i], 1) << i;  // 5 and 40 as their neighbours' members
+        ASSERT_EQ(submaps[i].has_value(), wanted(i)) << i;
+        if (!wanted(i)) continue;
+        const registration::PreparedScan expected =
+            registration::PrepareSubmap(i, poses, path_m, load_again, reduction);
+        EXPECT_EQ(submaps[i]->structure->points(), expected.structure->points()) << i;
+        EXPECT_EQ(submaps[i]->structure->normals(), expected.structure->normals()) << i;
+        EXPECT_EQ(submaps[i]->ground->points(), expected.ground->points()) << i;
+        EXPECT_EQ(submaps[i]->structure_distinctive, expected.structure_distinctive) << i;
+        largest_submap = std::max(largest_submap,
+                                  registration::SubmapMembers(path_m, i, {6.0, 30, false}).size());
+    }
+    EXPECT_GE(largest_submap, 3u);  // the windows reach across the blocks' ends
+}
+
 TEST_F(DetectionRun, ScansAreSubmapsWhenTheOdometryIsKnown) {
     app::DetectRequest request = Request("submaps", core::Method::kRange);
     request.config.detection.top_k = 1;
