@@ -13,6 +13,7 @@
 #include "lidarloop/app/detection.hpp"
 #include "lidarloop/core/descriptor.hpp"
 #include "lidarloop/core/error.hpp"
+#include "odometry_options.hpp"
 #include "progress.hpp"
 #include "run_options.hpp"
 #include "run_output.hpp"
@@ -25,9 +26,8 @@ struct DetectFlags {
     DescriptorOptions descriptor;
     RunOptionFlags options;  // app/run_options.hpp: --threshold, --top-k, --skip-bad, ...
     std::string out;
-    std::string map;             // a database.lldb to localise against (query-only mode)
-    std::string odometry;        // poses the path is measured on (a gap in metres, path_m)
-    std::string odometry_topic;  // the same from a bag's nav_msgs/Odometry topic
+    std::string map;           // a database.lldb to localise against (query-only mode)
+    OdometryOptions odometry;  // the path (a gap in metres, path_m), submaps, the gate
     bool overwrite = false;
     bool quiet = false;
 };
@@ -87,7 +87,7 @@ void PrintOutcome(const io::Dataset& dataset, const app::DetectRequest& request,
 std::vector<std::filesystem::path> Inputs(const DetectFlags& flags) {
     std::vector<std::filesystem::path> inputs = flags.dataset.Inputs();
     inputs.emplace_back(flags.map);
-    inputs.emplace_back(flags.odometry);
+    inputs.push_back(flags.odometry.Input());
     return inputs;
 }
 
@@ -96,8 +96,8 @@ void RunDetect(const DetectFlags& flags) {
     app::DetectRequest request;
     request.progress = progress.Callback();
     request.out = flags.out;
-    request.odometry_file = flags.odometry;
-    request.odometry_topic = flags.odometry_topic;
+    request.odometry_file = flags.odometry.file();
+    request.odometry_topic = flags.odometry.topic();
     if (!flags.map.empty()) {
         app::LoadedMap map = app::LoadMap(flags.map);
         request.config = ResolveAgainstMap(flags, map);
@@ -139,20 +139,11 @@ void AddDetectCommand(CLI::App& app) {
                      "localise against this database.lldb (written by an earlier detect): "
                      "every scan is a query, none is added, the map's descriptor config is used")
         ->check(CLI::ExistingFile);
-    auto* odometry =
-        command
-            ->add_option("--odometry", flags->odometry,
-                         "odometry poses, KITTI or TUM, one per scan: the path a gap in metres and "
-                         "loops.csv's path_m are measured on (default: the dataset's poses), and "
-                         "what places each scan's neighbours in its submap (without it: no "
-                         "submaps), and what a registered loop must agree with (reason "
-                         "odometry_mismatch)")
-            ->check(CLI::ExistingFile);
-    command
-        ->add_option("--odometry-topic", flags->odometry_topic,
-                     "instead of --odometry, for a bag: its nav_msgs/Odometry topic, "
-                     "interpolated at the scans' stamps")
-        ->excludes(odometry);
+    flags->odometry.AddTo(*command,
+                          "the path a gap in metres and loops.csv's path_m are measured on "
+                          "(default: the dataset's poses), what places each scan's neighbours in "
+                          "its submap (without it: no submaps), and what a registered loop must "
+                          "agree with (reason odometry_mismatch)");
     command->add_flag("--overwrite", flags->overwrite,
                       "write into a non-empty folder that holds no earlier lidarloop run");
     command->add_flag("--quiet", flags->quiet, "no progress bar");

@@ -13,6 +13,7 @@
 #include "lidarloop/app/evaluation.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/pipeline/descriptor_method.hpp"
+#include "odometry_options.hpp"
 #include "progress.hpp"
 #include "retrieval_print.hpp"
 #include "run_options.hpp"
@@ -27,6 +28,7 @@ struct EvaluateFlags {
     RunOptionFlags options;  // app/run_options.hpp: the ground truth, learning, detection keys
     std::vector<std::string> methods = pipeline::MethodNames();
     std::vector<std::string> results;
+    OdometryOptions odometry;  // submaps and the odometry gate in verification
     std::string train_on;
     std::string train_poses;
     std::string out;
@@ -75,6 +77,8 @@ app::EvaluationRequest RequestOf(const EvaluateFlags& flags) {
     request.config = ResolveConfig(flags, request.methods);
     flags.options.ApplyTo({&request.config, &request.skip_bad, &request});
     request.results_files = flags.results;
+    request.odometry_file = flags.odometry.file();
+    request.odometry_topic = flags.odometry.topic();
     request.out = flags.out;
     return request;
 }
@@ -109,6 +113,7 @@ std::vector<std::filesystem::path> Inputs(const EvaluateFlags& flags) {
     inputs.insert(inputs.end(), flags.results.begin(), flags.results.end());
     inputs.emplace_back(flags.train_on);
     inputs.emplace_back(flags.train_poses);
+    inputs.push_back(flags.odometry.Input());
     return inputs;
 }
 
@@ -155,6 +160,10 @@ void AddEvaluateCommand(CLI::App& app) {
         ->check(CLI::ExistingFile);
     flags->options.AddTo(*command, app::RunCommand::kEvaluate);
     AddTrainingFlags(*command, *flags);
+    flags->odometry.AddTo(*command,
+                          "verification registers submaps placed by it and rejects loops it "
+                          "contradicts, as detect --odometry (never the ground truth; without "
+                          "it each scan is verified alone)");
     command->add_option("--out", flags->out, "folder for the results (created)")->required();
     command->add_flag("--overwrite", flags->overwrite,
                       "write into a non-empty folder that holds no earlier lidarloop run");

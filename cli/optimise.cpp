@@ -13,6 +13,7 @@
 #include "descriptor_options.hpp"
 #include "lidarloop/app/optimisation.hpp"
 #include "lidarloop/core/error.hpp"
+#include "odometry_options.hpp"
 #include "progress.hpp"
 #include "run_options.hpp"
 #include "run_output.hpp"
@@ -24,8 +25,7 @@ struct OptimiseFlags {
     DatasetOptions dataset;
     DescriptorOptions descriptor;
     RunOptionFlags options;  // app/run_options.hpp: detection keys, --max-odometry-step, ...
-    std::string odometry;
-    std::string odometry_topic;
+    OdometryOptions odometry;
     std::string loops;
     std::string out;
     std::string format = "kitti";
@@ -66,13 +66,13 @@ void PrintOutcome(const app::OptimiseRequest& request, const app::OptimiseOutcom
 
 std::vector<std::filesystem::path> Inputs(const OptimiseFlags& flags) {
     std::vector<std::filesystem::path> inputs = flags.dataset.Inputs();
-    inputs.emplace_back(flags.odometry);
+    inputs.push_back(flags.odometry.Input());
     inputs.emplace_back(flags.loops);
     return inputs;
 }
 
 void RunOptimise(const OptimiseFlags& flags) {
-    if (flags.odometry.empty() && flags.odometry_topic.empty()) {
+    if (!flags.odometry.given()) {
         throw core::ConfigError(
             "optimise needs the odometry: give --odometry FILE, or --odometry-topic TOPIC for a "
             "bag");
@@ -81,8 +81,8 @@ void RunOptimise(const OptimiseFlags& flags) {
     app::OptimiseRequest request;
     request.config = flags.descriptor.Resolve();
     flags.options.ApplyTo({&request.config, &request.skip_bad});
-    request.odometry_file = flags.odometry;
-    request.odometry_topic = flags.odometry_topic;
+    request.odometry_file = flags.odometry.file();
+    request.odometry_topic = flags.odometry.topic();
     request.loops_file = flags.loops;
     request.format = flags.format == "tum" ? app::PoseFormat::kTum : app::PoseFormat::kKitti;
     request.progress = progress.Callback();
@@ -104,15 +104,7 @@ void AddOptimiseCommand(CLI::App& app) {
         "optimise", "Optimise the odometry with the accepted loops in a pose graph (Ceres)");
     auto flags = std::make_shared<OptimiseFlags>();
     flags->dataset.AddTo(*command, "--dataset-format");
-    auto* odometry = command
-                         ->add_option("--odometry", flags->odometry,
-                                      "odometry poses, KITTI or TUM, one per scan")
-                         ->check(CLI::ExistingFile);
-    auto* odometry_topic =
-        command->add_option("--odometry-topic", flags->odometry_topic,
-                            "instead of --odometry, for a bag: its nav_msgs/Odometry topic, "
-                            "interpolated at the scans' stamps");
-    odometry->excludes(odometry_topic);
+    flags->odometry.AddTo(*command, "the pose graph's odometry edges and initial estimate");
     command
         ->add_option("--loops", flags->loops,
                      "loops.csv of `detect` (with verification); default: detect them first")

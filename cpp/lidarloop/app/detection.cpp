@@ -87,21 +87,6 @@ std::vector<core::StampedPose> ReadOdometry(const std::filesystem::path& file,
 
 namespace {
 
-// The configuration a run applies: without poses no submaps, said in `notes` (and config.yaml
-// and database.scans record the scans as prepared alone).
-io::RunConfig EffectiveConfig(const io::RunConfig& config, const io::Dataset& dataset,
-                              const std::vector<core::StampedPose>& poses,
-                              std::vector<std::string>& notes) {
-    io::RunConfig effective = config;
-    std::string note;
-    auto& reduction = effective.detection.verification.reduction;
-    if (effective.detection.verify && !SubmapsApply(reduction, poses, dataset.size(), note)) {
-        if (!note.empty()) notes.push_back(note);
-        reduction.submap_path_m = 0.0;
-    }
-    return effective;
-}
-
 // With submaps, replaces each prepared scan by its submap.
 void PrepareSubmapsIfAsked(const io::Dataset& dataset, const io::RunConfig& config,
                            const std::vector<core::StampedPose>& poses,
@@ -196,7 +181,8 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     request.config.Validate();
     const std::vector<core::StampedPose> poses = OdometryOfScans(request, dataset);
     DetectOutcome outcome;
-    const io::RunConfig config = EffectiveConfig(request.config, dataset, poses, outcome.notes);
+    const io::RunConfig config =
+        WithSubmapsWhereTheyApply(request.config, dataset.size(), poses, outcome.notes);
     const double threshold = config.detection.ThresholdFor(config.descriptor.method);
     pipeline::MethodOf(config.descriptor.method).ValidateThreshold(threshold);
     RequireTimesForSeconds(config, dataset);
@@ -278,7 +264,8 @@ DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const Detec
     Stopwatch total;
     const std::vector<core::StampedPose> poses = OdometryOfScans(request, dataset);
     DetectOutcome outcome;
-    io::RunConfig config = EffectiveConfig(request.config, dataset, poses, outcome.notes);
+    io::RunConfig config =
+        WithSubmapsWhereTheyApply(request.config, dataset.size(), poses, outcome.notes);
     if (!config.detection.threshold) config.detection.threshold = map.detection.threshold;
     config.Validate();
     if (config.descriptor != map.database.config()) {

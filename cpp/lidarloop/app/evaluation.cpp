@@ -12,6 +12,7 @@
 #include <tbb/parallel_for.h>
 
 #include "lidarloop/app/describe_run.hpp"
+#include "lidarloop/app/detection.hpp"
 #include "lidarloop/app/evaluation_report.hpp"
 #include "lidarloop/app/metrics_json.hpp"
 #include "lidarloop/app/results_folder.hpp"
@@ -196,26 +197,23 @@ std::optional<LearntThreshold> TrainingThresholdOf(const EvaluationRequest& requ
         criterion == eval::Criterion::kMcc ? result.pairwise.best_mcc : result.pairwise.best_f1};
 }
 
-// The configuration evaluate applies: each scan verified alone. Submaps would be placed by the
-// dataset's poses, which are the ground truth scored against here, and would flatter the
-// verified recall; detect and optimise build them from odometry (--odometry).
-io::RunConfig WithoutSubmaps(io::RunConfig config, std::vector<std::string>& notes) {
-    auto& reduction = config.detection.verification.reduction;
-    if (config.detection.verify && reduction.submap_path_m > 0.0) {
-        notes.push_back(
-            "verification without submaps (verification.reduction.submap_path_m): the poses are "
-            "the ground truth; `lidarloop detect --odometry FILE` verifies with them");
-    }
-    reduction.submap_path_m = 0.0;
-    return config;
-}
-
-// Scans prepared for verification once per evaluation: while the first method describes them.
+// Scans prepared for verification once per evaluation: while the first method describes them
+// (and then as submaps when the odometry is known).
 struct VerificationState {
     std::optional<PreparedScans> prepared;
     bool collected = false;
     pipeline::VerificationCache cache;
+    std::optional<OdometryCheck> odometry;
 };
+
+// Scan i's submap replaces it once every scan has been read (skipped scans are then known).
+void CollectPrepared(const io::Dataset& dataset, const io::RunConfig& config,
+                     const Progress& progress, VerificationState& verification) {
+    const auto& reduction = config.detection.verification.reduction;
+    if (reduction.submap_path_m <= 0.0 || !verification.odometry) return;
+    PrepareSubmaps(dataset, verification.odometry->odometry, reduction, *verification.prepared,
+                   progress);
+}
 
 MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method method,
                                 const io::Dataset& dataset, const eval::GroundTruth& truth,
@@ -230,11 +228,16 @@ MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method m
                     pipeline::Execution::kParallel,
                     request.progress,
                     {}};
-    if (verification.prepared && !verification.collected) {
-        run.with_cloud = verification.prepared->Collector(config.detection.verification.reduction);
+    const bool collecting = verification.prepared && !verification.collected;
+    if (collecting) {
+        const auto& reduction = config.detection.verification.reduction;
+        run.with_cloud = reduction.submap_path_m > 0.0
+                             ? verification.prepared->ReadMarker()
+                             : verification.prepared->Collector(reduction);
         verification.collected = true;
     }
     const auto described = DescribeDataset(dataset, config.descriptor, run);
+    if (collecting) CollectPrepared(dataset, config, request.progress, verification);
     const pipeline::DescriptorDatabase& database = described.database;
     const bool keep_matrix = config.output.KeepsSimilarityMatrix(database.size());
     pipeline::SimilarityMatrix matrix;
@@ -256,15 +259,16 @@ MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method m
     e.ns_per_comparison = pairs > 0 ? 1e9 * comparisons_s / pairs : 0.0;
     e.matrix = std::move(matrix);
     const PreparedScans* prepared = verification.prepared ? &*verification.prepared : nullptr;
-    e.retrieval =
-        keep_matrix
-            ? CompareRetrieval(e.matrix, database.times_s(), config.detection, method, truth,
-                               dataset.poses(), prepared, &verification.cache, request.progress)
-            : CompareRetrieval(
-                  pipeline::DetectStreaming(database, config.detection,
-                                            pipeline::Execution::kParallel, truth.path_m),
-                  config.detection, method, truth, dataset.poses(), prepared, &verification.cache,
-                  request.progress);
+    const OdometryCheck* odometry = verification.odometry ? &*verification.odometry : nullptr;
+    e.retrieval = keep_matrix
+                      ? CompareRetrieval(e.matrix, database.times_s(), config.detection, method,
+                                         truth, dataset.poses(), prepared, &verification.cache,
+                                         request.progress, odometry)
+                      : CompareRetrieval(
+                            pipeline::DetectStreaming(database, config.detection,
+                                                      pipeline::Execution::kParallel, truth.path_m),
+                            config.detection, method, truth, dataset.poses(), prepared,
+                            &verification.cache, request.progress, odometry);
     return e;
 }
 
@@ -433,13 +437,29 @@ EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequ
         RequirePoses(*train_dataset, "threshold learning", "--train-poses");
     EvaluationOutcome outcome{
         eval::BuildGroundTruth(dataset.poses(), GroundTruthRule(request)), {}, {}};
+    std::vector<core::StampedPose> odometry;
+    if (!request.odometry_file.empty() || !request.odometry_topic.empty()) {
+        odometry = ReadOdometry(request.odometry_file, request.odometry_topic, dataset,
+                                request.config.posegraph.max_odometry_step_m);
+    }
+    EvaluationRequest effective = request;
+    // Submaps only from odometry: placed by the dataset's poses, the ground truth scored against
+    // here, they would flatter the verified recall.
+    effective.config =
+        WithSubmapsWhereTheyApply(request.config, dataset.size(), odometry, outcome.notes);
     const std::filesystem::path out_dir = PrepareOutputFolder(request.out);
-    io::WriteConfigYaml(out_dir / "config.yaml", WithoutSubmaps(request.config, outcome.notes));
+    io::WriteConfigYaml(out_dir / "config.yaml", effective.config);
     VerificationState verification;
-    if (request.config.detection.verify) verification.prepared.emplace(dataset.size());
+    if (effective.config.detection.verify) {
+        verification.prepared.emplace(dataset.size());
+        if (!odometry.empty()) {
+            verification.odometry = OdometryCheck{odometry, core::CumulativePathM(odometry),
+                                                  effective.config.posegraph};
+        }
+    }
     for (core::Method method : request.methods) {
         outcome.methods.push_back(
-            EvaluateMethod(request, method, dataset, outcome.truth, train_dataset, verification));
+            EvaluateMethod(effective, method, dataset, outcome.truth, train_dataset, verification));
     }
     for (const std::string& file : request.results_files) {
         outcome.methods.push_back(EvaluateResults(request, file, dataset.size(), outcome.truth));

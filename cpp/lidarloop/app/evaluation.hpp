@@ -110,6 +110,11 @@ struct EvaluationRequest {
     eval::ThresholdLearningConfig learning;
     std::vector<double> fixed_thresholds;  ///< MCC at each, as Röhling's table II
     bool skip_bad = false;
+    /// Odometry, KITTI or TUM, one pose per scan (never the ground truth): verification then
+    /// registers submaps placed by it and rejects loops it contradicts, as `detect --odometry`.
+    /// Empty: each scan verified alone.
+    std::filesystem::path odometry_file;
+    std::string odometry_topic;  ///< instead of odometry_file, for a bag: its Odometry topic
     Progress progress;
     std::filesystem::path out;  ///< the results folder (created)
 };

@@ -48,11 +48,12 @@ RetrievalComparison CompareRetrieval(const pipeline::SimilarityMatrix& matrix,
                                      const core::Method& method, const eval::GroundTruth& truth,
                                      std::span<const core::StampedPose> poses,
                                      const PreparedScans* prepared,
-                                     pipeline::VerificationCache* cache, const Progress& progress) {
+                                     pipeline::VerificationCache* cache, const Progress& progress,
+                                     const OdometryCheck* odometry) {
     // A gap in metres is measured on the ground-truth path.
     return CompareRetrieval(
         pipeline::DetectFromMatrix(matrix, times_s, detector, method, truth.path_m), detector,
-        method, truth, poses, prepared, cache, progress);
+        method, truth, poses, prepared, cache, progress, odometry);
 }
 
 RetrievalComparison CompareRetrieval(std::vector<pipeline::LoopQuery> queries,
@@ -60,7 +61,8 @@ RetrievalComparison CompareRetrieval(std::vector<pipeline::LoopQuery> queries,
                                      const core::Method& method, const eval::GroundTruth& truth,
                                      std::span<const core::StampedPose> poses,
                                      const PreparedScans* prepared,
-                                     pipeline::VerificationCache* cache, const Progress& progress) {
+                                     pipeline::VerificationCache* cache, const Progress& progress,
+                                     const OdometryCheck* odometry) {
     RetrievalComparison comparison;
     comparison.top_k = static_cast<std::size_t>(detector.top_k);
     comparison.queries = std::move(queries);
@@ -71,6 +73,10 @@ RetrievalComparison CompareRetrieval(std::vector<pipeline::LoopQuery> queries,
     if (!detector.verify || prepared == nullptr) return comparison;
     comparison.verification_times =
         VerifyAll(comparison.queries, *prepared, detector, method, progress, cache);
+    if (odometry != nullptr) {
+        RejectLoopsAgainstOdometry(comparison.queries, odometry->odometry, odometry->path_m,
+                                   odometry->config);
+    }
     comparison.verified =
         eval::EvaluateLoopRetrieval(VerifiedCandidates(comparison.queries), truth, poses, config);
     return comparison;

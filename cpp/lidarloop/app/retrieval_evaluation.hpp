@@ -15,6 +15,14 @@
 
 namespace lidarloop::app {
 
+/// The odometry a run's verified loops must agree with (RejectLoopsAgainstOdometry): T_world_sensor
+/// and the cumulative path of each scan, and the pose graph's gate.
+struct OdometryCheck {
+    std::vector<core::StampedPose> odometry;
+    std::vector<double> path_m;
+    posegraph::PoseGraphConfig config;
+};
+
 /// The online detector's view of one method on a sequence (docs/evaluation.md, "Ranked
 /// candidates"): every scan's top-k candidates by descriptor distance, scored as the descriptor
 /// alone decides them and as geometric verification decides them, on the same ground truth.
@@ -45,14 +53,16 @@ std::vector<eval::QueryCandidates> VerifiedCandidates(std::span<const pipeline::
 
 /// Detects the top-k candidates of every scan from `matrix` (pipeline::DetectFromMatrix with
 /// `detector`; a gap in metres on truth.path_m), verifies them when detector.verify (with
-/// `prepared`, sharing `cache`), and scores both against `truth` (built from `poses`).
+/// `prepared`, sharing `cache`, and rejecting what `odometry` contradicts when given), and
+/// scores both against `truth` (built from `poses`).
 RetrievalComparison CompareRetrieval(const pipeline::SimilarityMatrix& matrix,
                                      const std::vector<double>& times_s,
                                      const pipeline::DetectorConfig& detector,
                                      const core::Method& method, const eval::GroundTruth& truth,
                                      std::span<const core::StampedPose> poses,
                                      const PreparedScans* prepared,
-                                     pipeline::VerificationCache* cache, const Progress& progress);
+                                     pipeline::VerificationCache* cache, const Progress& progress,
+                                     const OdometryCheck* odometry = nullptr);
 
 /// CompareRetrieval of queries already detected (e.g. pipeline::DetectStreaming, without the
 /// matrix).
@@ -61,6 +71,7 @@ RetrievalComparison CompareRetrieval(std::vector<pipeline::LoopQuery> queries,
                                      const core::Method& method, const eval::GroundTruth& truth,
                                      std::span<const core::StampedPose> poses,
                                      const PreparedScans* prepared,
-                                     pipeline::VerificationCache* cache, const Progress& progress);
+                                     pipeline::VerificationCache* cache, const Progress& progress,
+                                     const OdometryCheck* odometry = nullptr);
 
 }  // namespace lidarloop::app

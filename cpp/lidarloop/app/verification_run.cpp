@@ -133,6 +133,19 @@ bool SubmapsApply(const registration::ScanReductionConfig& reduction,
     return true;
 }
 
+io::RunConfig WithSubmapsWhereTheyApply(const io::RunConfig& config, std::size_t scans,
+                                        const std::vector<core::StampedPose>& poses,
+                                        std::vector<std::string>& notes) {
+    io::RunConfig effective = config;
+    std::string note;
+    auto& reduction = effective.detection.verification.reduction;
+    if (effective.detection.verify && !SubmapsApply(reduction, poses, scans, note)) {
+        if (!note.empty()) notes.push_back(note);
+        reduction.submap_path_m = 0.0;
+    }
+    return effective;
+}
+
 pipeline::VerificationTimes VerifyAll(std::vector<pipeline::LoopQuery>& queries,
                                       const PreparedScans& prepared,
                                       const pipeline::DetectorConfig& detector,

@@ -10,6 +10,7 @@
 
 #include "lidarloop/app/progress.hpp"
 #include "lidarloop/core/point_cloud.hpp"
+#include "lidarloop/io/config_yaml.hpp"
 #include "lidarloop/io/dataset.hpp"
 #include "lidarloop/pipeline/candidate_verification.hpp"
 #include "lidarloop/posegraph/pose_graph_config.hpp"
@@ -72,6 +73,12 @@ void PrepareSubmaps(const io::Dataset& dataset, const std::vector<core::StampedP
 bool SubmapsApply(const registration::ScanReductionConfig& reduction,
                   const std::vector<core::StampedPose>& poses, std::size_t scans,
                   std::string& note);
+
+/// `config` as a run applies it: submaps only where SubmapsApply (else submap_path_m 0, with
+/// its note in `notes`), so that config.yaml and database.scans say what was done.
+io::RunConfig WithSubmapsWhereTheyApply(const io::RunConfig& config, std::size_t scans,
+                                        const std::vector<core::StampedPose>& poses,
+                                        std::vector<std::string>& notes);
 
 /// pipeline::VerifyQueries over `queries`, telling `progress` as stage "verifying".
 pipeline::VerificationTimes VerifyAll(std::vector<pipeline::LoopQuery>& queries,

@@ -16,6 +16,7 @@
 #include "app_test_utils.hpp"
 #include "lidarloop/app/describe_run.hpp"
 #include "lidarloop/app/detection.hpp"
+#include "lidarloop/app/evaluation.hpp"
 #include "lidarloop/app/verification_run.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/io/config_yaml.hpp"
@@ -582,6 +583,50 @@ TEST_F(DetectionRun, SubmapsInOrderReadEachScanOnceAndEqualEachSubmapAlone) {
                                   registration::SubmapMembers(path_m, i, {6.0, 30, false}).size());
     }
     EXPECT_GE(largest_submap, 3u);  // the windows reach across the blocks' ends
+}
+
+// evaluate --odometry verifies as detect --odometry does: the same submaps, the same gate.
+TEST_F(DetectionRun, EvaluateWithOdometryVerifiesAsDetectWithIt) {
+    LIDARLOOP_RELEASE_SUITE_ONLY();  // two verified runs with submaps, and an evaluation
+    app::DetectRequest detect = Request("detect", core::Method::kRange);
+    detect.config.detection.top_k = 1;
+    detect.odometry_file = dir_ / "sequence" / "poses_odometry.txt";
+    const app::DetectOutcome detected = app::RunDetect(*dataset_, detect);
+
+    app::EvaluationRequest evaluate;
+    evaluate.config = detect.config;
+    evaluate.methods = {core::Method::kRange};
+    evaluate.odometry_file = detect.odometry_file;
+    evaluate.out = dir_ / "evaluate";
+    const app::EvaluationOutcome evaluated = app::RunEvaluation(*dataset_, evaluate);
+    EXPECT_TRUE(evaluated.notes.empty()) << evaluated.notes.front();
+    EXPECT_EQ(io::LoadConfigYaml(evaluate.out / "config.yaml")
+                  .detection.verification.reduction.submap_path_m,
+              detect.config.detection.verification.reduction.submap_path_m);
+    ASSERT_EQ(evaluated.methods.size(), 1u);
+    ASSERT_TRUE(evaluated.methods[0].retrieval);
+    const std::vector<pipeline::LoopQuery>& queries = evaluated.methods[0].retrieval->queries;
+    ASSERT_EQ(queries.size(), detected.queries.size());
+    std::size_t loops = 0;
+    for (std::size_t q = 0; q < queries.size(); ++q) {
+        ASSERT_EQ(queries[q].loop(), detected.queries[q].loop()) << q;
+        if (!queries[q].loop()) continue;
+        ++loops;
+        const auto& verdict = queries[q].verifications[*queries[q].loop()];
+        const auto& detected_verdict = detected.queries[q].verifications[*queries[q].loop()];
+        EXPECT_EQ(verdict.T_match_query.matrix(), detected_verdict.T_match_query.matrix()) << q;
+    }
+    EXPECT_GT(loops, 0u);
+
+    // Without odometry each scan is verified alone, and a note says so.
+    evaluate.odometry_file.clear();
+    evaluate.out = dir_ / "evaluate_alone";
+    const app::EvaluationOutcome alone = app::RunEvaluation(*dataset_, evaluate);
+    ASSERT_EQ(alone.notes.size(), 1u);
+    EXPECT_TRUE(test::Contains(alone.notes.front(), "--odometry")) << alone.notes.front();
+    EXPECT_EQ(io::LoadConfigYaml(evaluate.out / "config.yaml")
+                  .detection.verification.reduction.submap_path_m,
+              0.0);
 }
 
 TEST_F(DetectionRun, ScansAreSubmapsWhenTheOdometryIsKnown) {

@@ -1,0 +1,17 @@
+#include "odometry_options.hpp"
+
+namespace lidarloop::cli {
+
+void OdometryOptions::AddTo(CLI::App& command, const std::string& use) {
+    auto* file =
+        command
+            .add_option("--odometry", file_, "odometry poses, KITTI or TUM, one per scan: " + use)
+            ->check(CLI::ExistingFile);
+    command
+        .add_option("--odometry-topic", topic_,
+                    "instead of --odometry, for a bag: its nav_msgs/Odometry topic, "
+                    "interpolated at the scans' stamps")
+        ->excludes(file);
+}
+
+}  // namespace lidarloop::cli
