@@ -36,14 +36,45 @@ std::vector<posegraph::LoopConstraint> DetectLoops(const io::Dataset& dataset,
     const DetectOutcome detected = RunDetect(dataset, detect);
     std::vector<posegraph::LoopConstraint> loops;
     for (const pipeline::LoopQuery& query : detected.queries) {
-        const std::optional<std::size_t> rank = query.loop();
-        if (!query.accepted || !rank || !query.verified()) continue;
-        const registration::Verification& v = query.verifications[*rank];
-        loops.push_back({query.query, query.candidates[*rank].index, v.T_match_query,
-                         v.overlap.Min(), v.overlap.rmse_m});
+        if (!query.accepted) continue;
+        for (const std::size_t rank :
+             LoopsForPoseGraph(query, detected.path_m, request.config.posegraph)) {
+            const registration::Verification& v = query.verifications[rank];
+            loops.push_back({query.query, query.candidates[rank].index, v.T_match_query,
+                             v.overlap.Min(), v.overlap.rmse_m});
+        }
     }
     return loops;
 }
+
+}  // namespace
+
+std::vector<std::size_t> LoopsForPoseGraph(const pipeline::LoopQuery& query,
+                                           const std::vector<double>& path_m,
+                                           const posegraph::PoseGraphConfig& config) {
+    const std::optional<std::size_t> best = query.loop();
+    if (!best || !query.verified()) return {};
+    std::vector<std::size_t> taken{*best};
+    if (path_m.empty()) return taken;
+    std::vector<std::size_t> others;
+    for (std::size_t c = 0; c < query.verifications.size(); ++c) {
+        if (c != *best && query.verifications[c].accepted) others.push_back(c);
+    }
+    std::stable_sort(others.begin(), others.end(), [&](std::size_t a, std::size_t b) {
+        return query.verifications[a].score() > query.verifications[b].score();
+    });
+    const auto path_of = [&](std::size_t c) { return path_m.at(query.candidates[c].index); };
+    for (const std::size_t c : others) {
+        if (taken.size() >= static_cast<std::size_t>(config.max_loops_per_scan)) break;
+        const bool separated = std::all_of(taken.begin(), taken.end(), [&](std::size_t t) {
+            return std::abs(path_of(c) - path_of(t)) >= config.min_loop_separation_m;
+        });
+        if (separated) taken.push_back(c);
+    }
+    return taken;
+}
+
+namespace {
 
 // "lines 5, 6, 7 and 3 more" for a note.
 std::string LineList(const std::vector<std::size_t>& lines) {

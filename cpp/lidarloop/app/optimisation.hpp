@@ -9,6 +9,7 @@
 #include "lidarloop/eval/trajectory.hpp"
 #include "lidarloop/io/config_yaml.hpp"
 #include "lidarloop/io/dataset.hpp"
+#include "lidarloop/pipeline/loop_detector.hpp"
 #include "lidarloop/posegraph/optimiser.hpp"
 
 namespace lidarloop::app {
@@ -61,6 +62,15 @@ struct OptimiseOutcome {
     std::vector<std::string> notes;  ///< e.g. no loop, no ground truth, no gnuplot
     double total_s = 0.0;
 };
+
+/// The verified loops of `query` the pose graph takes (posegraph.max_loops_per_scan and
+/// min_loop_separation_m), as indices into its candidates: the query's loop (LoopQuery::loop)
+/// first, then the other accepted candidates by score (the earlier on a tie) whose match lies at
+/// least min_loop_separation_m of `path_m` from every match taken. Empty without a verified
+/// loop; only the loop when `path_m` is empty.
+std::vector<std::size_t> LoopsForPoseGraph(const pipeline::LoopQuery& query,
+                                           const std::vector<double>& path_m,
+                                           const posegraph::PoseGraphConfig& config);
 
 /// Reads the odometry (io::ReadError naming the file when its pose count differs from the
 /// dataset's scan count; the pose readers name the line of a non-finite value, a 3x3 part that

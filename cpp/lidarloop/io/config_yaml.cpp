@@ -227,6 +227,10 @@ void VisitFields(posegraph::PoseGraphConfig& c, Visitor& v) {
     v.Section("robust", c.robust);
     v.Field("max_odometry_step_m", c.max_odometry_step_m,
             "optimise: odometry moving farther between two scans is an error (a jump or reset), m");
+    v.Field("max_loops_per_scan", c.max_loops_per_scan,
+            "optimise: verified loops taken per scan, the best and then earlier passes");
+    v.Field("min_loop_separation_m", c.min_loop_separation_m,
+            "optimise: a scan's further loops lie this much path from the matches taken, m");
     v.Field("max_iterations", c.max_iterations, "Ceres trust-region iterations per solve");
     v.Field("threads", c.threads, "Ceres threads");
 }

@@ -59,6 +59,8 @@ void PoseGraphConfig::Validate() const {
     Require(r.scale_step, 1.5, 100.0, false, "robust.scale_step");
     Require(r.max_reject_rounds, 0, 100, "robust.max_reject_rounds");
     Require(max_odometry_step_m, 0.0, 1e8, true, "max_odometry_step_m");
+    Require(max_loops_per_scan, 1, 100, "max_loops_per_scan");
+    Require(min_loop_separation_m, 0.0, 1e6, true, "min_loop_separation_m");
     Require(max_iterations, 1, 10000, "max_iterations");
     Require(threads, 1, 256, "threads");
 }

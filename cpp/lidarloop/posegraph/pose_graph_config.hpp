@@ -71,6 +71,12 @@ struct PoseGraphConfig {
     /// sensor rate: a car on a motorway (40 m/s) moves 4 m between scans at 10 Hz, a train at
     /// 360 km/h 10 m; 100 m still allows 1 Hz at that speed or skipped scans.
     double max_odometry_step_m = 100.0;
+    /// Loops `optimise` takes from one scan's verified candidates when it detects them itself:
+    /// the best (the scan's loop in loops.csv), then others whose match lies at least
+    /// min_loop_separation_m of path from every match taken (an earlier pass of the place: more
+    /// drift removed), up to max_loops_per_scan. [1, 100]; (0, 1e6] m
+    int max_loops_per_scan = 3;
+    double min_loop_separation_m = 50.0;
     int max_iterations = 50;  ///< Ceres (dogleg) iterations per solve, [1, 10000]
     int threads = 1;          ///< Ceres threads, [1, 256]
 

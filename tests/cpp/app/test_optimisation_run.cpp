@@ -1,6 +1,8 @@
 // The optimise run: it detects (or reads) the loops, shrinks the odometry's error, writes the
 // results folder, and names the file and line of bad input.
+#include <algorithm>
 #include <fstream>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -13,6 +15,49 @@
 
 namespace lidarloop {
 namespace {
+
+// A query whose candidates were verified: `accepted_overlaps[c]` < 0 means rejected.
+pipeline::LoopQuery VerifiedQuery(const std::vector<std::size_t>& matches,
+                                  const std::vector<double>& accepted_overlaps) {
+    pipeline::LoopQuery query;
+    query.query = 99;
+    for (std::size_t c = 0; c < matches.size(); ++c) {
+        query.candidates.push_back({matches[c], 0.1 * static_cast<double>(c)});
+        registration::Verification verdict;
+        verdict.accepted = accepted_overlaps[c] >= 0.0;
+        verdict.overlap.query_fraction = verdict.overlap.match_fraction =
+            std::max(accepted_overlaps[c], 0.0);
+        query.verifications.push_back(verdict);
+    }
+    query.accepted = query.loop().has_value();
+    return query;
+}
+
+TEST(LoopsForPoseGraph, TheLoopThenEarlierPassesFarApartInPath) {
+    std::vector<double> path_m(100);
+    for (std::size_t i = 0; i < path_m.size(); ++i) path_m[i] = 2.0 * static_cast<double>(i);
+    // Matches at 20, 22 (4 m of path from 20), 50 (60 m), 51, 80 (120 m), 81; 51 rejected.
+    const pipeline::LoopQuery query =
+        VerifiedQuery({20, 22, 50, 51, 80, 81}, {0.5, 0.7, 0.4, -1.0, 0.45, 0.6});
+    posegraph::PoseGraphConfig config;
+    ASSERT_EQ(config.max_loops_per_scan, 3);
+    ASSERT_EQ(config.min_loop_separation_m, 50.0);
+    // The loop (22, overlap 0.7), then 81 (0.6; 118 m from 22), then 50 (0.4): 20 lies 4 m
+    // from 22, 80 2 m from 81.
+    EXPECT_EQ(app::LoopsForPoseGraph(query, path_m, config), (std::vector<std::size_t>{1, 5, 2}));
+    config.max_loops_per_scan = 2;
+    EXPECT_EQ(app::LoopsForPoseGraph(query, path_m, config), (std::vector<std::size_t>{1, 5}));
+    config.max_loops_per_scan = 1;
+    EXPECT_EQ(app::LoopsForPoseGraph(query, path_m, config), (std::vector<std::size_t>{1}));
+    config.max_loops_per_scan = 10;
+    config.min_loop_separation_m = 1.0;
+    EXPECT_EQ(app::LoopsForPoseGraph(query, path_m, config),
+              (std::vector<std::size_t>{1, 5, 0, 4, 2}));
+    EXPECT_EQ(app::LoopsForPoseGraph(query, {}, config), (std::vector<std::size_t>{1}));
+    EXPECT_TRUE(
+        app::LoopsForPoseGraph(VerifiedQuery({20, 50}, {-1.0, -1.0}), path_m, config).empty());
+    EXPECT_TRUE(app::LoopsForPoseGraph(pipeline::LoopQuery{}, path_m, config).empty());
+}
 
 class OptimisationRun : public ::testing::Test {
 protected:
