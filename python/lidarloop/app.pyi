@@ -150,6 +150,7 @@ def evaluate(
     poses: Optional[PathLike] = None,
     calib: Optional[PathLike] = None,
     train_on: Union[None, PathLike, Dataset] = None,
+    odometry: Optional[PathLike] = None,
     # The run options of evaluate (lidarloop.run_options("evaluate")).
     threshold: Optional[float] = None,
     min_gap: Optional[float] = None,
@@ -167,7 +168,9 @@ def evaluate(
     """`lidarloop evaluate DATASET --out OUT`: every method (default all) on one ground truth
     (distance_m default 10 m, max_heading_deg 0: any, the config's min gap, min_path_m 0: no
     path rule, else pairs must be more than that much path apart too); train_on: learn
-    each method's threshold on that dataset (with poses) instead of the first part."""
+    each method's threshold on that dataset (with poses) instead of the first part; odometry
+    (KITTI or TUM, never the ground truth): verification with submaps and the odometry gate,
+    as detect's."""
 
 class OptimiseResult:
     @property

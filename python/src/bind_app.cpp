@@ -389,7 +389,7 @@ void BindEvaluate(py::module_& m) {
            const std::vector<fs::path>& results, bool overwrite, const py::object& progress,
            const std::string& format, const std::optional<fs::path>& poses,
            const std::optional<fs::path>& calib, const py::object& train_on,
-           const py::kwargs& options) {
+           const std::optional<fs::path>& odometry, const py::kwargs& options) {
             py::dict given(py::arg("out") = out.string(), py::arg("methods") = methods);
             const PythonProgress python_progress(progress);
             app::EvaluationRequest request;
@@ -402,6 +402,7 @@ void BindEvaluate(py::module_& m) {
             for (const fs::path& file : results) request.results_files.push_back(file.string());
             request.progress = python_progress.Callback();
             request.out = out;
+            if (odometry) request.odometry_file = *odometry;
             const io::Dataset data = DatasetOf(dataset, format, poses, calib);
             // --train-on: learn each method's threshold on another dataset (with poses).
             std::optional<io::Dataset> train_data;
@@ -411,6 +412,7 @@ void BindEvaluate(py::module_& m) {
             std::vector<fs::path> inputs = InputsOf(data, poses, calib);
             inputs.insert(inputs.end(), results.begin(), results.end());
             if (train_data) inputs.push_back(train_data->root());
+            if (odometry) inputs.push_back(*odometry);
             result.outcome = RunInFolder(
                 out, std::move(inputs), overwrite, CallText("evaluate", dataset, given),
                 python_progress, [&](const fs::path& staging) {
@@ -427,7 +429,7 @@ void BindEvaluate(py::module_& m) {
         py::arg("config") = py::none(), py::arg("results") = std::vector<fs::path>{},
         py::arg("overwrite") = false, py::arg("progress") = py::none(), py::arg("format") = "auto",
         py::arg("poses") = py::none(), py::arg("calib") = py::none(),
-        py::arg("train_on") = py::none(),
+        py::arg("train_on") = py::none(), py::arg("odometry") = py::none(),
         RunDoc(
             app::RunCommand::kEvaluate,
             "`lidarloop evaluate DATASET --out OUT`: scores every method (default all) and "
@@ -435,8 +437,9 @@ void BindEvaluate(py::module_& m) {
             "max_heading_deg, the config's min gap) and writes metrics.json, roc.csv, pr.csv, "
             "images, report.md, config.yaml and run.json into `out` (a results folder, as "
             "detect's). train_on (a folder or Dataset with poses) learns each method's threshold "
-            "there instead of on the first part. None keeps the default of app::EvaluationRequest "
-            "or the config."));
+            "there instead of on the first part. odometry (a KITTI or TUM file, never the ground "
+            "truth): verification with submaps and the odometry gate, as detect's. None keeps "
+            "the default of app::EvaluationRequest or the config."));
 }
 
 // ---- optimise ----

@@ -131,6 +131,19 @@ def test_evaluate_matches_the_cli(cli, sequence, tmp_path):
         assert (tmp_path / "py" / name).is_file(), name
 
 
+def test_evaluate_with_odometry_verifies_submaps_as_the_cli(cli, sequence, tmp_path):
+    odometry = sequence / "poses_odometry.txt"
+    run_cli(cli, "evaluate", sequence, "--method", "range", "--top-k", "1", "--odometry",
+            odometry, "--out", tmp_path / "cli")
+    result = lidarloop.evaluate(sequence, out=tmp_path / "py", methods=["range"], top_k=1,
+                                odometry=odometry)
+    cli_metrics = json.loads((tmp_path / "cli" / "metrics.json").read_text())
+    assert without_timings(result.metrics) == without_timings(cli_metrics)
+    assert result.methods["range"].retrieval_verified is not None
+    # Verified with submaps (config.yaml records the window), not scan by scan.
+    assert "submap_path_m: 5" in (tmp_path / "py" / "config.yaml").read_text()
+
+
 def test_evaluate_learns_on_another_dataset_as_the_cli(cli, sequence, tmp_path):
     other = tmp_path / "other"
     lidarloop.write_simulation(lidarloop.Simulator(scene="urban", route="uturn", sensor="vlp16",
