@@ -178,9 +178,12 @@ std::size_t RejectLoopsAgainstOdometry(std::vector<pipeline::LoopQuery>& queries
             require_pose(match);
             const core::Transform T_match_query_odometry =
                 odometry[match].T_world_sensor.inverse() * odometry[query.query].T_world_sensor;
+            const double path_between_m = std::abs(path_m[query.query] - path_m[match]);
+            // Odometry that does not know a scan's pose cannot contradict its loop.
+            if (!T_match_query_odometry.matrix().allFinite() || !std::isfinite(path_between_m))
+                continue;
             const posegraph::LoopResult gate = posegraph::GateAgainstOdometry(
-                verdict.T_match_query, T_match_query_odometry,
-                std::abs(path_m[query.query] - path_m[match]), config);
+                verdict.T_match_query, T_match_query_odometry, path_between_m, config);
             if (gate.verdict != posegraph::LoopVerdict::kRejectedByOdometry) continue;
             verdict.accepted = false;
             verdict.reason = registration::RejectReason::kOdometryMismatch;

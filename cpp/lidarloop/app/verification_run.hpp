@@ -92,8 +92,9 @@ pipeline::VerificationTimes VerifyAll(std::vector<pipeline::LoopQuery>& queries,
 /// and chooses each query's loop again among the rest: a place that repeats itself (a street
 /// with a period of 45 m) registers well at the wrong place, and the odometry knows better over
 /// a short path. `odometry`: T_world_sensor of each scan; `path_m`: its cumulative path, one per
-/// scan. Returns how many it rejected. Throws core::ConfigError when a query or candidate has
-/// no odometry.
+/// scan. Returns how many it rejected. A loop to or from a scan whose pose or path is not finite
+/// is kept (the odometry cannot judge it). Throws core::ConfigError when a query or candidate
+/// has no odometry.
 std::size_t RejectLoopsAgainstOdometry(std::vector<pipeline::LoopQuery>& queries,
                                        const std::vector<core::StampedPose>& odometry,
                                        const std::vector<double>& path_m,

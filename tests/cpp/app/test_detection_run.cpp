@@ -97,6 +97,12 @@ TEST(RejectLoopsAgainstOdometry, RejectsThePoseTheOdometryContradictsAndChoosesA
     consistent[0].verifications[1] = AcceptedAt(T_match_query(45, 99), 0.6);
     EXPECT_EQ(app::RejectLoopsAgainstOdometry(consistent, odometry, path_m, {}), 0u);
     EXPECT_EQ(consistent[0].loop(), 1u);
+    // A scan the odometry lost (not finite) cannot be judged: its wrong loop stays.
+    std::vector<core::StampedPose> lost = odometry;
+    lost[45].T_world_sensor.translation().x() = std::numeric_limits<double>::quiet_NaN();
+    std::vector<pipeline::LoopQuery> unjudged{two_loops};
+    EXPECT_EQ(app::RejectLoopsAgainstOdometry(unjudged, lost, path_m, {}), 0u);
+    EXPECT_EQ(unjudged[0].loop(), 1u);
     odometry.resize(60);
     EXPECT_THROW(app::RejectLoopsAgainstOdometry(consistent, odometry, path_m, {}),
                  core::ConfigError);
