@@ -624,6 +624,13 @@ TEST_F(DetectionRun, EvaluateWithOdometryVerifiesAsDetectWithIt) {
     }
     EXPECT_GT(loops, 0u);
 
+    // The ground truth given as odometry is said to flatter the figures.
+    evaluate.odometry_file = dir_ / "sequence" / "poses.txt";
+    evaluate.out = dir_ / "evaluate_truth";
+    const app::EvaluationOutcome flattered = app::RunEvaluation(*dataset_, evaluate);
+    ASSERT_EQ(flattered.notes.size(), 1u);
+    EXPECT_TRUE(test::Contains(flattered.notes.front(), "ground truth")) << flattered.notes[0];
+
     // Without odometry each scan is verified alone, and a note says so.
     evaluate.odometry_file.clear();
     evaluate.out = dir_ / "evaluate_alone";
