@@ -3,6 +3,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -48,11 +49,14 @@ std::string RpeText(const app::TrajectoryMetrics& before, const app::TrajectoryM
 
 void PrintOutcome(const app::OptimiseRequest& request, const app::OptimiseOutcome& outcome) {
     const posegraph::OptimisationResult& r = outcome.result;
-    std::cout << "lidarloop optimise: " << outcome.loops.size() << " accepted loops, "
-              << r.loops_used << " used, " << r.rejected_by_odometry
-              << " rejected against the odometry, " << r.rejected_by_consistency
-              << " without support, " << r.rejected_by_residual << " by their residual ("
-              << r.solves << " solves, " << Figure(r.seconds, "%.2f") << " s)\n";
+    std::set<std::size_t> scans_with_loops;
+    for (const posegraph::LoopConstraint& loop : outcome.loops) scans_with_loops.insert(loop.query);
+    std::cout << "lidarloop optimise: " << outcome.loops.size() << " accepted loops of "
+              << scans_with_loops.size() << " scans, " << r.loops_used << " used, "
+              << r.rejected_by_odometry << " rejected against the odometry, "
+              << r.rejected_by_consistency << " without support, " << r.rejected_by_residual
+              << " by their residual (" << r.solves << " solves, " << Figure(r.seconds, "%.2f")
+              << " s)\n";
     if (outcome.odometry && outcome.optimised) {
         std::cout << "  ATE RMSE: odometry " << Figure(outcome.odometry->ate_rmse_m, "%.3f")
                   << " m -> optimised " << Figure(outcome.optimised->ate_rmse_m, "%.3f")
