@@ -109,13 +109,15 @@ void PrepareSubmaps(const io::Dataset& dataset, const std::vector<core::StampedP
         return readable.at(k) != 0 ? dataset.LoadScan(k) : core::PointCloud{};
     };
     const auto wanted = [&readable](std::size_t i) { return readable.at(i) != 0; };
+    const auto total = static_cast<std::size_t>(
+        std::count_if(readable.begin(), readable.end(), [](char r) { return r != 0; }));
     std::atomic<std::size_t> done{0};
     PrepareSubmapsInOrder(poses, reduction, load, wanted,
                           [&](std::size_t i, registration::PreparedScan submap, double seconds) {
                               prepared.scans[i] = registration::CompactPreparedScan(submap);
                               prepared.prepare_seconds[i] += seconds;
                               const std::size_t finished = ++done;
-                              if (progress) progress("submaps", finished, readable.size());
+                              if (progress) progress("submaps", finished, total);
                           });
 }
 
