@@ -25,7 +25,7 @@ constexpr std::uint64_t kVersionBytes = sizeof(kVersionLine) - 1;
 constexpr std::uint32_t kMaxChunkBytes = 1U << 27;
 constexpr std::uint32_t kMaxHeaderBytes = 1U << 20;  // record headers hold a few short fields
 constexpr std::uint8_t kOpMessage = 0x02, kOpBagHeader = 0x03, kOpIndex = 0x04, kOpChunk = 0x05,
-                       kOpChunkInfo = 0x06;
+                       kOpChunkInfo = 0x06, kOpConnection = 0x07;
 
 class BagFile {
 public:
@@ -77,13 +77,11 @@ struct Record {
     std::uint8_t op = 0;
 };
 
-Record ReadRecord(BagFile& bag, std::uint64_t at) {
-    Record record;
-    record.at = at;
-    const std::uint32_t header_len = bag.U32(at, "a record's header length");
-    if (header_len > kMaxHeaderBytes)
-        bag.Fail(at, "a record header of " + std::to_string(header_len) + " bytes");
-    const std::string header = bag.Read(at + 4, header_len, "a record header");
+// The fields <uint32 len>name=value of `header` (a record's header, or a connection record's
+// data, which rosbag_storage parses the same way without checking the lengths).
+std::map<std::string, std::string> HeaderFields(BagFile& bag, std::uint64_t at,
+                                                const std::string& header) {
+    std::map<std::string, std::string> fields;
     for (std::size_t pos = 0; pos < header.size();) {
         if (header.size() - pos < 4) bag.Fail(at, "a header field's length is cut");
         std::uint32_t len;
@@ -94,8 +92,18 @@ Record ReadRecord(BagFile& bag, std::uint64_t at) {
         pos += len;
         const std::size_t equals = field.find('=');
         if (equals == std::string::npos) bag.Fail(at, "a header field without '='");
-        record.fields[field.substr(0, equals)] = field.substr(equals + 1);
+        fields[field.substr(0, equals)] = field.substr(equals + 1);
     }
+    return fields;
+}
+
+Record ReadRecord(BagFile& bag, std::uint64_t at) {
+    Record record;
+    record.at = at;
+    const std::uint32_t header_len = bag.U32(at, "a record's header length");
+    if (header_len > kMaxHeaderBytes)
+        bag.Fail(at, "a record header of " + std::to_string(header_len) + " bytes");
+    record.fields = HeaderFields(bag, at, bag.Read(at + 4, header_len, "a record header"));
     const auto op = record.fields.find("op");
     if (op == record.fields.end() || op->second.size() != 1) bag.Fail(at, "a record without op");
     record.op = static_cast<std::uint8_t>(op->second[0]);
@@ -167,6 +175,9 @@ void CheckIndex(BagFile& bag, const Record& record, const Chunk* chunk) {
         if (left < 8) bag.Fail(at, "a message record cut by its chunk's end");
         const std::uint32_t header_len = bag.U32(at, "a message header length");
         if (header_len > left - 8) bag.Fail(at, "a message header runs past its chunk");
+        if (header_len > kMaxHeaderBytes)
+            bag.Fail(at, "a message header of " + std::to_string(header_len) + " bytes");
+        HeaderFields(bag, at, bag.Read(at + 4, header_len, "a message header"));
         const std::uint32_t data_len = bag.U32(at + 4 + header_len, "a message length");
         if (data_len > left - 8 - header_len) bag.Fail(at, "a message runs past its chunk");
     }
@@ -205,6 +216,13 @@ void CheckBagStructure(const std::filesystem::path& file) {
             const std::uint64_t chunk_pos = Field64(bag, record, "chunk_pos");
             if (chunks.count(chunk_pos) == 0)
                 bag.Fail(record.at, "a chunk info that points at no chunk");
+        } else if (record.op == kOpConnection) {
+            // Its data is the connection header (topic, type, md5sum, message definition).
+            if (record.data_len > kMaxHeaderBytes)
+                bag.Fail(record.at,
+                         "a connection header of " + std::to_string(record.data_len) + " bytes");
+            HeaderFields(bag, record.at,
+                         bag.Read(record.data_at, record.data_len, "a connection header"));
         } else if (record.op == kOpMessage) {
             bag.Fail(record.at, "a message record outside any chunk");
         }
