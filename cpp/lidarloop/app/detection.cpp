@@ -166,12 +166,8 @@ pipeline::SequenceDescriptors DescribeAndPrepare(const io::Dataset& dataset,
                                                  PreparedScans& prepared) {
     DescribeRun run{
         "describing", request.skip_bad, pipeline::Execution::kParallel, request.progress, {}};
-    if (config.detection.verify) {
-        // With submaps a scan alone is never verified: only which scans were read matters.
-        const auto& reduction = config.detection.verification.reduction;
-        run.with_cloud =
-            reduction.submap_path_m > 0.0 ? prepared.ReadMarker() : prepared.Collector(reduction);
-    }
+    if (config.detection.verify)
+        run.with_cloud = prepared.CollectorFor(config.detection.verification.reduction);
     return DescribeDataset(dataset, config.descriptor, run);
 }
 

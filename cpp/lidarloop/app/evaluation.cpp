@@ -242,10 +242,8 @@ MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method m
                     {}};
     const bool collecting = verification.prepared && !verification.collected;
     if (collecting) {
-        const auto& reduction = config.detection.verification.reduction;
-        run.with_cloud = reduction.submap_path_m > 0.0
-                             ? verification.prepared->ReadMarker()
-                             : verification.prepared->Collector(reduction);
+        run.with_cloud =
+            verification.prepared->CollectorFor(config.detection.verification.reduction);
         verification.collected = true;
     }
     const auto described = DescribeDataset(dataset, config.descriptor, run);

@@ -31,6 +31,11 @@ std::function<void(std::size_t, const core::PointCloud&)> PreparedScans::ReadMar
     return [this](std::size_t i, const core::PointCloud&) { readable.at(i) = 1; };
 }
 
+std::function<void(std::size_t, const core::PointCloud&)> PreparedScans::CollectorFor(
+    const registration::ScanReductionConfig& reduction) {
+    return reduction.submap_path_m > 0.0 ? ReadMarker() : Collector(reduction);
+}
+
 std::vector<double> PreparedScans::BytesPerScan() const {
     std::vector<double> bytes;
     for (const auto& scan : scans) {

@@ -41,6 +41,10 @@ struct PreparedScans {
     /// One that only notes which scans were read: with submaps (PrepareSubmaps) a scan alone is
     /// never verified, so it is not prepared alone first.
     std::function<void(std::size_t, const core::PointCloud&)> ReadMarker();
+    /// The callback of a run verifying with `reduction`: Collector, or ReadMarker with submaps
+    /// (submap_path_m > 0; PrepareSubmaps follows once every scan was read).
+    std::function<void(std::size_t, const core::PointCloud&)> CollectorFor(
+        const registration::ScanReductionConfig& reduction);
     /// Heap bytes of the prepared scans, per scan (skipped scans excluded).
     std::vector<double> BytesPerScan() const;
 };
