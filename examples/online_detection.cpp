@@ -20,11 +20,11 @@ int main(int argc, char** argv) {
         ll::pipeline::DetectorConfig detection;  // candidates > 30 scans back, default threshold
         ll::pipeline::LoopDetector detector(descriptor, detection);
         for (std::size_t i = 0; i < dataset.size(); ++i) {
-            const ll::pipeline::LoopQuery loop =
+            const ll::pipeline::LoopQuery query =
                 detector.Process(dataset.LoadScan(i), static_cast<double>(i));
-            if (loop.accepted)
+            if (const auto loop = query.loop())  // the verified candidate that overlaps best
                 std::printf("scan %zu revisits scan %zu (distance %.4f)\n", i,
-                            loop.candidates.front().index, loop.candidates.front().distance);
+                            query.candidates[*loop].index, query.candidates[*loop].distance);
         }
         // [readme-snippet]
     } catch (const std::exception& e) {
