@@ -66,6 +66,7 @@ class LoopDetector:
         *,
         top_k: Optional[int] = None,
         min_gap: Optional[float] = None,
+        min_gap_unit: Optional[str] = None,
         threshold: Optional[float] = None,
         verify: Optional[bool] = None,
     ) -> None: ...
@@ -74,6 +75,7 @@ class LoopDetector:
         points: npt.NDArray[np.floating],
         time_s: Optional[float] = None,
         skip_non_finite: bool = False,
+        odometry: Optional[npt.NDArray[np.floating]] = None,
     ) -> LoopQuery: ...
     def process_descriptor(self, descriptor: Descriptor, time_s: Optional[float] = None) -> LoopQuery: ...
     def query(self, descriptor: Descriptor) -> LoopQuery: ...

@@ -12,6 +12,7 @@
 #include "bindings.hpp"
 #include "conversions.hpp"
 #include "lidarloop/app/detection.hpp"
+#include "lidarloop/app/verification_run.hpp"
 #include "lidarloop/io/database_file.hpp"
 #include "lidarloop/io/prepared_scans_file.hpp"
 #include "lidarloop/pipeline/descriptor_database.hpp"
@@ -225,11 +226,13 @@ void BindLoopQuery(py::module_& m) {
 }
 
 pipeline::DetectorConfig DetectionOf(const io::RunConfig& run, std::optional<int> top_k,
-                                     std::optional<double> min_gap, std::optional<double> threshold,
-                                     std::optional<bool> verify) {
+                                     std::optional<double> min_gap,
+                                     const std::optional<std::string>& min_gap_unit,
+                                     std::optional<double> threshold, std::optional<bool> verify) {
     pipeline::DetectorConfig detection = run.detection;
     if (top_k) detection.top_k = *top_k;
     if (min_gap) detection.min_gap.value = *min_gap;
+    if (min_gap_unit) detection.min_gap.unit = core::ParseMinGapUnit(*min_gap_unit);
     if (threshold) detection.threshold = *threshold;
     if (verify) detection.verify = *verify;
     detection.Validate();
@@ -277,30 +280,43 @@ void BindDetector(py::module_& m) {
         "stored. process() is not thread-safe; query() may run concurrently.")
         .def(py::init([](const py::object& config, const std::optional<std::string>& method,
                          std::optional<int> top_k, std::optional<double> min_gap,
+                         const std::optional<std::string>& min_gap_unit,
                          std::optional<double> threshold, std::optional<bool> verify) {
                  const io::RunConfig run = ResolveRunConfig(config, method);
-                 return std::make_unique<LoopDetector>(
-                     run.descriptor, DetectionOf(run, top_k, min_gap, threshold, verify));
+                 auto detector = std::make_unique<LoopDetector>(
+                     run.descriptor,
+                     DetectionOf(run, top_k, min_gap, min_gap_unit, threshold, verify));
+                 detector->SetOdometryGate(app::OdometryGateOf(run.posegraph));
+                 return detector;
              }),
              py::arg("config") = py::none(), py::arg("method") = py::none(), py::kw_only(),
              py::arg("top_k") = py::none(), py::arg("min_gap") = py::none(),
-             py::arg("threshold") = py::none(), py::arg("verify") = py::none(),
-             "config: None, dict or YAML path (descriptor and `detection` keys); method; top_k, "
-             "min_gap (in the config's unit, scans by default), threshold, verify override "
-             "detection.*.")
+             py::arg("min_gap_unit") = py::none(), py::arg("threshold") = py::none(),
+             py::arg("verify") = py::none(),
+             "config: None, dict or YAML path (descriptor, `detection` and `posegraph` keys); "
+             "method; top_k, min_gap (in the config's unit, scans by default), min_gap_unit "
+             "('scans', 'seconds', 'metres': needs the odometry), threshold, verify override "
+             "detection.*. Loops the odometry contradicts (process's odometry) are rejected by "
+             "the pose graph's gate (posegraph.robust).")
         .def(
             "process",
             [](LoopDetector& detector, const py::object& points, std::optional<double> time_s,
-               bool skip_non_finite) {
+               bool skip_non_finite, const py::object& odometry) {
                 const core::PointCloud& cloud = ScratchPointsFromArray(points, skip_non_finite);
                 const double t = time_s.value_or(static_cast<double>(detector.database().size()));
+                std::optional<core::Transform> T_odom_sensor;
+                if (!odometry.is_none()) T_odom_sensor = TransformFromArray(odometry, "odometry");
                 py::gil_scoped_release release;
-                return detector.Process(cloud, t);
+                return detector.Process(cloud, t, T_odom_sensor);
             },
             py::arg("points"), py::arg("time_s") = py::none(), py::arg("skip_non_finite") = false,
+            py::arg("odometry") = py::none(),
             "Describes an (N, 3)/(N, 4) scan (sensor frame, metres; copied once), finds its "
             "candidates among the stored scans (verifying them when verify is on), stores it "
-            "and returns the LoopQuery. time_s: seconds, default its index. Releases the GIL.")
+            "and returns the LoopQuery. time_s: seconds, default its index. odometry: the "
+            "scan's (4, 4) pose T_odom_sensor by the odometry, for every scan or none: a gap in "
+            "metres of path, and verified loops it contradicts rejected (odometry_mismatch). "
+            "Releases the GIL.")
         .def(
             "process_descriptor",
             [](LoopDetector& detector, const core::Descriptor& descriptor,

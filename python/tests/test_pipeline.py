@@ -175,3 +175,48 @@ def test_detector_rejects_bad_points_and_config():
     assert len(detector) == 0
     with pytest.raises(lidarloop.ConfigError, match="top_k"):
         lidarloop.LoopDetector(top_k=0)
+
+
+def test_online_detector_with_odometry_counts_the_gap_in_metres(cli, sequence, tmp_path):
+    """Online with each scan's odometry pose: the candidates `detect --odometry` gives with the
+    gap in metres of path."""
+    out = tmp_path / "detect"
+    subprocess.run(
+        [str(cli), "detect", str(sequence.root), "--method", "range", "--no-verify",
+         "--min-gap", "20", "--min-gap-unit", "metres",
+         "--odometry", str(sequence.root / "poses_odometry.txt"), "--out", str(out)],
+        check=True, capture_output=True)
+    expected = read_loops(out)
+    times, odometry = lidarloop.read_poses(sequence.root / "poses_odometry.txt")
+    detector = lidarloop.LoopDetector(method="range", min_gap=20, min_gap_unit="metres", verify=False)
+    queries = [detector.process(sequence[i], times[i], odometry=odometry[i]) for i in range(len(sequence))]
+    assert {q.query for q in queries if q.candidates} == set(expected)
+    for query in queries:
+        if query.candidates:
+            assert query.candidates[0].index == int(expected[query.query]["match"])
+    with pytest.raises(lidarloop.ConfigError, match="odometry"):
+        lidarloop.LoopDetector(method="range", min_gap_unit="metres").process(sequence[0])
+
+
+def test_online_detector_rejects_the_loops_its_odometry_contradicts(sequence):
+    """The pose graph's gate online: with the true poses as odometry the verified loops stay;
+    with the revisits' odometry 100 m off they are rejected as odometry_mismatch."""
+    times, truth = sequence.poses
+
+    def run(odometry):
+        detector = lidarloop.LoopDetector(method="range", min_gap=MIN_GAP, top_k=3)
+        return [detector.process(sequence[i], times[i], odometry=odometry[i]) for i in range(len(sequence))]
+
+    agreeing = run(truth)
+    across = [q for q in agreeing if q.query >= 40 and q.loop is not None and q.match < 40]
+    assert across, "the sequence has verified loops from scans 40.. back to scans before 40"
+    shifted = truth.copy()
+    shifted[40:, 0, 3] += 100.0  # the odometry jumps 100 m at scan 40
+    contradicted = run(shifted)
+    for query in contradicted[40:]:
+        assert query.loop is None or query.match >= 40, query.query
+    for query in across:
+        reasons = [v.reason for v in contradicted[query.query].verifications]
+        assert "odometry_mismatch" in reasons, query.query
+    with pytest.raises(lidarloop.ShapeError):
+        lidarloop.LoopDetector(method="range").process(sequence[0], odometry=np.eye(3))

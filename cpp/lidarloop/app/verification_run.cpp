@@ -165,6 +165,15 @@ pipeline::VerificationTimes VerifyAll(std::vector<pipeline::LoopQuery>& queries,
                                    pipeline::Execution::kParallel, tell, cache);
 }
 
+pipeline::OdometryGate OdometryGateOf(const posegraph::PoseGraphConfig& config) {
+    return [config](const core::Transform& T_match_query_loop,
+                    const core::Transform& T_match_query_odometry, double path_m) {
+        return posegraph::GateAgainstOdometry(T_match_query_loop, T_match_query_odometry, path_m,
+                                              config)
+                   .verdict == posegraph::LoopVerdict::kRejectedByOdometry;
+    };
+}
+
 std::size_t RejectLoopsAgainstOdometry(std::vector<pipeline::LoopQuery>& queries,
                                        const std::vector<core::StampedPose>& odometry,
                                        const std::vector<double>& path_m,
@@ -175,29 +184,18 @@ std::size_t RejectLoopsAgainstOdometry(std::vector<pipeline::LoopQuery>& queries
                                     std::to_string(odometry.size()) + " poses)");
         }
     };
+    const pipeline::OdometryGate gate = OdometryGateOf(config);
+    const auto pose_of = [&](std::size_t scan) {
+        require_pose(scan);
+        return odometry[scan].T_world_sensor;
+    };
+    const auto path_of = [&](std::size_t scan) {
+        require_pose(scan);
+        return path_m[scan];
+    };
     std::size_t rejected = 0;
-    for (pipeline::LoopQuery& query : queries) {
-        for (std::size_t c = 0; c < query.verifications.size(); ++c) {
-            registration::Verification& verdict = query.verifications[c];
-            if (!verdict.accepted) continue;
-            const std::size_t match = query.candidates[c].index;
-            require_pose(query.query);
-            require_pose(match);
-            const core::Transform T_match_query_odometry =
-                odometry[match].T_world_sensor.inverse() * odometry[query.query].T_world_sensor;
-            const double path_between_m = std::abs(path_m[query.query] - path_m[match]);
-            // Odometry that does not know a scan's pose cannot contradict its loop.
-            if (!T_match_query_odometry.matrix().allFinite() || !std::isfinite(path_between_m))
-                continue;
-            const posegraph::LoopResult gate = posegraph::GateAgainstOdometry(
-                verdict.T_match_query, T_match_query_odometry, path_between_m, config);
-            if (gate.verdict != posegraph::LoopVerdict::kRejectedByOdometry) continue;
-            verdict.accepted = false;
-            verdict.reason = registration::RejectReason::kOdometryMismatch;
-            ++rejected;
-        }
-        query.accepted = query.loop().has_value();
-    }
+    for (pipeline::LoopQuery& query : queries)
+        rejected += pipeline::RejectLoopsAgainstOdometry(query, pose_of, path_of, gate);
     return rejected;
 }
 

@@ -91,6 +91,11 @@ pipeline::VerificationTimes VerifyAll(std::vector<pipeline::LoopQuery>& queries,
                                       const core::Method& method, const Progress& progress,
                                       pipeline::VerificationCache* cache = nullptr);
 
+/// The pose graph's odometry gate (posegraph::GateAgainstOdometry with `config`'s robust and
+/// information sections) as the detectors take it: `detect --odometry`, and the online
+/// LoopDetector (SetOdometryGate) when it is given the odometry.
+pipeline::OdometryGate OdometryGateOf(const posegraph::PoseGraphConfig& config);
+
 /// Rejects (RejectReason::kOdometryMismatch) every accepted candidate whose registered pose the
 /// odometry contradicts beyond its drift (posegraph::GateAgainstOdometry with `posegraph`'s gate)
 /// and chooses each query's loop again among the rest: a place that repeats itself (a street

@@ -126,6 +126,29 @@ std::optional<std::size_t> LoopQuery::loop() const {
     return best;
 }
 
+std::size_t RejectLoopsAgainstOdometry(
+    LoopQuery& query, const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
+    const std::function<double(std::size_t)>& path_m_of, const OdometryGate& gate) {
+    std::size_t rejected = 0;
+    for (std::size_t c = 0; c < query.verifications.size(); ++c) {
+        registration::Verification& verdict = query.verifications[c];
+        if (!verdict.accepted) continue;
+        const std::size_t match = query.candidates[c].index;
+        const core::Transform T_match_query_odometry =
+            T_odom_sensor_of(match).inverse() * T_odom_sensor_of(query.query);
+        const double path_between_m = std::abs(path_m_of(query.query) - path_m_of(match));
+        // Odometry that does not know a scan's pose cannot contradict its loop.
+        if (!T_match_query_odometry.matrix().allFinite() || !std::isfinite(path_between_m))
+            continue;
+        if (!gate(verdict.T_match_query, T_match_query_odometry, path_between_m)) continue;
+        verdict.accepted = false;
+        verdict.reason = registration::RejectReason::kOdometryMismatch;
+        ++rejected;
+    }
+    query.accepted = query.loop().has_value();
+    return rejected;
+}
+
 std::vector<Neighbor> NearestCandidates(std::size_t count, std::size_t k,
                                         const std::function<double(std::size_t)>& distance_of,
                                         const std::function<bool(std::size_t)>& eligible) {
@@ -176,7 +199,8 @@ LoopDetector::LoopDetector(DescriptorDatabase database, const DetectorConfig& de
 }
 
 LoopQuery LoopDetector::Search(const PreparedQuery& query, std::size_t query_index,
-                               const std::function<bool(std::size_t)>& eligible) const {
+                               const std::function<bool(std::size_t)>& eligible,
+                               const std::vector<double>& path_m) const {
     const auto k = static_cast<std::size_t>(detector_.top_k);
     const auto search = [&](std::size_t count, const std::function<bool(std::size_t)>& filter) {
         if (index_) return index_->Search(query, count, filter);
@@ -187,9 +211,8 @@ LoopQuery LoopDetector::Search(const PreparedQuery& query, std::size_t query_ind
     LoopQuery result;
     result.query = query_index;
     result.candidates = search(k, eligible);
-    // The online detector knows no path: a gap in metres leaves second_ratio NaN.
-    static const std::vector<double> kNoPath;
-    Finish(result, detector_.min_gap, detector_.min_gap.Along(database_.times_s(), kNoPath),
+    // Without the path (no odometry, or localisation) a gap in metres leaves second_ratio NaN.
+    Finish(result, detector_.min_gap, detector_.min_gap.Along(database_.times_s(), path_m),
            database_.definition(), threshold_,
            [&](const std::function<bool(std::size_t)>& other_place) {
                return search(1, [&](std::size_t j) { return eligible(j) && other_place(j); });
@@ -211,33 +234,72 @@ std::size_t LoopDetector::prepared_bytes() const {
     return bytes;
 }
 
-LoopQuery LoopDetector::Process(const core::PointCloud& scan, double time_s) {
+LoopQuery LoopDetector::Process(const core::PointCloud& scan, double time_s,
+                                const std::optional<core::Transform>& T_odom_sensor) {
     registration::PreparedScan prepared;
     if (detector_.verify)
         prepared = registration::PrepareScan(scan, detector_.verification.reduction);
-    return Process(ComputeDescriptor(scan, database_.config()), time_s, std::move(prepared));
+    return Process(ComputeDescriptor(scan, database_.config()), time_s, std::move(prepared),
+                   T_odom_sensor);
+}
+
+std::optional<double> LoopDetector::PathOf(
+    const std::optional<core::Transform>& T_odom_sensor) const {
+    const std::size_t index = database_.size();
+    if (!T_odom_sensor) {
+        if (!odometry_.empty()) {
+            throw core::ConfigError("scan " + std::to_string(index) +
+                                    " has no odometry pose, the scans before it had one: give "
+                                    "the pose with every scan or with none");
+        }
+        if (detector_.min_gap.unit == core::MinGap::Unit::kMetres) {
+            throw core::ConfigError(
+                "detection.min_gap_unit metres needs the path: give each scan's odometry pose "
+                "(T_odom_sensor) to Process, or the gap in scans or seconds");
+        }
+        return std::nullopt;
+    }
+    if (odometry_.size() != index) {
+        throw core::ConfigError("scan " + std::to_string(index) +
+                                " has an odometry pose, the scans before it had none: give the "
+                                "pose with every scan or with none");
+    }
+    if (!T_odom_sensor->matrix().allFinite()) {
+        throw core::ConfigError("the odometry pose of scan " + std::to_string(index) +
+                                " is not finite");
+    }
+    if (index == 0) return 0.0;
+    return path_m_.back() + (T_odom_sensor->translation() - odometry_.back().translation()).norm();
 }
 
 LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_s,
-                                registration::PreparedScan scan) {
-    if (detector_.min_gap.unit == core::MinGap::Unit::kMetres) {
-        throw core::ConfigError(
-            "detection.min_gap_unit metres: the online detector knows no path lengths; detect "
-            "the sequence offline (DetectStreaming with the path) or give the gap in scans or "
-            "seconds");
-    }
+                                registration::PreparedScan scan,
+                                const std::optional<core::Transform>& T_odom_sensor) {
+    const std::optional<double> query_path_m = PathOf(T_odom_sensor);
     const std::unique_ptr<PreparedQuery> query = database_.Prepare(descriptor);
     const std::size_t query_index = database_.size();
-    const auto& times_s = database_.times_s();
     const core::MinGap gap = detector_.min_gap;
-    LoopQuery result = Search(*query, query_index, [&](std::size_t j) {
-        return j < query_index && database_.IsValid(j) &&
-               gap.Allows(query_index, j, time_s, times_s[j]);
-    });
+    const std::vector<double>& along = gap.Along(database_.times_s(), path_m_);
+    const double query_along =
+        query_path_m && gap.unit == core::MinGap::Unit::kMetres ? *query_path_m : time_s;
+    LoopQuery result = Search(
+        *query, query_index,
+        [&](std::size_t j) {
+            return j < query_index && database_.IsValid(j) &&
+                   gap.Allows(query_index, j, query_along, along[j]);
+        },
+        path_m_);
     registration::CompactPreparedScan compact(scan);
     Verify(result, compact);
+    if (odometry_gate_ && query_path_m) {
+        RejectLoopsAgainstOdometry(
+            result, [&](std::size_t j) { return j == query_index ? *T_odom_sensor : odometry_[j]; },
+            [&](std::size_t j) { return j == query_index ? *query_path_m : path_m_[j]; },
+            odometry_gate_);
+    }
     database_.Add(descriptor, time_s);
     scans_.push_back(std::move(compact));
+    if (query_path_m) odometry_.push_back(*T_odom_sensor), path_m_.push_back(*query_path_m);
     if (index_) index_->Insert(query_index);
     return result;
 }

@@ -67,6 +67,22 @@ struct LoopQuery {
     std::optional<std::size_t> loop() const;
 };
 
+/// Whether the odometry contradicts a verified loop: given the loop's registered T_match_query,
+/// the odometry's T_match_query and the path between the two scans (m); true rejects the loop.
+/// app::OdometryGateOf makes the pose graph's gate (posegraph::GateAgainstOdometry) one.
+using OdometryGate =
+    std::function<bool(const core::Transform& T_match_query_loop,
+                       const core::Transform& T_match_query_odometry, double path_m)>;
+
+/// Rejects (RejectReason::kOdometryMismatch) each accepted verification of `query` that `gate`
+/// says the odometry contradicts, and chooses the query's loop again among the rest.
+/// `T_odom_sensor_of(j)`: scan j's pose by the odometry; `path_m_of(j)`: its cumulative path. A
+/// loop to or from a scan whose pose or path is not finite is kept (the odometry cannot judge
+/// it). Returns how many it rejected.
+std::size_t RejectLoopsAgainstOdometry(
+    LoopQuery& query, const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
+    const std::function<double(std::size_t)>& path_m_of, const OdometryGate& gate);
+
 /// The k nearest of the scans 0..count-1 for which `eligible(j)` holds, by (distance, index),
 /// with `distance_of(j)` (called for eligible scans only; +inf and NaN are never candidates):
 /// the brute-force search both detectors share. O(k) memory (a bounded heap).
@@ -83,6 +99,10 @@ std::vector<Neighbor> NearestCandidates(std::size_t count, std::size_t k,
 /// 0.1 MB instead of a raw HDL-64E scan's 2 MB; prepared_bytes()) and its candidates are
 /// verified against the stored reduced scans; a scan given as a descriptor alone is neither
 /// verified nor verifiable as a candidate (kTooFewPoints).
+/// Given each scan's pose by the odometry (Process's T_odom_sensor), it also measures the gap
+/// in metres of path, and with an odometry gate (SetOdometryGate) rejects the loops the
+/// odometry contradicts, as `detect --odometry` does (docs/verification.md, "The odometry's
+/// word"). Scans given with and without a pose do not mix.
 /// Process is not thread-safe; Query may run concurrently.
 /// Neither copyable nor movable: the index refers to the detector's own database.
 class LoopDetector {
@@ -98,13 +118,19 @@ public:
     LoopDetector& operator=(const LoopDetector&) = delete;
 
     /// Describes `scan`, finds its candidates among the stored scans (and verifies them when
-    /// verify is on), then stores it. ConfigError for a gap in metres: the online detector knows
-    /// no path (DetectStreaming does).
-    LoopQuery Process(const core::PointCloud& scan, double time_s);
+    /// verify is on, then applies the odometry gate), then stores it. `T_odom_sensor`: the
+    /// scan's pose by the odometry, given for every scan or for none. ConfigError for a gap in
+    /// metres without it, for a pose on some scans only, and for a pose that is not finite.
+    LoopQuery Process(const core::PointCloud& scan, double time_s,
+                      const std::optional<core::Transform>& T_odom_sensor = std::nullopt);
     /// The same for a scan described (and, for verification, prepared) by the caller; an empty
     /// `scan` is not verified.
     LoopQuery Process(const core::Descriptor& descriptor, double time_s,
-                      registration::PreparedScan scan = {});
+                      registration::PreparedScan scan = {},
+                      const std::optional<core::Transform>& T_odom_sensor = std::nullopt);
+    /// The odometry gate applied to verified loops between scans given with poses (none by
+    /// default; an empty function removes it).
+    void SetOdometryGate(OdometryGate gate) { odometry_gate_ = std::move(gate); }
     /// Localisation against the stored scans: every stored scan is eligible and the query is not
     /// stored. Verified when verify is on and `scan` (the query, prepared) is not empty.
     LoopQuery Query(const core::Descriptor& descriptor,
@@ -128,8 +154,12 @@ public:
 
 private:
     LoopQuery Search(const PreparedQuery& query, std::size_t query_index,
-                     const std::function<bool(std::size_t)>& eligible) const;
+                     const std::function<bool(std::size_t)>& eligible,
+                     const std::vector<double>& path_m = {}) const;
     void Verify(LoopQuery& result, const registration::CompactPreparedScan& scan) const;
+    // The next scan's cumulative path (m) from its odometry pose; nullopt without odometry.
+    // Throws ConfigError when the pose is missing where it is needed, or not finite.
+    std::optional<double> PathOf(const std::optional<core::Transform>& T_odom_sensor) const;
 
     DescriptorDatabase database_;
     DetectorConfig detector_;
@@ -138,6 +168,10 @@ private:
     // By database index, for verification; compact (about 36 kB a scan instead of 140 kB).
     std::vector<registration::CompactPreparedScan> scans_;
     mutable ExpandedScans expanded_;  // the candidates verified lately (thread-safe)
+    // With odometry: per scan, its pose T_odom_sensor and cumulative path (m); empty without.
+    std::vector<core::Transform> odometry_;
+    std::vector<double> path_m_;
+    OdometryGate odometry_gate_;
 };
 
 /// Localisation of a whole sequence against a map: LoopDetector::Query for every scan of

@@ -334,7 +334,7 @@ TEST(DetectStreaming, EqualsDetectFromMatrixForNdt) {
 // A slow platform: 40 scans driven 2 m apart, then 80 scans creeping 5 cm apart that all look
 // like the query; scan 5 looks like it too, a little less. Returns the database (the query is
 // the last scan, 120) and the scans' cumulative path, metres.
-DescriptorDatabase SlowPlatform(std::vector<double>& path_m) {
+std::vector<core::Descriptor> SlowPlatformScans(std::vector<double>& path_m) {
     std::mt19937 rng(21);
     std::normal_distribution<double> noise(0.0, 1.0);
     std::exponential_distribution<double> weight(1.0);
@@ -349,7 +349,7 @@ DescriptorDatabase SlowPlatform(std::vector<double>& path_m) {
         for (double& v : h) v = std::max(0.0, v + spread * noise(rng));
         return h;
     };
-    DescriptorDatabase database(HeightConfig(40));
+    std::vector<core::Descriptor> scans;
     for (std::size_t i = 0; i <= 120; ++i) {
         const bool creeping = i >= 40;
         path_m.push_back(i == 0 ? 0.0 : path_m.back() + (creeping ? 0.05 : 2.0));
@@ -357,8 +357,16 @@ DescriptorDatabase SlowPlatform(std::vector<double>& path_m) {
                                       : creeping ? near_here(0.001)
                                       : i == 5   ? near_here(0.02)
                                                  : place();
-        database.Add(test::HistogramDescriptor(h), 0.1 * static_cast<double>(i));
+        scans.push_back(test::HistogramDescriptor(h));
     }
+    return scans;
+}
+
+// SlowPlatformScans stored, scan i at 0.1 i seconds.
+DescriptorDatabase SlowPlatform(std::vector<double>& path_m) {
+    DescriptorDatabase database(HeightConfig(40));
+    for (const core::Descriptor& scan : SlowPlatformScans(path_m))
+        database.Add(scan, 0.1 * static_cast<double>(database.size()));
     return database;
 }
 
@@ -401,6 +409,33 @@ TEST(LoopDetector, AGapInMetresNeedsThePath) {
     LoopDetector online(HeightConfig(40), detector);  // localisation needs no gap
     EXPECT_THROW(online.Process(test::HistogramDescriptor(std::vector<double>(40, 1.0)), 0.0),
                  core::ConfigError);
+}
+
+// Online, the odometry's poses give the path: the same candidates as offline with that path.
+TEST(LoopDetector, OnlineWithOdometryEqualsOfflineWithTheGapInMetres) {
+    std::vector<double> path_m;
+    const std::vector<core::Descriptor> scans = SlowPlatformScans(path_m);
+    DescriptorDatabase database(HeightConfig(40));
+    for (const core::Descriptor& scan : scans)
+        database.Add(scan, 0.1 * static_cast<double>(database.size()));
+    DetectorConfig detector = Deciding(DetectorConfig{}, 0.01);
+    detector.top_k = 5;
+    detector.min_gap = {20.0, core::MinGap::Unit::kMetres};
+    const std::vector<LoopQuery> offline =
+        DetectFromMatrix(ComputeSimilarityMatrix(database), database.times_s(), detector,
+                         core::Method::kHeight, path_m);
+    LoopDetector online(HeightConfig(40), detector);
+    for (std::size_t i = 0; i < database.size(); ++i) {
+        // Driving along x, turning a little: the path is the sum of the steps.
+        core::Transform T_odom_sensor = core::Transform::Identity();
+        T_odom_sensor.translation() << path_m[i], 0.0, 0.0;
+        T_odom_sensor.linear() =
+            Eigen::AngleAxisd(0.01 * static_cast<double>(i), Eigen::Vector3d::UnitZ())
+                .toRotationMatrix();
+        const LoopQuery query = online.Process(scans[i], database.times_s()[i], {}, T_odom_sensor);
+        ExpectSameQueries(query, offline[i]);
+    }
+    EXPECT_EQ(offline.back().candidates.front().index, 5u);
 }
 
 TEST(LoopDetector, RejectsBadConfigAndMixedMethods) {

@@ -1,3 +1,7 @@
+#include <algorithm>
+#include <limits>
+#include <vector>
+
 #include <gtest/gtest.h>
 
 #include "lidarloop/core/error.hpp"
@@ -115,6 +119,95 @@ TEST(OnlineVerification, ScansGivenAsDescriptorsAreNotVerified) {
     // A descriptor-only query is decided by the threshold alone (not verified).
     const LoopQuery unverified = online.Process(ComputeDescriptor(sequence.scans[4], config), 4.0);
     EXPECT_FALSE(unverified.verified());
+}
+
+// The sequence's odometry: places 0, 1 and 2 100 m apart, scans 3 and 4 where they truly are,
+// and scan 3 put `error_m` further along x (drift, or the odometry of another place).
+std::vector<core::Transform> Odometry(double error_m) {
+    std::vector<core::Transform> T_odom_sensor;
+    for (const double x_m : {0.0, 100.0, 200.0})
+        T_odom_sensor.push_back(test::PlanarTransform(x_m, 0.0, 0.0));
+    const core::Transform T_3_0 = test::PlanarTransform(1.0, -1.5, 170.0);
+    T_odom_sensor.push_back(T_odom_sensor[0] * T_3_0.inverse());
+    T_odom_sensor.back().translation().x() += error_m;
+    T_odom_sensor.push_back(T_odom_sensor[1] * test::PlanarTransform(-2.0, 0.0, 0.0).inverse());
+    return T_odom_sensor;
+}
+
+// What a gate was asked: the odometry's T_match_query and the path between, per call.
+struct GateCall {
+    core::Transform T_match_query_odometry;
+    double path_m = 0.0;
+};
+
+// A gate that rejects a loop more than 5 m from the odometry's pose, and records each call.
+OdometryGate FiveMetreGate(std::vector<GateCall>& calls) {
+    return
+        [&calls](const core::Transform& T_loop, const core::Transform& T_odometry, double path_m) {
+            calls.push_back({T_odometry, path_m});
+            return (T_loop.inverse() * T_odometry).translation().norm() > 5.0;
+        };
+}
+
+std::vector<LoopQuery> ProcessWithOdometry(const std::vector<core::Transform>& odometry,
+                                           std::vector<GateCall>& calls) {
+    const Sequence sequence = MakeSequence();
+    core::DescriptorConfig config;
+    config.method = core::Method::kRange;
+    LoopDetector online(config, Verifying());
+    online.SetOdometryGate(FiveMetreGate(calls));
+    std::vector<LoopQuery> results;
+    for (std::size_t i = 0; i < sequence.scans.size(); ++i)
+        results.push_back(online.Process(sequence.scans[i], static_cast<double>(i), odometry[i]));
+    return results;
+}
+
+TEST(OnlineVerification, TheOdometryGateRejectsOnlyTheLoopsItContradicts) {
+    std::vector<GateCall> calls;
+    const std::vector<LoopQuery> agreeing = ProcessWithOdometry(Odometry(0.0), calls);
+    ASSERT_TRUE(agreeing[3].loop() && agreeing[4].loop());
+    EXPECT_EQ(agreeing[3].candidates[*agreeing[3].loop()].index, 0U);
+    EXPECT_EQ(agreeing[4].candidates[*agreeing[4].loop()].index, 1U);
+    // The gate was asked about each accepted loop with the odometry's pose and the path along it.
+    ASSERT_FALSE(calls.empty());
+    const auto odometry = Odometry(0.0);
+    // Scans 0, 1, 2 are 100 m apart; scan 3 is where scan 2 leaves it.
+    const double path_0_to_3_m =
+        200.0 + (odometry[3].translation() - odometry[2].translation()).norm();
+    const GateCall& first = calls.front();  // scan 3 to scan 0
+    EXPECT_TRUE(first.T_match_query_odometry.isApprox(odometry[0].inverse() * odometry[3], 1e-12));
+    EXPECT_NEAR(first.path_m, path_0_to_3_m, 1e-9);
+
+    // 60 m off: the revisit of place 0 is rejected, that of place 1 kept.
+    calls.clear();
+    const std::vector<LoopQuery> contradicted = ProcessWithOdometry(Odometry(60.0), calls);
+    EXPECT_FALSE(contradicted[3].accepted);
+    EXPECT_FALSE(contradicted[3].loop());
+    const auto& verdicts = contradicted[3].verifications;
+    EXPECT_TRUE(std::any_of(verdicts.begin(), verdicts.end(), [](const auto& v) {
+        return v.reason == registration::RejectReason::kOdometryMismatch;
+    }));
+    ASSERT_TRUE(contradicted[4].loop());
+    EXPECT_EQ(contradicted[4].candidates[*contradicted[4].loop()].index, 1U);
+}
+
+TEST(OnlineVerification, TheOdometryIsGivenForEveryScanOrNone) {
+    const Sequence sequence = MakeSequence();
+    core::DescriptorConfig config;
+    config.method = core::Method::kRange;
+    const auto odometry = Odometry(0.0);
+    LoopDetector with(config, Verifying());
+    with.Process(sequence.scans[0], 0.0, odometry[0]);
+    EXPECT_THROW(with.Process(sequence.scans[1], 1.0), core::ConfigError);
+    LoopDetector without(config, Verifying());
+    without.Process(sequence.scans[0], 0.0);
+    EXPECT_THROW(without.Process(sequence.scans[1], 1.0, odometry[1]), core::ConfigError);
+    core::Transform not_finite = odometry[1];
+    not_finite.translation().x() = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_THROW(with.Process(sequence.scans[1], 1.0, not_finite), core::ConfigError);
+    // The refused scans were not stored; the next good one is scan 1.
+    EXPECT_EQ(with.database().size(), 1U);
+    EXPECT_NO_THROW(with.Process(sequence.scans[1], 1.0, odometry[1]));
 }
 
 TEST(OnlineVerification, PreparedScansMustMatchTheDatabase) {
