@@ -258,7 +258,11 @@ std::unique_ptr<LoopDetector> LoadDetector(const path& file, std::optional<bool>
     app::LoadedMap map = app::LoadMap(file);
     if (verify) map.detection.verify = *verify;
     std::vector<registration::PreparedScan> scans = MapScans(map, map.detection);
-    return std::make_unique<LoopDetector>(std::move(map.database), map.detection, std::move(scans));
+    auto detector =
+        std::make_unique<LoopDetector>(std::move(map.database), map.detection, std::move(scans));
+    // The map keeps no pose graph section: the default gate, as a new detector's.
+    detector->SetOdometryGate(app::OdometryGateOf(posegraph::PoseGraphConfig{}));
+    return detector;
 }
 
 void SaveDetector(const LoopDetector& detector, const path& file) {

@@ -220,3 +220,18 @@ def test_online_detector_rejects_the_loops_its_odometry_contradicts(sequence):
         assert "odometry_mismatch" in reasons, query.query
     with pytest.raises(lidarloop.ShapeError):
         lidarloop.LoopDetector(method="range").process(sequence[0], odometry=np.eye(3))
+
+
+def test_a_loaded_map_continues_with_odometry(sequence, tmp_path):
+    """A map saved by a session with odometry, loaded and fed the rest with odometry: its scans
+    stay candidates (another session), and scans with and without a pose still do not mix."""
+    times, odometry = lidarloop.read_poses(sequence.root / "poses_odometry.txt")
+    first = lidarloop.LoopDetector(method="range", min_gap=20, min_gap_unit="metres", verify=False)
+    for i in range(30):
+        first.process(sequence[i], times[i], odometry=odometry[i])
+    first.save(tmp_path / "map.lldb")
+    loaded = lidarloop.LoopDetector.load(tmp_path / "map.lldb")
+    queries = [loaded.process(sequence[i], times[i], odometry=odometry[i]) for i in range(30, 40)]
+    assert all(n.index < 30 for n in queries[0].candidates) and queries[0].candidates
+    with pytest.raises(lidarloop.ConfigError, match="no odometry pose"):
+        loaded.process(sequence[40], times[40])

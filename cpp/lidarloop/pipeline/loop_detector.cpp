@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include <tbb/blocked_range.h>
@@ -12,6 +13,10 @@
 
 namespace lidarloop::pipeline {
 namespace {
+
+constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+// The odometry pose of a scan that has none (a loaded map's): the gate cannot judge it.
+const Eigen::Matrix4d kUnknownPose = Eigen::Matrix4d::Constant(kNan);
 
 double SecondRatio(double best, double second) {
     if (second == 0.0) return 1.0;
@@ -192,6 +197,7 @@ LoopDetector::LoopDetector(DescriptorDatabase database, const DetectorConfig& de
                                 std::to_string(database_.size()));
     }
     scans_.resize(database_.size());
+    session_start_ = database_.size();
     database_.definition().ValidateThreshold(threshold_);
     index_ = database_.store().MakeIndex();
     // One sort instead of n sorted inserts: a loaded map may hold a million scans.
@@ -246,6 +252,7 @@ LoopQuery LoopDetector::Process(const core::PointCloud& scan, double time_s,
 std::optional<double> LoopDetector::PathOf(
     const std::optional<core::Transform>& T_odom_sensor) const {
     const std::size_t index = database_.size();
+    const std::size_t in_session = index - session_start_;  // scans processed before this one
     if (!T_odom_sensor) {
         if (!odometry_.empty()) {
             throw core::ConfigError("scan " + std::to_string(index) +
@@ -259,7 +266,7 @@ std::optional<double> LoopDetector::PathOf(
         }
         return std::nullopt;
     }
-    if (odometry_.size() != index) {
+    if (odometry_.size() != in_session) {
         throw core::ConfigError("scan " + std::to_string(index) +
                                 " has an odometry pose, the scans before it had none: give the "
                                 "pose with every scan or with none");
@@ -268,7 +275,7 @@ std::optional<double> LoopDetector::PathOf(
         throw core::ConfigError("the odometry pose of scan " + std::to_string(index) +
                                 " is not finite");
     }
-    if (index == 0) return 0.0;
+    if (in_session == 0) return 0.0;
     return path_m_.back() + (T_odom_sensor->translation() - odometry_.back().translation()).norm();
 }
 
@@ -279,24 +286,32 @@ LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_
     const std::unique_ptr<PreparedQuery> query = database_.Prepare(descriptor);
     const std::size_t query_index = database_.size();
     const core::MinGap gap = detector_.min_gap;
-    const std::vector<double>& along = gap.Along(database_.times_s(), path_m_);
-    const double query_along =
-        query_path_m && gap.unit == core::MinGap::Unit::kMetres ? *query_path_m : time_s;
+    const bool in_metres = gap.unit == core::MinGap::Unit::kMetres;
+    const std::vector<double>& times_s = database_.times_s();
+    // Scan j's odometry pose and path; a loaded map's scans have none (NaN).
+    const auto pose_of = [&](std::size_t j) {
+        if (j == query_index) return *T_odom_sensor;
+        if (j < session_start_) return core::Transform(kUnknownPose);
+        return odometry_[j - session_start_];
+    };
+    const auto path_of = [&](std::size_t j) {
+        if (j == query_index) return *query_path_m;
+        return j < session_start_ ? kNan : path_m_[j - session_start_];
+    };
     LoopQuery result = Search(
         *query, query_index,
         [&](std::size_t j) {
-            return j < query_index && database_.IsValid(j) &&
-                   gap.Allows(query_index, j, query_along, along[j]);
+            if (j >= query_index || !database_.IsValid(j)) return false;
+            // A map's scan belongs to another session: no path separates it from this one.
+            if (in_metres)
+                return j < session_start_ || gap.Allows(query_index, j, *query_path_m, path_of(j));
+            return gap.Allows(query_index, j, time_s, times_s[j]);
         },
-        path_m_);
+        session_start_ == 0 ? path_m_ : std::vector<double>{});
     registration::CompactPreparedScan compact(scan);
     Verify(result, compact);
-    if (odometry_gate_ && query_path_m) {
-        RejectLoopsAgainstOdometry(
-            result, [&](std::size_t j) { return j == query_index ? *T_odom_sensor : odometry_[j]; },
-            [&](std::size_t j) { return j == query_index ? *query_path_m : path_m_[j]; },
-            odometry_gate_);
-    }
+    if (odometry_gate_ && query_path_m)
+        RejectLoopsAgainstOdometry(result, pose_of, path_of, odometry_gate_);
     database_.Add(descriptor, time_s);
     scans_.push_back(std::move(compact));
     if (query_path_m) odometry_.push_back(*T_odom_sensor), path_m_.push_back(*query_path_m);

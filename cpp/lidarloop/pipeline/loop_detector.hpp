@@ -102,7 +102,8 @@ std::vector<Neighbor> NearestCandidates(std::size_t count, std::size_t k,
 /// Given each scan's pose by the odometry (Process's T_odom_sensor), it also measures the gap
 /// in metres of path, and with an odometry gate (SetOdometryGate) rejects the loops the
 /// odometry contradicts, as `detect --odometry` does (docs/verification.md, "The odometry's
-/// word"). Scans given with and without a pose do not mix.
+/// word"). Scans given with and without a pose do not mix; a loaded map's scans have none, and
+/// with a gap in metres they are always candidates (another session: no path separates them).
 /// Process is not thread-safe; Query may run concurrently.
 /// Neither copyable nor movable: the index refers to the detector's own database.
 class LoopDetector {
@@ -168,7 +169,10 @@ private:
     // By database index, for verification; compact (about 36 kB a scan instead of 140 kB).
     std::vector<registration::CompactPreparedScan> scans_;
     mutable ExpandedScans expanded_;  // the candidates verified lately (thread-safe)
-    // With odometry: per scan, its pose T_odom_sensor and cumulative path (m); empty without.
+    // The scans loaded from a map come first; this session's scans start here.
+    std::size_t session_start_ = 0;
+    // With odometry: per scan of this session, its pose T_odom_sensor and cumulative path (m);
+    // empty without.
     std::vector<core::Transform> odometry_;
     std::vector<double> path_m_;
     OdometryGate odometry_gate_;

@@ -438,6 +438,34 @@ TEST(LoopDetector, OnlineWithOdometryEqualsOfflineWithTheGapInMetres) {
     EXPECT_EQ(offline.back().candidates.front().index, 5u);
 }
 
+// A map saved from another session, then this session's scans with their odometry: the map's
+// scans (no poses) are candidates whatever the gap in metres, this session's only beyond it.
+TEST(LoopDetector, AMapsScansAreCandidatesOfASessionWithOdometry) {
+    std::vector<double> path_m;
+    const std::vector<core::Descriptor> scans = SlowPlatformScans(path_m);
+    constexpr std::size_t kMapScans = 30;  // scan 5, the place, is among them
+    DescriptorDatabase map(HeightConfig(40));
+    for (std::size_t i = 0; i < kMapScans; ++i) map.Add(scans[i], 0.1 * static_cast<double>(i));
+    DetectorConfig detector = Deciding(DetectorConfig{}, 0.01);
+    detector.top_k = 5;
+    detector.min_gap = {20.0, core::MinGap::Unit::kMetres};
+    LoopDetector session(map, detector);
+    LoopQuery last;
+    for (std::size_t i = kMapScans; i < scans.size(); ++i) {
+        core::Transform T_odom_sensor = core::Transform::Identity();
+        T_odom_sensor.translation().x() = path_m[i];
+        last = session.Process(scans[i], 0.1 * static_cast<double>(i), {}, T_odom_sensor);
+        for (const Neighbor& n : last.candidates) {
+            EXPECT_TRUE(n.index < kMapScans || path_m[i] - path_m[n.index] > 20.0)
+                << i << " -> " << n.index;
+        }
+    }
+    ASSERT_FALSE(last.candidates.empty());
+    EXPECT_EQ(last.candidates.front().index, 5u);
+    // Within the session, with and without a pose still do not mix.
+    EXPECT_THROW(session.Process(scans[0], 99.0), core::ConfigError);
+}
+
 TEST(LoopDetector, RejectsBadConfigAndMixedMethods) {
     DetectorConfig detector;
     detector.top_k = 0;
