@@ -44,19 +44,33 @@ std::set<std::size_t> RevisitingScans(const std::vector<core::StampedPose>& trut
     return revisiting;
 }
 
+// HKU_2 (266 real scans, verified: release suite only), its ground truth and path; the tests
+// skip when the folder is absent.
+class HkuAviaLoops : public ::testing::Test {
+protected:
+    void SetUp() override {
+        LIDARLOOP_RELEASE_SUITE_ONLY();
+        if (!std::filesystem::exists(sequence_ / "poses_odometry.txt"))
+            GTEST_SKIP() << "real Livox sequences not found at " << kHkuLoops
+                         << " (see ../shared/data/hku-avia-loops/README.md)";
+        dataset_.emplace(io::OpenDataset(sequence_));
+        ASSERT_TRUE(dataset_->HasPoses());
+        path_m_ = core::CumulativePathM(dataset_->poses());
+    }
+
+    const std::filesystem::path sequence_ = kHkuLoops / "HKU_2_bag";
+    std::optional<io::Dataset> dataset_;
+    std::vector<double> path_m_;
+};
+
 // HKU_2 at the settings of docs/BENCHMARK.md (a gap of 50 m of path, the LIO odometry): every
 // accepted loop is a real one, at least 90 % of the real revisits are closed, and the odometry
 // gate rejects no candidate that is the same place.
-TEST(HkuAviaLoops, DetectWithOdometryClosesTheRealRevisitsAndTheGateKeepsTrueLoops) {
-    LIDARLOOP_RELEASE_SUITE_ONLY();  // 266 real scans verified as submaps
-    const std::filesystem::path sequence = kHkuLoops / "HKU_2_bag";
-    if (!std::filesystem::exists(sequence / "poses_odometry.txt"))
-        GTEST_SKIP() << "real Livox sequences not found at " << kHkuLoops
-                     << " (see ../shared/data/hku-avia-loops/README.md)";
-    const io::Dataset dataset = io::OpenDataset(sequence);
-    ASSERT_TRUE(dataset.HasPoses());
+TEST_F(HkuAviaLoops, DetectWithOdometryClosesTheRealRevisitsAndTheGateKeepsTrueLoops) {
+    const io::Dataset& dataset = *dataset_;
+    const std::filesystem::path& sequence = sequence_;
     const std::vector<core::StampedPose>& truth = dataset.poses();
-    const std::vector<double> path_m = core::CumulativePathM(truth);
+    const std::vector<double>& path_m = path_m_;
 
     test::TempDir dir;
     app::DetectRequest request;
@@ -90,16 +104,11 @@ TEST(HkuAviaLoops, DetectWithOdometryClosesTheRealRevisitsAndTheGateKeepsTrueLoo
 // The online detector given the LIO odometry scan by scan (gap of 50 m of path, the pose graph's
 // gate), as a SLAM front end would feed it: no false loop, and at least 80 % of the real
 // revisits closed (28 of 32 today; 20 with the 30-scan gap and no odometry). No submaps online.
-TEST(HkuAviaLoops, OnlineDetectorWithOdometryClosesTheRealRevisits) {
-    LIDARLOOP_RELEASE_SUITE_ONLY();  // 266 real scans verified one at a time
-    const std::filesystem::path sequence = kHkuLoops / "HKU_2_bag";
-    if (!std::filesystem::exists(sequence / "poses_odometry.txt"))
-        GTEST_SKIP() << "real Livox sequences not found at " << kHkuLoops
-                     << " (see ../shared/data/hku-avia-loops/README.md)";
-    const io::Dataset dataset = io::OpenDataset(sequence);
-    ASSERT_TRUE(dataset.HasPoses());
+TEST_F(HkuAviaLoops, OnlineDetectorWithOdometryClosesTheRealRevisits) {
+    const io::Dataset& dataset = *dataset_;
+    const std::filesystem::path& sequence = sequence_;
     const std::vector<core::StampedPose>& truth = dataset.poses();
-    const std::vector<double> path_m = core::CumulativePathM(truth);
+    const std::vector<double>& path_m = path_m_;
     const std::vector<core::StampedPose> odometry = io::ReadPoses(sequence / "poses_odometry.txt");
     ASSERT_EQ(odometry.size(), dataset.size());
 
