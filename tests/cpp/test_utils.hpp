@@ -34,11 +34,14 @@ inline constexpr double kDeg = std::numbers::pi / 180.0;  // radians per degree
 /// Skips the test in a build with AddressSanitizer (scripts/test's first pass, the dev preset): for
 /// run-scale tests that register hundreds of scan pairs, a minute or more there and seconds in the
 /// release suite, which runs them. Lighter tests cover the same code under the sanitizers.
+/// kSanitizedBuild says which build this is, for a run-scale test that runs smaller there.
 #if defined(__SANITIZE_ADDRESS__)
 #define LIDARLOOP_RELEASE_SUITE_ONLY() \
     GTEST_SKIP() << "run-scale: the release suite runs it (minutes under the sanitizers)"
+inline constexpr bool kSanitizedBuild = true;
 #else
 #define LIDARLOOP_RELEASE_SUITE_ONLY() static_cast<void>(0)
+inline constexpr bool kSanitizedBuild = false;
 #endif
 
 /// A fresh temporary folder per test, removed at the end of the test. Named after the test, the

@@ -198,6 +198,10 @@ TEST_F(DetectionRun, WithoutTheMatrixGivesTheSameResults) {
 }
 
 TEST_F(DetectionRun, LocalisingTheSequenceAgainstItsOwnMapFindsEveryScanItself) {
+    // Two verified runs; localisation runs under the sanitizers in
+    // LocalisationTakesTheMapsThresholdUnlessGivenOne and ScanContextRuns, verification in
+    // ReportsProgressOfEveryScanAndEndsTheStage.
+    LIDARLOOP_RELEASE_SUITE_ONLY();
     app::DetectRequest detect = Request("detect", core::Method::kRange);
     detect.config.detection.top_k = 1;
     app::RunDetect(*dataset_, detect);
@@ -643,6 +647,9 @@ TEST_F(DetectionRun, EvaluateWithOdometryVerifiesAsDetectWithIt) {
 }
 
 TEST_F(DetectionRun, ScansAreSubmapsWhenTheOdometryIsKnown) {
+    // Two verified runs; submaps run under the sanitizers in SubmapsInOrderReadEachScanOnce...
+    // and ReportsProgressOfEveryScanAndEndsTheStage.
+    LIDARLOOP_RELEASE_SUITE_ONLY();
     app::DetectRequest request = Request("submaps", core::Method::kRange);
     request.config.detection.top_k = 1;
     request.odometry_file = dir_ / "sequence" / "poses_odometry.txt";
