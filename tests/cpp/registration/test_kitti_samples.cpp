@@ -4,8 +4,11 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -145,6 +148,68 @@ TEST_F(KittiSamples, DecisionsHoldOnThinnedScans) {
         }
         for (const Pair& pair : others) {
             EXPECT_FALSE(run(pair).accepted) << pair.match << " <- " << pair.query;
+        }
+    }
+}
+
+// The points of `scan` that `keep` selects.
+template <typename Keep>
+core::PointCloud Kept(const core::PointCloud& scan, Keep keep) {
+    core::PointCloud kept;
+    for (const Eigen::Vector3f& point : scan) {
+        if (keep(point)) kept.push_back(point);
+    }
+    return kept;
+}
+
+double ElevationDeg(const Eigen::Vector3f& p) {
+    return std::atan2(p.z(), std::hypot(p.x(), p.y())) * 180.0 / M_PI;
+}
+
+double AzimuthDeg(const Eigen::Vector3f& p) { return std::atan2(p.y(), p.x()) * 180.0 / M_PI; }
+
+// Issue 24's bad input, cut from real scans of a true loop: one ring, every point pressed onto
+// the road's plane, a 10-degree field of view, a handful of points. None can pin a loop's pose:
+// each is rejected with a reason, never accepted (the full scans are, in the tests above).
+TEST_F(KittiSamples, ScansThatCannotPinAPoseAreRejectedWithAReason) {
+    const auto one_ring = [](const core::PointCloud& scan) {
+        return Kept(scan,
+                    [](const Eigen::Vector3f& p) { return std::abs(ElevationDeg(p) + 8.0) < 0.2; });
+    };
+    const auto on_the_road_plane = [](core::PointCloud scan) {
+        for (Eigen::Vector3f& point : scan) point.z() = -1.73F;  // the sensor's height
+        return scan;
+    };
+    const auto field_of_view = [](double centre_deg) {
+        return [centre_deg](const core::PointCloud& scan) {
+            return Kept(scan, [centre_deg](const Eigen::Vector3f& p) {
+                return std::abs(std::remainder(AzimuthDeg(p) - centre_deg, 360.0)) < 5.0;
+            });
+        };
+    };
+    const auto handful = [](const core::PointCloud& scan) {
+        return Thinned(scan, scan.size() / 30);
+    };
+    const std::vector<std::pair<std::string, std::function<core::PointCloud(core::PointCloud)>>>
+        cuts = {{"one ring", one_ring},
+                {"one plane", on_the_road_plane},
+                {"10 degrees ahead", field_of_view(0.0)},
+                {"10 degrees to the left", field_of_view(90.0)},
+                {"10 degrees behind", field_of_view(180.0)},
+                {"30 points", handful}};
+    for (const Pair& pair : {Pair{"08", 209, 1684}, Pair{"08", 720, 1500}, Pair{"00", 94, 95}}) {
+        const core::PointCloud query = Scan(pair.sequence, pair.query);
+        const core::PointCloud match = Scan(pair.sequence, pair.match);
+        for (const auto& [name, cut] : cuts) {
+            SCOPED_TRACE(pair.sequence + " " + std::to_string(pair.match) + " <- " +
+                         std::to_string(pair.query) + ", " + name);
+            const core::PointCloud cut_query = cut(query);
+            ASSERT_FALSE(cut_query.empty());
+            for (const Verification& v : {VerifyPair(cut_query, cut(match), VerificationConfig{}),
+                                          VerifyPair(cut_query, match, VerificationConfig{})}) {
+                EXPECT_FALSE(v.accepted) << "overlap " << v.overlap.Min();
+                EXPECT_NE(v.reason, RejectReason::kNone);
+            }
         }
     }
 }
