@@ -79,7 +79,10 @@ std::vector<Candidate> ReadCandidates(const std::filesystem::path& file) {
     std::vector<Candidate> candidates;
     while (std::getline(in, line)) {
         const auto fields = Fields(line);
-        if (fields.size() != header.size() || fields[reason] == "pruned") continue;
+        if (fields.size() != header.size() || fields[reason] == "pruned" ||
+            fields[reason] == "not_needed") {
+            continue;
+        }
         Candidate candidate{std::stoul(fields[query]), std::stoul(fields[match]),
                             fields[accepted] == "1", fields[reason]};
         for (int i = 0; i < 3; ++i) {

@@ -69,15 +69,17 @@ void PrintSummary(const nlohmann::json& figures) {
                  verification["coarse_images_ms_per_query"]["thread_cpu"]);
         PrintRow("verify (CPU)", "candidate pair",
                  verification["verify_ms_per_pair"]["thread_cpu"]);
-        PrintRow("online step, top " + std::to_string(verification.value("top_k", 0)) + " verified",
-                 "scan", verification["online_step_ms_per_scan"]);
+        const bool to_first = verification.value("stop_at_first_loop", false);
+        const std::string verified = "top " + std::to_string(verification.value("top_k", 0)) +
+                                     (to_first ? " verified to the first loop" : " verified");
+        PrintRow("online step, " + verified, "scan", verification["online_step_ms_per_scan"]);
         online_ms = verification["online_step_ms_per_scan"].value("median", 0.0);
         std::printf(
             "\nonline step: %s per scan on one core = %.1f Hz (describe, retrieve, prepare, "
-            "coarse images and verify the top %d, over %d scans with candidates; file "
-            "reading excluded)\n",
+            "coarse images and the %s, over %d scans with candidates; file reading "
+            "excluded)\n",
             Duration(online_ms).c_str(), verification.value("online_rate_hz", 0.0),
-            verification.value("top_k", 0), verification.value("queries", 0));
+            verified.c_str(), verification.value("queries", 0));
         std::printf("memory: %.0f bytes per prepared scan (median)\n",
                     verification["bytes_per_prepared_scan"].value("median", 0.0));
     } else {

@@ -73,6 +73,7 @@ def detect(
     min_gap_unit: Optional[str] = None,
     top_k: Optional[int] = None,
     verify: Optional[bool] = None,
+    stop_at_first_loop: Optional[bool] = None,
     skip_bad: Optional[bool] = None,
 ) -> DetectResult:
     """`lidarloop detect DATASET --out OUT` (None keeps the config's value; verification is on
@@ -157,6 +158,7 @@ def evaluate(
     min_gap_unit: Optional[str] = None,
     top_k: Optional[int] = None,
     verify: Optional[bool] = None,
+    stop_at_first_loop: Optional[bool] = None,
     skip_bad: Optional[bool] = None,
     distance_m: Optional[float] = None,
     max_heading_deg: Optional[float] = None,
@@ -219,6 +221,7 @@ def optimise(
     min_gap_unit: Optional[str] = None,
     top_k: Optional[int] = None,
     verify: Optional[bool] = None,
+    stop_at_first_loop: Optional[bool] = None,
     skip_bad: Optional[bool] = None,
     max_odometry_step_m: Optional[float] = None,
 ) -> OptimiseResult:

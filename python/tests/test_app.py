@@ -284,6 +284,38 @@ def test_stubs_match_the_module(area):
         assert public <= members, f"{name}: no stub for {public - members}"
 
 
+@pytest.mark.parametrize("command", ["detect", "evaluate", "optimise"])
+def test_stubs_list_the_run_options(command):
+    """The stub of each run command lists exactly its run options as keywords."""
+    import ast
+    from pathlib import Path
+
+    import lidarloop.app
+
+    tree = ast.parse(Path(lidarloop.app.__file__).with_suffix(".pyi").read_text())
+    stub = next(n for n in tree.body if isinstance(n, ast.FunctionDef) and n.name == command)
+    keywords = {a.arg for a in stub.args.kwonlyargs}
+    options = {o["keyword"] for o in lidarloop.run_options(command)}
+    assert options <= keywords, f"{command}: no stub keyword for {options - keywords}"
+
+
+def test_stopping_at_the_first_loop_closes_the_same_scans(cli, sequence, tmp_path):
+    """stop_at_first_loop (--stop-at-first-loop): the scans closed with every candidate
+    registered, fewer candidates registered (the rest 'not_needed'), as the CLI."""
+    run_cli(cli, "detect", sequence, "--method", "range", "--top-k", "3", "--stop-at-first-loop",
+            "--out", tmp_path / "cli")
+    first = lidarloop.detect(sequence, out=tmp_path / "py", method="range", top_k=3,
+                             stop_at_first_loop=True)
+    every = lidarloop.detect(sequence, out=tmp_path / "every", method="range", top_k=3)
+    assert (tmp_path / "py" / "candidates.csv").read_bytes() == \
+        (tmp_path / "cli" / "candidates.csv").read_bytes()
+    assert first.accepted == every.accepted > 10
+    reasons = [r["reason"] for r in read_csv(tmp_path / "py" / "candidates.csv")]
+    assert "not_needed" in reasons
+    registered = sum(r != "not_needed" for r in reasons)
+    assert registered < len(read_csv(tmp_path / "every" / "candidates.csv"))
+
+
 def test_a_gap_in_metres_and_min_path_match_the_cli(cli, sequence, tmp_path):
     odometry = sequence / "poses_odometry.txt"
     run_cli(cli, "detect", sequence, "--method", "range", "--no-verify", "--min-gap", "20",

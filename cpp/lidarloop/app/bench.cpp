@@ -116,8 +116,9 @@ double OnlineStepMs(const pipeline::SequenceDescriptors& described, const Prepar
 }
 
 // Verifies the top-k candidates of `queries` evenly spaced scans that have candidates, one pair
-// at a time on this thread, and sums each query's online step. `path_m`: per scan, for a gap in
-// metres (empty: none known); `retrieval_ms`: the median candidate search.
+// at a time on this thread (in rank order up to the first accepted with
+// detection.stop_at_first_loop; no odometry gate), and sums each query's online step. `path_m`:
+// per scan, for a gap in metres (empty: none known); `retrieval_ms`: the median candidate search.
 nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
                                 const pipeline::SimilarityMatrix& matrix,
                                 const PreparedScans& prepared, const io::RunConfig& config,
@@ -149,6 +150,7 @@ nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
             });
             verification_cpu_ms += pair_times.cpu_ms.back();
             accepted += verdict.accepted ? 1 : 0;
+            if (verdict.accepted && config.detection.stop_at_first_loop) break;
         }
         online_ms.push_back(
             OnlineStepMs(described, prepared, all[q].query, retrieval_ms, verification_cpu_ms));
@@ -158,6 +160,7 @@ nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
     json["pairs"] = pair_times.wall_ms.size();
     json["pairs_accepted"] = accepted;
     json["top_k"] = config.detection.top_k;
+    json["stop_at_first_loop"] = config.detection.stop_at_first_loop;
     json["prepare_ms_per_scan"] = SummaryJson(prepared.prepare_seconds, 1e3);
     json["prepare_cpu_ms_per_scan"] = SummaryJson(prepared.prepare_cpu_seconds, 1e3);
     json["bytes_per_prepared_scan"] = SummaryJson(prepared.BytesPerScan());

@@ -1,5 +1,6 @@
 #include "lidarloop/app/detection.hpp"
 
+#include <atomic>
 #include <optional>
 
 #include "lidarloop/app/describe_run.hpp"
@@ -213,18 +214,18 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     Stopwatch verify_clock;
     pipeline::VerificationTimes verification_times;
     if (verify) {
-        verification_times = VerifyAll(outcome.queries, prepared, config.detection,
-                                       config.descriptor.method, request.progress);
-        if (!poses.empty()) {
-            const std::size_t rejected =
-                RejectLoopsAgainstOdometry(outcome.queries, poses, path_m, config.posegraph);
-            if (rejected > 0) {
-                outcome.notes.push_back(
-                    std::to_string(rejected) +
-                    " registered candidates rejected: the odometry contradicts their pose "
-                    "beyond its drift (reason odometry_mismatch in candidates.csv; the gate of "
-                    "posegraph.robust)");
-            }
+        std::atomic<std::size_t> rejected{0};
+        pipeline::LoopCheck odometry_check;
+        if (!poses.empty())
+            odometry_check = OdometryLoopCheck(poses, path_m, config.posegraph, &rejected);
+        verification_times =
+            VerifyAll(outcome.queries, prepared, config.detection, config.descriptor.method,
+                      request.progress, nullptr, odometry_check);
+        if (rejected > 0) {
+            outcome.notes.push_back(
+                std::to_string(rejected) +
+                " registered candidates rejected: the odometry contradicts their pose beyond its "
+                "drift (reason odometry_mismatch in candidates.csv; the gate of posegraph.robust)");
         }
     }
     const double verify_s = verify_clock.Seconds();

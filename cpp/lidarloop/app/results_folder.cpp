@@ -82,7 +82,8 @@ void WritePathM(std::ostream& out, const std::vector<double>& path_m, std::size_
 void WriteVerification(std::ostream& out, const registration::Verification& v) {
     const bool registered = v.reason != registration::RejectReason::kTooFewPoints &&
                             v.reason != registration::RejectReason::kNoAlignment &&
-                            v.reason != registration::RejectReason::kPruned;
+                            v.reason != registration::RejectReason::kPruned &&
+                            v.reason != registration::RejectReason::kNotNeeded;
     if (registered) {
         const Eigen::Vector3d t = v.T_match_query.translation();
         const Eigen::Quaterniond q(v.T_match_query.rotation());

@@ -71,12 +71,11 @@ RetrievalComparison CompareRetrieval(std::vector<pipeline::LoopQuery> queries,
         DescriptorCandidates(comparison.queries, method, detector.ThresholdFor(method)), truth,
         poses, config);
     if (!detector.verify || prepared == nullptr) return comparison;
+    pipeline::LoopCheck odometry_check;
+    if (odometry != nullptr)
+        odometry_check = OdometryLoopCheck(odometry->odometry, odometry->path_m, odometry->config);
     comparison.verification_times =
-        VerifyAll(comparison.queries, *prepared, detector, method, progress, cache);
-    if (odometry != nullptr) {
-        RejectLoopsAgainstOdometry(comparison.queries, odometry->odometry, odometry->path_m,
-                                   odometry->config);
-    }
+        VerifyAll(comparison.queries, *prepared, detector, method, progress, cache, odometry_check);
     comparison.verified =
         eval::EvaluateLoopRetrieval(VerifiedCandidates(comparison.queries), truth, poses, config);
     return comparison;

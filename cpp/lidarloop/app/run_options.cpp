@@ -84,6 +84,14 @@ std::vector<RunOption> MakeRunOptions() {
              t.config->detection.verify = std::get<bool>(v);
          },
          [] { return std::string(io::RunConfig{}.detection.verify ? "verify" : "no-verify"); }},
+        {"stop_at_first_loop", "--stop-at-first-loop", "", T::kSwitch,
+         "register the candidates in rank order and stop at the first accepted one (faster; one "
+         "loop per scan)",
+         "detection.stop_at_first_loop", kDetecting,
+         [](const RunTargets& t, const RunOptionValue& v) {
+             t.config->detection.stop_at_first_loop = std::get<bool>(v);
+         },
+         [] { return std::string(io::RunConfig{}.detection.stop_at_first_loop ? "stop" : "all"); }},
         {"skip_bad", "--skip-bad", "", T::kSwitch,
          "skip unreadable scans instead of stopping (detect lists them in skipped.txt)",
          "the request's skip_bad", kRunning,

@@ -157,12 +157,13 @@ pipeline::VerificationTimes VerifyAll(std::vector<pipeline::LoopQuery>& queries,
                                       const PreparedScans& prepared,
                                       const pipeline::DetectorConfig& detector,
                                       const core::Method& method, const Progress& progress,
-                                      pipeline::VerificationCache* cache) {
+                                      pipeline::VerificationCache* cache,
+                                      const pipeline::LoopCheck& check) {
     std::function<void(std::size_t, std::size_t)> tell;
     if (progress)
         tell = [&progress](std::size_t done, std::size_t n) { progress("verifying", done, n); };
     return pipeline::VerifyQueries(queries, prepared.scans, detector, method,
-                                   pipeline::Execution::kParallel, tell, cache);
+                                   pipeline::Execution::kParallel, tell, cache, check);
 }
 
 pipeline::OdometryGate OdometryGateOf(const posegraph::PoseGraphConfig& config) {
@@ -174,28 +175,38 @@ pipeline::OdometryGate OdometryGateOf(const posegraph::PoseGraphConfig& config) 
     };
 }
 
-std::size_t RejectLoopsAgainstOdometry(std::vector<pipeline::LoopQuery>& queries,
-                                       const std::vector<core::StampedPose>& odometry,
-                                       const std::vector<double>& path_m,
-                                       const posegraph::PoseGraphConfig& config) {
-    const auto require_pose = [&](std::size_t scan) {
+pipeline::LoopCheck OdometryLoopCheck(const std::vector<core::StampedPose>& odometry,
+                                      const std::vector<double>& path_m,
+                                      const posegraph::PoseGraphConfig& config,
+                                      std::atomic<std::size_t>* rejected) {
+    const auto require_pose = [&odometry, &path_m](std::size_t scan) {
         if (scan >= odometry.size() || scan >= path_m.size()) {
             throw core::ConfigError("scan " + std::to_string(scan) + " has no odometry (" +
                                     std::to_string(odometry.size()) + " poses)");
         }
     };
-    const pipeline::OdometryGate gate = OdometryGateOf(config);
-    const auto pose_of = [&](std::size_t scan) {
+    const auto pose_of = [&odometry, require_pose](std::size_t scan) {
         require_pose(scan);
         return odometry[scan].T_world_sensor;
     };
-    const auto path_of = [&](std::size_t scan) {
+    const auto path_of = [&path_m, require_pose](std::size_t scan) {
         require_pose(scan);
         return path_m[scan];
     };
-    std::size_t rejected = 0;
-    for (pipeline::LoopQuery& query : queries)
-        rejected += pipeline::RejectLoopsAgainstOdometry(query, pose_of, path_of, gate);
+    return [pose_of, path_of, gate = OdometryGateOf(config), rejected](pipeline::LoopQuery& query) {
+        const std::size_t count =
+            pipeline::RejectLoopsAgainstOdometry(query, pose_of, path_of, gate);
+        if (rejected != nullptr) *rejected += count;
+    };
+}
+
+std::size_t RejectLoopsAgainstOdometry(std::vector<pipeline::LoopQuery>& queries,
+                                       const std::vector<core::StampedPose>& odometry,
+                                       const std::vector<double>& path_m,
+                                       const posegraph::PoseGraphConfig& config) {
+    std::atomic<std::size_t> rejected{0};
+    const pipeline::LoopCheck check = OdometryLoopCheck(odometry, path_m, config, &rejected);
+    for (pipeline::LoopQuery& query : queries) check(query);
     return rejected;
 }
 

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <filesystem>
 #include <functional>
@@ -84,12 +85,14 @@ io::RunConfig WithSubmapsWhereTheyApply(const io::RunConfig& config, std::size_t
                                         const std::vector<core::StampedPose>& poses,
                                         std::vector<std::string>& notes);
 
-/// pipeline::VerifyQueries over `queries`, telling `progress` as stage "verifying".
+/// pipeline::VerifyQueries over `queries`, telling `progress` as stage "verifying"; `check`
+/// (e.g. OdometryLoopCheck) runs on each verified query.
 pipeline::VerificationTimes VerifyAll(std::vector<pipeline::LoopQuery>& queries,
                                       const PreparedScans& prepared,
                                       const pipeline::DetectorConfig& detector,
                                       const core::Method& method, const Progress& progress,
-                                      pipeline::VerificationCache* cache = nullptr);
+                                      pipeline::VerificationCache* cache = nullptr,
+                                      const pipeline::LoopCheck& check = {});
 
 /// The pose graph's odometry gate (posegraph::GateAgainstOdometry with `config`'s robust and
 /// information sections) as the detectors take it: `detect --odometry`, and the online
@@ -108,6 +111,15 @@ std::size_t RejectLoopsAgainstOdometry(std::vector<pipeline::LoopQuery>& queries
                                        const std::vector<core::StampedPose>& odometry,
                                        const std::vector<double>& path_m,
                                        const posegraph::PoseGraphConfig& config);
+
+/// RejectLoopsAgainstOdometry for one query at a time, as verification runs it (VerifyAll):
+/// with detection.stop_at_first_loop a loop the odometry rejects lets the next candidate be
+/// registered. Adds the rejections to `rejected` when given (thread-safe). The vectors are
+/// referenced, not copied: they must outlive the check.
+pipeline::LoopCheck OdometryLoopCheck(const std::vector<core::StampedPose>& odometry,
+                                      const std::vector<double>& path_m,
+                                      const posegraph::PoseGraphConfig& config,
+                                      std::atomic<std::size_t>* rejected = nullptr);
 
 /// The figures of a verification run for timings.json: per scan preparation (ms) and memory
 /// (bytes), per query coarse images (ms), per candidate pair (ms), counts.

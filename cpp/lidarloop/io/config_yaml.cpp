@@ -106,6 +106,8 @@ void VisitFields(pipeline::DetectorConfig& c, Visitor& v) {
     v.Field("threshold", c.threshold, ThresholdHelp());
     v.Field("verify", c.verify,
             "register candidates and accept only verified loops (section verification)");
+    v.Field("stop_at_first_loop", c.stop_at_first_loop,
+            "register candidates in rank order and stop at the first accepted one");
 }
 
 template <typename Visitor>

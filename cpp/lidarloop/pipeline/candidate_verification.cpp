@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <optional>
 
 #include <tbb/parallel_for.h>
 
@@ -21,6 +22,14 @@ registration::Verification Rejected(registration::RejectReason reason) {
     registration::Verification rejected;
     rejected.reason = reason;
     return rejected;
+}
+
+// The candidates ranked after `loop`, not registered (pruned ones stay pruned).
+void MarkNotNeededAfter(LoopQuery& query, std::size_t loop) {
+    for (std::size_t later = loop + 1; later < query.candidates.size(); ++later) {
+        if (query.verifications[later].reason != registration::RejectReason::kPruned)
+            query.verifications[later] = Rejected(registration::RejectReason::kNotNeeded);
+    }
 }
 
 }  // namespace
@@ -51,7 +60,8 @@ std::size_t VerificationCache::size() const {
 void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
                  const std::function<registration::PreparedScan(std::size_t)>& match_of,
                  const DetectorConfig& detector, const core::Method& method,
-                 VerificationTimes* times, VerificationCache* cache, Execution execution) {
+                 VerificationTimes* times, VerificationCache* cache, Execution execution,
+                 const LoopCheck& check) {
     query.verifications.clear();
     query.accepted = false;
     if (!query.has_match()) return;
@@ -63,41 +73,64 @@ void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
     // Pruned and cached candidates are answered at once; the others are registered.
     const DescriptorMethod& definition = MethodOf(method);
     query.verifications.resize(query.candidates.size());
-    std::vector<std::size_t> to_register;
+    std::vector<bool> answered(query.candidates.size(), false);
     for (std::size_t c = 0; c < query.candidates.size(); ++c) {
         const Neighbor& candidate = query.candidates[c];
         std::optional<registration::Verification> cached;
         if (cache) cached = cache->Find(query.query, candidate.index);
         if (detector.threshold && !definition.IsMatch(candidate.distance, *detector.threshold)) {
             query.verifications[c] = Rejected(registration::RejectReason::kPruned);
+            answered[c] = true;
         } else if (cached) {
             query.verifications[c] = *cached;
-        } else {
-            to_register.push_back(c);
+            answered[c] = true;
         }
     }
-    if (!to_register.empty()) {
+    std::optional<registration::CoarseQuery> coarse;  // the query's images, shared by its pairs
+    std::vector<double> pair_seconds(query.candidates.size(), -1.0);
+    const auto register_one = [&](std::size_t c) {
+        const std::size_t match = query.candidates[c].index;
+        const auto pair_start = Clock::now();
+        query.verifications[c] =
+            registration::Verify(prepared, *coarse, match_of(match), detector.verification);
+        pair_seconds[c] = SecondsSince(pair_start);
+        if (cache) cache->Store(query.query, match, query.verifications[c]);
+    };
+    const auto make_coarse = [&] {
         const auto query_start = Clock::now();
-        const registration::CoarseQuery coarse(*prepared.structure, detector.verification.coarse);
+        coarse.emplace(*prepared.structure, detector.verification.coarse);
         if (times) times->query_seconds.push_back(SecondsSince(query_start));
-        std::vector<double> pair_seconds(to_register.size());
-        const auto register_one = [&](std::size_t k) {
-            const std::size_t c = to_register[k];
-            const std::size_t match = query.candidates[c].index;
-            const auto pair_start = Clock::now();
-            query.verifications[c] =
-                registration::Verify(prepared, coarse, match_of(match), detector.verification);
-            pair_seconds[k] = SecondsSince(pair_start);
-            if (cache) cache->Store(query.query, match, query.verifications[c]);
-        };
-        if (execution == Execution::kParallel) {
-            tbb::parallel_for(std::size_t{0}, to_register.size(), register_one);
-        } else {
-            for (std::size_t k = 0; k < to_register.size(); ++k) register_one(k);
+    };
+    if (detector.stop_at_first_loop) {
+        // In rank order: the first accepted candidate that the check keeps is the loop.
+        for (std::size_t c = 0; c < query.candidates.size(); ++c) {
+            if (!answered[c]) {
+                if (!coarse) make_coarse();
+                register_one(c);
+            }
+            if (!query.verifications[c].accepted) continue;
+            if (check) check(query);
+            if (!query.verifications[c].accepted) continue;
+            MarkNotNeededAfter(query, c);
+            break;
         }
-        if (times) {
-            times->pair_seconds.insert(times->pair_seconds.end(), pair_seconds.begin(),
-                                       pair_seconds.end());
+    } else {
+        std::vector<std::size_t> to_register;
+        for (std::size_t c = 0; c < query.candidates.size(); ++c) {
+            if (!answered[c]) to_register.push_back(c);
+        }
+        if (!to_register.empty()) make_coarse();
+        if (execution == Execution::kParallel) {
+            tbb::parallel_for(std::size_t{0}, to_register.size(),
+                              [&](std::size_t k) { register_one(to_register[k]); });
+        } else {
+            for (const std::size_t c : to_register) register_one(c);
+        }
+        if (check) check(query);
+    }
+    if (times) {
+        for (const double seconds : pair_seconds) {
+            if (seconds >= 0.0) times->pair_seconds.push_back(seconds);
         }
     }
     query.accepted = query.loop().has_value();
@@ -108,14 +141,14 @@ VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
                                 const DetectorConfig& detector, const core::Method& method,
                                 Execution execution,
                                 const std::function<void(std::size_t, std::size_t)>& progress,
-                                VerificationCache* cache) {
+                                VerificationCache* cache, const LoopCheck& check) {
     ExpandedScans expanded;
     const auto scan_of = [&](std::size_t i) { return expanded.Get(scans, i); };
     std::vector<VerificationTimes> per_query(queries.size());
     std::atomic<std::size_t> done{0};
     const auto run = [&](std::size_t i) {
         VerifyQuery(queries[i], scan_of(queries[i].query), scan_of, detector, method, &per_query[i],
-                    cache, execution);
+                    cache, execution, check);
         const std::size_t finished = ++done;
         if (progress) progress(finished, queries.size());
     };

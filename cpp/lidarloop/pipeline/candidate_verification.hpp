@@ -46,11 +46,14 @@ private:
 /// Appends to `times` when given (pairs found in `cache` are not timed); takes verdicts from and
 /// adds them to `cache` when given. The candidates are registered in parallel unless told
 /// otherwise (`match_of` is then called from worker threads); the verdicts do not depend on it.
+/// `check`, when given, runs on the verified query. With detector.stop_at_first_loop the
+/// candidates are registered one after another in rank order until one is accepted and stays so
+/// after `check`; the later ones get kNotNeeded (pruned ones stay kPruned).
 void VerifyQuery(LoopQuery& query, const registration::PreparedScan& query_scan,
                  const std::function<registration::PreparedScan(std::size_t)>& match_of,
                  const DetectorConfig& detector, const core::Method& method,
                  VerificationTimes* times = nullptr, VerificationCache* cache = nullptr,
-                 Execution execution = Execution::kParallel);
+                 Execution execution = Execution::kParallel, const LoopCheck& check = {});
 
 /// VerifyQuery for every query that has candidates (in parallel unless told otherwise);
 /// `scans[i]` is scan i prepared, kept compact (each expanded when verified; the pair times
@@ -60,6 +63,6 @@ VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
                                 const DetectorConfig& detector, const core::Method& method,
                                 Execution execution = Execution::kParallel,
                                 const std::function<void(std::size_t, std::size_t)>& progress = {},
-                                VerificationCache* cache = nullptr);
+                                VerificationCache* cache = nullptr, const LoopCheck& check = {});
 
 }  // namespace lidarloop::pipeline

@@ -226,12 +226,13 @@ LoopQuery LoopDetector::Search(const PreparedQuery& query, std::size_t query_ind
     return result;
 }
 
-void LoopDetector::Verify(LoopQuery& result, const registration::CompactPreparedScan& scan) const {
+void LoopDetector::Verify(LoopQuery& result, const registration::CompactPreparedScan& scan,
+                          const LoopCheck& check) const {
     if (!detector_.verify || !scan.prepared()) return;
     // The query as it is stored: online, offline and localisation see the same scans.
     VerifyQuery(
         result, scan.Expand(), [this](std::size_t j) { return expanded_.Get(scans_, j); },
-        detector_, database_.method());
+        detector_, database_.method(), nullptr, nullptr, Execution::kParallel, check);
 }
 
 std::size_t LoopDetector::prepared_bytes() const {
@@ -309,9 +310,13 @@ LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_
         },
         session_start_ == 0 ? path_m_ : std::vector<double>{});
     registration::CompactPreparedScan compact(scan);
-    Verify(result, compact);
-    if (odometry_gate_ && query_path_m)
-        RejectLoopsAgainstOdometry(result, pose_of, path_of, odometry_gate_);
+    LoopCheck odometry_check;
+    if (odometry_gate_ && query_path_m) {
+        odometry_check = [&](LoopQuery& verified) {
+            RejectLoopsAgainstOdometry(verified, pose_of, path_of, odometry_gate_);
+        };
+    }
+    Verify(result, compact, odometry_check);
     database_.Add(descriptor, time_s);
     scans_.push_back(std::move(compact));
     if (query_path_m) odometry_.push_back(*T_odom_sensor), path_m_.push_back(*query_path_m);

@@ -33,6 +33,13 @@ struct DetectorConfig {
     /// Needs the scans (or their registration::PreparedScan), not descriptors alone. When on, the
     /// descriptor ranks candidates and the threshold prunes them only when set explicitly.
     bool verify = true;
+    /// With verify: register the candidates in rank order and stop at the first accepted one
+    /// (that the odometry gate keeps, when there is one); the rest get kNotNeeded. About half the
+    /// verification time on dense scans, a fifth on sparse keyframes, the same scans closed with
+    /// poses as good (docs/BENCHMARK.md); but one verified loop per scan for the pose graph, and
+    /// a query's candidates are registered one after another. Off: every candidate is
+    /// registered and the loop is the accepted one that overlaps most.
+    bool stop_at_first_loop = false;
     registration::VerificationConfig verification;  ///< YAML section `verification`
 
     /// `threshold` when set, else the default of `method`.
@@ -66,6 +73,10 @@ struct LoopQuery {
     /// the best candidate when accepted; nullopt when there is no loop.
     std::optional<std::size_t> loop() const;
 };
+
+/// Rejects the accepted candidates of a query that other knowledge contradicts, e.g. the odometry
+/// (RejectLoopsAgainstOdometry, reason kOdometryMismatch).
+using LoopCheck = std::function<void(LoopQuery&)>;
 
 /// Whether the odometry contradicts a verified loop: given the loop's registered T_match_query,
 /// the odometry's T_match_query and the path between the two scans (m); true rejects the loop.
@@ -157,7 +168,8 @@ private:
     LoopQuery Search(const PreparedQuery& query, std::size_t query_index,
                      const std::function<bool(std::size_t)>& eligible,
                      const std::vector<double>& path_m = {}) const;
-    void Verify(LoopQuery& result, const registration::CompactPreparedScan& scan) const;
+    void Verify(LoopQuery& result, const registration::CompactPreparedScan& scan,
+                const LoopCheck& check = {}) const;
     // The next scan's cumulative path (m) from its odometry pose; nullopt without odometry.
     // Throws ConfigError when the pose is missing where it is needed, or not finite.
     std::optional<double> PathOf(const std::optional<core::Transform>& T_odom_sensor) const;

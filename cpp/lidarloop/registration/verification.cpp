@@ -255,6 +255,8 @@ std::string ToString(RejectReason reason) {
             return "pruned";
         case RejectReason::kOdometryMismatch:
             return "odometry_mismatch";
+        case RejectReason::kNotNeeded:
+            return "not_needed";
     }
     return "unknown";
 }

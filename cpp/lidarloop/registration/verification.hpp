@@ -26,10 +26,13 @@ enum class RejectReason {
     /// registered, but the odometry puts the two scans elsewhere beyond its drift (detect with
     /// odometry: the pose graph's gate, posegraph::GateAgainstOdometry)
     kOdometryMismatch,
+    /// not registered: a candidate ranked higher is the query's loop (detection.stop_at_first_loop)
+    kNotNeeded,
 };
 
 /// "none", "too_few_points", "no_alignment", "not_converged", "low_overlap", "high_rmse",
-/// "degenerate", "ambiguous", "too_far", "pruned", "odometry_mismatch": the spelling of loops.csv
+/// "degenerate", "ambiguous", "too_far", "pruned", "odometry_mismatch", "not_needed": the
+/// spelling of loops.csv
 /// and `lidarloop verify`.
 std::string ToString(RejectReason reason);
 

@@ -691,6 +691,58 @@ TEST_F(DetectionRun, ScansAreSubmapsWhenTheOdometryIsKnown) {
               registration::PrepareScan(dataset_->LoadScan(77), reduction).usable_points);
 }
 
+// detect --stop-at-first-loop with the odometry (submaps, the gate): each query's loop is the
+// first candidate in rank order that registering every one accepts and the gate keeps, with the
+// same verdicts up to it; the same scans are closed, registering fewer pairs.
+TEST_F(DetectionRun, StoppingAtTheFirstLoopClosesTheSameScansRegisteringFewerPairs) {
+    LIDARLOOP_RELEASE_SUITE_ONLY();  // two verified runs; StopAtFirstLoop covers the sanitizers
+    app::DetectRequest every = Request("every", core::Method::kRange);
+    every.config.detection.top_k = 5;
+    every.odometry_file = dir_ / "sequence" / "poses_odometry.txt";
+    app::DetectRequest first = every;
+    first.out = dir_ / "first";
+    first.config.detection.stop_at_first_loop = true;
+    const app::DetectOutcome all = app::RunDetect(*dataset_, every);
+    const app::DetectOutcome stopped = app::RunDetect(*dataset_, first);
+    ASSERT_EQ(all.queries.size(), stopped.queries.size());
+    std::size_t registered_all = 0, registered_stopped = 0;
+    const auto registered = [](const registration::Verification& v) {
+        return v.reason != registration::RejectReason::kNotNeeded &&
+               v.reason != registration::RejectReason::kPruned;
+    };
+    for (std::size_t i = 0; i < all.queries.size(); ++i) {
+        const pipeline::LoopQuery& a = all.queries[i];
+        const pipeline::LoopQuery& s = stopped.queries[i];
+        ASSERT_EQ(s.verifications.size(), a.verifications.size()) << i;
+        const auto loop = std::find_if(a.verifications.begin(), a.verifications.end(),
+                                       [](const auto& v) { return v.accepted; });
+        const std::size_t until = static_cast<std::size_t>(loop - a.verifications.begin());
+        for (std::size_t c = 0; c < a.verifications.size(); ++c) {
+            if (c <= until) {
+                EXPECT_EQ(s.verifications[c].reason, a.verifications[c].reason) << i << " " << c;
+                EXPECT_TRUE(
+                    s.verifications[c].T_match_query.isApprox(a.verifications[c].T_match_query))
+                    << i << " " << c;
+            } else {
+                EXPECT_EQ(s.verifications[c].reason, registration::RejectReason::kNotNeeded);
+            }
+            registered_all += registered(a.verifications[c]) ? 1 : 0;
+            registered_stopped += registered(s.verifications[c]) ? 1 : 0;
+        }
+        EXPECT_EQ(s.accepted, a.accepted) << i;
+        if (s.accepted) {
+            EXPECT_EQ(*s.loop(), until) << i;
+        }
+    }
+    EXPECT_EQ(stopped.accepted, all.accepted);
+    EXPECT_GT(all.accepted, 10u);  // the sequence revisits: there are loops to stop at
+    EXPECT_LT(registered_stopped, registered_all);
+    std::ifstream candidates(first.out / "candidates.csv");
+    const std::string text((std::istreambuf_iterator<char>(candidates)), {});
+    EXPECT_TRUE(test::Contains(text, ",not_needed,"));
+    EXPECT_TRUE(io::LoadConfigYaml(first.out / "config.yaml").detection.stop_at_first_loop);
+}
+
 // optimise --loops reads a verified loops.csv with path_m, and one written before it existed.
 TEST_F(DetectionRun, TheLoopsReaderTakesFilesWithAndWithoutPathM) {
     app::DetectRequest request = Request("verified", core::Method::kRange);

@@ -210,6 +210,111 @@ TEST(OnlineVerification, TheOdometryIsGivenForEveryScanOrNone) {
     EXPECT_NO_THROW(with.Process(sequence.scans[1], 1.0, odometry[1]));
 }
 
+// Another place: the synthetic place mirrored along one axis (0: x, 1: y).
+core::PointCloud Mirrored(core::PointCloud cloud, int axis) {
+    for (Eigen::Vector3f& point : cloud) point[axis] = -point[axis];
+    return cloud;
+}
+
+// A query of a place and four candidates in rank order: the place mirrored (rejected), the
+// place seen from where the query is and from 1 m aside (both accepted), the place mirrored the
+// other way (rejected).
+struct RankedCandidates {
+    LoopQuery query;
+    registration::PreparedScan query_scan;
+    std::vector<registration::PreparedScan> scans;  // by scan index; the query is scan 4
+};
+
+RankedCandidates MakeRankedCandidates(const DetectorConfig& detector) {
+    const auto prepare = [&](const core::PointCloud& cloud) {
+        return registration::PrepareScan(cloud, detector.verification.reduction);
+    };
+    RankedCandidates r;
+    const core::PointCloud place = test::SyntheticPlace(1);
+    r.scans = {prepare(Mirrored(place, 1)), prepare(place),
+               prepare(test::Transformed(place, test::PlanarTransform(1.0, 0.5, 3.0))),
+               prepare(Mirrored(place, 0))};
+    r.query_scan = prepare(test::Transformed(place, test::PlanarTransform(0.5, -1.0, 170.0)));
+    r.query.query = 4;
+    for (std::size_t j = 0; j < r.scans.size(); ++j)
+        r.query.candidates.push_back({j, 0.1 * static_cast<double>(j + 1)});
+    return r;
+}
+
+LoopQuery Verified(RankedCandidates r, const DetectorConfig& detector,
+                   const LoopCheck& check = {}) {
+    VerifyQuery(
+        r.query, r.query_scan, [&](std::size_t j) { return r.scans.at(j); }, detector,
+        core::Method::kRange, nullptr, nullptr, Execution::kSerial, check);
+    return r.query;
+}
+
+void ExpectSameVerdict(const registration::Verification& a, const registration::Verification& b,
+                       std::size_t candidate) {
+    EXPECT_EQ(a.accepted, b.accepted) << candidate;
+    EXPECT_EQ(a.reason, b.reason) << candidate;
+    EXPECT_TRUE(a.T_match_query.isApprox(b.T_match_query, 1e-12)) << candidate;
+}
+
+// stop_at_first_loop registers in rank order up to the first accepted candidate, with the
+// verdicts of registering every one, and leaves the rest kNotNeeded.
+TEST(StopAtFirstLoop, RegistersInRankOrderUpToTheFirstAcceptedCandidate) {
+    DetectorConfig detector = Verifying();
+    const RankedCandidates ranked = MakeRankedCandidates(detector);
+    const LoopQuery every = Verified(ranked, detector);
+    ASSERT_FALSE(every.verifications[0].accepted);
+    ASSERT_TRUE(every.verifications[1].accepted && every.verifications[2].accepted);
+    ASSERT_FALSE(every.verifications[3].accepted);
+
+    detector.stop_at_first_loop = true;
+    const LoopQuery first = Verified(ranked, detector);
+    ASSERT_EQ(first.verifications.size(), 4u);
+    for (const std::size_t c : {0u, 1u})
+        ExpectSameVerdict(first.verifications[c], every.verifications[c], c);
+    for (const std::size_t c : {2u, 3u})
+        EXPECT_EQ(first.verifications[c].reason, registration::RejectReason::kNotNeeded) << c;
+    ASSERT_TRUE(first.loop().has_value());
+    EXPECT_EQ(*first.loop(), 1u);
+    EXPECT_TRUE(first.accepted);
+}
+
+// A loop the check rejects (the odometry gate) lets the next candidate be registered.
+TEST(StopAtFirstLoop, ALoopTheCheckRejectsLetsTheNextCandidateBeRegistered) {
+    DetectorConfig detector = Verifying();
+    detector.stop_at_first_loop = true;
+    const RankedCandidates ranked = MakeRankedCandidates(detector);
+    std::vector<std::size_t> checked_accepted;
+    const LoopQuery first = Verified(ranked, detector, [&](LoopQuery& query) {
+        std::size_t accepted = 0;
+        for (registration::Verification& v : query.verifications) {
+            if (!v.accepted) continue;
+            ++accepted;
+            if (&v == &query.verifications[1]) {
+                v.accepted = false;
+                v.reason = registration::RejectReason::kOdometryMismatch;
+            }
+        }
+        checked_accepted.push_back(accepted);
+    });
+    EXPECT_EQ(checked_accepted, (std::vector<std::size_t>{1, 1}));  // one new loop a call
+    EXPECT_EQ(first.verifications[1].reason, registration::RejectReason::kOdometryMismatch);
+    EXPECT_TRUE(first.verifications[2].accepted);
+    EXPECT_EQ(first.verifications[3].reason, registration::RejectReason::kNotNeeded);
+    ASSERT_TRUE(first.loop().has_value());
+    EXPECT_EQ(*first.loop(), 2u);
+
+    // Without a loop among them every candidate is registered, as without the option.
+    RankedCandidates elsewhere = ranked;
+    elsewhere.query.candidates = {ranked.query.candidates[0], ranked.query.candidates[3]};
+    const LoopQuery none = Verified(elsewhere, detector);
+    detector.stop_at_first_loop = false;
+    const LoopQuery all = Verified(elsewhere, detector);
+    ASSERT_EQ(none.verifications.size(), 2u);
+    for (const std::size_t c : {0u, 1u})
+        ExpectSameVerdict(none.verifications[c], all.verifications[c], c);
+    EXPECT_FALSE(none.accepted);
+}
+
 TEST(OnlineVerification, PreparedScansMustMatchTheDatabase) {
     core::DescriptorConfig config;
     DescriptorDatabase database(config);

@@ -327,6 +327,8 @@ TEST(Verification, ReasonsHaveStableNames) {
     EXPECT_EQ(ToString(RejectReason::kAmbiguous), "ambiguous");
     EXPECT_EQ(ToString(RejectReason::kTooFar), "too_far");
     EXPECT_EQ(ToString(RejectReason::kPruned), "pruned");
+    EXPECT_EQ(ToString(RejectReason::kOdometryMismatch), "odometry_mismatch");
+    EXPECT_EQ(ToString(RejectReason::kNotNeeded), "not_needed");
 }
 
 // Simulated scans: exact ground truth, real ray casting (occlusion, beam pattern, noise).
