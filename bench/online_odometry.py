@@ -4,9 +4,11 @@ takes the odometry"): every scan of SEQUENCE through lidarloop.LoopDetector (ran
 once alone and once with each scan's pose from SEQUENCE/poses_odometry.txt, which applies the pose
 graph's odometry gate and, with --min-gap-metres, counts the gap in metres of path. Writes each
 run's loops as OUT.alone.csv and OUT.odometry.csv (query, match, accepted) for
-../shared/tools/verified_recall.py, and prints one line per run.
+../shared/tools/verified_recall.py, and prints one line per run. --stop-at-first-loop sets
+detection.stop_at_first_loop (docs/verification.md, "Stopping at the first loop").
 
     PYTHONPATH=build/python /usr/bin/python3 bench/online_odometry.py SEQUENCE OUT [--min-gap-metres M]
+        [--stop-at-first-loop]
 """
 
 import argparse
@@ -16,11 +18,13 @@ import time
 import lidarloop
 
 
-def run(dataset, times, odometry, min_gap_metres):
+def run(dataset, times, odometry, min_gap_metres, stop_at_first_loop):
+    config = {"detection": {"stop_at_first_loop": stop_at_first_loop}}
     if odometry is not None and min_gap_metres is not None:
-        detector = lidarloop.LoopDetector(method="range", min_gap=min_gap_metres, min_gap_unit="metres")
+        detector = lidarloop.LoopDetector(method="range", min_gap=min_gap_metres,
+                                          min_gap_unit="metres", config=config)
     else:
-        detector = lidarloop.LoopDetector(method="range")
+        detector = lidarloop.LoopDetector(method="range", config=config)
     loops, mismatches = [], 0
     start = time.process_time()
     for i in range(len(dataset)):
@@ -37,11 +41,13 @@ def main():
     parser.add_argument("sequence")
     parser.add_argument("out")
     parser.add_argument("--min-gap-metres", type=float, default=None)
+    parser.add_argument("--stop-at-first-loop", action="store_true")
     args = parser.parse_args()
     dataset = lidarloop.open_dataset(args.sequence)
     times, odometry = lidarloop.read_poses(f"{args.sequence}/poses_odometry.txt")
     for name, poses in (("alone", None), ("odometry", odometry)):
-        loops, mismatches, cpu_s = run(dataset, times, poses, args.min_gap_metres)
+        loops, mismatches, cpu_s = run(dataset, times, poses, args.min_gap_metres,
+                                         args.stop_at_first_loop)
         with open(f"{args.out}.{name}.csv", "w", newline="") as file:
             writer = csv.writer(file)
             writer.writerow(["query", "match", "accepted"])
