@@ -381,7 +381,7 @@ registration::Verification VerifyAsKept(const core::PointCloud& query,
 // same verdicts and poses within a centimetre as the scans at full precision.
 TEST_F(DetectionRun, VerifiesEveryCandidateAsRegisteringThePairAlone) {
     // Each sampled pair is registered twice more; detection's verification runs under the
-    // sanitizers in ReportsProgressOfEveryScanAndEndsTheStage and the loops reader's test.
+    // sanitizers in ReportsProgressOfEveryScanAndEndsTheStage.
     LIDARLOOP_RELEASE_SUITE_ONLY();
     app::DetectRequest request = Request("verified", core::Method::kRange);
     request.config.detection.verification.reduction.submap_path_m = 0.0;  // each scan alone
@@ -745,6 +745,9 @@ TEST_F(DetectionRun, StoppingAtTheFirstLoopClosesTheSameScansRegisteringFewerPai
 
 // optimise --loops reads a verified loops.csv with path_m, and one written before it existed.
 TEST_F(DetectionRun, TheLoopsReaderTakesFilesWithAndWithoutPathM) {
+    // A verified run; the reader is fuzzed and replayed under the sanitizers (tests/fuzz), and
+    // detection's verification runs there in ReportsProgressOfEveryScanAndEndsTheStage.
+    LIDARLOOP_RELEASE_SUITE_ONLY();
     app::DetectRequest request = Request("verified", core::Method::kRange);
     request.config.detection.top_k = 1;
     const app::DetectOutcome outcome = app::RunDetect(*dataset_, request);
