@@ -69,6 +69,7 @@ class LoopDetector:
         min_gap_unit: Optional[str] = None,
         threshold: Optional[float] = None,
         verify: Optional[bool] = None,
+        stop_at_first_loop: Optional[bool] = None,
     ) -> None: ...
     def process(
         self,
@@ -88,6 +89,9 @@ class LoopDetector:
     def top_k(self) -> int: ...
     @property
     def verify(self) -> bool: ...
+    @property
+    def stop_at_first_loop(self) -> bool:
+        """Candidates registered in rank order up to the first loop (detection.stop_at_first_loop)."""
     def save(self, file: PathLike) -> None: ...
     @staticmethod
     def load(file: PathLike, verify: Optional[bool] = None) -> LoopDetector: ...

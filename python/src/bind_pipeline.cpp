@@ -228,13 +228,15 @@ void BindLoopQuery(py::module_& m) {
 pipeline::DetectorConfig DetectionOf(const io::RunConfig& run, std::optional<int> top_k,
                                      std::optional<double> min_gap,
                                      const std::optional<std::string>& min_gap_unit,
-                                     std::optional<double> threshold, std::optional<bool> verify) {
+                                     std::optional<double> threshold, std::optional<bool> verify,
+                                     std::optional<bool> stop_at_first_loop) {
     pipeline::DetectorConfig detection = run.detection;
     if (top_k) detection.top_k = *top_k;
     if (min_gap) detection.min_gap.value = *min_gap;
     if (min_gap_unit) detection.min_gap.unit = core::ParseMinGapUnit(*min_gap_unit);
     if (threshold) detection.threshold = *threshold;
     if (verify) detection.verify = *verify;
+    if (stop_at_first_loop) detection.stop_at_first_loop = *stop_at_first_loop;
     detection.Validate();
     return detection;
 }
@@ -285,22 +287,25 @@ void BindDetector(py::module_& m) {
         .def(py::init([](const py::object& config, const std::optional<std::string>& method,
                          std::optional<int> top_k, std::optional<double> min_gap,
                          const std::optional<std::string>& min_gap_unit,
-                         std::optional<double> threshold, std::optional<bool> verify) {
+                         std::optional<double> threshold, std::optional<bool> verify,
+                         std::optional<bool> stop_at_first_loop) {
                  const io::RunConfig run = ResolveRunConfig(config, method);
                  auto detector = std::make_unique<LoopDetector>(
-                     run.descriptor,
-                     DetectionOf(run, top_k, min_gap, min_gap_unit, threshold, verify));
+                     run.descriptor, DetectionOf(run, top_k, min_gap, min_gap_unit, threshold,
+                                                 verify, stop_at_first_loop));
                  detector->SetOdometryGate(app::OdometryGateOf(run.posegraph));
                  return detector;
              }),
              py::arg("config") = py::none(), py::arg("method") = py::none(), py::kw_only(),
              py::arg("top_k") = py::none(), py::arg("min_gap") = py::none(),
              py::arg("min_gap_unit") = py::none(), py::arg("threshold") = py::none(),
-             py::arg("verify") = py::none(),
+             py::arg("verify") = py::none(), py::arg("stop_at_first_loop") = py::none(),
              "config: None, dict or YAML path (descriptor, `detection` and `posegraph` keys); "
              "method; top_k, min_gap (in the config's unit, scans by default), min_gap_unit "
-             "('scans', 'seconds', 'metres': needs the odometry), threshold, verify override "
-             "detection.*. Loops the odometry contradicts (process's odometry) are rejected by "
+             "('scans', 'seconds', 'metres': needs the odometry), threshold, verify, "
+             "stop_at_first_loop (register the candidates in rank order up to the first loop) "
+             "override detection.*. Loops the odometry contradicts (process's odometry) are "
+             "rejected by "
              "the pose graph's gate (posegraph.robust).")
         .def(
             "process",
@@ -351,6 +356,9 @@ void BindDetector(py::module_& m) {
                                [](const LoopDetector& d) { return d.detector_config().top_k; })
         .def_property_readonly("verify",
                                [](const LoopDetector& d) { return d.detector_config().verify; })
+        .def_property_readonly(
+            "stop_at_first_loop",
+            [](const LoopDetector& d) { return d.detector_config().stop_at_first_loop; })
         .def(
             "save",
             [](const LoopDetector& detector, const path& file) {

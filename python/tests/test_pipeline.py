@@ -166,6 +166,29 @@ def test_verifying_detector_keeps_and_saves_its_scans(sequence, tmp_path):
     assert len(lidarloop.LoopDetector.load(tmp_path / "map.lldb")) == 15
 
 
+def test_stopping_at_the_first_loop_closes_the_same_scans(sequence):
+    """stop_at_first_loop: each query's loop is its first candidate that registering every one
+    accepts, with the same verdict; the candidates after it are not registered."""
+    every = lidarloop.LoopDetector(method="range", min_gap=MIN_GAP, top_k=3)
+    first = lidarloop.LoopDetector(method="range", min_gap=MIN_GAP, top_k=3,
+                                   stop_at_first_loop=True)
+    assert first.stop_at_first_loop and not every.stop_at_first_loop
+    not_needed = closed = 0
+    for i in range(len(sequence)):
+        a, b = every.process(sequence[i]), first.process(sequence[i])
+        assert a.accepted == b.accepted, i
+        closed += b.accepted
+        reasons = [v.reason for v in b.verifications]
+        not_needed += reasons.count("not_needed")
+        if b.accepted:
+            loop = next(c for c, v in enumerate(a.verifications) if v.accepted)
+            assert b.loop == loop, i
+            np.testing.assert_allclose(b.verifications[loop].T_match_query,
+                                       a.verifications[loop].T_match_query)
+            assert reasons[loop + 1:] == ["not_needed"] * (len(reasons) - loop - 1)
+    assert not_needed > 0 and closed > 3  # the sequence revisits: there are loops to stop at
+
+
 def test_detector_rejects_bad_points_and_config():
     detector = lidarloop.LoopDetector(method="range", verify=False)
     with pytest.raises(lidarloop.ShapeError):
