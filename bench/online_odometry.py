@@ -4,11 +4,11 @@ takes the odometry"): every scan of SEQUENCE through lidarloop.LoopDetector (ran
 once alone and once with each scan's pose from SEQUENCE/poses_odometry.txt, which applies the pose
 graph's odometry gate and, with --min-gap-metres, counts the gap in metres of path. Writes each
 run's loops as OUT.alone.csv and OUT.odometry.csv (query, match, accepted) for
-../shared/tools/verified_recall.py, and prints one line per run. --stop-at-first-loop sets
+../shared/tools/verified_recall.py, and prints one line per run. --all-candidates turns off
 detection.stop_at_first_loop (docs/verification.md, "Stopping at the first loop").
 
     PYTHONPATH=build/python /usr/bin/python3 bench/online_odometry.py SEQUENCE OUT [--min-gap-metres M]
-        [--stop-at-first-loop]
+        [--all-candidates]
 """
 
 import argparse
@@ -41,13 +41,13 @@ def main():
     parser.add_argument("sequence")
     parser.add_argument("out")
     parser.add_argument("--min-gap-metres", type=float, default=None)
-    parser.add_argument("--stop-at-first-loop", action="store_true")
+    parser.add_argument("--all-candidates", action="store_true")
     args = parser.parse_args()
     dataset = lidarloop.open_dataset(args.sequence)
     times, odometry = lidarloop.read_poses(f"{args.sequence}/poses_odometry.txt")
     for name, poses in (("alone", None), ("odometry", odometry)):
         loops, mismatches, cpu_s = run(dataset, times, poses, args.min_gap_metres,
-                                         args.stop_at_first_loop)
+                                         not args.all_candidates)
         with open(f"{args.out}.{name}.csv", "w", newline="") as file:
             writer = csv.writer(file)
             writer.writerow(["query", "match", "accepted"])

@@ -91,7 +91,8 @@ class LoopDetector:
     def verify(self) -> bool: ...
     @property
     def stop_at_first_loop(self) -> bool:
-        """Candidates registered in rank order up to the first loop (detection.stop_at_first_loop)."""
+        """Candidates registered in rank order up to the first loop (detection.stop_at_first_loop,
+        True by default); False: every candidate."""
     def save(self, file: PathLike) -> None: ...
     @staticmethod
     def load(file: PathLike, verify: Optional[bool] = None) -> LoopDetector: ...

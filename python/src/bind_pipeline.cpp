@@ -303,7 +303,8 @@ void BindDetector(py::module_& m) {
              "config: None, dict or YAML path (descriptor, `detection` and `posegraph` keys); "
              "method; top_k, min_gap (in the config's unit, scans by default), min_gap_unit "
              "('scans', 'seconds', 'metres': needs the odometry), threshold, verify, "
-             "stop_at_first_loop (register the candidates in rank order up to the first loop) "
+             "stop_at_first_loop (default True: register the candidates in rank order up to "
+             "the first loop; False: every candidate) "
              "override detection.*. Loops the odometry contradicts (process's odometry) are "
              "rejected by "
              "the pose graph's gate (posegraph.robust).")

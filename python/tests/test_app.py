@@ -300,15 +300,16 @@ def test_stubs_list_the_run_options(command):
 
 
 def test_stopping_at_the_first_loop_closes_the_same_scans(cli, sequence, tmp_path):
-    """stop_at_first_loop (--stop-at-first-loop): the scans closed with every candidate
-    registered, fewer candidates registered (the rest 'not_needed'), as the CLI."""
-    run_cli(cli, "detect", sequence, "--method", "range", "--top-k", "3", "--stop-at-first-loop",
-            "--out", tmp_path / "cli")
-    first = lidarloop.detect(sequence, out=tmp_path / "py", method="range", top_k=3,
-                             stop_at_first_loop=True)
-    every = lidarloop.detect(sequence, out=tmp_path / "every", method="range", top_k=3)
-    assert (tmp_path / "py" / "candidates.csv").read_bytes() == \
-        (tmp_path / "cli" / "candidates.csv").read_bytes()
+    """stop_at_first_loop (the default; --all-candidates turns it off): the scans closed with
+    every candidate registered, fewer candidates registered (the rest 'not_needed'), as the
+    CLI."""
+    run_cli(cli, "detect", sequence, "--method", "range", "--top-k", "3", "--all-candidates",
+            "--out", tmp_path / "cli_every")
+    first = lidarloop.detect(sequence, out=tmp_path / "py", method="range", top_k=3)
+    every = lidarloop.detect(sequence, out=tmp_path / "every", method="range", top_k=3,
+                             stop_at_first_loop=False)
+    assert (tmp_path / "every" / "candidates.csv").read_bytes() == \
+        (tmp_path / "cli_every" / "candidates.csv").read_bytes()
     assert first.accepted == every.accepted > 10
     reasons = [r["reason"] for r in read_csv(tmp_path / "py" / "candidates.csv")]
     assert "not_needed" in reasons

@@ -169,9 +169,9 @@ def test_verifying_detector_keeps_and_saves_its_scans(sequence, tmp_path):
 def test_stopping_at_the_first_loop_closes_the_same_scans(sequence):
     """stop_at_first_loop: each query's loop is its first candidate that registering every one
     accepts, with the same verdict; the candidates after it are not registered."""
-    every = lidarloop.LoopDetector(method="range", min_gap=MIN_GAP, top_k=3)
-    first = lidarloop.LoopDetector(method="range", min_gap=MIN_GAP, top_k=3,
-                                   stop_at_first_loop=True)
+    every = lidarloop.LoopDetector(method="range", min_gap=MIN_GAP, top_k=3,
+                                   stop_at_first_loop=False)
+    first = lidarloop.LoopDetector(method="range", min_gap=MIN_GAP, top_k=3)
     assert first.stop_at_first_loop and not every.stop_at_first_loop
     not_needed = closed = 0
     for i in range(len(sequence)):

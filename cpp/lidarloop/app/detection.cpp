@@ -4,6 +4,7 @@
 #include <optional>
 
 #include "lidarloop/app/describe_run.hpp"
+#include "lidarloop/app/optimisation.hpp"
 #include "lidarloop/app/results_folder.hpp"
 #include "lidarloop/app/verification_run.hpp"
 #include "lidarloop/core/descriptor.hpp"
@@ -218,9 +219,11 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
         pipeline::LoopCheck odometry_check;
         if (!poses.empty())
             odometry_check = OdometryLoopCheck(poses, path_m, config.posegraph, &rejected);
+        pipeline::MoreLoopsWanted more;
+        if (request.pose_graph_loops) more = PoseGraphLoopsWanted(path_m, config.posegraph);
         verification_times =
             VerifyAll(outcome.queries, prepared, config.detection, config.descriptor.method,
-                      request.progress, nullptr, odometry_check);
+                      request.progress, nullptr, odometry_check, more);
         if (rejected > 0) {
             outcome.notes.push_back(
                 std::to_string(rejected) +

@@ -26,6 +26,10 @@ struct DetectRequest {
     /// Instead of odometry_file, for a bag: its nav_msgs/Odometry topic, matched to the scans by
     /// their stamps (io::ReadBagOdometry).
     std::string odometry_topic;
+    /// With detection.stop_at_first_loop, verification goes on after a query's first loop to
+    /// the candidates that may give the pose graph a further loop of the scan
+    /// (PoseGraphLoopsWanted: posegraph.max_loops_per_scan, min_loop_separation_m): optimise.
+    bool pose_graph_loops = false;
 };
 
 struct DetectOutcome {

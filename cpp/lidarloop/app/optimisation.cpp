@@ -33,6 +33,7 @@ std::vector<posegraph::LoopConstraint> DetectLoops(const io::Dataset& dataset,
     detect.out = request.out / "detection";
     detect.odometry_file = request.odometry_file;  // the path a gap in metres is measured on
     detect.odometry_topic = request.odometry_topic;
+    detect.pose_graph_loops = true;
     const DetectOutcome detected = RunDetect(dataset, detect);
     std::vector<posegraph::LoopConstraint> loops;
     for (const pipeline::LoopQuery& query : detected.queries) {
@@ -72,6 +73,22 @@ std::vector<std::size_t> LoopsForPoseGraph(const pipeline::LoopQuery& query,
         if (separated) taken.push_back(c);
     }
     return taken;
+}
+
+pipeline::MoreLoopsWanted PoseGraphLoopsWanted(const std::vector<double>& path_m,
+                                               const posegraph::PoseGraphConfig& config) {
+    if (path_m.empty()) return {};
+    return [&path_m, config](const pipeline::LoopQuery& query, std::size_t candidate) {
+        const auto path_of = [&](std::size_t c) { return path_m.at(query.candidates[c].index); };
+        std::size_t accepted = 0;
+        for (std::size_t c = 0; c < query.verifications.size(); ++c) {
+            if (!query.verifications[c].accepted) continue;
+            if (std::abs(path_of(c) - path_of(candidate)) < config.min_loop_separation_m)
+                return false;
+            ++accepted;
+        }
+        return accepted < static_cast<std::size_t>(config.max_loops_per_scan);
+    };
 }
 
 namespace {

@@ -72,6 +72,13 @@ std::vector<std::size_t> LoopsForPoseGraph(const pipeline::LoopQuery& query,
                                            const std::vector<double>& path_m,
                                            const posegraph::PoseGraphConfig& config);
 
+/// With detection.stop_at_first_loop, the candidates of a query with a loop that may still add
+/// one LoopsForPoseGraph takes: while the query has fewer than max_loops_per_scan accepted
+/// candidates, one whose match lies at least min_loop_separation_m of `path_m` from every
+/// accepted match. Empty (no more) when `path_m` is empty. `path_m` is referenced, not copied.
+pipeline::MoreLoopsWanted PoseGraphLoopsWanted(const std::vector<double>& path_m,
+                                               const posegraph::PoseGraphConfig& config);
+
 /// Reads the odometry (io::ReadError naming the file when its pose count differs from the
 /// dataset's scan count; the pose readers name the line of a non-finite value, a 3x3 part that
 /// is no rotation, a time that does not increase or a step above posegraph.max_odometry_step_m) and

@@ -84,9 +84,9 @@ std::vector<RunOption> MakeRunOptions() {
              t.config->detection.verify = std::get<bool>(v);
          },
          [] { return std::string(io::RunConfig{}.detection.verify ? "verify" : "no-verify"); }},
-        {"stop_at_first_loop", "--stop-at-first-loop", "", T::kSwitch,
-         "register the candidates in rank order and stop at the first accepted one (faster; one "
-         "loop per scan)",
+        {"stop_at_first_loop", "--all-candidates", "", T::kSwitchOff,
+         "register every candidate, not only those up to the first loop in rank order (slower; "
+         "the loop is the accepted one that overlaps most; keyword: stop_at_first_loop=False)",
          "detection.stop_at_first_loop", kDetecting,
          [](const RunTargets& t, const RunOptionValue& v) {
              t.config->detection.stop_at_first_loop = std::get<bool>(v);

@@ -158,12 +158,13 @@ pipeline::VerificationTimes VerifyAll(std::vector<pipeline::LoopQuery>& queries,
                                       const pipeline::DetectorConfig& detector,
                                       const core::Method& method, const Progress& progress,
                                       pipeline::VerificationCache* cache,
-                                      const pipeline::LoopCheck& check) {
+                                      const pipeline::LoopCheck& check,
+                                      const pipeline::MoreLoopsWanted& more) {
     std::function<void(std::size_t, std::size_t)> tell;
     if (progress)
         tell = [&progress](std::size_t done, std::size_t n) { progress("verifying", done, n); };
     return pipeline::VerifyQueries(queries, prepared.scans, detector, method,
-                                   pipeline::Execution::kParallel, tell, cache, check);
+                                   pipeline::Execution::kParallel, tell, cache, check, more);
 }
 
 pipeline::OdometryGate OdometryGateOf(const posegraph::PoseGraphConfig& config) {

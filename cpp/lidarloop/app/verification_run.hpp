@@ -92,7 +92,8 @@ pipeline::VerificationTimes VerifyAll(std::vector<pipeline::LoopQuery>& queries,
                                       const pipeline::DetectorConfig& detector,
                                       const core::Method& method, const Progress& progress,
                                       pipeline::VerificationCache* cache = nullptr,
-                                      const pipeline::LoopCheck& check = {});
+                                      const pipeline::LoopCheck& check = {},
+                                      const pipeline::MoreLoopsWanted& more = {});
 
 /// The pose graph's odometry gate (posegraph::GateAgainstOdometry with `config`'s robust and
 /// information sections) as the detectors take it: `detect --odometry`, and the online

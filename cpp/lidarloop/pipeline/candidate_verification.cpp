@@ -1,5 +1,6 @@
 #include "lidarloop/pipeline/candidate_verification.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <optional>
@@ -24,12 +25,13 @@ registration::Verification Rejected(registration::RejectReason reason) {
     return rejected;
 }
 
-// The candidates ranked after `loop`, not registered (pruned ones stay pruned).
-void MarkNotNeededAfter(LoopQuery& query, std::size_t loop) {
-    for (std::size_t later = loop + 1; later < query.candidates.size(); ++later) {
-        if (query.verifications[later].reason != registration::RejectReason::kPruned)
-            query.verifications[later] = Rejected(registration::RejectReason::kNotNeeded);
-    }
+// Whether candidate `c` is to be registered in rank order: until the query has a loop, every
+// one; after that, those `more` wants.
+bool Wanted(const LoopQuery& query, std::size_t c, const MoreLoopsWanted& more) {
+    const bool has_loop = std::any_of(query.verifications.begin(),
+                                      query.verifications.begin() + static_cast<std::ptrdiff_t>(c),
+                                      [](const auto& v) { return v.accepted; });
+    return !has_loop || (more && more(query, c));
 }
 
 }  // namespace
@@ -61,7 +63,7 @@ void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
                  const std::function<registration::PreparedScan(std::size_t)>& match_of,
                  const DetectorConfig& detector, const core::Method& method,
                  VerificationTimes* times, VerificationCache* cache, Execution execution,
-                 const LoopCheck& check) {
+                 const LoopCheck& check, const MoreLoopsWanted& more) {
     query.verifications.clear();
     query.accepted = false;
     if (!query.has_match()) return;
@@ -102,17 +104,19 @@ void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
         if (times) times->query_seconds.push_back(SecondsSince(query_start));
     };
     if (detector.stop_at_first_loop) {
-        // In rank order: the first accepted candidate that the check keeps is the loop.
+        // In rank order: the first accepted candidate that the check keeps is the loop; after
+        // it, only the candidates `more` still wants.
         for (std::size_t c = 0; c < query.candidates.size(); ++c) {
+            if (query.verifications[c].reason == registration::RejectReason::kPruned) continue;
+            if (!Wanted(query, c, more)) {
+                query.verifications[c] = Rejected(registration::RejectReason::kNotNeeded);
+                continue;
+            }
             if (!answered[c]) {
                 if (!coarse) make_coarse();
                 register_one(c);
             }
-            if (!query.verifications[c].accepted) continue;
-            if (check) check(query);
-            if (!query.verifications[c].accepted) continue;
-            MarkNotNeededAfter(query, c);
-            break;
+            if (query.verifications[c].accepted && check) check(query);
         }
     } else {
         std::vector<std::size_t> to_register;
@@ -141,14 +145,15 @@ VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
                                 const DetectorConfig& detector, const core::Method& method,
                                 Execution execution,
                                 const std::function<void(std::size_t, std::size_t)>& progress,
-                                VerificationCache* cache, const LoopCheck& check) {
+                                VerificationCache* cache, const LoopCheck& check,
+                                const MoreLoopsWanted& more) {
     ExpandedScans expanded;
     const auto scan_of = [&](std::size_t i) { return expanded.Get(scans, i); };
     std::vector<VerificationTimes> per_query(queries.size());
     std::atomic<std::size_t> done{0};
     const auto run = [&](std::size_t i) {
         VerifyQuery(queries[i], scan_of(queries[i].query), scan_of, detector, method, &per_query[i],
-                    cache, execution, check);
+                    cache, execution, check, more);
         const std::size_t finished = ++done;
         if (progress) progress(finished, queries.size());
     };

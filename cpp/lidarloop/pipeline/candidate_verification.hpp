@@ -48,12 +48,14 @@ private:
 /// otherwise (`match_of` is then called from worker threads); the verdicts do not depend on it.
 /// `check`, when given, runs on the verified query. With detector.stop_at_first_loop the
 /// candidates are registered one after another in rank order until one is accepted and stays so
-/// after `check`; the later ones get kNotNeeded (pruned ones stay kPruned).
+/// after `check`; after that only those `more` still wants are registered (none when `more` is
+/// empty), the others get kNotNeeded (pruned ones stay kPruned).
 void VerifyQuery(LoopQuery& query, const registration::PreparedScan& query_scan,
                  const std::function<registration::PreparedScan(std::size_t)>& match_of,
                  const DetectorConfig& detector, const core::Method& method,
                  VerificationTimes* times = nullptr, VerificationCache* cache = nullptr,
-                 Execution execution = Execution::kParallel, const LoopCheck& check = {});
+                 Execution execution = Execution::kParallel, const LoopCheck& check = {},
+                 const MoreLoopsWanted& more = {});
 
 /// VerifyQuery for every query that has candidates (in parallel unless told otherwise);
 /// `scans[i]` is scan i prepared, kept compact (each expanded when verified; the pair times
@@ -63,6 +65,7 @@ VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
                                 const DetectorConfig& detector, const core::Method& method,
                                 Execution execution = Execution::kParallel,
                                 const std::function<void(std::size_t, std::size_t)>& progress = {},
-                                VerificationCache* cache = nullptr, const LoopCheck& check = {});
+                                VerificationCache* cache = nullptr, const LoopCheck& check = {},
+                                const MoreLoopsWanted& more = {});
 
 }  // namespace lidarloop::pipeline

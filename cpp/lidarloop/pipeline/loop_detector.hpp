@@ -34,12 +34,13 @@ struct DetectorConfig {
     /// descriptor ranks candidates and the threshold prunes them only when set explicitly.
     bool verify = true;
     /// With verify: register the candidates in rank order and stop at the first accepted one
-    /// (that the odometry gate keeps, when there is one); the rest get kNotNeeded. About half the
-    /// verification time on dense scans, a fifth on sparse keyframes, the same scans closed with
-    /// poses as good (docs/BENCHMARK.md); but one verified loop per scan for the pose graph, and
-    /// a query's candidates are registered one after another. Off: every candidate is
-    /// registered and the loop is the accepted one that overlaps most.
-    bool stop_at_first_loop = false;
+    /// (that the odometry gate keeps, when there is one); the rest get kNotNeeded, except those
+    /// that may give the pose graph a further loop (optimise: app::PoseGraphLoopsWanted). About
+    /// half the verification time on dense scans, a fifth on sparse keyframes, the same scans
+    /// closed with poses as good (docs/BENCHMARK.md); a query's candidates are registered one
+    /// after another. Off: every candidate is registered (in parallel) and the loop is the
+    /// accepted one that overlaps most.
+    bool stop_at_first_loop = true;
     registration::VerificationConfig verification;  ///< YAML section `verification`
 
     /// `threshold` when set, else the default of `method`.
@@ -77,6 +78,12 @@ struct LoopQuery {
 /// Rejects the accepted candidates of a query that other knowledge contradicts, e.g. the odometry
 /// (RejectLoopsAgainstOdometry, reason kOdometryMismatch).
 using LoopCheck = std::function<void(LoopQuery&)>;
+
+/// With DetectorConfig::stop_at_first_loop, once `query` has a loop: whether registering its
+/// candidate `candidate` (ranked after every one registered so far) may still give a loop its
+/// user keeps, e.g. the pose graph's further loops of a scan far apart in path
+/// (app::PoseGraphLoopsWanted). Empty: none after the first.
+using MoreLoopsWanted = std::function<bool(const LoopQuery& query, std::size_t candidate)>;
 
 /// Whether the odometry contradicts a verified loop: given the loop's registered T_match_query,
 /// the odometry's T_match_query and the path between the two scans (m); true rejects the loop.

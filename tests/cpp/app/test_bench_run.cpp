@@ -87,12 +87,15 @@ TEST(BenchRun, VerificationFiguresAreRecountedIndependently) {
     const auto queries = BenchedQueries(dataset, request.config, request.verify_queries);
     const registration::VerificationConfig& config = request.config.detection.verification;
     std::size_t pairs = 0, accepted = 0;
+    ASSERT_TRUE(request.config.detection.stop_at_first_loop);  // the default
     for (const pipeline::LoopQuery& q : queries) {
         for (const pipeline::Neighbor& candidate : q.candidates) {
             ++pairs;
-            accepted += registration::VerifyPair(dataset.LoadScan(q.query),
-                                                 dataset.LoadScan(candidate.index), config)
-                            .accepted;
+            const bool loop = registration::VerifyPair(dataset.LoadScan(q.query),
+                                                       dataset.LoadScan(candidate.index), config)
+                                  .accepted;
+            accepted += loop;
+            if (loop) break;  // the online step stops at the first loop
         }
     }
     ASSERT_EQ(queries.size(), 3U);

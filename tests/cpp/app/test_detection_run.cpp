@@ -385,6 +385,7 @@ TEST_F(DetectionRun, VerifiesEveryCandidateAsRegisteringThePairAlone) {
     LIDARLOOP_RELEASE_SUITE_ONLY();
     app::DetectRequest request = Request("verified", core::Method::kRange);
     request.config.detection.verification.reduction.submap_path_m = 0.0;  // each scan alone
+    request.config.detection.stop_at_first_loop = false;
     const app::DetectOutcome outcome = app::RunDetect(*dataset_, request);
     const registration::VerificationConfig& config = request.config.detection.verification;
     std::size_t checked = 0, accepted = 0;
@@ -691,13 +692,14 @@ TEST_F(DetectionRun, ScansAreSubmapsWhenTheOdometryIsKnown) {
               registration::PrepareScan(dataset_->LoadScan(77), reduction).usable_points);
 }
 
-// detect --stop-at-first-loop with the odometry (submaps, the gate): each query's loop is the
-// first candidate in rank order that registering every one accepts and the gate keeps, with the
-// same verdicts up to it; the same scans are closed, registering fewer pairs.
+// detect stopping at the first loop (the default) with the odometry (submaps, the gate): each
+// query's loop is the first candidate in rank order that registering every one accepts and the
+// gate keeps, with the same verdicts up to it; the same scans are closed, registering fewer pairs.
 TEST_F(DetectionRun, StoppingAtTheFirstLoopClosesTheSameScansRegisteringFewerPairs) {
     LIDARLOOP_RELEASE_SUITE_ONLY();  // two verified runs; StopAtFirstLoop covers the sanitizers
     app::DetectRequest every = Request("every", core::Method::kRange);
     every.config.detection.top_k = 5;
+    every.config.detection.stop_at_first_loop = false;
     every.odometry_file = dir_ / "sequence" / "poses_odometry.txt";
     app::DetectRequest first = every;
     first.out = dir_ / "first";

@@ -59,6 +59,29 @@ TEST(LoopsForPoseGraph, TheLoopThenEarlierPassesFarApartInPath) {
     EXPECT_TRUE(app::LoopsForPoseGraph(pipeline::LoopQuery{}, path_m, config).empty());
 }
 
+// Verifying up to the first loop, optimise goes on only to the candidates that may add a loop
+// LoopsForPoseGraph takes: far in path from every accepted match, while there are fewer than
+// max_loops_per_scan.
+TEST(PoseGraphLoopsWanted, OnlyCandidatesFarInPathFromEveryLoopWhileThereIsRoom) {
+    std::vector<double> path_m(100);
+    for (std::size_t i = 0; i < path_m.size(); ++i) path_m[i] = 2.0 * static_cast<double>(i);
+    // Matches at 20 (accepted), 22 (4 m of path from 20), 50 (60 m), 80 (120 m).
+    pipeline::LoopQuery query = VerifiedQuery({20, 22, 50, 80}, {0.5, -1.0, -1.0, -1.0});
+    posegraph::PoseGraphConfig config;
+    const pipeline::MoreLoopsWanted wanted = app::PoseGraphLoopsWanted(path_m, config);
+    EXPECT_FALSE(wanted(query, 1));
+    EXPECT_TRUE(wanted(query, 2));
+    EXPECT_TRUE(wanted(query, 3));
+    query.verifications[2].accepted = true;  // 50 accepted: 80 is 60 m from it
+    EXPECT_TRUE(wanted(query, 3));
+    config.max_loops_per_scan = 2;  // two loops taken: no room
+    EXPECT_FALSE(app::PoseGraphLoopsWanted(path_m, config)(query, 3));
+    config.max_loops_per_scan = 3;
+    config.min_loop_separation_m = 70.0;  // 80 lies 60 m from 50
+    EXPECT_FALSE(app::PoseGraphLoopsWanted(path_m, config)(query, 3));
+    EXPECT_FALSE(static_cast<bool>(app::PoseGraphLoopsWanted({}, config)));  // no path: the loop
+}
+
 class OptimisationRun : public ::testing::Test {
 protected:
     void SetUp() override { dataset_.emplace(test::SmallSequence(dir_ / "sequence")); }

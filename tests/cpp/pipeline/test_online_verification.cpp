@@ -241,11 +241,11 @@ RankedCandidates MakeRankedCandidates(const DetectorConfig& detector) {
     return r;
 }
 
-LoopQuery Verified(RankedCandidates r, const DetectorConfig& detector,
-                   const LoopCheck& check = {}) {
+LoopQuery Verified(RankedCandidates r, const DetectorConfig& detector, const LoopCheck& check = {},
+                   const MoreLoopsWanted& more = {}) {
     VerifyQuery(
         r.query, r.query_scan, [&](std::size_t j) { return r.scans.at(j); }, detector,
-        core::Method::kRange, nullptr, nullptr, Execution::kSerial, check);
+        core::Method::kRange, nullptr, nullptr, Execution::kSerial, check, more);
     return r.query;
 }
 
@@ -260,6 +260,8 @@ void ExpectSameVerdict(const registration::Verification& a, const registration::
 // verdicts of registering every one, and leaves the rest kNotNeeded.
 TEST(StopAtFirstLoop, RegistersInRankOrderUpToTheFirstAcceptedCandidate) {
     DetectorConfig detector = Verifying();
+    EXPECT_TRUE(detector.stop_at_first_loop);  // the default
+    detector.stop_at_first_loop = false;
     const RankedCandidates ranked = MakeRankedCandidates(detector);
     const LoopQuery every = Verified(ranked, detector);
     ASSERT_FALSE(every.verifications[0].accepted);
@@ -313,6 +315,27 @@ TEST(StopAtFirstLoop, ALoopTheCheckRejectsLetsTheNextCandidateBeRegistered) {
     for (const std::size_t c : {0u, 1u})
         ExpectSameVerdict(none.verifications[c], all.verifications[c], c);
     EXPECT_FALSE(none.accepted);
+}
+
+// After the first loop, the candidates the user still wants (the pose graph's loops far apart in
+// path) are registered, with the verdicts of registering every one; the others are not.
+TEST(StopAtFirstLoop, TheCandidatesStillWantedAfterTheLoopAreRegistered) {
+    DetectorConfig detector = Verifying();
+    detector.stop_at_first_loop = false;
+    const RankedCandidates ranked = MakeRankedCandidates(detector);
+    const LoopQuery every = Verified(ranked, detector);
+    detector.stop_at_first_loop = true;
+    std::vector<std::size_t> asked;
+    const LoopQuery wanted = Verified(ranked, detector, {}, [&](const LoopQuery&, std::size_t c) {
+        asked.push_back(c);
+        return c == 3;
+    });
+    EXPECT_EQ(asked, (std::vector<std::size_t>{2, 3}));  // only once the query has a loop
+    for (const std::size_t c : {0u, 1u, 3u})
+        ExpectSameVerdict(wanted.verifications[c], every.verifications[c], c);
+    EXPECT_EQ(wanted.verifications[2].reason, registration::RejectReason::kNotNeeded);
+    ASSERT_TRUE(wanted.loop().has_value());
+    EXPECT_EQ(*wanted.loop(), 1u);
 }
 
 TEST(OnlineVerification, PreparedScansMustMatchTheDatabase) {
