@@ -22,7 +22,7 @@ int main(int argc, char** argv) {
         for (std::size_t i = 0; i < dataset.size(); ++i) {
             const ll::pipeline::LoopQuery query =
                 detector.Process(dataset.LoadScan(i), static_cast<double>(i));
-            if (const auto loop = query.loop())  // the verified candidate that overlaps best
+            if (const auto loop = query.loop())  // the verified loop (the first accepted candidate)
                 std::printf("scan %zu revisits scan %zu (distance %.4f)\n", i,
                             query.candidates[*loop].index, query.candidates[*loop].distance);
         }
