@@ -83,7 +83,8 @@ pipeline::MoreLoopsWanted PoseGraphLoopsWanted(const std::vector<double>& path_m
         std::size_t accepted = 0;
         for (std::size_t c = 0; c < query.verifications.size(); ++c) {
             if (!query.verifications[c].accepted) continue;
-            if (std::abs(path_of(c) - path_of(candidate)) < config.min_loop_separation_m)
+            // As LoopsForPoseGraph: an unknown (NaN) path separates nothing.
+            if (!(std::abs(path_of(c) - path_of(candidate)) >= config.min_loop_separation_m))
                 return false;
             ++accepted;
         }

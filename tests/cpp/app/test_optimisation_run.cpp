@@ -2,6 +2,7 @@
 // results folder, and names the file and line of bad input.
 #include <algorithm>
 #include <fstream>
+#include <limits>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -80,6 +81,9 @@ TEST(PoseGraphLoopsWanted, OnlyCandidatesFarInPathFromEveryLoopWhileThereIsRoom)
     config.min_loop_separation_m = 70.0;  // 80 lies 60 m from 50
     EXPECT_FALSE(app::PoseGraphLoopsWanted(path_m, config)(query, 3));
     EXPECT_FALSE(static_cast<bool>(app::PoseGraphLoopsWanted({}, config)));  // no path: the loop
+    path_m[80] = std::numeric_limits<double>::quiet_NaN();  // LoopsForPoseGraph would not take it
+    config.min_loop_separation_m = 50.0;
+    EXPECT_FALSE(app::PoseGraphLoopsWanted(path_m, config)(query, 3));
 }
 
 class OptimisationRun : public ::testing::Test {
