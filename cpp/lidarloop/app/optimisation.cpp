@@ -81,7 +81,7 @@ pipeline::MoreLoopsWanted PoseGraphLoopsWanted(const std::vector<double>& path_m
     return [&path_m, config](const pipeline::LoopQuery& query, std::size_t candidate) {
         const auto path_of = [&](std::size_t c) { return path_m.at(query.candidates[c].index); };
         std::size_t accepted = 0;
-        for (std::size_t c = 0; c < query.verifications.size(); ++c) {
+        for (std::size_t c = 0; c < candidate; ++c) {
             if (!query.verifications[c].accepted) continue;
             // As LoopsForPoseGraph: an unknown (NaN) path separates nothing.
             if (!(std::abs(path_of(c) - path_of(candidate)) >= config.min_loop_separation_m))

@@ -73,9 +73,9 @@ std::vector<std::size_t> LoopsForPoseGraph(const pipeline::LoopQuery& query,
                                            const posegraph::PoseGraphConfig& config);
 
 /// With detection.stop_at_first_loop, the candidates of a query with a loop that may still add
-/// one LoopsForPoseGraph takes: while the query has fewer than max_loops_per_scan accepted
-/// candidates, one whose match lies at least min_loop_separation_m of `path_m` from every
-/// accepted match. Empty (no more) when `path_m` is empty. `path_m` is referenced, not copied.
+/// one LoopsForPoseGraph takes: while fewer than max_loops_per_scan candidates ranked before it
+/// are accepted, one whose match lies at least min_loop_separation_m of `path_m` from each of
+/// theirs. Empty (no more) when `path_m` is empty. `path_m` is referenced, not copied.
 pipeline::MoreLoopsWanted PoseGraphLoopsWanted(const std::vector<double>& path_m,
                                                const posegraph::PoseGraphConfig& config);
 

@@ -6,6 +6,7 @@
 #include <optional>
 
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "lidarloop/pipeline/descriptor_method.hpp"
 #include "lidarloop/pipeline/expanded_scans.hpp"
@@ -32,6 +33,52 @@ bool Wanted(const LoopQuery& query, std::size_t c, const MoreLoopsWanted& more) 
                                       query.verifications.begin() + static_cast<std::ptrdiff_t>(c),
                                       [](const auto& v) { return v.accepted; });
     return !has_loop || (more && more(query, c));
+}
+
+// detector.stop_at_first_loop: the candidates in rank order, `width` at a time. A batch's wanted
+// candidates are registered at once (`register_batch`), then decided in rank order as if
+// registered one after another: a candidate no longer wanted by then gets kNotNeeded whatever
+// was found, so the verdicts do not depend on `width`. `answered[c]`: c has its verdict already.
+void DecideInRankOrder(LoopQuery& query, std::vector<bool> answered, std::size_t width,
+                       const std::function<void(const std::vector<std::size_t>&)>& register_batch,
+                       const LoopCheck& check, const MoreLoopsWanted& more) {
+    const std::size_t n = query.candidates.size();
+    const auto pruned = [&](std::size_t c) {
+        return query.verifications[c].reason == registration::RejectReason::kPruned;
+    };
+    for (std::size_t begin = 0; begin < n; begin += width) {
+        const std::size_t end = std::min(n, begin + width);
+        std::vector<std::size_t> batch;  // wanted as far as the decided candidates tell
+        for (std::size_t c = begin; c < end; ++c) {
+            if (!answered[c] && !pruned(c) && Wanted(query, c, more)) batch.push_back(c);
+        }
+        if (!batch.empty()) register_batch(batch);
+        for (const std::size_t c : batch) answered[c] = true;
+        // Decide in rank order from the state registering one after another would have reached.
+        std::vector<registration::Verification> found(
+            query.verifications.begin() + static_cast<std::ptrdiff_t>(begin),
+            query.verifications.begin() + static_cast<std::ptrdiff_t>(end));
+        for (std::size_t c = begin; c < end; ++c) {
+            if (!pruned(c)) query.verifications[c] = registration::Verification{};
+        }
+        for (std::size_t c = begin; c < end; ++c) {
+            if (found[c - begin].reason == registration::RejectReason::kPruned) {
+                query.verifications[c] = found[c - begin];
+                continue;
+            }
+            if (!Wanted(query, c, more)) {
+                query.verifications[c] = Rejected(registration::RejectReason::kNotNeeded);
+                continue;
+            }
+            if (answered[c]) {
+                query.verifications[c] = found[c - begin];
+            } else {  // a loop before it in the batch was rejected by the check
+                register_batch({c});
+                answered[c] = true;
+            }
+            if (query.verifications[c].accepted && check) check(query);
+        }
+    }
 }
 
 }  // namespace
@@ -105,19 +152,19 @@ void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
     };
     if (detector.stop_at_first_loop) {
         // In rank order: the first accepted candidate that the check keeps is the loop; after
-        // it, only the candidates `more` still wants.
-        for (std::size_t c = 0; c < query.candidates.size(); ++c) {
-            if (query.verifications[c].reason == registration::RejectReason::kPruned) continue;
-            if (!Wanted(query, c, more)) {
-                query.verifications[c] = Rejected(registration::RejectReason::kNotNeeded);
-                continue;
-            }
-            if (!answered[c]) {
-                if (!coarse) make_coarse();
-                register_one(c);
-            }
-            if (query.verifications[c].accepted && check) check(query);
-        }
+        // it, only the candidates `more` still wants. Online, as many at once as there are
+        // threads: a query's latency, not its CPU time, is what keeps up with the sensor.
+        const auto width =
+            execution == Execution::kParallel
+                ? static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency()))
+                : std::size_t{1};
+        const auto register_batch = [&](const std::vector<std::size_t>& batch) {
+            if (!coarse) make_coarse();
+            if (batch.size() == 1) return register_one(batch.front());
+            tbb::parallel_for(std::size_t{0}, batch.size(),
+                              [&](std::size_t k) { register_one(batch[k]); });
+        };
+        DecideInRankOrder(query, answered, width, register_batch, check, more);
     } else {
         std::vector<std::size_t> to_register;
         for (std::size_t c = 0; c < query.candidates.size(); ++c) {
@@ -152,8 +199,12 @@ VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
     std::vector<VerificationTimes> per_query(queries.size());
     std::atomic<std::size_t> done{0};
     const auto run = [&](std::size_t i) {
+        // Queries run in parallel: stopping at the first loop, each registers its candidates one
+        // after another (a batch at once would register some for nothing).
+        const Execution per_query_execution =
+            detector.stop_at_first_loop ? Execution::kSerial : execution;
         VerifyQuery(queries[i], scan_of(queries[i].query), scan_of, detector, method, &per_query[i],
-                    cache, execution, check, more);
+                    cache, per_query_execution, check, more);
         const std::size_t finished = ++done;
         if (progress) progress(finished, queries.size());
     };

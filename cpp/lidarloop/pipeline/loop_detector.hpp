@@ -37,9 +37,10 @@ struct DetectorConfig {
     /// (that the odometry gate keeps, when there is one); the rest get kNotNeeded, except those
     /// that may give the pose graph a further loop (optimise: app::PoseGraphLoopsWanted). About
     /// half the verification time on dense scans, a fifth on sparse keyframes, the same scans
-    /// closed with poses as good (docs/BENCHMARK.md); a query's candidates are registered one
-    /// after another. Off: every candidate is registered (in parallel) and the loop is the
-    /// accepted one that overlaps most.
+    /// closed with poses as good (docs/BENCHMARK.md); a query's candidates are registered in
+    /// rank order (online, as many at once as there are threads, decided one after another).
+    /// Off: every candidate is registered (in parallel) and the loop is the accepted one that
+    /// overlaps most.
     bool stop_at_first_loop = true;
     registration::VerificationConfig verification;  ///< YAML section `verification`
 
@@ -80,9 +81,10 @@ struct LoopQuery {
 using LoopCheck = std::function<void(LoopQuery&)>;
 
 /// With DetectorConfig::stop_at_first_loop, once `query` has a loop: whether registering its
-/// candidate `candidate` (ranked after every one registered so far) may still give a loop its
-/// user keeps, e.g. the pose graph's further loops of a scan far apart in path
-/// (app::PoseGraphLoopsWanted). Empty: none after the first.
+/// candidate `candidate` may still give a loop its user keeps, judged by the verdicts of the
+/// candidates ranked before it (later ones may hold cached verdicts: ignore them), e.g. the pose
+/// graph's further loops of a scan far apart in path (app::PoseGraphLoopsWanted). Empty: none
+/// after the first.
 using MoreLoopsWanted = std::function<bool(const LoopQuery& query, std::size_t candidate)>;
 
 /// Whether the odometry contradicts a verified loop: given the loop's registered T_match_query,

@@ -3,6 +3,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/pipeline/candidate_verification.hpp"
@@ -330,12 +331,54 @@ TEST(StopAtFirstLoop, TheCandidatesStillWantedAfterTheLoopAreRegistered) {
         asked.push_back(c);
         return c == 3;
     });
+    asked.erase(std::unique(asked.begin(), asked.end()), asked.end());
     EXPECT_EQ(asked, (std::vector<std::size_t>{2, 3}));  // only once the query has a loop
     for (const std::size_t c : {0u, 1u, 3u})
         ExpectSameVerdict(wanted.verifications[c], every.verifications[c], c);
     EXPECT_EQ(wanted.verifications[2].reason, registration::RejectReason::kNotNeeded);
     ASSERT_TRUE(wanted.loop().has_value());
     EXPECT_EQ(*wanted.loop(), 1u);
+}
+
+// Online, stopping at the first loop registers as many candidates at once as there are threads,
+// then decides them in rank order: the verdicts of registering one after another, whatever the
+// width, also when a cached loop inside a batch is rejected by the check and the candidate after
+// it, skipped by the batch, must be registered after all.
+TEST(StopAtFirstLoop, RegisteringSeveralAtOnceGivesTheVerdictsOfOneAfterAnother) {
+    DetectorConfig detector = Verifying();
+    const RankedCandidates ranked = MakeRankedCandidates(detector);
+    const LoopCheck reject_candidate_1 = [](LoopQuery& query) {
+        registration::Verification& v = query.verifications[1];
+        if (v.accepted)
+            v.accepted = false, v.reason = registration::RejectReason::kOdometryMismatch;
+    };
+    const auto verify = [&](int threads, Execution execution, const LoopCheck& check,
+                            VerificationCache* cache) {
+        LoopQuery query = ranked.query;
+        tbb::task_arena(threads).execute([&] {
+            VerifyQuery(
+                query, ranked.query_scan, [&](std::size_t j) { return ranked.scans.at(j); },
+                detector, core::Method::kRange, nullptr, cache, execution, check);
+        });
+        return query;
+    };
+    for (const LoopCheck& check : {LoopCheck{}, reject_candidate_1}) {
+        const LoopQuery one_by_one = verify(1, Execution::kSerial, check, nullptr);
+        for (const int threads : {2, 3, 4}) {
+            VerificationCache cache;
+            const LoopQuery batched = verify(threads, Execution::kParallel, check, &cache);
+            const auto registered_1 = cache.Find(4, 1);  // before the check
+            ASSERT_TRUE(registered_1 && registered_1->accepted) << threads;
+            VerificationCache cached_loop;  // candidate 1's verdict known: the batch skips 2, 3
+            cached_loop.Store(4, 1, *registered_1);
+            const LoopQuery with_cached =
+                verify(threads, Execution::kParallel, check, &cached_loop);
+            for (std::size_t c = 0; c < 4; ++c) {
+                ExpectSameVerdict(batched.verifications[c], one_by_one.verifications[c], c);
+                ExpectSameVerdict(with_cached.verifications[c], one_by_one.verifications[c], c);
+            }
+        }
+    }
 }
 
 TEST(OnlineVerification, PreparedScansMustMatchTheDatabase) {
