@@ -304,10 +304,9 @@ void BindDetector(py::module_& m) {
              "method; top_k, min_gap (in the config's unit, scans by default), min_gap_unit "
              "('scans', 'seconds', 'metres': needs the odometry), threshold, verify, "
              "stop_at_first_loop (default True: register the candidates in rank order up to "
-             "the first loop; False: every candidate) "
-             "override detection.*. Loops the odometry contradicts (process's odometry) are "
-             "rejected by "
-             "the pose graph's gate (posegraph.robust).")
+             "the first loop; False: every candidate) override detection.*. Loops the odometry "
+             "contradicts (process's odometry) are rejected by the pose graph's gate "
+             "(posegraph.robust).")
         .def(
             "process",
             [](LoopDetector& detector, const py::object& points, std::optional<double> time_s,

@@ -22,6 +22,12 @@
 namespace lidarloop::app {
 namespace {
 
+// Whether two loops of one scan are far enough apart in path for the pose graph to take both. An
+// unknown (NaN) path separates nothing.
+bool SeparatedInPath(double a_m, double b_m, const posegraph::PoseGraphConfig& config) {
+    return std::abs(a_m - b_m) >= config.min_loop_separation_m;
+}
+
 // The accepted loops of a detection run with verification (the verified candidate's pose).
 std::vector<posegraph::LoopConstraint> DetectLoops(const io::Dataset& dataset,
                                                    const OptimiseRequest& request) {
@@ -68,7 +74,7 @@ std::vector<std::size_t> LoopsForPoseGraph(const pipeline::LoopQuery& query,
     for (const std::size_t c : others) {
         if (taken.size() >= static_cast<std::size_t>(config.max_loops_per_scan)) break;
         const bool separated = std::all_of(taken.begin(), taken.end(), [&](std::size_t t) {
-            return std::abs(path_of(c) - path_of(t)) >= config.min_loop_separation_m;
+            return SeparatedInPath(path_of(c), path_of(t), config);
         });
         if (separated) taken.push_back(c);
     }
@@ -83,9 +89,7 @@ pipeline::MoreLoopsWanted PoseGraphLoopsWanted(const std::vector<double>& path_m
         std::size_t accepted = 0;
         for (std::size_t c = 0; c < candidate; ++c) {
             if (!query.verifications[c].accepted) continue;
-            // As LoopsForPoseGraph: an unknown (NaN) path separates nothing.
-            if (!(std::abs(path_of(c) - path_of(candidate)) >= config.min_loop_separation_m))
-                return false;
+            if (!SeparatedInPath(path_of(c), path_of(candidate), config)) return false;
             ++accepted;
         }
         return accepted < static_cast<std::size_t>(config.max_loops_per_scan);

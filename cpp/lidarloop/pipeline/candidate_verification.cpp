@@ -62,10 +62,7 @@ void DecideInRankOrder(LoopQuery& query, std::vector<bool> answered, std::size_t
             if (!pruned(c)) query.verifications[c] = registration::Verification{};
         }
         for (std::size_t c = begin; c < end; ++c) {
-            if (found[c - begin].reason == registration::RejectReason::kPruned) {
-                query.verifications[c] = found[c - begin];
-                continue;
-            }
+            if (pruned(c)) continue;  // never reset
             if (!Wanted(query, c, more)) {
                 query.verifications[c] = Rejected(registration::RejectReason::kNotNeeded);
                 continue;
