@@ -24,7 +24,8 @@ void RunOptionFlags::AddTo(CLI::App& command, app::RunCommand which) {
                 break;
             case T::kSwitch:
             case T::kSwitchOff:
-                slot.flag = command.add_flag(flag, slot.on, help);
+                // A switch takes no value: "--no-verify=false" would still turn verification off.
+                slot.flag = command.add_flag(flag, slot.on, help)->disable_flag_override();
                 break;
         }
         if (!option->value_name.empty()) slot.flag->type_name(std::string(option->value_name));

@@ -528,6 +528,8 @@ section_bad_input() {
     expect_error "unknown format" "unknown scan format '.las'" "$cli" describe "$work/scan.las"
     expect_error "unknown method" "unknown method 'sift'" "$cli" describe --method sift \
         "$samples/corner_a.bin"
+    expect_error "a switch given a value" "all-candidates" "$cli" detect "$samples" \
+        --all-candidates=false --out "$work/switch_value"
     expect_error "zero bins" "--bins: histogram.bins must be in [1, 1000000], got 0" "$cli" \
         describe --bins 0 "$samples/corner_a.bin"
     expect_error "huge bins" "histogram.bins must be in [1, 1000000]" "$cli" describe \
