@@ -168,6 +168,10 @@ void VisitFields(registration::AcceptanceConfig& c, Visitor& v) {
             "RMS plane distance of the overlap over the scans' own roughness, at most");
     v.Field("min_allowed_rmse_m", c.min_allowed_rmse_m, "the allowed RMS is at least this");
     v.Field("max_rmse_m", c.max_rmse_m, "and at most this");
+    v.Field("min_constraining_points", c.min_constraining_points,
+            "overlapping points facing the weakest direction, at least");
+    v.Field("min_constraining_points_with_odometry", c.min_constraining_points_with_odometry,
+            "the same where the odometry judges the loop (--odometry)");
     v.Field("degeneracy_shift_m", c.degeneracy_shift_m, "shift along the weakest direction");
     v.Field("max_shifted_overlap_ratio", c.max_shifted_overlap_ratio,
             "share of the points pinning that direction still overlapping there, at most");

@@ -76,9 +76,24 @@ struct LoopQuery {
     std::optional<std::size_t> loop() const;
 };
 
-/// Rejects the accepted candidates of a query that other knowledge contradicts, e.g. the odometry
-/// (RejectLoopsAgainstOdometry, reason kOdometryMismatch).
-using LoopCheck = std::function<void(LoopQuery&)>;
+/// Knowledge besides the scans that judges a query's verified loops: the odometry
+/// (app::OdometryLoopCheck). Empty: none.
+struct LoopCheck {
+    /// Rejects the accepted candidates of a query that the knowledge contradicts
+    /// (RejectLoopsAgainstOdometry, reason kOdometryMismatch).
+    std::function<void(LoopQuery&)> reject;
+    /// Whether `reject` judges the pose of a loop from scan `query` to scan `match` (the odometry
+    /// knows both). Such a candidate is verified with VerificationConfig::CheckedByOdometry():
+    /// the odometry's gate stands in for the points that pin the position along a road. Empty:
+    /// none is.
+    std::function<bool(std::size_t query, std::size_t match)> judges_pose;
+
+    explicit operator bool() const { return static_cast<bool>(reject); }
+    void operator()(LoopQuery& query) const { reject(query); }
+    bool JudgesPose(std::size_t query, std::size_t match) const {
+        return judges_pose && judges_pose(query, match);
+    }
+};
 
 /// With DetectorConfig::stop_at_first_loop, once `query` has a loop: whether registering its
 /// candidate `candidate` may still give a loop its user keeps, judged by the verdicts of the
@@ -102,6 +117,12 @@ using OdometryGate =
 std::size_t RejectLoopsAgainstOdometry(
     LoopQuery& query, const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
     const std::function<double(std::size_t)>& path_m_of, const OdometryGate& gate);
+
+/// Whether the odometry knows the relative pose of scans `query` and `match` and the path
+/// between them (all finite), so that RejectLoopsAgainstOdometry judges a loop between them.
+bool OdometryJudges(std::size_t query, std::size_t match,
+                    const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
+                    const std::function<double(std::size_t)>& path_m_of);
 
 /// The k nearest of the scans 0..count-1 for which `eligible(j)` holds, by (distance, index),
 /// with `distance_of(j)` (called for eligible scans only; +inf and NaN are never candidates):

@@ -164,7 +164,7 @@ RejectReason Judge(const PreparedScan& query, const PreparedScan& match,
         return RejectReason::kLowOverlap;
     }
     if (overlap.rmse_m > AllowedRmse(query, match, config)) return RejectReason::kHighRmse;
-    if (overlap.constraining_points < min_points / 4 ||
+    if (overlap.constraining_points < static_cast<std::size_t>(config.min_constraining_points) ||
         overlap.shifted_overlap_ratio > config.max_shifted_overlap_ratio) {
         return RejectReason::kDegenerate;
     }

@@ -74,10 +74,19 @@ void AcceptanceConfig::Validate() const {
     RequireIn(max_rmse_ratio, 0.0, 1000.0, "acceptance.max_rmse_ratio");
     RequireIn(min_allowed_rmse_m, 0.0, 100.0, "acceptance.min_allowed_rmse_m");
     RequireIn(max_rmse_m, std::max(0.001, min_allowed_rmse_m), 100.0, "acceptance.max_rmse_m");
+    RequireIn(min_constraining_points, 1, 1'000'000, "acceptance.min_constraining_points");
+    RequireIn(min_constraining_points_with_odometry, 1, 1'000'000,
+              "acceptance.min_constraining_points_with_odometry");
     RequireIn(degeneracy_shift_m, 0.0, 100.0, "acceptance.degeneracy_shift_m");
     RequireIn(max_shifted_overlap_ratio, 0.0, 1.0, "acceptance.max_shifted_overlap_ratio");
     RequireIn(max_rival_overlap_ratio, 0.0, 10.0, "acceptance.max_rival_overlap_ratio");
     RequireIn(max_loop_distance_m, 0.1, 1e4, "acceptance.max_loop_distance_m");
+}
+
+VerificationConfig VerificationConfig::CheckedByOdometry() const {
+    VerificationConfig checked = *this;
+    checked.acceptance.min_constraining_points = acceptance.min_constraining_points_with_odometry;
+    return checked;
 }
 
 void VerificationConfig::Validate() const {

@@ -103,6 +103,11 @@ TEST(RejectLoopsAgainstOdometry, RejectsThePoseTheOdometryContradictsAndChoosesA
     std::vector<pipeline::LoopQuery> unjudged{two_loops};
     EXPECT_EQ(app::RejectLoopsAgainstOdometry(unjudged, lost, path_m, {}), 0u);
     EXPECT_EQ(unjudged[0].loop(), 1u);
+    // The check says which loops it judges: those the odometry knows both scans of.
+    EXPECT_TRUE(app::OdometryLoopCheck(odometry, path_m, {}).JudgesPose(99, 40));
+    EXPECT_FALSE(app::OdometryLoopCheck(lost, path_m, {}).JudgesPose(99, 45));
+    EXPECT_FALSE(app::OdometryLoopCheck(lost, path_m, {}).JudgesPose(45, 40));
+    EXPECT_TRUE(app::OdometryLoopCheck(lost, path_m, {}).JudgesPose(99, 40));
     odometry.resize(60);
     EXPECT_THROW(app::RejectLoopsAgainstOdometry(consistent, odometry, path_m, {}),
                  core::ConfigError);

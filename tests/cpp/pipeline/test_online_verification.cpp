@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -150,13 +151,24 @@ OdometryGate FiveMetreGate(std::vector<GateCall>& calls) {
         };
 }
 
+// A detector whose degeneracy floor no registration passes on its own, but every one passes
+// where the odometry judges the pose.
+DetectorConfig OnlyTheOdometryPins() {
+    DetectorConfig detector = Verifying();
+    detector.verification.acceptance.min_constraining_points = 1'000'000;
+    detector.verification.acceptance.min_constraining_points_with_odometry = 1;
+    return detector;
+}
+
 std::vector<LoopQuery> ProcessWithOdometry(const std::vector<core::Transform>& odometry,
-                                           std::vector<GateCall>& calls) {
+                                           std::vector<GateCall>& calls,
+                                           const DetectorConfig& detector = Verifying(),
+                                           bool with_gate = true) {
     const Sequence sequence = MakeSequence();
     core::DescriptorConfig config;
     config.method = core::Method::kRange;
-    LoopDetector online(config, Verifying());
-    online.SetOdometryGate(FiveMetreGate(calls));
+    LoopDetector online(config, detector);
+    if (with_gate) online.SetOdometryGate(FiveMetreGate(calls));
     std::vector<LoopQuery> results;
     for (std::size_t i = 0; i < sequence.scans.size(); ++i)
         results.push_back(online.Process(sequence.scans[i], static_cast<double>(i), odometry[i]));
@@ -190,6 +202,23 @@ TEST(OnlineVerification, TheOdometryGateRejectsOnlyTheLoopsItContradicts) {
     }));
     ASSERT_TRUE(contradicted[4].loop());
     EXPECT_EQ(contradicted[4].candidates[*contradicted[4].loop()].index, 1U);
+}
+
+// The odometry's degeneracy floor applies where the gate judges the pose, and only there.
+TEST(OnlineVerification, TheOdometrysDegeneracyFloorNeedsTheGate) {
+    std::vector<GateCall> calls;
+    const DetectorConfig detector = OnlyTheOdometryPins();
+    const std::vector<LoopQuery> gated = ProcessWithOdometry(Odometry(0.0), calls, detector);
+    EXPECT_TRUE(gated[3].loop() && gated[4].loop());
+    const std::vector<LoopQuery> alone =
+        ProcessWithOdometry(Odometry(0.0), calls, detector, /*with_gate=*/false);
+    for (const LoopQuery& query : alone) {
+        EXPECT_FALSE(query.accepted) << query.query;
+        for (const auto& verdict : query.verifications) {
+            EXPECT_TRUE(verdict.reason != registration::RejectReason::kNone) << query.query;
+        }
+    }
+    EXPECT_EQ(alone[3].verifications.front().reason, registration::RejectReason::kDegenerate);
 }
 
 TEST(OnlineVerification, TheOdometryIsGivenForEveryScanOrNone) {
@@ -287,18 +316,21 @@ TEST(StopAtFirstLoop, ALoopTheCheckRejectsLetsTheNextCandidateBeRegistered) {
     detector.stop_at_first_loop = true;
     const RankedCandidates ranked = MakeRankedCandidates(detector);
     std::vector<std::size_t> checked_accepted;
-    const LoopQuery first = Verified(ranked, detector, [&](LoopQuery& query) {
-        std::size_t accepted = 0;
-        for (registration::Verification& v : query.verifications) {
-            if (!v.accepted) continue;
-            ++accepted;
-            if (&v == &query.verifications[1]) {
-                v.accepted = false;
-                v.reason = registration::RejectReason::kOdometryMismatch;
-            }
-        }
-        checked_accepted.push_back(accepted);
-    });
+    const LoopQuery first =
+        Verified(ranked, detector,
+                 LoopCheck{[&](LoopQuery& query) {
+                               std::size_t accepted = 0;
+                               for (registration::Verification& v : query.verifications) {
+                                   if (!v.accepted) continue;
+                                   ++accepted;
+                                   if (&v == &query.verifications[1]) {
+                                       v.accepted = false;
+                                       v.reason = registration::RejectReason::kOdometryMismatch;
+                                   }
+                               }
+                               checked_accepted.push_back(accepted);
+                           },
+                           {}});
     EXPECT_EQ(checked_accepted, (std::vector<std::size_t>{1, 1}));  // one new loop a call
     EXPECT_EQ(first.verifications[1].reason, registration::RejectReason::kOdometryMismatch);
     EXPECT_TRUE(first.verifications[2].accepted);
@@ -347,11 +379,13 @@ TEST(StopAtFirstLoop, TheCandidatesStillWantedAfterTheLoopAreRegistered) {
 TEST(StopAtFirstLoop, RegisteringSeveralAtOnceGivesTheVerdictsOfOneAfterAnother) {
     DetectorConfig detector = Verifying();
     const RankedCandidates ranked = MakeRankedCandidates(detector);
-    const LoopCheck reject_candidate_1 = [](LoopQuery& query) {
-        registration::Verification& v = query.verifications[1];
-        if (v.accepted)
-            v.accepted = false, v.reason = registration::RejectReason::kOdometryMismatch;
-    };
+    const LoopCheck reject_candidate_1{
+        [](LoopQuery& query) {
+            registration::Verification& v = query.verifications[1];
+            if (v.accepted)
+                v.accepted = false, v.reason = registration::RejectReason::kOdometryMismatch;
+        },
+        {}};
     const auto verify = [&](int threads, Execution execution, const LoopCheck& check,
                             VerificationCache* cache) {
         LoopQuery query = ranked.query;
@@ -387,6 +421,32 @@ TEST(OnlineVerification, PreparedScansMustMatchTheDatabase) {
     database.Add(ComputeDescriptor(test::SyntheticPlace(1), config), 0.0);
     std::vector<registration::PreparedScan> two(2);
     EXPECT_THROW(LoopDetector(database, Verifying(), two), core::ConfigError);
+}
+
+// VerifyQuery registers with the odometry's degeneracy floor exactly the candidates whose pose
+// the check judges.
+TEST(OdometryFloor, OnlyTheCandidatesWhosePoseTheCheckJudges) {
+    DetectorConfig detector = OnlyTheOdometryPins();
+    detector.stop_at_first_loop = false;
+    const RankedCandidates ranked = MakeRankedCandidates(detector);
+    std::vector<std::pair<std::size_t, std::size_t>> asked;
+    const LoopCheck judges_candidate_2{[](LoopQuery& /*unused*/) {},
+                                       [&](std::size_t query, std::size_t match) {
+                                           asked.emplace_back(query, match);
+                                           return match == 2;
+                                       }};
+    const LoopQuery verified = Verified(ranked, detector, judges_candidate_2);
+    EXPECT_EQ(verified.verifications[1].reason, registration::RejectReason::kDegenerate);
+    EXPECT_TRUE(verified.verifications[2].accepted);
+    EXPECT_FALSE(verified.verifications[0].accepted || verified.verifications[3].accepted);
+    ASSERT_EQ(verified.loop(), 2u);
+    // The verdict of the floor it was given, the same pose.
+    DetectorConfig floor_1 = detector;
+    floor_1.verification.acceptance.min_constraining_points = 1;
+    ExpectSameVerdict(verified.verifications[2], Verified(ranked, floor_1).verifications[2], 2);
+    std::sort(asked.begin(), asked.end());
+    EXPECT_EQ(asked,
+              (std::vector<std::pair<std::size_t, std::size_t>>{{4, 0}, {4, 1}, {4, 2}, {4, 3}}));
 }
 
 }  // namespace

@@ -178,5 +178,37 @@ TEST(Submap, SparseRuralRevisitNeedsTheSubmap) {
     EXPECT_LT((merged.T_match_query.translation() - truth.translation()).norm(), 0.3);
 }
 
+// A sparse rural revisit (the same sequence, scan 290 back to scan 84, 8.2 m apart): as submaps
+// the right pose is found, but the road leaves only a handful of points facing along it (5 to
+// 19: fewer than the 20 asked of the geometry alone). Where the odometry judges the pose (its
+// gate rejects a look-alike place farther along the road), 5 suffice, and the loop is accepted
+// at the true pose (docs/verification.md, "The odometry's word").
+TEST(Submap, ARoadPinnedByAFewPointsIsALoopWhereTheOdometryJudgesIt) {
+    const sim::Simulator simulator(test::SparseUTurnKeyframes(sim::SceneType::kRural, 10));
+    const std::vector<core::StampedPose> odometry = simulator.OdometryPoses(0, simulator.size());
+    const auto load = [&simulator](std::size_t k) { return simulator.Scan(k); };
+    const std::size_t query = 290, match = 84;
+    const core::Transform truth = simulator.GroundTruthPose(match).T_world_sensor.inverse() *
+                                  simulator.GroundTruthPose(query).T_world_sensor;
+    const VerificationConfig config;
+    const std::vector<double> path_m = SubmapPathM(odometry);
+    const PreparedScan query_submap =
+        PrepareSubmap(query, odometry, path_m, load, config.reduction);
+    const PreparedScan match_submap =
+        PrepareSubmap(match, odometry, path_m, load, config.reduction);
+    const CoarseQuery coarse(*query_submap.structure, config.coarse);
+
+    const Verification alone = Verify(query_submap, coarse, match_submap, config);
+    EXPECT_EQ(alone.reason, RejectReason::kDegenerate) << "pick a pair the floor rejects";
+    EXPECT_LT(alone.overlap.constraining_points,
+              static_cast<std::size_t>(config.acceptance.min_constraining_points));
+    EXPECT_LE(alone.overlap.shifted_overlap_ratio, config.acceptance.max_shifted_overlap_ratio);
+
+    const Verification judged =
+        Verify(query_submap, coarse, match_submap, config.CheckedByOdometry());
+    EXPECT_TRUE(judged.accepted) << ToString(judged.reason);
+    EXPECT_LT((judged.T_match_query.translation() - truth.translation()).norm(), 0.1);
+}
+
 }  // namespace
 }  // namespace lidarloop::registration
