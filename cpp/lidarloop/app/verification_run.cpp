@@ -194,15 +194,15 @@ pipeline::LoopCheck OdometryLoopCheck(const std::vector<core::StampedPose>& odom
         require_pose(scan);
         return path_m[scan];
     };
+    const pipeline::OdometryGate gate = OdometryGateOf(config);
     pipeline::LoopCheck check;
-    check.reject = [pose_of, path_of, gate = OdometryGateOf(config),
-                    rejected](pipeline::LoopQuery& query) {
+    check.reject = [pose_of, path_of, gate, rejected](pipeline::LoopQuery& query) {
         const std::size_t count =
             pipeline::RejectLoopsAgainstOdometry(query, pose_of, path_of, gate);
         if (rejected != nullptr) *rejected += count;
     };
-    check.judges_pose = [pose_of, path_of](std::size_t query, std::size_t match) {
-        return pipeline::OdometryJudges(query, match, pose_of, path_of);
+    check.allowed_poses = [pose_of, path_of, gate](std::size_t query, std::size_t match) {
+        return pipeline::OdometryAllowedPoses(query, match, pose_of, path_of, gate);
     };
     return check;
 }

@@ -134,13 +134,12 @@ void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
     }
     std::optional<registration::CoarseQuery> coarse;  // the query's images, shared by its pairs
     std::vector<double> pair_seconds(query.candidates.size(), -1.0);
-    const registration::VerificationConfig checked = detector.verification.CheckedByOdometry();
     const auto register_one = [&](std::size_t c) {
         const std::size_t match = query.candidates[c].index;
         const auto pair_start = Clock::now();
-        query.verifications[c] = registration::Verify(
-            prepared, *coarse, match_of(match),
-            check.JudgesPose(query.query, match) ? checked : detector.verification);
+        query.verifications[c] =
+            registration::Verify(prepared, *coarse, match_of(match), detector.verification,
+                                 check.AllowedPoses(query.query, match));
         pair_seconds[c] = SecondsSince(pair_start);
         if (cache) cache->Store(query.query, match, query.verifications[c]);
     };

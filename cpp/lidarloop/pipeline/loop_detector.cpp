@@ -4,7 +4,6 @@
 #include <cmath>
 #include <limits>
 #include <string>
-#include <utility>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -132,26 +131,18 @@ std::optional<std::size_t> LoopQuery::loop() const {
     return best;
 }
 
-namespace {
-
-// The odometry's T_match_query and the path between the two scans (m); not finite where the
-// odometry does not know a scan's pose or path.
-std::pair<core::Transform, double> OdometryBetween(
+registration::PoseAllowed OdometryAllowedPoses(
     std::size_t query, std::size_t match,
     const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
-    const std::function<double(std::size_t)>& path_m_of) {
-    return {T_odom_sensor_of(match).inverse() * T_odom_sensor_of(query),
-            std::abs(path_m_of(query) - path_m_of(match))};
-}
-
-}  // namespace
-
-bool OdometryJudges(std::size_t query, std::size_t match,
-                    const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
-                    const std::function<double(std::size_t)>& path_m_of) {
-    const auto [T_match_query, path_between_m] =
-        OdometryBetween(query, match, T_odom_sensor_of, path_m_of);
-    return T_match_query.matrix().allFinite() && std::isfinite(path_between_m);
+    const std::function<double(std::size_t)>& path_m_of, const OdometryGate& gate) {
+    const core::Transform T_match_query_odometry =
+        T_odom_sensor_of(match).inverse() * T_odom_sensor_of(query);
+    const double path_between_m = std::abs(path_m_of(query) - path_m_of(match));
+    // Odometry that does not know a scan's pose cannot judge its loop.
+    if (!T_match_query_odometry.matrix().allFinite() || !std::isfinite(path_between_m)) return {};
+    return [gate, T_match_query_odometry, path_between_m](const core::Transform& T_match_query) {
+        return !gate(T_match_query, T_match_query_odometry, path_between_m);
+    };
 }
 
 std::size_t RejectLoopsAgainstOdometry(
@@ -161,12 +152,9 @@ std::size_t RejectLoopsAgainstOdometry(
     for (std::size_t c = 0; c < query.verifications.size(); ++c) {
         registration::Verification& verdict = query.verifications[c];
         if (!verdict.accepted) continue;
-        const std::size_t match = query.candidates[c].index;
-        // Odometry that does not know a scan's pose cannot contradict its loop.
-        if (!OdometryJudges(query.query, match, T_odom_sensor_of, path_m_of)) continue;
-        const auto [T_match_query_odometry, path_between_m] =
-            OdometryBetween(query.query, match, T_odom_sensor_of, path_m_of);
-        if (!gate(verdict.T_match_query, T_match_query_odometry, path_between_m)) continue;
+        const registration::PoseAllowed allowed = OdometryAllowedPoses(
+            query.query, query.candidates[c].index, T_odom_sensor_of, path_m_of, gate);
+        if (!allowed || allowed(verdict.T_match_query)) continue;
         verdict.accepted = false;
         verdict.reason = registration::RejectReason::kOdometryMismatch;
         ++rejected;
@@ -336,8 +324,8 @@ LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_
         odometry_check.reject = [&](LoopQuery& verified) {
             RejectLoopsAgainstOdometry(verified, pose_of, path_of, odometry_gate_);
         };
-        odometry_check.judges_pose = [&](std::size_t from, std::size_t to) {
-            return OdometryJudges(from, to, pose_of, path_of);
+        odometry_check.allowed_poses = [&](std::size_t from, std::size_t to) {
+            return OdometryAllowedPoses(from, to, pose_of, path_of, odometry_gate_);
         };
     }
     Verify(result, compact, odometry_check);

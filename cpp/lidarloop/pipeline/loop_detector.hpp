@@ -82,16 +82,16 @@ struct LoopCheck {
     /// Rejects the accepted candidates of a query that the knowledge contradicts
     /// (RejectLoopsAgainstOdometry, reason kOdometryMismatch).
     std::function<void(LoopQuery&)> reject;
-    /// Whether `reject` judges the pose of a loop from scan `query` to scan `match` (the odometry
-    /// knows both). Such a candidate is verified with VerificationConfig::CheckedByOdometry():
-    /// the odometry's gate stands in for the points that pin the position along a road. Empty:
-    /// none is.
-    std::function<bool(std::size_t query, std::size_t match)> judges_pose;
+    /// The poses of a loop from scan `query` to scan `match` that `reject` keeps; an empty
+    /// function where it cannot judge them (the odometry does not know both scans). The pair is
+    /// verified with them (registration::Verify's `allowed`): the odometry stands in for the
+    /// points that pin the position along a road. Empty: no pair is judged.
+    std::function<registration::PoseAllowed(std::size_t query, std::size_t match)> allowed_poses;
 
     explicit operator bool() const { return static_cast<bool>(reject); }
     void operator()(LoopQuery& query) const { reject(query); }
-    bool JudgesPose(std::size_t query, std::size_t match) const {
-        return judges_pose && judges_pose(query, match);
+    registration::PoseAllowed AllowedPoses(std::size_t query, std::size_t match) const {
+        return allowed_poses ? allowed_poses(query, match) : registration::PoseAllowed{};
     }
 };
 
@@ -118,11 +118,13 @@ std::size_t RejectLoopsAgainstOdometry(
     LoopQuery& query, const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
     const std::function<double(std::size_t)>& path_m_of, const OdometryGate& gate);
 
-/// Whether the odometry knows the relative pose of scans `query` and `match` and the path
-/// between them (all finite), so that RejectLoopsAgainstOdometry judges a loop between them.
-bool OdometryJudges(std::size_t query, std::size_t match,
-                    const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
-                    const std::function<double(std::size_t)>& path_m_of);
+/// The poses of a loop from scan `query` to scan `match` that `gate` lets pass against the
+/// odometry (as RejectLoopsAgainstOdometry judges them); an empty function when the odometry
+/// does not know both scans' poses and path (finite).
+registration::PoseAllowed OdometryAllowedPoses(
+    std::size_t query, std::size_t match,
+    const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
+    const std::function<double(std::size_t)>& path_m_of, const OdometryGate& gate);
 
 /// The k nearest of the scans 0..count-1 for which `eligible(j)` holds, by (distance, index),
 /// with `distance_of(j)` (called for eligible scans only; +inf and NaN are never candidates):

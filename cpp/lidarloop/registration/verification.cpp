@@ -151,10 +151,11 @@ double AllowedRmse(const PreparedScan& query, const PreparedScan& match,
 
 namespace {
 
-// The first acceptance rule the registered pair breaks (kNone: none).
+// The first acceptance rule the registered pair breaks (kNone: none). `odometry_judges`: the
+// odometry's gate judges the pose, and fewer points need to pin it.
 RejectReason Judge(const PreparedScan& query, const PreparedScan& match,
-                   const Verification& verification, bool converged,
-                   const AcceptanceConfig& config) {
+                   const Verification& verification, bool converged, const AcceptanceConfig& config,
+                   bool odometry_judges) {
     const auto min_points = static_cast<std::size_t>(config.min_overlapping_points);
     const Overlap& overlap = verification.overlap;
     if (!converged) return RejectReason::kNotConverged;
@@ -164,7 +165,9 @@ RejectReason Judge(const PreparedScan& query, const PreparedScan& match,
         return RejectReason::kLowOverlap;
     }
     if (overlap.rmse_m > AllowedRmse(query, match, config)) return RejectReason::kHighRmse;
-    if (overlap.constraining_points < static_cast<std::size_t>(config.min_constraining_points) ||
+    const int min_constraining = odometry_judges ? config.min_constraining_points_with_odometry
+                                                 : config.min_constraining_points;
+    if (overlap.constraining_points < static_cast<std::size_t>(min_constraining) ||
         overlap.shifted_overlap_ratio > config.max_shifted_overlap_ratio) {
         return RejectReason::kDegenerate;
     }
@@ -189,7 +192,8 @@ IcpResult Refine(const PreparedScan& query, const PreparedScan& match,
 
 // ICP from one coarse hypothesis, then the acceptance rule.
 Verification RegisterFrom(const PreparedScan& query, const PreparedScan& match,
-                          const PlanarHypothesis& hypothesis, const VerificationConfig& config) {
+                          const PlanarHypothesis& hypothesis, const VerificationConfig& config,
+                          bool odometry_judges) {
     const IcpResult icp = Refine(query, match, PlanarPose(hypothesis), config);
     Verification result;
     result.T_match_query = icp.T_match_query;
@@ -198,7 +202,8 @@ Verification RegisterFrom(const PreparedScan& query, const PreparedScan& match,
     result.icp_iterations = icp.iterations;
     result.shifted_overlap_ratio = result.overlap.shifted_overlap_ratio;
     result.reason = icp.abandoned ? RejectReason::kLowOverlap
-                                  : Judge(query, match, result, icp.converged, config.acceptance);
+                                  : Judge(query, match, result, icp.converged, config.acceptance,
+                                          odometry_judges);
     result.accepted = result.reason == RejectReason::kNone;
     return result;
 }
@@ -212,14 +217,17 @@ bool SamePose(const core::Transform& a, const core::Transform& b) {
 
 // Whether a pose other than the accepted one also fits: ICP from every other hypothesis, and a
 // rival is a different pose whose overlap reaches max_rival_overlap_ratio of the accepted one
-// within the allowed RMSE. Periodic places (rows of trees, identical corridors) have rivals.
+// within the allowed RMSE. Periodic places (rows of trees, identical corridors) have rivals. A
+// pose that `allowed` (the odometry) rules out is none: it will not be the loop.
 bool HasRivalPose(const PreparedScan& query, const PreparedScan& match,
                   const std::vector<PlanarHypothesis>& hypotheses, std::size_t accepted_index,
-                  const Verification& accepted, const VerificationConfig& config) {
+                  const Verification& accepted, const VerificationConfig& config,
+                  const PoseAllowed& allowed) {
     for (std::size_t j = 0; j < hypotheses.size(); ++j) {
         if (j == accepted_index) continue;
         const IcpResult icp = Refine(query, match, PlanarPose(hypotheses[j]), config);
         if (icp.abandoned || SamePose(icp.T_match_query, accepted.T_match_query)) continue;
+        if (allowed && !allowed(icp.T_match_query)) continue;
         const Overlap overlap = MeasureOverlap(query, match, icp.T_match_query, config.acceptance);
         if (overlap.Min() >= config.acceptance.max_rival_overlap_ratio * accepted.overlap.Min() &&
             overlap.rmse_m <= AllowedRmse(query, match, config.acceptance)) {
@@ -298,7 +306,7 @@ bool OverlapReaches(const PreparedScan& query, const PreparedScan& match,
 }
 
 Verification Verify(const PreparedScan& query, const CoarseQuery& coarse, const PreparedScan& match,
-                    const VerificationConfig& config) {
+                    const VerificationConfig& config, const PoseAllowed& allowed) {
     Verification best;
     if (TooFewPoints(query, config.acceptance) || TooFewPoints(match, config.acceptance)) {
         best.reason = RejectReason::kTooFewPoints;
@@ -317,13 +325,14 @@ Verification Verify(const PreparedScan& query, const CoarseQuery& coarse, const 
     const double min_score = config.coarse.min_hypothesis_score_ratio * hypotheses.front().score;
     for (std::size_t i = 0; i < tried; ++i) {
         if (i > 0 && hypotheses[i].score < min_score) break;  // scores descend
-        Verification trial = RegisterFrom(query, match, hypotheses[i], config);
+        Verification trial =
+            RegisterFrom(query, match, hypotheses[i], config, static_cast<bool>(allowed));
         trial.registered_hypotheses = static_cast<int>(i) + 1;
         if (trial.accepted) {
             if (trial.T_match_query.translation().norm() > config.acceptance.max_loop_distance_m) {
                 trial.accepted = false;
                 trial.reason = RejectReason::kTooFar;
-            } else if (HasRivalPose(query, match, hypotheses, i, trial, config)) {
+            } else if (HasRivalPose(query, match, hypotheses, i, trial, config, allowed)) {
                 trial.accepted = false;
                 trial.reason = RejectReason::kAmbiguous;
             }

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <limits>
 #include <string>
 
@@ -96,12 +97,20 @@ bool OverlapReaches(const PreparedScan& query, const PreparedScan& match,
 double AllowedRmse(const PreparedScan& query, const PreparedScan& match,
                    const AcceptanceConfig& config);
 
+/// Whether another source of the pose, the odometry's gate, allows T_match_query for a loop of
+/// two scans (app::OdometryLoopCheck). Empty where no such source judges the pair.
+using PoseAllowed = std::function<bool(const core::Transform& T_match_query)>;
+
 /// Registers one candidate to its query without a prior pose (coarse search, ICP from each
 /// hypothesis, the best overlap wins) and decides by AcceptanceConfig. `coarse` must be built
 /// from `query` with config.coarse. Never throws on bad data: degenerate input is a rejection
 /// with its reason. Thread-safe.
+/// Given `allowed` (the odometry judges the loop's pose and will reject what it does not allow),
+/// the degeneracy test asks for acceptance.min_constraining_points_with_odometry points instead of
+/// min_constraining_points, and only a rival pose it allows makes the place ambiguous
+/// (docs/verification.md, "The odometry pins the road").
 Verification Verify(const PreparedScan& query, const CoarseQuery& coarse, const PreparedScan& match,
-                    const VerificationConfig& config);
+                    const VerificationConfig& config, const PoseAllowed& allowed = {});
 
 /// The same for two raw scans (sensor frames, metres): prepares both, then verifies. Validates
 /// `config` (core::ConfigError).

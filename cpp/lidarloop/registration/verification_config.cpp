@@ -83,12 +83,6 @@ void AcceptanceConfig::Validate() const {
     RequireIn(max_loop_distance_m, 0.1, 1e4, "acceptance.max_loop_distance_m");
 }
 
-VerificationConfig VerificationConfig::CheckedByOdometry() const {
-    VerificationConfig checked = *this;
-    checked.acceptance.min_constraining_points = acceptance.min_constraining_points_with_odometry;
-    return checked;
-}
-
 void VerificationConfig::Validate() const {
     reduction.Validate();
     coarse.Validate();

@@ -124,10 +124,10 @@ struct AcceptanceConfig {
     /// `max_shifted_overlap_ratio` of them may still lie on a surface; else the geometry does
     /// not pin the position (a straight street, a corridor, an open field).
     int min_constraining_points = 20;
-    /// The same floor where the odometry judges the loop's pose (VerificationConfig::
-    /// CheckedByOdometry): its gate rejects a pose slid to a look-alike place beyond the drift,
-    /// the shifted test one slid by a few metres, and 5 points are the fewest whose shifted
-    /// share tells sliding from breaking (docs/verification.md, "The odometry's word").
+    /// The same floor where the odometry judges the loop's pose (Verify's `allowed`): its gate
+    /// rejects a pose slid to a look-alike place beyond the drift, the shifted test one slid by a
+    /// few metres, and 5 points are the fewest whose shifted share tells sliding from breaking
+    /// (docs/verification.md, "The odometry's word").
     int min_constraining_points_with_odometry = 5;
     double degeneracy_shift_m = 2.0;
     double max_shifted_overlap_ratio = 0.5;
@@ -152,11 +152,6 @@ struct VerificationConfig {
     CoarseConfig coarse;
     IcpConfig icp;
     AcceptanceConfig acceptance;
-
-    /// This configuration where the odometry judges each accepted loop's pose (the gate of
-    /// posegraph.robust): acceptance.min_constraining_points_with_odometry replaces
-    /// acceptance.min_constraining_points.
-    VerificationConfig CheckedByOdometry() const;
 
     void Validate() const;
     bool operator==(const VerificationConfig&) const = default;

@@ -103,11 +103,14 @@ TEST(RejectLoopsAgainstOdometry, RejectsThePoseTheOdometryContradictsAndChoosesA
     std::vector<pipeline::LoopQuery> unjudged{two_loops};
     EXPECT_EQ(app::RejectLoopsAgainstOdometry(unjudged, lost, path_m, {}), 0u);
     EXPECT_EQ(unjudged[0].loop(), 1u);
-    // The check says which loops it judges: those the odometry knows both scans of.
-    EXPECT_TRUE(app::OdometryLoopCheck(odometry, path_m, {}).JudgesPose(99, 40));
-    EXPECT_FALSE(app::OdometryLoopCheck(lost, path_m, {}).JudgesPose(99, 45));
-    EXPECT_FALSE(app::OdometryLoopCheck(lost, path_m, {}).JudgesPose(45, 40));
-    EXPECT_TRUE(app::OdometryLoopCheck(lost, path_m, {}).JudgesPose(99, 40));
+    // The check's allowed poses: those of the gate, where the odometry knows both scans.
+    const pipeline::LoopCheck check = app::OdometryLoopCheck(lost, path_m, {});
+    const registration::PoseAllowed allowed = check.AllowedPoses(99, 40);
+    ASSERT_TRUE(allowed);
+    EXPECT_TRUE(allowed(T_match_query(40, 99)));
+    EXPECT_FALSE(allowed(T_match_query(40, 99) * period_off));
+    EXPECT_FALSE(check.AllowedPoses(99, 45));
+    EXPECT_FALSE(check.AllowedPoses(45, 40));
     odometry.resize(60);
     EXPECT_THROW(app::RejectLoopsAgainstOdometry(consistent, odometry, path_m, {}),
                  core::ConfigError);

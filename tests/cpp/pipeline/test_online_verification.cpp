@@ -423,18 +423,21 @@ TEST(OnlineVerification, PreparedScansMustMatchTheDatabase) {
     EXPECT_THROW(LoopDetector(database, Verifying(), two), core::ConfigError);
 }
 
-// VerifyQuery registers with the odometry's degeneracy floor exactly the candidates whose pose
-// the check judges.
+// VerifyQuery registers with the poses the check allows, and so with the odometry's degeneracy
+// floor, exactly the candidates whose pose the check judges.
 TEST(OdometryFloor, OnlyTheCandidatesWhosePoseTheCheckJudges) {
     DetectorConfig detector = OnlyTheOdometryPins();
     detector.stop_at_first_loop = false;
     const RankedCandidates ranked = MakeRankedCandidates(detector);
     std::vector<std::pair<std::size_t, std::size_t>> asked;
-    const LoopCheck judges_candidate_2{[](LoopQuery& /*unused*/) {},
-                                       [&](std::size_t query, std::size_t match) {
-                                           asked.emplace_back(query, match);
-                                           return match == 2;
-                                       }};
+    const auto any_pose = [](const core::Transform& /*unused*/) { return true; };
+    const LoopCheck judges_candidate_2{
+        [](LoopQuery& /*unused*/) {},
+        [&](std::size_t query, std::size_t match) -> registration::PoseAllowed {
+            asked.emplace_back(query, match);
+            if (match == 2) return any_pose;
+            return {};
+        }};
     const LoopQuery verified = Verified(ranked, detector, judges_candidate_2);
     EXPECT_EQ(verified.verifications[1].reason, registration::RejectReason::kDegenerate);
     EXPECT_TRUE(verified.verifications[2].accepted);

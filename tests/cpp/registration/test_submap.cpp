@@ -204,8 +204,41 @@ TEST(Submap, ARoadPinnedByAFewPointsIsALoopWhereTheOdometryJudgesIt) {
               static_cast<std::size_t>(config.acceptance.min_constraining_points));
     EXPECT_LE(alone.overlap.shifted_overlap_ratio, config.acceptance.max_shifted_overlap_ratio);
 
-    const Verification judged =
-        Verify(query_submap, coarse, match_submap, config.CheckedByOdometry());
+    // The odometry's gate as it would judge here: within 5 m of the true pose.
+    const PoseAllowed near_the_truth = [&truth](const core::Transform& T_match_query) {
+        return (T_match_query.translation() - truth.translation()).norm() < 5.0;
+    };
+    const Verification judged = Verify(query_submap, coarse, match_submap, config, near_the_truth);
+    EXPECT_TRUE(judged.accepted) << ToString(judged.reason);
+    EXPECT_LT((judged.T_match_query.translation() - truth.translation()).norm(), 0.1);
+}
+
+// A rural revisit (scan 135 back to scan 60, 3.9 m apart) whose trees repeat along the road: a
+// second pose 12 m on fits nearly as well, so alone the place is ambiguous. The odometry's gate
+// rules that pose out, and then only the right one is left; a rival it allows still counts.
+TEST(Submap, ARivalPoseTheOdometryRulesOutLeavesTheRightOne) {
+    const sim::Simulator simulator(test::SparseUTurnKeyframes(sim::SceneType::kRural, 10));
+    const std::vector<core::StampedPose> odometry = simulator.OdometryPoses(0, simulator.size());
+    const auto load = [&simulator](std::size_t k) { return simulator.Scan(k); };
+    const std::size_t query = 135, match = 60;
+    const core::Transform truth = simulator.GroundTruthPose(match).T_world_sensor.inverse() *
+                                  simulator.GroundTruthPose(query).T_world_sensor;
+    const VerificationConfig config;
+    const std::vector<double> path_m = SubmapPathM(odometry);
+    const PreparedScan query_submap =
+        PrepareSubmap(query, odometry, path_m, load, config.reduction);
+    const PreparedScan match_submap =
+        PrepareSubmap(match, odometry, path_m, load, config.reduction);
+    const CoarseQuery coarse(*query_submap.structure, config.coarse);
+
+    const PoseAllowed any_pose = [](const core::Transform& /*unused*/) { return true; };
+    const Verification rival_allowed = Verify(query_submap, coarse, match_submap, config, any_pose);
+    EXPECT_EQ(rival_allowed.reason, RejectReason::kAmbiguous) << "pick a pair with a rival";
+
+    const PoseAllowed near_the_truth = [&truth](const core::Transform& T_match_query) {
+        return (T_match_query.translation() - truth.translation()).norm() < 5.0;
+    };
+    const Verification judged = Verify(query_submap, coarse, match_submap, config, near_the_truth);
     EXPECT_TRUE(judged.accepted) << ToString(judged.reason);
     EXPECT_LT((judged.T_match_query.translation() - truth.translation()).norm(), 0.1);
 }
