@@ -21,9 +21,9 @@ struct VerificationTimes {
 };
 
 /// Verifications already computed, by (query, match) scan pair: runs over the same prepared scans
-/// with the same VerificationConfig (e.g. the methods of one evaluation, whose top-k candidates
-/// overlap) register each pair once. Verify is deterministic, so a cached verdict equals a fresh
-/// one. Thread-safe.
+/// with the same VerificationConfig and LoopCheck (e.g. the methods of one evaluation, whose top-k
+/// candidates overlap) register each pair once. Verify is deterministic, so a cached verdict equals
+/// a fresh one. Thread-safe.
 class VerificationCache {
 public:
     std::optional<registration::Verification> Find(std::size_t query, std::size_t match) const;

@@ -127,7 +127,7 @@ struct AcceptanceConfig {
     /// The same floor where the odometry judges the loop's pose (Verify's `allowed`): its gate
     /// rejects a pose slid to a look-alike place beyond the drift, the shifted test one slid by a
     /// few metres, and 5 points are the fewest whose shifted share tells sliding from breaking
-    /// (docs/verification.md, "The odometry's word").
+    /// (docs/verification.md, "The odometry pins the road").
     int min_constraining_points_with_odometry = 5;
     double degeneracy_shift_m = 2.0;
     double max_shifted_overlap_ratio = 0.5;
