@@ -297,6 +297,8 @@ TEST(Verification, InvalidConfigIsAConfigError) {
     expect_error([](auto& c) { c.acceptance.max_rmse_m = -1.0; });
     expect_error([](auto& c) { c.acceptance.overlap_plane_m = 2 * c.acceptance.overlap_radius_m; });
     expect_error([](auto& c) { c.acceptance.max_loop_distance_m = 0.0; });
+    expect_error([](auto& c) { c.acceptance.min_constraining_points = 0; });
+    expect_error([](auto& c) { c.acceptance.min_constraining_points_with_odometry = -1; });
 }
 
 // One place seen from 11.6 m away registers at the right pose, but a loop is a revisit of one
