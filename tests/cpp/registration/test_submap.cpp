@@ -150,97 +150,88 @@ TEST(Submap, ConfigRangesAreValidated) {
 }
 
 // Sparse keyframes in open country (`lidarloop simulate --scene rural --route uturn --seed 3
-// --sensor hdl32 --keep-every 10 --scans 300 --spacing-min-m 1 --spacing-max-m 2`): scan 294
-// revisits scan 87 in the opposite direction, 6.9 m away. One scan of 133 structure points
-// overlaps the other too little to pass (low_overlap: fewer than 80 points on the other's
-// surfaces); merged with the neighbours within 5 m of path, placed by the drifting odometry,
-// the two overlap 0.9 at the true pose (bench/verify_replay, docs/verification.md "Submaps").
+// --sensor hdl32 --keep-every 10 --scans 300 --spacing-min-m 1 --spacing-max-m 2`) and one of its
+// revisits: the query and match scans, the true T_match_query, and both scans as submaps (the
+// neighbours within 5 m of path, placed by the drifting odometry).
+struct SparseRuralRevisit {
+    SparseRuralRevisit(std::size_t query_scan, std::size_t match_scan)
+        : simulator(test::SparseUTurnKeyframes(sim::SceneType::kRural, 10)),
+          query(query_scan),
+          match(match_scan),
+          truth(simulator.GroundTruthPose(match).T_world_sensor.inverse() *
+                simulator.GroundTruthPose(query).T_world_sensor) {
+        const std::vector<core::StampedPose> odometry =
+            simulator.OdometryPoses(0, simulator.size());
+        const std::vector<double> path_m = SubmapPathM(odometry);
+        const auto load = [this](std::size_t k) { return simulator.Scan(k); };
+        query_submap = PrepareSubmap(query, odometry, path_m, load, config.reduction);
+        match_submap = PrepareSubmap(match, odometry, path_m, load, config.reduction);
+    }
+    Verification VerifySubmaps(const PoseAllowed& allowed = {}) const {
+        const CoarseQuery coarse(*query_submap.structure, config.coarse);
+        return Verify(query_submap, coarse, match_submap, config, allowed);
+    }
+    double ErrorM(const Verification& verification) const {
+        return (verification.T_match_query.translation() - truth.translation()).norm();
+    }
+    // The odometry's gate as it would judge here: within 5 m of the true pose.
+    PoseAllowed NearTheTruth() const {
+        return [truth = truth](const core::Transform& T_match_query) {
+            return (T_match_query.translation() - truth.translation()).norm() < 5.0;
+        };
+    }
+
+    const sim::Simulator simulator;
+    const std::size_t query, match;
+    const core::Transform truth;
+    const VerificationConfig config;
+    PreparedScan query_submap, match_submap;
+};
+
+// Scan 294 revisits scan 87 in the opposite direction, 6.9 m away. One scan of 133 structure
+// points overlaps the other too little to pass (low_overlap: fewer than 80 points on the other's
+// surfaces); as submaps the two overlap 0.9 at the true pose (bench/verify_replay,
+// docs/verification.md "Submaps").
 TEST(Submap, SparseRuralRevisitNeedsTheSubmap) {
-    const sim::Simulator simulator(test::SparseUTurnKeyframes(sim::SceneType::kRural, 10));
-    const std::vector<core::StampedPose> odometry = simulator.OdometryPoses(0, simulator.size());
-    const auto load = [&simulator](std::size_t k) { return simulator.Scan(k); };
-    const std::size_t query = 294, match = 87;
-    const core::Transform truth = simulator.GroundTruthPose(match).T_world_sensor.inverse() *
-                                  simulator.GroundTruthPose(query).T_world_sensor;
-
-    VerificationConfig config;
-    const Verification alone = VerifyPair(simulator.Scan(query), simulator.Scan(match), config);
+    const SparseRuralRevisit revisit(294, 87);
+    const Verification alone = VerifyPair(revisit.simulator.Scan(revisit.query),
+                                          revisit.simulator.Scan(revisit.match), revisit.config);
     EXPECT_FALSE(alone.accepted) << "one scan alone now suffices: pick a harder pair";
-
-    const std::vector<double> path_m = SubmapPathM(odometry);
-    const PreparedScan query_submap =
-        PrepareSubmap(query, odometry, path_m, load, config.reduction);
-    const PreparedScan match_submap =
-        PrepareSubmap(match, odometry, path_m, load, config.reduction);
-    const CoarseQuery coarse(*query_submap.structure, config.coarse);
-    const Verification merged = Verify(query_submap, coarse, match_submap, config);
+    const Verification merged = revisit.VerifySubmaps();
     EXPECT_TRUE(merged.accepted) << ToString(merged.reason);
-    EXPECT_LT((merged.T_match_query.translation() - truth.translation()).norm(), 0.3);
+    EXPECT_LT(revisit.ErrorM(merged), 0.3);
 }
 
-// A sparse rural revisit (the same sequence, scan 290 back to scan 84, 8.2 m apart): as submaps
-// the right pose is found, but the road leaves only a handful of points facing along it (5 to
-// 19: fewer than the 20 asked of the geometry alone). Where the odometry judges the pose (its
-// gate rejects a look-alike place farther along the road), 5 suffice, and the loop is accepted
-// at the true pose (docs/verification.md, "The odometry's word").
+// Scan 290 back to scan 84, 8.2 m apart: as submaps the right pose is found, but the road leaves
+// only a handful of points facing along it (5 to 19: fewer than the 20 asked of the geometry
+// alone). Where the odometry judges the pose (its gate rejects a look-alike place farther along
+// the road), 5 suffice, and the loop is accepted at the true pose (docs/verification.md, "The
+// odometry pins the road").
 TEST(Submap, ARoadPinnedByAFewPointsIsALoopWhereTheOdometryJudgesIt) {
-    const sim::Simulator simulator(test::SparseUTurnKeyframes(sim::SceneType::kRural, 10));
-    const std::vector<core::StampedPose> odometry = simulator.OdometryPoses(0, simulator.size());
-    const auto load = [&simulator](std::size_t k) { return simulator.Scan(k); };
-    const std::size_t query = 290, match = 84;
-    const core::Transform truth = simulator.GroundTruthPose(match).T_world_sensor.inverse() *
-                                  simulator.GroundTruthPose(query).T_world_sensor;
-    const VerificationConfig config;
-    const std::vector<double> path_m = SubmapPathM(odometry);
-    const PreparedScan query_submap =
-        PrepareSubmap(query, odometry, path_m, load, config.reduction);
-    const PreparedScan match_submap =
-        PrepareSubmap(match, odometry, path_m, load, config.reduction);
-    const CoarseQuery coarse(*query_submap.structure, config.coarse);
-
-    const Verification alone = Verify(query_submap, coarse, match_submap, config);
+    const SparseRuralRevisit revisit(290, 84);
+    const Verification alone = revisit.VerifySubmaps();
     EXPECT_EQ(alone.reason, RejectReason::kDegenerate) << "pick a pair the floor rejects";
     EXPECT_LT(alone.overlap.constraining_points,
-              static_cast<std::size_t>(config.acceptance.min_constraining_points));
-    EXPECT_LE(alone.overlap.shifted_overlap_ratio, config.acceptance.max_shifted_overlap_ratio);
+              static_cast<std::size_t>(revisit.config.acceptance.min_constraining_points));
+    EXPECT_LE(alone.overlap.shifted_overlap_ratio,
+              revisit.config.acceptance.max_shifted_overlap_ratio);
 
-    // The odometry's gate as it would judge here: within 5 m of the true pose.
-    const PoseAllowed near_the_truth = [&truth](const core::Transform& T_match_query) {
-        return (T_match_query.translation() - truth.translation()).norm() < 5.0;
-    };
-    const Verification judged = Verify(query_submap, coarse, match_submap, config, near_the_truth);
+    const Verification judged = revisit.VerifySubmaps(revisit.NearTheTruth());
     EXPECT_TRUE(judged.accepted) << ToString(judged.reason);
-    EXPECT_LT((judged.T_match_query.translation() - truth.translation()).norm(), 0.1);
+    EXPECT_LT(revisit.ErrorM(judged), 0.1);
 }
 
-// A rural revisit (scan 135 back to scan 60, 3.9 m apart) whose trees repeat along the road: a
-// second pose 12 m on fits nearly as well, so alone the place is ambiguous. The odometry's gate
-// rules that pose out, and then only the right one is left; a rival it allows still counts.
+// Scan 135 back to scan 60, 3.9 m apart, where trees repeat along the road: a second pose 12 m
+// on fits nearly as well, so the place is ambiguous. The odometry's gate rules that pose out, and
+// then only the right one is left; a rival it allows still counts.
 TEST(Submap, ARivalPoseTheOdometryRulesOutLeavesTheRightOne) {
-    const sim::Simulator simulator(test::SparseUTurnKeyframes(sim::SceneType::kRural, 10));
-    const std::vector<core::StampedPose> odometry = simulator.OdometryPoses(0, simulator.size());
-    const auto load = [&simulator](std::size_t k) { return simulator.Scan(k); };
-    const std::size_t query = 135, match = 60;
-    const core::Transform truth = simulator.GroundTruthPose(match).T_world_sensor.inverse() *
-                                  simulator.GroundTruthPose(query).T_world_sensor;
-    const VerificationConfig config;
-    const std::vector<double> path_m = SubmapPathM(odometry);
-    const PreparedScan query_submap =
-        PrepareSubmap(query, odometry, path_m, load, config.reduction);
-    const PreparedScan match_submap =
-        PrepareSubmap(match, odometry, path_m, load, config.reduction);
-    const CoarseQuery coarse(*query_submap.structure, config.coarse);
-
+    const SparseRuralRevisit revisit(135, 60);
     const PoseAllowed any_pose = [](const core::Transform& /*unused*/) { return true; };
-    const Verification rival_allowed = Verify(query_submap, coarse, match_submap, config, any_pose);
-    EXPECT_EQ(rival_allowed.reason, RejectReason::kAmbiguous) << "pick a pair with a rival";
-
-    const PoseAllowed near_the_truth = [&truth](const core::Transform& T_match_query) {
-        return (T_match_query.translation() - truth.translation()).norm() < 5.0;
-    };
-    const Verification judged = Verify(query_submap, coarse, match_submap, config, near_the_truth);
+    EXPECT_EQ(revisit.VerifySubmaps(any_pose).reason, RejectReason::kAmbiguous)
+        << "pick a pair with a rival";
+    const Verification judged = revisit.VerifySubmaps(revisit.NearTheTruth());
     EXPECT_TRUE(judged.accepted) << ToString(judged.reason);
-    EXPECT_LT((judged.T_match_query.translation() - truth.translation()).norm(), 0.1);
+    EXPECT_LT(revisit.ErrorM(judged), 0.1);
 }
 
 }  // namespace
