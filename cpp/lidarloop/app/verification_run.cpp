@@ -194,17 +194,7 @@ pipeline::LoopCheck OdometryLoopCheck(const std::vector<core::StampedPose>& odom
         require_pose(scan);
         return path_m[scan];
     };
-    const pipeline::OdometryGate gate = OdometryGateOf(config);
-    pipeline::LoopCheck check;
-    check.reject = [pose_of, path_of, gate, rejected](pipeline::LoopQuery& query) {
-        const std::size_t count =
-            pipeline::RejectLoopsAgainstOdometry(query, pose_of, path_of, gate);
-        if (rejected != nullptr) *rejected += count;
-    };
-    check.allowed_poses = [pose_of, path_of, gate](std::size_t query, std::size_t match) {
-        return pipeline::OdometryAllowedPoses(query, match, pose_of, path_of, gate);
-    };
-    return check;
+    return pipeline::CheckAgainstOdometry(pose_of, path_of, OdometryGateOf(config), rejected);
 }
 
 std::size_t RejectLoopsAgainstOdometry(std::vector<pipeline::LoopQuery>& queries,

@@ -163,6 +163,22 @@ std::size_t RejectLoopsAgainstOdometry(
     return rejected;
 }
 
+LoopCheck CheckAgainstOdometry(std::function<core::Transform(std::size_t)> T_odom_sensor_of,
+                               std::function<double(std::size_t)> path_m_of, OdometryGate gate,
+                               std::atomic<std::size_t>* rejected) {
+    LoopCheck check;
+    check.reject = [T_odom_sensor_of, path_m_of, gate, rejected](LoopQuery& query) {
+        const std::size_t count =
+            RejectLoopsAgainstOdometry(query, T_odom_sensor_of, path_m_of, gate);
+        if (rejected != nullptr) *rejected += count;
+    };
+    check.allowed_poses = [T_odom_sensor_of, path_m_of, gate](std::size_t query,
+                                                              std::size_t match) {
+        return OdometryAllowedPoses(query, match, T_odom_sensor_of, path_m_of, gate);
+    };
+    return check;
+}
+
 std::vector<Neighbor> NearestCandidates(std::size_t count, std::size_t k,
                                         const std::function<double(std::size_t)>& distance_of,
                                         const std::function<bool(std::size_t)>& eligible) {
@@ -320,14 +336,8 @@ LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_
         session_start_ == 0 ? path_m_ : std::vector<double>{});
     registration::CompactPreparedScan compact(scan);
     LoopCheck odometry_check;
-    if (odometry_gate_ && query_path_m) {
-        odometry_check.reject = [&](LoopQuery& verified) {
-            RejectLoopsAgainstOdometry(verified, pose_of, path_of, odometry_gate_);
-        };
-        odometry_check.allowed_poses = [&](std::size_t from, std::size_t to) {
-            return OdometryAllowedPoses(from, to, pose_of, path_of, odometry_gate_);
-        };
-    }
+    if (odometry_gate_ && query_path_m)
+        odometry_check = CheckAgainstOdometry(pose_of, path_of, odometry_gate_);
     Verify(result, compact, odometry_check);
     database_.Add(descriptor, time_s);
     scans_.push_back(std::move(compact));

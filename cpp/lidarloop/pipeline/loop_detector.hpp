@@ -1,5 +1,6 @@
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <functional>
 #include <limits>
@@ -125,6 +126,13 @@ registration::PoseAllowed OdometryAllowedPoses(
     std::size_t query, std::size_t match,
     const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
     const std::function<double(std::size_t)>& path_m_of, const OdometryGate& gate);
+
+/// The odometry as a LoopCheck: RejectLoopsAgainstOdometry on each verified query, and for each
+/// pair the poses OdometryAllowedPoses lets pass. Adds the rejections to `rejected` when given
+/// (thread-safe). The functions are copied; what they refer to must outlive the check.
+LoopCheck CheckAgainstOdometry(std::function<core::Transform(std::size_t)> T_odom_sensor_of,
+                               std::function<double(std::size_t)> path_m_of, OdometryGate gate,
+                               std::atomic<std::size_t>* rejected = nullptr);
 
 /// The k nearest of the scans 0..count-1 for which `eligible(j)` holds, by (distance, index),
 /// with `distance_of(j)` (called for eligible scans only; +inf and NaN are never candidates):
