@@ -23,8 +23,9 @@ Config = Union[None, Mapping[str, Any], PathLike]
 # `dataset`: a folder (opened with format, poses and calib, as the CLI's DATASET) or a Dataset
 # from open_dataset (then without those).
 Progress = Callable[[str, int, int], Any]
-"""progress(stage, done, total), called from worker threads (with the GIL); if it raises, the
-run's folder is abandoned as failed and the exception raised when the run returns."""
+"""progress(stage, done, total), called from worker threads (with the GIL), one call at a time
+with done rising to total in each stage; if it raises, the run's folder is abandoned as failed
+and the exception raised when the run returns."""
 
 class DetectResult:
     """What `lidarloop detect` found and wrote."""

@@ -6,7 +6,8 @@ import numpy.typing as npt
 
 PathLike = Union[str, os.PathLike]
 Progress = Callable[[str, int, int], Any]
-"""progress(stage, done, total), called from worker threads (with the GIL)."""
+"""progress(stage, done, total), called from worker threads (with the GIL), one call at a time
+with done rising to total."""
 
 class Simulator:
     """A synthetic LiDAR sequence computed on demand (as `lidarloop simulate`). World frame z

@@ -288,7 +288,9 @@ void BindDetect(py::module_& m) {
             "loops.csv, candidates.csv, the similarity matrix and images, database.lldb, "
             "config.yaml, timings.json and run.json into `out` (a results folder: refused inside "
             "the dataset or when it holds other files, unless overwrite=True). None keeps the "
-            "config's value. progress(stage, done, total) is called from worker threads."));
+            "config's value. progress(stage, done, total) is called from worker threads, one call "
+            "at "
+            "a time, with done rising to total in each stage."));
 }
 
 // ---- evaluate ----

@@ -238,7 +238,8 @@ void BindWriteSimulation(py::module_& m) {
         "times.txt, poses_odometry.txt, simulation.yaml), as `lidarloop simulate`, by the "
         "results-folder rule (docs/cli.md): a folder that lidarloop did not write is replaced "
         "only with overwrite=True, an interrupted run leaves the earlier sequence. "
-        "progress(stage, done, total) is called from worker threads.");
+        "progress(stage, done, total) is called from worker threads, one call at a time, with done "
+        "rising to total.");
 }
 
 }  // namespace

@@ -85,10 +85,16 @@ def test_an_opened_dataset_runs_as_its_folder(sequence, tmp_path):
 def test_verified_detect_matches_the_cli(cli_verified, sequence, tmp_path):
     calls = []
     result = lidarloop.detect(sequence, out=tmp_path / "py", method="range", top_k=1,
-                              progress=lambda stage, done, total: calls.append(stage))
+                              progress=lambda *args: calls.append(args))
     assert (tmp_path / "py" / "loops.csv").read_bytes() == \
         (cli_verified / "loops.csv").read_bytes()
-    assert "verifying" in calls
+    stages = {stage: [] for stage, _, _ in calls}
+    for stage, done, total in calls:
+        stages[stage].append((done, total))
+    assert "verifying" in stages
+    for told in stages.values():  # each stage told in rising order, ending with all done
+        assert [done for done, _ in told] == sorted({done for done, _ in told})
+        assert told[-1][0] == told[-1][1]
     from_file = lidarloop.read_loops_csv(cli_verified / "loops.csv", 80)
     assert len(result.accepted_loops) == len(from_file) > 10
     for ours, theirs in zip(result.accepted_loops, from_file):

@@ -48,7 +48,7 @@ def test_write_simulation_matches_the_cli_byte_for_byte(cli, tmp_path):
     summary = lidarloop.write_simulation(lidarloop.Simulator(**SMALL), tmp_path / "python",
                                          progress=lambda *args: calls.append(args))
     assert summary.min_points <= summary.mean_points <= summary.max_points
-    assert calls and calls[-1][1] == calls[-1][2] == 12  # the last call: all 12 done
+    assert calls == [("simulate", done, 12) for done in range(1, 13)]  # in order, one by one
     cli_files = sorted(p.relative_to(tmp_path / "cli") for p in (tmp_path / "cli").rglob("*")
                        if p.is_file())
     python_files = sorted(p.relative_to(tmp_path / "python")

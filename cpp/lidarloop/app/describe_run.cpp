@@ -35,11 +35,7 @@ pipeline::SequenceDescriptors DescribeDataset(const io::Dataset& dataset,
     options.skip_bad = run.skip_bad;
     options.execution = run.execution;
     options.with_cloud = run.with_cloud;
-    if (run.progress) {
-        options.progress = [&run](std::size_t done, std::size_t n) {
-            run.progress(run.stage, done, n);
-        };
-    }
+    options.progress = StageReport(run.progress, run.stage);
     return pipeline::DescribeSequence(SourceOf(dataset), config, options);
 }
 

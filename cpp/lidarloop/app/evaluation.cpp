@@ -1,7 +1,6 @@
 #include "lidarloop/app/evaluation.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -83,7 +82,7 @@ eval::StreamedResult StreamPairs(eval::StreamedPairwise& evaluation, std::size_t
     while (!evaluation.finished()) {
         const std::string stage =
             "pairs (" + name + "), pass " + std::to_string(evaluation.pass()) + " of 2";
-        std::atomic<std::size_t> done{0};
+        pipeline::ProgressCounter done(StageReport(progress, stage), total);
         tbb::enumerable_thread_specific<eval::StreamedPairwise::Sink> sinks(
             [&] { return evaluation.NewSink(); });
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 1),
@@ -95,7 +94,7 @@ eval::StreamedResult StreamPairs(eval::StreamedPairwise& evaluation, std::size_t
                                   StreamBlock(sink, begin, end, n, distance);
                                   const std::size_t pairs =
                                       PairsBeforeRow(end, n) - PairsBeforeRow(begin, n);
-                                  if (progress) progress(stage, done += pairs, total);
+                                  done.Add(pairs);
                               }
                           });
         for (eval::StreamedPairwise::Sink& sink : sinks) evaluation.Merge(sink);

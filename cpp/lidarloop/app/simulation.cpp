@@ -74,7 +74,6 @@ struct ScanStats {
     std::atomic<std::size_t> points{0};
     std::atomic<std::size_t> min_points{std::numeric_limits<std::size_t>::max()};
     std::atomic<std::size_t> max_points{0};
-    std::atomic<std::size_t> done{0};
 
     void Add(std::size_t count) {
         points += count;
@@ -84,13 +83,13 @@ struct ScanStats {
         seen = max_points.load();
         while (count > seen && !max_points.compare_exchange_weak(seen, count)) {
         }
-        ++done;
     }
 };
 
 void WriteScans(const sim::Simulator& simulator, const io::KittiSequenceWriter& writer, int threads,
                 const Progress& progress, ScanStats& stats) {
     tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
+    pipeline::ProgressCounter done(StageReport(progress, "simulate"), simulator.size());
     arena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, simulator.size(), 1),
                           [&](const tbb::blocked_range<std::size_t>& range) {
@@ -98,7 +97,7 @@ void WriteScans(const sim::Simulator& simulator, const io::KittiSequenceWriter& 
                                   const core::PointCloud cloud = simulator.Scan(i);
                                   writer.WriteScan(i, cloud);
                                   stats.Add(cloud.size());
-                                  if (progress) progress("simulate", stats.done, simulator.size());
+                                  done.Add();
                               }
                           });
     });

@@ -116,13 +116,12 @@ void PrepareSubmaps(const io::Dataset& dataset, const std::vector<core::StampedP
     const auto wanted = [&readable](std::size_t i) { return readable.at(i) != 0; };
     const auto total = static_cast<std::size_t>(
         std::count_if(readable.begin(), readable.end(), [](char r) { return r != 0; }));
-    std::atomic<std::size_t> done{0};
+    pipeline::ProgressCounter done(StageReport(progress, "submaps"), total);
     PrepareSubmapsInOrder(poses, reduction, load, wanted,
                           [&](std::size_t i, registration::PreparedScan submap, double seconds) {
                               prepared.scans[i] = registration::CompactPreparedScan(submap);
                               prepared.prepare_seconds[i] += seconds;
-                              const std::size_t finished = ++done;
-                              if (progress) progress("submaps", finished, total);
+                              done.Add();
                           });
 }
 
@@ -160,11 +159,9 @@ pipeline::VerificationTimes VerifyAll(std::vector<pipeline::LoopQuery>& queries,
                                       pipeline::VerificationCache* cache,
                                       const pipeline::LoopCheck& check,
                                       const pipeline::MoreLoopsWanted& more) {
-    std::function<void(std::size_t, std::size_t)> tell;
-    if (progress)
-        tell = [&progress](std::size_t done, std::size_t n) { progress("verifying", done, n); };
     return pipeline::VerifyQueries(queries, prepared.scans, detector, method,
-                                   pipeline::Execution::kParallel, tell, cache, check, more);
+                                   pipeline::Execution::kParallel,
+                                   StageReport(progress, "verifying"), cache, check, more);
 }
 
 pipeline::OdometryGate OdometryGateOf(const posegraph::PoseGraphConfig& config) {

@@ -1,7 +1,6 @@
 #include "lidarloop/pipeline/candidate_verification.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <optional>
 
@@ -188,14 +187,13 @@ void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
 VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
                                 const std::vector<registration::CompactPreparedScan>& scans,
                                 const DetectorConfig& detector, const core::Method& method,
-                                Execution execution,
-                                const std::function<void(std::size_t, std::size_t)>& progress,
+                                Execution execution, const ProgressReport& progress,
                                 VerificationCache* cache, const LoopCheck& check,
                                 const MoreLoopsWanted& more) {
     ExpandedScans expanded;
     const auto scan_of = [&](std::size_t i) { return expanded.Get(scans, i); };
     std::vector<VerificationTimes> per_query(queries.size());
-    std::atomic<std::size_t> done{0};
+    ProgressCounter done(progress, queries.size());
     const auto run = [&](std::size_t i) {
         // Queries run in parallel: stopping at the first loop, each registers its candidates one
         // after another (a batch at once would register some for nothing).
@@ -203,8 +201,7 @@ VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
             detector.stop_at_first_loop ? Execution::kSerial : execution;
         VerifyQuery(queries[i], scan_of(queries[i].query), scan_of, detector, method, &per_query[i],
                     cache, per_query_execution, check, more);
-        const std::size_t finished = ++done;
-        if (progress) progress(finished, queries.size());
+        done.Add();
     };
     if (execution == Execution::kParallel) {
         tbb::parallel_for(std::size_t{0}, queries.size(), run);

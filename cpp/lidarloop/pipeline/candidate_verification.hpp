@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "lidarloop/pipeline/loop_detector.hpp"
+#include "lidarloop/pipeline/progress_counter.hpp"
 #include "lidarloop/registration/compact_prepared_scan.hpp"
 #include "lidarloop/registration/prepared_scan.hpp"
 
@@ -59,12 +60,13 @@ void VerifyQuery(LoopQuery& query, const registration::PreparedScan& query_scan,
 
 /// VerifyQuery for every query that has candidates (in parallel unless told otherwise);
 /// `scans[i]` is scan i prepared, kept compact (each expanded when verified; the pair times
-/// include expanding the candidate). `progress(done, total)` is called from worker threads.
+/// include expanding the candidate). `progress(done, total)` is called from worker threads, one
+/// call at a time with `done` rising.
 VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
                                 const std::vector<registration::CompactPreparedScan>& scans,
                                 const DetectorConfig& detector, const core::Method& method,
                                 Execution execution = Execution::kParallel,
-                                const std::function<void(std::size_t, std::size_t)>& progress = {},
+                                const ProgressReport& progress = {},
                                 VerificationCache* cache = nullptr, const LoopCheck& check = {},
                                 const MoreLoopsWanted& more = {});
 

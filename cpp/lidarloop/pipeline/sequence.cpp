@@ -1,6 +1,5 @@
 #include "lidarloop/pipeline/sequence.hpp"
 
-#include <atomic>
 #include <chrono>
 #include <optional>
 
@@ -64,11 +63,10 @@ SequenceDescriptors DescribeSequence(const ScanSource& source, const core::Descr
                                      const DescribeOptions& options) {
     SequenceDescriptors out{DescriptorDatabase(config), {}, {}, {}};
     std::vector<ScanResult> results(source.count);
-    std::atomic<std::size_t> done{0};
+    ProgressCounter done(options.progress, source.count);
     const auto run = [&](std::size_t i) {
         results[i] = DescribeOne(source, config, i, options);
-        const std::size_t finished = ++done;
-        if (options.progress) options.progress(finished, source.count);
+        done.Add();
     };
     if (options.execution == Execution::kParallel) {
         tbb::parallel_for(std::size_t{0}, source.count, run);

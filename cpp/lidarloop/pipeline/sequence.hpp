@@ -8,6 +8,7 @@
 #include "lidarloop/core/descriptor_config.hpp"
 #include "lidarloop/core/point_cloud.hpp"
 #include "lidarloop/pipeline/descriptor_database.hpp"
+#include "lidarloop/pipeline/progress_counter.hpp"
 #include "lidarloop/pipeline/similarity_matrix.hpp"
 
 namespace lidarloop::pipeline {
@@ -29,8 +30,9 @@ struct DescribeOptions {
     /// true: such scans get a placeholder that matches nothing, and are listed in `skipped`.
     bool skip_bad = false;
     Execution execution = Execution::kParallel;
-    /// Called after each scan with (scans done, total), from any worker thread.
-    std::function<void(std::size_t, std::size_t)> progress;
+    /// Called after each scan with (scans done, total), from any worker thread, one call at a
+    /// time with `done` rising.
+    ProgressReport progress;
     /// Also called with (scan index, cloud) for every scan read and described, from any worker
     /// thread, e.g. to keep what verification needs of it; must not throw.
     std::function<void(std::size_t, const core::PointCloud&)> with_cloud;
