@@ -72,6 +72,7 @@ def detect(
     threshold: Optional[float] = None,
     min_gap: Optional[float] = None,
     min_gap_unit: Optional[str] = None,
+    min_path_m: Optional[float] = None,
     top_k: Optional[int] = None,
     verify: Optional[bool] = None,
     stop_at_first_loop: Optional[bool] = None,
@@ -157,20 +158,20 @@ def evaluate(
     threshold: Optional[float] = None,
     min_gap: Optional[float] = None,
     min_gap_unit: Optional[str] = None,
+    min_path_m: Optional[float] = None,
     top_k: Optional[int] = None,
     verify: Optional[bool] = None,
     stop_at_first_loop: Optional[bool] = None,
     skip_bad: Optional[bool] = None,
     distance_m: Optional[float] = None,
     max_heading_deg: Optional[float] = None,
-    min_path_m: Optional[float] = None,
     train_fraction: Optional[float] = None,
     criterion: Optional[str] = None,
     fixed_thresholds: Optional[Sequence[float]] = None,
 ) -> EvaluateResult:
     """`lidarloop evaluate DATASET --out OUT`: every method (default all) on one ground truth
-    (distance_m default 10 m, max_heading_deg 0: any, the config's min gap, min_path_m 0: no
-    path rule, else pairs must be more than that much path apart too); train_on: learn
+    (distance_m default 10 m, max_heading_deg 0: any, the config's min gap and min_path_m: pairs
+    must be more than that much path apart too, 0: no path rule); train_on: learn
     each method's threshold on that dataset (with poses) instead of the first part; odometry
     (KITTI or TUM, never the ground truth): verification with submaps and the odometry gate,
     as detect's."""
@@ -220,6 +221,7 @@ def optimise(
     threshold: Optional[float] = None,
     min_gap: Optional[float] = None,
     min_gap_unit: Optional[str] = None,
+    min_path_m: Optional[float] = None,
     top_k: Optional[int] = None,
     verify: Optional[bool] = None,
     stop_at_first_loop: Optional[bool] = None,

@@ -67,6 +67,7 @@ class LoopDetector:
         top_k: Optional[int] = None,
         min_gap: Optional[float] = None,
         min_gap_unit: Optional[str] = None,
+        min_path_m: Optional[float] = None,
         threshold: Optional[float] = None,
         verify: Optional[bool] = None,
         stop_at_first_loop: Optional[bool] = None,

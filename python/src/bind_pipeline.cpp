@@ -228,12 +228,14 @@ void BindLoopQuery(py::module_& m) {
 pipeline::DetectorConfig DetectionOf(const io::RunConfig& run, std::optional<int> top_k,
                                      std::optional<double> min_gap,
                                      const std::optional<std::string>& min_gap_unit,
+                                     std::optional<double> min_path_m,
                                      std::optional<double> threshold, std::optional<bool> verify,
                                      std::optional<bool> stop_at_first_loop) {
     pipeline::DetectorConfig detection = run.detection;
     if (top_k) detection.top_k = *top_k;
     if (min_gap) detection.min_gap.value = *min_gap;
     if (min_gap_unit) detection.min_gap.unit = core::ParseMinGapUnit(*min_gap_unit);
+    if (min_path_m) detection.min_path_m = *min_path_m;
     if (threshold) detection.threshold = *threshold;
     if (verify) detection.verify = *verify;
     if (stop_at_first_loop) detection.stop_at_first_loop = *stop_at_first_loop;
@@ -287,22 +289,25 @@ void BindDetector(py::module_& m) {
         .def(py::init([](const py::object& config, const std::optional<std::string>& method,
                          std::optional<int> top_k, std::optional<double> min_gap,
                          const std::optional<std::string>& min_gap_unit,
-                         std::optional<double> threshold, std::optional<bool> verify,
-                         std::optional<bool> stop_at_first_loop) {
+                         std::optional<double> min_path_m, std::optional<double> threshold,
+                         std::optional<bool> verify, std::optional<bool> stop_at_first_loop) {
                  const io::RunConfig run = ResolveRunConfig(config, method);
                  auto detector = std::make_unique<LoopDetector>(
-                     run.descriptor, DetectionOf(run, top_k, min_gap, min_gap_unit, threshold,
-                                                 verify, stop_at_first_loop));
+                     run.descriptor, DetectionOf(run, top_k, min_gap, min_gap_unit, min_path_m,
+                                                 threshold, verify, stop_at_first_loop));
                  detector->SetOdometryGate(app::OdometryGateOf(run.posegraph));
                  return detector;
              }),
              py::arg("config") = py::none(), py::arg("method") = py::none(), py::kw_only(),
              py::arg("top_k") = py::none(), py::arg("min_gap") = py::none(),
-             py::arg("min_gap_unit") = py::none(), py::arg("threshold") = py::none(),
-             py::arg("verify") = py::none(), py::arg("stop_at_first_loop") = py::none(),
+             py::arg("min_gap_unit") = py::none(), py::arg("min_path_m") = py::none(),
+             py::arg("threshold") = py::none(), py::arg("verify") = py::none(),
+             py::arg("stop_at_first_loop") = py::none(),
              "config: None, dict or YAML path (descriptor, `detection` and `posegraph` keys); "
              "method; top_k, min_gap (in the config's unit, scans by default), min_gap_unit "
-             "('scans', 'seconds', 'metres': needs the odometry), threshold, verify, "
+             "('scans', 'seconds', 'metres': needs the odometry), min_path_m (default 50: and "
+             "more than this much path back when process is given the odometry; 0: off), "
+             "threshold, verify, "
              "stop_at_first_loop (default True: register the candidates in rank order up to "
              "the first loop; False: every candidate) override detection.*. Loops the odometry "
              "contradicts (process's odometry) are rejected by the pose graph's gate "

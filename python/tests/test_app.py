@@ -130,9 +130,9 @@ def test_evaluate_matches_the_cli(cli, sequence, tmp_path):
     assert range_eval.pairwise.best_mcc.threshold == pytest.approx(cli_range["tau_best_mcc"])
     assert range_eval.pairwise.roc_auc == pytest.approx(cli_range["roc_auc"])
     assert range_eval.per_scan.zero_error.recall == pytest.approx(cli_range["recall_at_zero_fp"])
-    assert range_eval.retrieval.recall_at_1 == pytest.approx(0.625)  # the CLI printed 62.5 %
+    assert range_eval.retrieval.recall_at_1 == pytest.approx(0.59375)  # the CLI printed 59.375 %
     assert range_eval.retrieval_verified is None
-    assert result.truth.overlapping_count == 55
+    assert result.truth.overlapping_count == 53  # as printed, with the default 50 m path rule
     for name in ("metrics.json", "roc.csv", "pr.csv", "report.md", "config.yaml"):
         assert (tmp_path / "py" / name).is_file(), name
 

@@ -428,7 +428,7 @@ eval::GroundTruthConfig GroundTruthRule(const EvaluationRequest& request) {
     rule.distance_m = request.distance_m;
     rule.max_heading_deg = request.max_heading_deg;
     rule.min_gap = request.config.detection.min_gap;
-    rule.min_path_m = request.min_path_m;
+    rule.min_path_m = request.config.detection.min_path_m;  // the detector's own rule
     rule.Validate();
     return rule;
 }

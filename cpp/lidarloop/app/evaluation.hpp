@@ -99,14 +99,13 @@ pipeline::SimilarityMatrix MatrixOfResults(const std::filesystem::path& file, st
 
 /// What `lidarloop evaluate` (and `lidarloop demo`) asks for.
 struct EvaluationRequest {
-    io::RunConfig config;  ///< descriptors, and detection.min_gap as the evaluation's gap S
+    /// Descriptors, and detection.min_gap (S) and min_path_m as the evaluation's rule of which
+    /// pairs may be revisits (eval::GroundTruthConfig), the rule the detector's candidates obey.
+    io::RunConfig config;
     std::vector<core::Method> methods;
     std::vector<std::string> results_files;  ///< other detectors' query,match,distance CSVs
     double distance_m = 10.0;                ///< same place when closer (Röhling d, Magnusson t_r)
     double max_heading_deg = 0.0;            ///< and headings closer than this; 0: any
-    /// Pairs not more than this much path apart (on the poses), metres, are not evaluated,
-    /// besides the gap; 0: no path rule (eval::GroundTruthConfig::min_path_m).
-    double min_path_m = 0.0;
     eval::ThresholdLearningConfig learning;
     std::vector<double> fixed_thresholds;  ///< MCC at each, as Röhling's table II
     bool skip_bad = false;

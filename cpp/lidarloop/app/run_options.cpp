@@ -71,6 +71,14 @@ std::vector<RunOption> MakeRunOptions() {
              t.config->detection.min_gap.unit = core::ParseMinGapUnit(AsName(v));
          },
          [] { return Code(core::ToString(io::RunConfig{}.detection.min_gap.unit)); }},
+        {"min_path_m", "--min-path", "M", T::kNumber,
+         "and more than this much path back (metres, on the odometry or the poses, where known; "
+         "evaluate: closer pairs are no revisits); 0: no path rule",
+         "detection.min_path_m", kDetecting,
+         [](const RunTargets& t, const RunOptionValue& v) {
+             t.config->detection.min_path_m = AsNumber(v);
+         },
+         [] { return Number(io::RunConfig{}.detection.min_path_m); }},
         {"top_k", "--top-k", "K", T::kInt, "candidates per query scan, each verified",
          "detection.top_k", kDetecting,
          [](const RunTargets& t, const RunOptionValue& v) {
@@ -121,14 +129,6 @@ std::vector<RunOption> MakeRunOptions() {
              Evaluation(t).max_heading_deg = AsNumber(v);
          },
          [] { return Number(EvaluationRequest{}.max_heading_deg); }},
-        {"min_path_m", "--min-path", "M", T::kNumber,
-         "pairs not more than this much path apart (metres on the poses) are not evaluated, "
-         "besides the gap (0: no path rule; SLAM revisits: 50)",
-         "the ground truth", kEvaluate,
-         [](const RunTargets& t, const RunOptionValue& v) {
-             Evaluation(t).min_path_m = AsNumber(v);
-         },
-         [] { return Number(EvaluationRequest{}.min_path_m); }},
         {"train_fraction", "--train-fraction", "F", T::kNumber,
          "share of the sequence a threshold is learnt on", "threshold learning", kEvaluate,
          [](const RunTargets& t, const RunOptionValue& v) {

@@ -102,6 +102,8 @@ void VisitFields(pipeline::DetectorConfig& c, Visitor& v) {
     v.Field("min_gap", c.min_gap.value, "S: candidates are at least this far back (Magnusson)");
     v.Field("min_gap_unit", c.min_gap.unit,
             "unit of min_gap: scans | seconds | metres (of path travelled)");
+    v.Field("min_path_m", c.min_path_m,
+            "and more than this much path back (metres), where the odometry or poses give it");
     v.Field("top_k", c.top_k, "candidates reported per query scan");
     v.Field("threshold", c.threshold, ThresholdHelp());
     v.Field("verify", c.verify,

@@ -53,6 +53,10 @@ double CheckOfflineDetection(const DetectorConfig& detector, const core::Method&
         throw core::ConfigError("offline detection: " + std::to_string(times_s.size()) +
                                 " times for " + std::to_string(scans) + " scans");
     }
+    if (!path_m.empty() && path_m.size() != scans) {
+        throw core::ConfigError("offline detection: " + std::to_string(path_m.size()) +
+                                " path lengths for " + std::to_string(scans) + " scans");
+    }
     if (detector.min_gap.unit == core::MinGap::Unit::kMetres && path_m.size() != scans) {
         throw core::ConfigError(
             "detection.min_gap_unit is metres, which needs the path length "
@@ -67,13 +71,14 @@ using Filter = std::function<bool(std::size_t)>;
 // holds (rounded to float).
 using CandidateSearch = std::function<std::vector<Neighbor>(std::size_t count, const Filter&)>;
 
-// Scan i's candidates among the scans j < i outside the gap, as LoopDetector::Process gives them
-// online.
+// Scan i's candidates among the scans j < i outside the gap (and the path rule, when `path_m` is
+// known), as LoopDetector::Process gives them online.
 LoopQuery DetectOne(std::size_t i, const CandidateSearch& search, const std::vector<double>& along,
-                    const DetectorConfig& detector, const DescriptorMethod& method,
-                    double threshold) {
+                    const std::vector<double>& path_m, const DetectorConfig& detector,
+                    const DescriptorMethod& method, double threshold) {
     const auto eligible = [&](std::size_t j) {
-        return j < i && detector.min_gap.Allows(i, j, along[i], along[j]);
+        return j < i && detector.min_gap.Allows(i, j, along[i], along[j]) &&
+               (path_m.empty() || detector.PathAllows(path_m[i], path_m[j]));
     };
     LoopQuery result;
     result.query = i;
@@ -108,6 +113,10 @@ std::optional<std::vector<Neighbor>> RankedAsTheMatrix(std::vector<Neighbor> fou
 
 void DetectorConfig::Validate() const {
     min_gap.Validate("detection.min_gap");
+    if (!(std::isfinite(min_path_m) && min_path_m >= 0.0)) {
+        throw core::ConfigError("detection.min_path_m must be a finite number >= 0, got " +
+                                std::to_string(min_path_m));
+    }
     if (threshold && !(std::isfinite(*threshold) && *threshold >= 0.0)) {
         throw core::ConfigError("detection.threshold must be a finite number >= 0, got " +
                                 std::to_string(*threshold));
@@ -329,6 +338,7 @@ LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_
         [&](std::size_t j) {
             if (j >= query_index || !database_.IsValid(j)) return false;
             // A map's scan belongs to another session: no path separates it from this one.
+            if (query_path_m && !detector_.PathAllows(*query_path_m, path_of(j))) return false;
             if (in_metres)
                 return j < session_start_ || gap.Allows(query_index, j, *query_path_m, path_of(j));
             return gap.Allows(query_index, j, time_s, times_s[j]);
@@ -402,7 +412,7 @@ std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,
             [&](std::size_t count, const Filter& filter) {
                 return NearestCandidates(i, count, distance_of, filter);
             },
-            along, detector, MethodOf(method), threshold);
+            along, path_m, detector, MethodOf(method), threshold);
     }
     return results;
 }
@@ -445,7 +455,8 @@ std::vector<LoopQuery> DetectStreaming(const DescriptorDatabase& database,
                 return NearestCandidates(
                     i, count, [&](std::size_t j) { return double{row[j]}; }, filter);
             };
-            results[i] = DetectOne(i, search, along, detector, database.definition(), threshold);
+            results[i] =
+                DetectOne(i, search, along, path_m, detector, database.definition(), threshold);
         }
     };
     const tbb::blocked_range<std::size_t> all(0, n);

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <atomic>
+#include <cmath>
 #include <cstddef>
 #include <functional>
 #include <limits>
@@ -23,6 +24,11 @@ namespace lidarloop::pipeline {
 struct DetectorConfig {
     /// S: a scan's candidates are the scans at least this far back (Magnusson II-E).
     core::MinGap min_gap;
+    /// And more than this much path back, metres, wherever the path is known (the odometry, else
+    /// the poses): a loop worth having removes the drift of a long path, and on a slow platform
+    /// the gap alone lets the recent past crowd out the revisits (docs/verification.md). 0: no
+    /// path rule. Evaluation counts revisits by the same rule.
+    double min_path_m = 50.0;
     /// Candidates reported (and verified) per query, nearest first; 1..1000. 10: on the demo
     /// sequence range has a true loop among its top 5 for 89 % of the revisiting scans and its
     /// top 10 for 96 % (docs/verification.md); on real data 85 % at 10 (issue 14).
@@ -45,6 +51,11 @@ struct DetectorConfig {
     bool stop_at_first_loop = true;
     registration::VerificationConfig verification;  ///< YAML section `verification`
 
+    /// The path rule: false when both paths (metres, core::CumulativePathM) are known and lie
+    /// not more than min_path_m apart; true when either is unknown (NaN).
+    bool PathAllows(double path_i_m, double path_j_m) const {
+        return min_path_m <= 0.0 || !(std::abs(path_i_m - path_j_m) <= min_path_m);
+    }
     /// `threshold` when set, else the default of `method`.
     double ThresholdFor(const core::Method& method) const {
         return threshold ? *threshold : DefaultThreshold(method);

@@ -148,9 +148,10 @@ TEST_F(DetectionRun, EqualsThePipelineOnTheSameDescriptors) {
         const auto described =
             pipeline::DescribeSequence(app::SourceOf(*dataset_), request.config.descriptor);
         const double threshold = request.config.detection.ThresholdFor(method);
+        // detect measures the path rule on the dataset's poses.
         const auto expected = pipeline::DetectFromMatrix(
             pipeline::ComputeSimilarityMatrix(described.database), described.database.times_s(),
-            request.config.detection, method);
+            request.config.detection, method, core::CumulativePathM(dataset_->poses()));
         ASSERT_EQ(outcome.queries.size(), expected.size());
         std::size_t with_match = 0;
         for (std::size_t i = 0; i < expected.size(); ++i) {

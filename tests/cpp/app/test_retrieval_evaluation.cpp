@@ -173,16 +173,32 @@ TEST(RetrievalEvaluation, MinPathCountsOnlyRevisitsFarBackInPath) {
     }
     ASSERT_FALSE(longest_back_m.empty());
     std::sort(longest_back_m.begin(), longest_back_m.end());
-    request.min_path_m = longest_back_m[longest_back_m.size() / 2];
+    request.config.detection.min_path_m = longest_back_m[longest_back_m.size() / 2];
     request.out = dir / "evaluation";
     const app::EvaluationOutcome evaluated = app::RunEvaluation(dataset, request);
     const app::RetrievalComparison& r = *evaluated.methods.at(0).retrieval;
-    const Recount expected = RecountWithPath(dataset, r.queries, request.min_path_m);
+    const Recount expected =
+        RecountWithPath(dataset, r.queries, request.config.detection.min_path_m);
     ExpectSame(expected, r.descriptor, dataset.size());
-    // The rule must bite: without it more scans revisit, and some loops are to the recent past.
-    const Recount without = RecountWithPath(dataset, r.queries, 0.0);
-    EXPECT_GT(without.revisiting, expected.revisiting);
-    EXPECT_GT(without.true_loops, expected.true_loops);
+    // The candidates obey the rule, which bites: without it more scans revisit, and some
+    // candidates are to the recent past.
+    const double min_path_m = request.config.detection.min_path_m;
+    const auto path_back = [&](const pipeline::LoopQuery& q, const pipeline::Neighbor& c) {
+        return test::BrutePathM(dataset.poses(), q.query, c.index);
+    };
+    for (const pipeline::LoopQuery& q : r.queries) {
+        for (const auto& c : q.candidates) EXPECT_GT(path_back(q, c), min_path_m);
+    }
+    EXPECT_GT(RecountWithPath(dataset, r.queries, 0.0).revisiting, expected.revisiting);
+    request.config.detection.min_path_m = 0.0;
+    request.out = dir / "no_path_rule";
+    const app::EvaluationOutcome no_rule = app::RunEvaluation(dataset, request);
+    std::size_t recent = 0;
+    for (const pipeline::LoopQuery& q : no_rule.methods.at(0).retrieval->queries) {
+        for (const auto& c : q.candidates) recent += path_back(q, c) > min_path_m ? 0 : 1;
+    }
+    EXPECT_GT(recent, 0u);
+    request.config.detection.min_path_m = min_path_m;
     EXPECT_GT(expected.revisiting, 0u);
     EXPECT_EQ(evaluated.truth.OverlappingCount(), [&] {
         std::size_t overlapping = 0;  // either direction, outside the gap
@@ -191,7 +207,7 @@ TEST(RetrievalEvaluation, MinPathCountsOnlyRevisitsFarBackInPath) {
             for (std::size_t j = 0; j < dataset.size() && !any; ++j) {
                 const std::size_t apart = i > j ? i - j : j - i;
                 any = apart > kGapScans && SamePlace(dataset, i, j) &&
-                      test::BrutePathM(dataset.poses(), i, j) > request.min_path_m;
+                      test::BrutePathM(dataset.poses(), i, j) > request.config.detection.min_path_m;
             }
             overlapping += any ? 1 : 0;
         }

@@ -134,7 +134,8 @@ protected:
     void SetUp() override { dataset_.emplace(test::SmallSequence(dir_ / "sequence")); }
     io::RunConfig RingsConfig() const {
         io::RunConfig config;
-        io::ApplyConfigYaml("method: rings\ndetection:\n  min_gap: 10\n", "rings.yaml", config);
+        io::ApplyConfigYaml("method: rings\ndetection:\n  min_gap: 10\n  min_path_m: 0\n",
+                            "rings.yaml", config);
         // The method interface is under test, not registration (slow under the sanitizers).
         config.detection.verify = false;
         return config;

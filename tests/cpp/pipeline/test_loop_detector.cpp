@@ -376,6 +376,7 @@ TEST(LoopDetector, AGapInMetresKeepsTheRecentPastOutOfTheCandidates) {
     const SimilarityMatrix matrix = ComputeSimilarityMatrix(database);
     DetectorConfig detector = Deciding(DetectorConfig{}, 0.01);
     detector.top_k = 5;
+    detector.min_path_m = 0.0;  // the gap alone
     // 30 scans back is only 1.5 m of path: the candidates are the recent past.
     detector.min_gap = {30.0, core::MinGap::Unit::kScans};
     const LoopQuery scans =
@@ -394,6 +395,48 @@ TEST(LoopDetector, AGapInMetresKeepsTheRecentPastOutOfTheCandidates) {
     }
     ExpectIdenticalQueries(DetectStreaming(database, detector, Execution::kParallel, path_m),
                            metres);
+}
+
+// The default: 30 scans and, where the path is known, more than 50 m of it. Without the path
+// the gap alone decides.
+TEST(LoopDetector, ThePathRuleKeepsTheRecentPastOutBesideAGapInScans) {
+    std::vector<double> path_m;
+    const std::vector<core::Descriptor> scans = SlowPlatformScans(path_m);
+    DescriptorDatabase database(HeightConfig(40));
+    for (const core::Descriptor& scan : scans)
+        database.Add(scan, 0.1 * static_cast<double>(database.size()));
+    const SimilarityMatrix matrix = ComputeSimilarityMatrix(database);
+    DetectorConfig detector = Deciding(DetectorConfig{}, 0.01);
+    detector.top_k = 5;
+    ASSERT_EQ(detector.min_gap, (core::MinGap{30.0, core::MinGap::Unit::kScans}));
+    ASSERT_EQ(detector.min_path_m, 50.0);
+    const std::vector<LoopQuery> with_path =
+        DetectFromMatrix(matrix, database.times_s(), detector, core::Method::kHeight, path_m);
+    ASSERT_EQ(with_path.back().candidates.size(), 5u);
+    EXPECT_EQ(with_path.back().candidates.front().index, 5u);
+    std::size_t queries_with_candidates = 0;
+    for (const LoopQuery& q : with_path) {
+        queries_with_candidates += q.has_match() ? 1 : 0;
+        for (const Neighbor& n : q.candidates) {
+            EXPECT_GT(path_m[q.query] - path_m[n.index], 50.0);
+            EXPECT_GT(q.query - n.index, 30u);
+        }
+    }
+    EXPECT_GT(queries_with_candidates, 0u);
+    ExpectIdenticalQueries(DetectStreaming(database, detector, Execution::kParallel, path_m),
+                           with_path);
+    const LoopQuery without_path =
+        DetectFromMatrix(matrix, database.times_s(), detector, core::Method::kHeight).back();
+    ASSERT_FALSE(without_path.candidates.empty());
+    EXPECT_LT(path_m[120] - path_m[without_path.candidates.front().index], 5.0);
+    // Online, the odometry gives the path: the same candidates.
+    LoopDetector online(HeightConfig(40), detector);
+    for (std::size_t i = 0; i < database.size(); ++i) {
+        core::Transform T_odom_sensor = core::Transform::Identity();
+        T_odom_sensor.translation().x() = path_m[i];
+        ExpectSameQueries(online.Process(scans[i], database.times_s()[i], {}, T_odom_sensor),
+                          with_path[i]);
+    }
 }
 
 TEST(LoopDetector, AGapInMetresNeedsThePath) {
@@ -421,6 +464,7 @@ TEST(LoopDetector, OnlineWithOdometryEqualsOfflineWithTheGapInMetres) {
     DetectorConfig detector = Deciding(DetectorConfig{}, 0.01);
     detector.top_k = 5;
     detector.min_gap = {20.0, core::MinGap::Unit::kMetres};
+    detector.min_path_m = 0.0;  // the gap alone
     const std::vector<LoopQuery> offline =
         DetectFromMatrix(ComputeSimilarityMatrix(database), database.times_s(), detector,
                          core::Method::kHeight, path_m);
@@ -449,6 +493,7 @@ TEST(LoopDetector, AMapsScansAreCandidatesOfASessionWithOdometry) {
     DetectorConfig detector = Deciding(DetectorConfig{}, 0.01);
     detector.top_k = 5;
     detector.min_gap = {20.0, core::MinGap::Unit::kMetres};
+    detector.min_path_m = 0.0;  // the gap alone
     LoopDetector session(map, detector);
     LoopQuery last;
     for (std::size_t i = kMapScans; i < scans.size(); ++i) {
@@ -476,6 +521,10 @@ TEST(LoopDetector, RejectsBadConfigAndMixedMethods) {
     for (double bad : {-0.1, std::nan(""), HUGE_VAL}) {
         EXPECT_THROW(LoopDetector(HeightConfig(10), Deciding(DetectorConfig{}, bad)),
                      core::ConfigError)
+            << bad;
+        DetectorConfig path_rule;
+        path_rule.min_path_m = bad;
+        EXPECT_THROW(LoopDetector(HeightConfig(10), Deciding(path_rule, 0.01)), core::ConfigError)
             << bad;
     }
     LoopDetector ok(HeightConfig(10), Deciding(DetectorConfig{}, 0.01));
