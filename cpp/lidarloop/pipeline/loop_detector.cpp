@@ -337,7 +337,7 @@ LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_
         *query, query_index,
         [&](std::size_t j) {
             if (j >= query_index || !database_.IsValid(j)) return false;
-            // A map's scan belongs to another session: no path separates it from this one.
+            // A map's scan (path NaN) belongs to another session: no path separates it from this.
             if (query_path_m && !detector_.PathAllows(*query_path_m, path_of(j))) return false;
             if (in_metres)
                 return j < session_start_ || gap.Allows(query_index, j, *query_path_m, path_of(j));

@@ -26,8 +26,8 @@ struct DetectorConfig {
     core::MinGap min_gap;
     /// And more than this much path back, metres, wherever the path is known (the odometry, else
     /// the poses): a loop worth having removes the drift of a long path, and on a slow platform
-    /// the gap alone lets the recent past crowd out the revisits (docs/verification.md). 0: no
-    /// path rule. Evaluation counts revisits by the same rule.
+    /// the gap alone lets the recent past crowd out the revisits (docs/cli.md, "Run options"). 0:
+    /// no path rule. Evaluation counts revisits by the same rule.
     double min_path_m = 50.0;
     /// Candidates reported (and verified) per query, nearest first; 1..1000. 10: on the demo
     /// sequence range has a true loop among its top 5 for 89 % of the revisiting scans and its

@@ -362,12 +362,17 @@ std::vector<core::Descriptor> SlowPlatformScans(std::vector<double>& path_m) {
     return scans;
 }
 
-// SlowPlatformScans stored, scan i at 0.1 i seconds.
-DescriptorDatabase SlowPlatform(std::vector<double>& path_m) {
+// `scans` stored, scan i at 0.1 i seconds.
+DescriptorDatabase StoredAtTenHertz(const std::vector<core::Descriptor>& scans) {
     DescriptorDatabase database(HeightConfig(40));
-    for (const core::Descriptor& scan : SlowPlatformScans(path_m))
+    for (const core::Descriptor& scan : scans)
         database.Add(scan, 0.1 * static_cast<double>(database.size()));
     return database;
+}
+
+// SlowPlatformScans stored, scan i at 0.1 i seconds.
+DescriptorDatabase SlowPlatform(std::vector<double>& path_m) {
+    return StoredAtTenHertz(SlowPlatformScans(path_m));
 }
 
 TEST(LoopDetector, AGapInMetresKeepsTheRecentPastOutOfTheCandidates) {
@@ -402,9 +407,7 @@ TEST(LoopDetector, AGapInMetresKeepsTheRecentPastOutOfTheCandidates) {
 TEST(LoopDetector, ThePathRuleKeepsTheRecentPastOutBesideAGapInScans) {
     std::vector<double> path_m;
     const std::vector<core::Descriptor> scans = SlowPlatformScans(path_m);
-    DescriptorDatabase database(HeightConfig(40));
-    for (const core::Descriptor& scan : scans)
-        database.Add(scan, 0.1 * static_cast<double>(database.size()));
+    const DescriptorDatabase database = StoredAtTenHertz(scans);
     const SimilarityMatrix matrix = ComputeSimilarityMatrix(database);
     DetectorConfig detector = Deciding(DetectorConfig{}, 0.01);
     detector.top_k = 5;
@@ -458,9 +461,7 @@ TEST(LoopDetector, AGapInMetresNeedsThePath) {
 TEST(LoopDetector, OnlineWithOdometryEqualsOfflineWithTheGapInMetres) {
     std::vector<double> path_m;
     const std::vector<core::Descriptor> scans = SlowPlatformScans(path_m);
-    DescriptorDatabase database(HeightConfig(40));
-    for (const core::Descriptor& scan : scans)
-        database.Add(scan, 0.1 * static_cast<double>(database.size()));
+    const DescriptorDatabase database = StoredAtTenHertz(scans);
     DetectorConfig detector = Deciding(DetectorConfig{}, 0.01);
     detector.top_k = 5;
     detector.min_gap = {20.0, core::MinGap::Unit::kMetres};
