@@ -1,5 +1,6 @@
 #include "lidarloop/registration/submap.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -232,6 +233,23 @@ TEST(Submap, ARivalPoseTheOdometryRulesOutLeavesTheRightOne) {
     const Verification judged = revisit.VerifySubmaps(revisit.NearTheTruth());
     EXPECT_TRUE(judged.accepted) << ToString(judged.reason);
     EXPECT_LT(revisit.ErrorM(judged), 0.1);
+}
+
+// Scan 292 back to scan 82, one scan each (no odometry): the right pose overlaps well (0.62 and
+// 0.79) but with fewer than 80 points each way, the floor before 2026-11-28. 60 points each way
+// pass (docs/BENCHMARK.md, "The overlap floor").
+TEST(Submap, SixtyOverlappingPointsPinASparseRuralLoop) {
+    const SparseRuralRevisit revisit(292, 82);
+    const core::PointCloud query = revisit.simulator.Scan(revisit.query);
+    const core::PointCloud match = revisit.simulator.Scan(revisit.match);
+    const Verification alone = VerifyPair(query, match, revisit.config);
+    ASSERT_TRUE(alone.accepted) << ToString(alone.reason);
+    EXPECT_LT(revisit.ErrorM(alone), 0.1);
+    EXPECT_LT(std::min(alone.overlap.query_overlapping, alone.overlap.match_overlapping), 80u)
+        << "pick a pair the old floor rejects";
+    VerificationConfig old_floor = revisit.config;
+    old_floor.acceptance.min_overlapping_points = 80;
+    EXPECT_EQ(VerifyPair(query, match, old_floor).reason, RejectReason::kLowOverlap);
 }
 
 }  // namespace
