@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <string>
 #include <string_view>
@@ -40,6 +41,13 @@ struct MinGap {
     void Validate(const std::string& field) const;
     bool operator==(const MinGap&) const = default;
 };
+
+/// The path rule beside the gap (detection.min_path_m): true when two scans lie more than
+/// `min_path_m` of path apart (`path_i_m`, `path_j_m`: CumulativePathM), when `min_path_m` is 0
+/// (no rule), or when either path is unknown (NaN). Detection and evaluation share it.
+inline bool PathAllows(double min_path_m, double path_i_m, double path_j_m) {
+    return min_path_m <= 0.0 || !(std::abs(path_i_m - path_j_m) <= min_path_m);
+}
 
 std::string ToString(MinGap::Unit unit);
 /// Parses "scans" / "seconds" / "metres"; throws ConfigError listing the valid names.

@@ -96,8 +96,9 @@ struct GroundTruth {
     /// True when scans i and j are far enough apart in the sequence to be evaluated: outside
     /// the gap, and more than min_path_m of path apart when that rule is on.
     bool Comparable(std::size_t i, std::size_t j) const {
-        return OutsideGap(i, j) &&
-               (config.min_path_m <= 0.0 || std::abs(path_m[i] - path_m[j]) > config.min_path_m);
+        // path_m is read only with the rule on (a hand-built truth may have no path).
+        return OutsideGap(i, j) && (config.min_path_m <= 0.0 ||
+                                    core::PathAllows(config.min_path_m, path_m[i], path_m[j]));
     }
     /// The rules besides the distance: Comparable, and headings closer than max_heading_deg
     /// when the heading rule is on.

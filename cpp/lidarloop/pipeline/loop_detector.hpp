@@ -1,7 +1,6 @@
 #pragma once
 
 #include <atomic>
-#include <cmath>
 #include <cstddef>
 #include <functional>
 #include <limits>
@@ -51,10 +50,10 @@ struct DetectorConfig {
     bool stop_at_first_loop = true;
     registration::VerificationConfig verification;  ///< YAML section `verification`
 
-    /// The path rule: false when both paths (metres, core::CumulativePathM) are known and lie
-    /// not more than min_path_m apart; true when either is unknown (NaN).
+    /// core::PathAllows with min_path_m: false when both paths (metres) are known and lie not
+    /// more than min_path_m apart; true when either is unknown (NaN).
     bool PathAllows(double path_i_m, double path_j_m) const {
-        return min_path_m <= 0.0 || !(std::abs(path_i_m - path_j_m) <= min_path_m);
+        return core::PathAllows(min_path_m, path_i_m, path_j_m);
     }
     /// `threshold` when set, else the default of `method`.
     double ThresholdFor(const core::Method& method) const {
