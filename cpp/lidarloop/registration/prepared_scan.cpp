@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "lidarloop/core/voxel_grid.hpp"
+#include "lidarloop/registration/neighbor_grid.hpp"
 
 namespace lidarloop::registration {
 namespace {
@@ -56,10 +57,10 @@ Eigen::Vector3f NormalAt(const std::vector<Eigen::Vector3f>& points,
 }
 
 // Whether `point` lies on a large plane: the surface variation of its k nearest centroids.
-bool OnLargePlane(const std::vector<Eigen::Vector3f>& centroids, const PointTree& tree,
+bool OnLargePlane(const std::vector<Eigen::Vector3f>& centroids, const NeighborGrid& grid,
                   const Eigen::Vector3f& point, const ScanReductionConfig& config,
-                  std::vector<std::uint32_t>& neighbors) {
-    tree.Knn(point, config.distinctive_neighbors, neighbors);
+                  NeighborGrid::Scratch& scratch, std::vector<std::uint32_t>& neighbors) {
+    grid.Knn(point, config.distinctive_neighbors, scratch, neighbors);
     if (neighbors.size() < 5) return false;
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
     for (const auto index : neighbors) mean += centroids[index].cast<double>();
@@ -159,25 +160,31 @@ PreparedScan PrepareScan(const core::PointCloud& scan, const ScanReductionConfig
     PreparedScan prepared;
     prepared.input_points = scan.size();
     const auto centroids = VoxelCentroids(scan, config, prepared.usable_points);
-    const PointTree tree(&centroids);
+    const NeighborGrid grid(centroids, static_cast<float>(config.voxel_m));
+    NeighborGrid::Scratch scratch;
     const float max_vertical_z =
         static_cast<float>(std::cos(config.structure_min_tilt_deg * std::numbers::pi / 180.0));
-    std::vector<Eigen::Vector3f> structure, structure_normals, ground, ground_normals;
     std::vector<std::uint32_t> neighbors;
-    for (const auto& point : centroids) {
-        tree.Knn(point, config.normal_neighbors, neighbors);
-        if (neighbors.size() < 5) continue;  // no plane through fewer points
-        const Eigen::Vector3f normal = NormalAt(centroids, neighbors, point);
-        const bool is_structure = std::abs(normal.z()) <= max_vertical_z;
-        (is_structure ? structure : ground).push_back(point);
-        (is_structure ? structure_normals : ground_normals).push_back(normal);
+    // Zero: no plane through fewer than 5 points.
+    std::vector<Eigen::Vector3f> normals(centroids.size(), Eigen::Vector3f::Zero());
+    for (const std::uint32_t i : grid.SpatialOrder()) {
+        grid.Knn(centroids[i], config.normal_neighbors, scratch, neighbors);
+        if (neighbors.size() >= 5) normals[i] = NormalAt(centroids, neighbors, centroids[i]);
+    }
+    std::vector<Eigen::Vector3f> structure, structure_normals, ground, ground_normals;
+    for (std::size_t i = 0; i < centroids.size(); ++i) {
+        if (normals[i].isZero()) continue;
+        const bool is_structure = std::abs(normals[i].z()) <= max_vertical_z;
+        (is_structure ? structure : ground).push_back(centroids[i]);
+        (is_structure ? structure_normals : ground_normals).push_back(normals[i]);
     }
     Subsample(structure, structure_normals, config.max_structure_points);
     Subsample(ground, ground_normals, config.max_ground_points);
     prepared.structure_distinctive.reserve(structure.size());
+    NeighborGrid::Scratch wide_scratch;
     for (const auto& point : structure) {
         prepared.structure_distinctive.push_back(
-            OnLargePlane(centroids, tree, point, config, neighbors) ? 0 : 1);
+            OnLargePlane(centroids, grid, point, config, wide_scratch, neighbors) ? 0 : 1);
     }
     prepared.structure =
         std::make_shared<const SurfacePoints>(std::move(structure), std::move(structure_normals));

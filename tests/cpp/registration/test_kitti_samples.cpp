@@ -12,7 +12,10 @@
 
 #include <gtest/gtest.h>
 
+#include "lidarloop/core/voxel_grid.hpp"
 #include "lidarloop/io/kitti_bin.hpp"
+#include "lidarloop/registration/neighbor_grid.hpp"
+#include "lidarloop/registration/point_tree.hpp"
 #include "lidarloop/registration/verification.hpp"
 
 namespace lidarloop::registration {
@@ -210,6 +213,35 @@ TEST_F(KittiSamples, ScansThatCannotPinAPoseAreRejectedWithAReason) {
                 EXPECT_FALSE(v.accepted) << "overlap " << v.overlap.Min();
                 EXPECT_NE(v.reason, RejectReason::kNone);
             }
+        }
+    }
+}
+
+// PrepareScan's neighbour search on real centroids: the grid finds exactly the k-d tree's
+// neighbours, in the same order, for the normals (k = 10) and distinctiveness (k = 30).
+TEST_F(KittiSamples, TheNeighbourGridFindsWhatTheTreeFinds) {
+    for (const int frame : {209, 1684}) {
+        core::VoxelGrid voxels(0.5);
+        for (const Eigen::Vector3f& point : Scan("08", frame)) {
+            const double range_m = point.cast<double>().norm();
+            if (range_m >= 3.0 && range_m <= 60.0) voxels.Add(point.cast<double>());
+        }
+        std::vector<Eigen::Vector3f> centroids;
+        for (const core::Voxel& voxel : voxels.Voxels())
+            centroids.push_back(voxel.centroid.cast<float>());
+        ASSERT_GT(centroids.size(), 10000u);
+        const PointTree tree(&centroids);
+        const NeighborGrid grid(centroids, 0.5F);
+        for (const int k : {10, 30}) {
+            NeighborGrid::Scratch scratch;
+            std::vector<std::uint32_t> from_tree, from_grid;
+            std::size_t differing = 0;
+            for (const Eigen::Vector3f& centroid : centroids) {
+                tree.Knn(centroid, k, from_tree);
+                grid.Knn(centroid, k, scratch, from_grid);
+                differing += from_tree != from_grid ? 1 : 0;
+            }
+            EXPECT_EQ(differing, 0u) << "frame " << frame << ", k " << k;
         }
     }
 }

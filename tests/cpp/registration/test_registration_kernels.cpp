@@ -11,6 +11,7 @@
 
 #include "lidarloop/registration/coarse_alignment.hpp"
 #include "lidarloop/registration/detail/fft2d.hpp"
+#include "lidarloop/registration/neighbor_grid.hpp"
 #include "lidarloop/registration/point_tree.hpp"
 #include "lidarloop/registration/prepared_scan.hpp"
 #include "registration_test_utils.hpp"
@@ -102,6 +103,122 @@ TEST(PointTree, EmptyTreeFindsNothing) {
     std::vector<std::uint32_t> found;
     tree.Knn(Eigen::Vector3f::Zero(), 3, found);
     EXPECT_TRUE(found.empty());
+}
+
+// The squared distances of the k nearest of `points` to `query`, by brute force, nearest first.
+std::vector<float> NearestSquaredDistances(const std::vector<Eigen::Vector3f>& points,
+                                           const Eigen::Vector3f& query, std::size_t k) {
+    std::vector<float> all;
+    for (const auto& p : points) all.push_back((p - query).squaredNorm());
+    const auto kept = all.begin() + static_cast<std::ptrdiff_t>(std::min(k, all.size()));
+    std::partial_sort(all.begin(), kept, all.end());
+    all.erase(kept, all.end());
+    return all;
+}
+
+void ExpectGridKnnIsExact(const std::vector<Eigen::Vector3f>& points, float cell_m,
+                          const std::vector<Eigen::Vector3f>& queries, int k) {
+    const NeighborGrid grid(points, cell_m);
+    NeighborGrid::Scratch scratch;  // shared by all queries, as PrepareScan shares it
+    std::vector<std::uint32_t> found;
+    for (const auto& query : queries) {
+        grid.Knn(query, k, scratch, found);
+        const auto expected = NearestSquaredDistances(points, query, static_cast<std::size_t>(k));
+        ASSERT_EQ(found.size(), expected.size());
+        for (std::size_t i = 0; i < found.size(); ++i)
+            ASSERT_FLOAT_EQ((points[found[i]] - query).squaredNorm(), expected[i]) << i;
+    }
+}
+
+// Uniform points, queries inside and well outside them, k from 1 to more than there are points:
+// each query starts from the radius the last one left, too small or far too large.
+TEST(NeighborGrid, KnnMatchesBruteForce) {
+    const auto points = RandomPoints(1500, 11, 10.0F);
+    const auto queries = RandomPoints(150, 12, 30.0F);
+    for (const int k : {1, 5, 10, 30, 1499, 1500, 2000})
+        for (const float cell_m : {0.05F, 0.5F, 3.0F, 100.0F})
+            ExpectGridKnnIsExact(points, cell_m, queries, k);
+}
+
+// A scan's kind of cloud: dense walls and ground near the sensor, a few far points. The grid
+// must widen its columns for the far ones and still find the exact neighbours everywhere.
+TEST(NeighborGrid, KnnIsExactOnAScanWithFarOutliers) {
+    std::vector<Eigen::Vector3f> points;
+    for (const auto& p : test::SyntheticPlace(3)) points.push_back(p);
+    points.emplace_back(1e6F, -1e6F, 5.0F);
+    points.emplace_back(-3e5F, 2e5F, -40.0F);
+    std::vector<Eigen::Vector3f> queries(points.begin(), points.begin() + 300);
+    queries.push_back(points.back());
+    ExpectGridKnnIsExact(points, 0.5F, queries, 10);
+    ExpectGridKnnIsExact(points, 0.5F, queries, 30);
+}
+
+TEST(NeighborGrid, EqualPointsAndOneColumnAreHandled) {
+    const std::vector<Eigen::Vector3f> same(50, Eigen::Vector3f(1.0F, 2.0F, 3.0F));
+    ExpectGridKnnIsExact(same, 0.5F, {Eigen::Vector3f(1.0F, 2.0F, 3.0F)}, 10);
+    std::vector<Eigen::Vector3f> pole;
+    for (int i = 0; i < 200; ++i) pole.emplace_back(0.0F, 0.0F, 0.1F * static_cast<float>(i));
+    ExpectGridKnnIsExact(pole, 0.5F, RandomPoints(50, 13, 5.0F), 7);
+}
+
+// ICP's search: the nearest within the bound, whatever the hint and the column edge.
+TEST(NeighborGrid, NearestWithAnyHintMatchesBruteForce) {
+    const auto points = RandomPoints(2000, 16, 20.0F);
+    std::mt19937_64 rng(17);
+    std::uniform_int_distribution<std::int64_t> any(0, 1999);
+    for (const float cell_m : {0.1F, 1.0F, 8.0F}) {
+        const NeighborGrid grid(points, cell_m);
+        for (const auto& query : RandomPoints(300, 18, 26.0F)) {
+            for (const float bound_m : {0.3F, 1.5F, 6.0F}) {
+                std::int64_t best = -1, farther = -1;  // farther: in the bound, not the nearest
+                float best_m2 = bound_m * bound_m;
+                for (std::size_t i = 0; i < points.size(); ++i) {
+                    const float d2 = (points[i] - query).squaredNorm();
+                    if (d2 < bound_m * bound_m && best >= 0)
+                        farther = d2 < best_m2 ? best : static_cast<std::int64_t>(i);
+                    if (d2 < best_m2) best_m2 = d2, best = static_cast<std::int64_t>(i);
+                }
+                for (const std::int64_t hint : {std::int64_t{-1}, any(rng), best, farther,
+                                                std::int64_t{2000}, std::int64_t{1} << 40}) {
+                    const auto found = grid.Nearest(query, bound_m, hint);
+                    if (best < 0) {
+                        ASSERT_EQ(found, -1) << hint;
+                    } else {
+                        ASSERT_GE(found, 0) << hint;
+                        ASSERT_FLOAT_EQ(
+                            (points[static_cast<std::size_t>(found)] - query).squaredNorm(),
+                            best_m2)
+                            << hint << " " << cell_m << " " << bound_m;
+                    }
+                }
+            }
+        }
+    }
+}
+
+TEST(NeighborGrid, NothingToFindGivesNothing) {
+    const std::vector<Eigen::Vector3f> none;
+    const NeighborGrid empty(none, 0.5F);
+    NeighborGrid::Scratch scratch;
+    std::vector<std::uint32_t> found = {7};
+    empty.Knn(Eigen::Vector3f::Zero(), 3, scratch, found);
+    EXPECT_TRUE(found.empty());
+    EXPECT_EQ(empty.Nearest(Eigen::Vector3f::Zero(), 10.0F, 0), -1);
+    const auto points = RandomPoints(100, 14, 5.0F);
+    const NeighborGrid grid(points, 0.5F);
+    grid.Knn(Eigen::Vector3f::Zero(), 0, scratch, found);
+    EXPECT_TRUE(found.empty());
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    grid.Knn(Eigen::Vector3f(nan, 0.0F, 0.0F), 3, scratch, found);
+    EXPECT_TRUE(found.empty());
+    EXPECT_EQ(grid.Nearest(Eigen::Vector3f(nan, 0.0F, 0.0F), 10.0F), -1);
+    EXPECT_EQ(grid.Nearest(points[3], 0.0F), -1);
+    EXPECT_EQ(grid.Nearest(points[3], nan), -1);
+    // An unusable column edge falls back to a usable one.
+    ExpectGridKnnIsExact(points, nan, RandomPoints(20, 15, 5.0F), 4);
+    ExpectGridKnnIsExact(points, -1.0F, RandomPoints(20, 15, 5.0F), 4);
+    // Absurdly fine columns are widened until there are a few per point.
+    ExpectGridKnnIsExact(points, 1e-30F, RandomPoints(20, 15, 5.0F), 4);
 }
 
 TEST(Fft2d, MatchesTheDefinitionAndInverts) {
