@@ -1,7 +1,10 @@
 #include "lidarloop/registration/neighbor_grid.hpp"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
+#include <limits>
 
 namespace lidarloop::registration {
 namespace {
@@ -16,6 +19,9 @@ constexpr double kReachMargin = 1e-5;
 // The next query starts from the last one's k-th distance times this: near enough to succeed
 // at once most of the time, small enough not to read many extra points.
 constexpr float kRadiusCarry = 1.2F;
+// Up to this many candidates are ordered by counting ranks (quadratic, but without branches to
+// mispredict: faster than a sort for the 10 or so of a normal's neighbourhood).
+constexpr std::size_t kRankedAtMost = 32;
 
 std::int64_t ColumnOf(double coordinate, double origin, double cell_m, std::int64_t count) {
     const double column = std::floor((coordinate - origin) / cell_m);
@@ -63,13 +69,11 @@ NeighborGrid::NeighborGrid(const std::vector<Eigen::Vector3f>& cloud, float cell
     for (std::size_t c = 0; c < columns; ++c) column_start_[c + 1] += column_start_[c];
     points_.resize(cloud.size());
     original_.resize(cloud.size());
-    slot_.resize(cloud.size());
     std::vector<std::uint32_t> next(column_start_.begin(), column_start_.end() - 1);
     for (std::size_t i = 0; i < cloud.size(); ++i) {
         const std::uint32_t slot = next[column_of[i]]++;
         points_[slot] = cloud[i];
         original_[slot] = static_cast<std::uint32_t>(i);
-        slot_[i] = slot;
     }
 }
 
@@ -80,79 +84,55 @@ NeighborGrid::Span NeighborGrid::ColumnsWithin(float low, float high, float orig
             std::min<std::int64_t>(count - 1, ColumnOf(high + reach, origin, cell_m_, count))};
 }
 
-float NeighborGrid::RowGap(std::int64_t row, float y) const {
-    const double low = min_y_ + static_cast<double>(row) * cell_m_;
-    const double gap = std::max({0.0, low - y, y - (low + cell_m_)});
-    // Shrunk a little: rounding must not skip a row that holds a point within the bound.
-    return static_cast<float>(gap * (1.0 - kReachMargin) - kReachMargin);
-}
-
-std::int64_t NeighborGrid::Nearest(const Eigen::Vector3f& query, float max_distance_m,
-                                   std::int64_t hint) const {
-    if (points_.empty() || !query.allFinite() || !(max_distance_m > 0.0F)) return -1;
-    float bound_m2 = max_distance_m * max_distance_m;
-    std::int64_t best = -1;
-    if (hint >= 0 && static_cast<std::size_t>(hint) < points_.size()) {
-        const Eigen::Vector3f& at = points_[slot_[static_cast<std::size_t>(hint)]];
-        const float dx = at.x() - query.x(), dy = at.y() - query.y(), dz = at.z() - query.z();
-        const float hint_m2 = dx * dx + dy * dy + dz * dz;
-        if (hint_m2 < bound_m2) bound_m2 = hint_m2, best = hint;
-    }
-    std::int64_t best_slot = -1;
-    const std::int64_t centre = std::clamp<std::int64_t>(
-        ColumnOf(query.y(), min_y_, cell_m_, columns_y_), 0, columns_y_ - 1);
-    const auto search_row = [&](std::int64_t row) {
-        if (row < 0 || row >= columns_y_) return false;
-        const float gap_m = RowGap(row, query.y());
-        if (gap_m > 0.0F && gap_m * gap_m >= bound_m2) return false;
-        const float reach_m = std::sqrt(bound_m2);
-        const Span x = ColumnsWithin(query.x() - reach_m, query.x() + reach_m, min_x_, columns_x_);
-        if (x.first > x.last) return true;
-        const std::uint32_t end =
-            column_start_[static_cast<std::size_t>(row * columns_x_ + x.last + 1)];
-        for (std::uint32_t i = column_start_[static_cast<std::size_t>(row * columns_x_ + x.first)];
-             i < end; ++i) {
-            const float dx = points_[i].x() - query.x();
-            const float dy = points_[i].y() - query.y();
-            const float dz = points_[i].z() - query.z();
-            const float squared_m2 = dx * dx + dy * dy + dz * dz;
-            if (squared_m2 < bound_m2) bound_m2 = squared_m2, best_slot = i;
-        }
-        return true;
-    };
-    // Outwards from the query's row; each side ends at its first row beyond the bound.
-    bool below = true, above = true;
-    search_row(centre);
-    for (std::int64_t step = 1; below || above; ++step) {
-        if (below) below = search_row(centre - step);
-        if (above) above = search_row(centre + step);
-    }
-    return best_slot >= 0 ? original_[static_cast<std::size_t>(best_slot)] : best;
-}
-
-bool NeighborGrid::Collect(const Eigen::Vector3f& query, float radius_m,
-                           std::vector<std::pair<float, std::uint32_t>>& candidates) const {
+bool NeighborGrid::Collect(const Eigen::Vector3f& query, float radius_m, std::size_t wanted,
+                           std::vector<std::uint64_t>& nearest) const {
+    nearest.clear();
     const Span x = ColumnsWithin(query.x() - radius_m, query.x() + radius_m, min_x_, columns_x_);
     const Span y = ColumnsWithin(query.y() - radius_m, query.y() + radius_m, min_y_, columns_y_);
     const bool whole_grid =
         x.first == 0 && x.last == columns_x_ - 1 && y.first == 0 && y.last == columns_y_ - 1;
     if (x.first > x.last) return whole_grid;
-    const float radius_m2 = radius_m * radius_m;
+    const float bound_m2 =
+        whole_grid ? std::numeric_limits<float>::infinity() : radius_m * radius_m;
+    std::size_t readable = 0;
+    for (std::int64_t row = y.first; row <= y.last; ++row)
+        readable += RowEnd(row, x) - RowBegin(row, x);
+    nearest.resize(readable);
+    std::size_t found = 0;
     for (std::int64_t row = y.first; row <= y.last; ++row) {
-        const std::uint32_t begin =
-            column_start_[static_cast<std::size_t>(row * columns_x_ + x.first)];
-        const std::uint32_t end =
-            column_start_[static_cast<std::size_t>(row * columns_x_ + x.last + 1)];
-        for (std::uint32_t i = begin; i < end; ++i) {
+        for (std::uint32_t i = RowBegin(row, x), end = RowEnd(row, x); i < end; ++i) {
             // Summed as nanoflann sums (x, y, z in turn), so distances and their order agree.
             const float dx = points_[i].x() - query.x();
             const float dy = points_[i].y() - query.y();
             const float dz = points_[i].z() - query.z();
             const float squared_m2 = dx * dx + dy * dy + dz * dz;
-            if (squared_m2 <= radius_m2 || whole_grid)
-                candidates.emplace_back(squared_m2, original_[i]);
+            // Written always, kept when within: no branch to mispredict.
+            nearest[found] =
+                std::uint64_t{std::bit_cast<std::uint32_t>(squared_m2)} << 32 | original_[i];
+            found += squared_m2 <= bound_m2 ? 1 : 0;
         }
     }
+    nearest.resize(found);
+    if (found <= kRankedAtMost) {
+        // Few: each key's rank by counting the smaller ones, without a branch per comparison.
+        std::array<std::uint64_t, kRankedAtMost> ranked;
+        for (std::size_t i = 0; i < found; ++i) {
+            std::size_t rank = 0;
+            for (std::size_t j = 0; j < found; ++j) rank += nearest[j] < nearest[i] ? 1 : 0;
+            ranked[rank] = nearest[i];
+        }
+        const std::size_t kept = std::min(found, wanted);
+        std::copy(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(kept),
+                  nearest.begin());
+        nearest.resize(kept);
+        return whole_grid;
+    }
+    if (nearest.size() >= wanted) {
+        const auto kept = nearest.begin() + static_cast<std::ptrdiff_t>(wanted);
+        std::nth_element(nearest.begin(), kept - 1, nearest.end());
+        nearest.erase(kept, nearest.end());
+    }
+    std::sort(nearest.begin(), nearest.end());
     return whole_grid;
 }
 
@@ -161,22 +141,16 @@ void NeighborGrid::Knn(const Eigen::Vector3f& query, int k, Scratch& scratch,
     indices.clear();
     if (k <= 0 || points_.empty() || !query.allFinite()) return;
     const std::size_t wanted = std::min(static_cast<std::size_t>(k), points_.size());
-    auto& candidates = scratch.candidates;
+    auto& nearest = scratch.nearest;
+    nearest.reserve(wanted);
     float radius_m = scratch.radius_m > 0.0F ? scratch.radius_m : cell_m_;
-    for (;;) {
-        candidates.clear();
-        // Every point outside the columns read is farther than the radius: once `wanted` lie
-        // within it, they include the nearest.
-        if (Collect(query, radius_m, candidates) || candidates.size() >= wanted) break;
-        radius_m *= 2.0F;
-    }
-    const auto kept = candidates.begin() + static_cast<std::ptrdiff_t>(wanted);
-    std::nth_element(candidates.begin(), kept - 1, candidates.end());
-    std::sort(candidates.begin(), kept);
+    // Every point outside the columns read is farther than the radius: once `wanted` lie within
+    // it, they are the nearest.
+    while (!Collect(query, radius_m, wanted, nearest) && nearest.size() < wanted) radius_m *= 2.0F;
     indices.reserve(wanted);
-    for (auto it = candidates.begin(); it != kept; ++it) indices.push_back(it->second);
-    scratch.radius_m =
-        std::max(kRadiusCarry * std::sqrt(candidates[wanted - 1].first), 0.5F * cell_m_);
+    for (const std::uint64_t key : nearest) indices.push_back(static_cast<std::uint32_t>(key));
+    const float kth_m2 = std::bit_cast<float>(static_cast<std::uint32_t>(nearest.back() >> 32));
+    scratch.radius_m = std::max(kRadiusCarry * std::sqrt(kth_m2), 0.5F * cell_m_);
 }
 
 }  // namespace lidarloop::registration

@@ -180,11 +180,13 @@ PreparedScan PrepareScan(const core::PointCloud& scan, const ScanReductionConfig
     }
     Subsample(structure, structure_normals, config.max_structure_points);
     Subsample(ground, ground_normals, config.max_ground_points);
-    prepared.structure_distinctive.reserve(structure.size());
+    prepared.structure_distinctive.assign(structure.size(), 0);
     NeighborGrid::Scratch wide_scratch;
-    for (const auto& point : structure) {
-        prepared.structure_distinctive.push_back(
-            OnLargePlane(centroids, grid, point, config, wide_scratch, neighbors) ? 0 : 1);
+    // Asked in a spatial order too: a grid of the structure points gives one.
+    const NeighborGrid structure_order(structure, static_cast<float>(config.voxel_m));
+    for (const std::uint32_t i : structure_order.SpatialOrder()) {
+        prepared.structure_distinctive[i] =
+            OnLargePlane(centroids, grid, structure[i], config, wide_scratch, neighbors) ? 0 : 1;
     }
     prepared.structure =
         std::make_shared<const SurfacePoints>(std::move(structure), std::move(structure_normals));

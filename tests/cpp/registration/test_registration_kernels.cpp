@@ -161,41 +161,6 @@ TEST(NeighborGrid, EqualPointsAndOneColumnAreHandled) {
     ExpectGridKnnIsExact(pole, 0.5F, RandomPoints(50, 13, 5.0F), 7);
 }
 
-// ICP's search: the nearest within the bound, whatever the hint and the column edge.
-TEST(NeighborGrid, NearestWithAnyHintMatchesBruteForce) {
-    const auto points = RandomPoints(2000, 16, 20.0F);
-    std::mt19937_64 rng(17);
-    std::uniform_int_distribution<std::int64_t> any(0, 1999);
-    for (const float cell_m : {0.1F, 1.0F, 8.0F}) {
-        const NeighborGrid grid(points, cell_m);
-        for (const auto& query : RandomPoints(300, 18, 26.0F)) {
-            for (const float bound_m : {0.3F, 1.5F, 6.0F}) {
-                std::int64_t best = -1, farther = -1;  // farther: in the bound, not the nearest
-                float best_m2 = bound_m * bound_m;
-                for (std::size_t i = 0; i < points.size(); ++i) {
-                    const float d2 = (points[i] - query).squaredNorm();
-                    if (d2 < bound_m * bound_m && best >= 0)
-                        farther = d2 < best_m2 ? best : static_cast<std::int64_t>(i);
-                    if (d2 < best_m2) best_m2 = d2, best = static_cast<std::int64_t>(i);
-                }
-                for (const std::int64_t hint : {std::int64_t{-1}, any(rng), best, farther,
-                                                std::int64_t{2000}, std::int64_t{1} << 40}) {
-                    const auto found = grid.Nearest(query, bound_m, hint);
-                    if (best < 0) {
-                        ASSERT_EQ(found, -1) << hint;
-                    } else {
-                        ASSERT_GE(found, 0) << hint;
-                        ASSERT_FLOAT_EQ(
-                            (points[static_cast<std::size_t>(found)] - query).squaredNorm(),
-                            best_m2)
-                            << hint << " " << cell_m << " " << bound_m;
-                    }
-                }
-            }
-        }
-    }
-}
-
 TEST(NeighborGrid, NothingToFindGivesNothing) {
     const std::vector<Eigen::Vector3f> none;
     const NeighborGrid empty(none, 0.5F);
@@ -203,7 +168,6 @@ TEST(NeighborGrid, NothingToFindGivesNothing) {
     std::vector<std::uint32_t> found = {7};
     empty.Knn(Eigen::Vector3f::Zero(), 3, scratch, found);
     EXPECT_TRUE(found.empty());
-    EXPECT_EQ(empty.Nearest(Eigen::Vector3f::Zero(), 10.0F, 0), -1);
     const auto points = RandomPoints(100, 14, 5.0F);
     const NeighborGrid grid(points, 0.5F);
     grid.Knn(Eigen::Vector3f::Zero(), 0, scratch, found);
@@ -211,9 +175,6 @@ TEST(NeighborGrid, NothingToFindGivesNothing) {
     const float nan = std::numeric_limits<float>::quiet_NaN();
     grid.Knn(Eigen::Vector3f(nan, 0.0F, 0.0F), 3, scratch, found);
     EXPECT_TRUE(found.empty());
-    EXPECT_EQ(grid.Nearest(Eigen::Vector3f(nan, 0.0F, 0.0F), 10.0F), -1);
-    EXPECT_EQ(grid.Nearest(points[3], 0.0F), -1);
-    EXPECT_EQ(grid.Nearest(points[3], nan), -1);
     // An unusable column edge falls back to a usable one.
     ExpectGridKnnIsExact(points, nan, RandomPoints(20, 15, 5.0F), 4);
     ExpectGridKnnIsExact(points, -1.0F, RandomPoints(20, 15, 5.0F), 4);
