@@ -37,20 +37,35 @@ std::vector<Eigen::Vector3f> VoxelCentroids(const core::PointCloud& scan,
     return centroids;
 }
 
+// The neighbourhood's scatter: the sum of the outer products of the points less their mean.
+// Six scalar sums in the neighbours' order: the values of Eigen's `c += d * d.transpose()`
+// (each entry is the same products added in the same order), without its shuffles and spills.
+Eigen::Matrix3d ScatterOf(const std::vector<Eigen::Vector3f>& points,
+                          const std::vector<std::uint32_t>& neighbors) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const auto index : neighbors) mean += points[index].cast<double>();
+    mean /= static_cast<double>(neighbors.size());
+    double xx = 0.0, xy = 0.0, xz = 0.0, yy = 0.0, yz = 0.0, zz = 0.0;
+    for (const auto index : neighbors) {
+        const Eigen::Vector3d d = points[index].cast<double>() - mean;
+        xx += d.x() * d.x();
+        xy += d.x() * d.y();
+        xz += d.x() * d.z();
+        yy += d.y() * d.y();
+        yz += d.y() * d.z();
+        zz += d.z() * d.z();
+    }
+    Eigen::Matrix3d scatter;
+    scatter << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+    return scatter;
+}
+
 // The plane through the neighbourhood: its unit normal (the eigenvector of the smallest
 // eigenvalue of the covariance) oriented towards the sensor so that both scans agree on its sign.
 Eigen::Vector3f NormalAt(const std::vector<Eigen::Vector3f>& points,
                          const std::vector<std::uint32_t>& neighbors, const Eigen::Vector3f& at) {
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (const auto index : neighbors) mean += points[index].cast<double>();
-    mean /= static_cast<double>(neighbors.size());
-    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-    for (const auto index : neighbors) {
-        const Eigen::Vector3d d = points[index].cast<double>() - mean;
-        covariance += d * d.transpose();
-    }
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-    solver.computeDirect(covariance);
+    solver.computeDirect(ScatterOf(points, neighbors));
     Eigen::Vector3f normal = solver.eigenvectors().col(0).cast<float>();
     if (normal.dot(at) > 0.0F) normal = -normal;
     return normal;
@@ -62,16 +77,8 @@ bool OnLargePlane(const std::vector<Eigen::Vector3f>& centroids, const NeighborG
                   NeighborGrid::Scratch& scratch, std::vector<std::uint32_t>& neighbors) {
     grid.Knn(point, config.distinctive_neighbors, scratch, neighbors);
     if (neighbors.size() < 5) return false;
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (const auto index : neighbors) mean += centroids[index].cast<double>();
-    mean /= static_cast<double>(neighbors.size());
-    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-    for (const auto index : neighbors) {
-        const Eigen::Vector3d d = centroids[index].cast<double>() - mean;
-        covariance += d * d.transpose();
-    }
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-    solver.computeDirect(covariance, Eigen::EigenvaluesOnly);
+    solver.computeDirect(ScatterOf(centroids, neighbors), Eigen::EigenvaluesOnly);
     const Eigen::Vector3d eigenvalues = solver.eigenvalues().cwiseMax(0.0);
     const double total = eigenvalues.sum();
     return total > 0.0 && eigenvalues(0) / total <= config.max_plane_variation;

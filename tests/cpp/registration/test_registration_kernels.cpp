@@ -7,8 +7,10 @@
 #include <utility>
 
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 #include <unsupported/Eigen/FFT>
 
+#include "lidarloop/core/voxel_grid.hpp"
 #include "lidarloop/registration/coarse_alignment.hpp"
 #include "lidarloop/registration/detail/fft2d.hpp"
 #include "lidarloop/registration/neighbor_grid.hpp"
@@ -314,6 +316,59 @@ TEST(PrepareScan, SplitsWallsFromGroundWithUnitNormalsFacingTheSensor) {
     EXPECT_LE(scan.structure->size(), static_cast<std::size_t>(config.max_structure_points));
     EXPECT_LE(scan.ground->size(), static_cast<std::size_t>(config.max_ground_points));
     EXPECT_GT(scan.MemoryBytes(), (scan.structure->size() + scan.ground->size()) * 24);
+}
+
+// PrepareScan's fast paths (the column grid's neighbours, the scatter in six sums) against the
+// slow ones they replaced: nanoflann's k nearest and Eigen's outer products. Every kept point's
+// normal and distinctive flag must come out bit for bit the same.
+TEST(PrepareScan, NormalsAndFlagsEqualTheTreeAndOuterProductPath) {
+    const core::PointCloud scan = test::SyntheticPlace(4);
+    const ScanReductionConfig config;
+    core::VoxelGrid voxels(config.voxel_m);
+    for (const Eigen::Vector3f& point : scan) {
+        const double range_m = point.cast<double>().norm();
+        if (range_m >= config.min_range_m && range_m <= config.max_range_m)
+            voxels.Add(point.cast<double>());
+    }
+    std::vector<Eigen::Vector3f> centroids;
+    for (const core::Voxel& voxel : voxels.Voxels())
+        centroids.push_back(voxel.centroid.cast<float>());
+    const PointTree tree(&centroids);
+    std::vector<std::uint32_t> neighbors;
+    const auto eigen_solver = [&](const Eigen::Vector3f& at, int k) {
+        tree.Knn(at, k, neighbors);
+        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+        for (const auto i : neighbors) mean += centroids[i].cast<double>();
+        mean /= static_cast<double>(neighbors.size());
+        Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+        for (const auto i : neighbors) {
+            const Eigen::Vector3d d = centroids[i].cast<double>() - mean;
+            covariance += d * d.transpose();
+        }
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+        solver.computeDirect(covariance);
+        return solver;
+    };
+    const PreparedScan prepared = PrepareScan(scan, config);
+    ASSERT_GT(prepared.structure->size(), 1000u);
+    ASSERT_GT(prepared.ground->size(), 300u);
+    for (const SurfacePoints* surface : {prepared.structure.get(), prepared.ground.get()}) {
+        for (std::size_t i = 0; i < surface->size(); ++i) {
+            const Eigen::Vector3f& point = surface->points()[i];
+            Eigen::Vector3f normal =
+                eigen_solver(point, config.normal_neighbors).eigenvectors().col(0).cast<float>();
+            if (normal.dot(point) > 0.0F) normal = -normal;
+            ASSERT_EQ(surface->normals()[i], normal) << i;
+        }
+    }
+    for (std::size_t i = 0; i < prepared.structure->size(); ++i) {
+        const Eigen::Vector3d eigenvalues =
+            eigen_solver(prepared.structure->points()[i], config.distinctive_neighbors)
+                .eigenvalues()
+                .cwiseMax(0.0);
+        const bool on_plane = eigenvalues(0) / eigenvalues.sum() <= config.max_plane_variation;
+        ASSERT_EQ(prepared.structure_distinctive[i], on_plane ? 0 : 1) << i;
+    }
 }
 
 TEST(PrepareScan, DropsNonFiniteAndOutOfRangePoints) {
