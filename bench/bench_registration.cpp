@@ -11,8 +11,11 @@
 
 #include <benchmark/benchmark.h>
 
+#include "lidarloop/core/voxel_grid.hpp"
 #include "lidarloop/registration/coarse_alignment.hpp"
 #include "lidarloop/registration/icp.hpp"
+#include "lidarloop/registration/neighbor_grid.hpp"
+#include "lidarloop/registration/point_tree.hpp"
 #include "lidarloop/registration/prepared_scan.hpp"
 #include "lidarloop/registration/verification.hpp"
 #include "lidarloop/sim/simulator.hpp"
@@ -73,6 +76,50 @@ void BM_PrepareScan(benchmark::State& state) {
         benchmark::DoNotOptimize(registration::PrepareScan(scans.query_raw, config.reduction));
     }
     state.counters["raw_points"] = static_cast<double>(scans.query_raw.size());
+}
+
+// The query scan's voxel centroids, as PrepareScan makes them (range filter, 0.5 m voxels).
+std::vector<Eigen::Vector3f> QueryCentroids(const benchmark::State& state) {
+    const registration::ScanReductionConfig reduction;
+    core::VoxelGrid voxels(reduction.voxel_m);
+    for (const Eigen::Vector3f& point : Scans(SensorOf(state)).query_raw) {
+        const double range_m = point.cast<double>().norm();
+        if (range_m >= reduction.min_range_m && range_m <= reduction.max_range_m)
+            voxels.Add(point.cast<double>());
+    }
+    std::vector<Eigen::Vector3f> centroids;
+    for (const core::Voxel& voxel : voxels.Voxels())
+        centroids.push_back(voxel.centroid.cast<float>());
+    return centroids;
+}
+
+// The normals' neighbour search of one scan: the 10 nearest centroids of every centroid, the
+// index built included. PrepareScan's grid against the nanoflann k-d tree it replaced.
+void BM_NormalNeighboursGrid(benchmark::State& state) {
+    const auto centroids = QueryCentroids(state);
+    std::vector<std::uint32_t> neighbors;
+    for (auto _ : state) {
+        const registration::NeighborGrid grid(centroids, 0.5F);
+        registration::NeighborGrid::Scratch scratch;
+        for (const std::uint32_t i : grid.SpatialOrder()) {
+            grid.Knn(centroids[i], 10, scratch, neighbors);
+            benchmark::DoNotOptimize(neighbors.data());
+        }
+    }
+    state.counters["centroids"] = static_cast<double>(centroids.size());
+}
+
+void BM_NormalNeighboursTree(benchmark::State& state) {
+    const auto centroids = QueryCentroids(state);
+    std::vector<std::uint32_t> neighbors;
+    for (auto _ : state) {
+        const registration::PointTree tree(&centroids);
+        for (const Eigen::Vector3f& centroid : centroids) {
+            tree.Knn(centroid, 10, neighbors);
+            benchmark::DoNotOptimize(neighbors.data());
+        }
+    }
+    state.counters["centroids"] = static_cast<double>(centroids.size());
 }
 
 // The query's side of the coarse search: its rotated images' spectra, once per query.
@@ -142,6 +189,8 @@ void BM_VerifyDifferentPlaces(benchmark::State& state) {
     BENCHMARK(bm)->ArgName("beams")->Arg(64)->Arg(16)->Unit(benchmark::kMillisecond)
 
 LIDARLOOP_SENSORS(BM_PrepareScan);
+LIDARLOOP_SENSORS(BM_NormalNeighboursGrid);
+LIDARLOOP_SENSORS(BM_NormalNeighboursTree);
 LIDARLOOP_SENSORS(BM_CoarseQuery);
 LIDARLOOP_SENSORS(BM_CoarseAlign);
 LIDARLOOP_SENSORS(BM_IcpFromTruth);
