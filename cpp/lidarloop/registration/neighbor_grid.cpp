@@ -142,7 +142,6 @@ void NeighborGrid::Knn(const Eigen::Vector3f& query, int k, Scratch& scratch,
     if (k <= 0 || points_.empty() || !query.allFinite()) return;
     const std::size_t wanted = std::min(static_cast<std::size_t>(k), points_.size());
     auto& nearest = scratch.nearest;
-    nearest.reserve(wanted);
     float radius_m = scratch.radius_m > 0.0F ? scratch.radius_m : cell_m_;
     // Every point outside the columns read is farther than the radius: once `wanted` lie within
     // it, they are the nearest.
