@@ -11,7 +11,6 @@
 
 #include <benchmark/benchmark.h>
 
-#include "lidarloop/core/voxel_grid.hpp"
 #include "lidarloop/registration/coarse_alignment.hpp"
 #include "lidarloop/registration/icp.hpp"
 #include "lidarloop/registration/neighbor_grid.hpp"
@@ -20,6 +19,7 @@
 #include "lidarloop/registration/verification.hpp"
 #include "lidarloop/sim/simulator.hpp"
 #include "registration/comparison_pairs.hpp"
+#include "registration/registration_test_utils.hpp"
 
 namespace lidarloop::bench {
 namespace {
@@ -78,25 +78,10 @@ void BM_PrepareScan(benchmark::State& state) {
     state.counters["raw_points"] = static_cast<double>(scans.query_raw.size());
 }
 
-// The query scan's voxel centroids, as PrepareScan makes them (range filter, 0.5 m voxels).
-std::vector<Eigen::Vector3f> QueryCentroids(const benchmark::State& state) {
-    const registration::ScanReductionConfig reduction;
-    core::VoxelGrid voxels(reduction.voxel_m);
-    for (const Eigen::Vector3f& point : Scans(SensorOf(state)).query_raw) {
-        const double range_m = point.cast<double>().norm();
-        if (range_m >= reduction.min_range_m && range_m <= reduction.max_range_m)
-            voxels.Add(point.cast<double>());
-    }
-    std::vector<Eigen::Vector3f> centroids;
-    for (const core::Voxel& voxel : voxels.Voxels())
-        centroids.push_back(voxel.centroid.cast<float>());
-    return centroids;
-}
-
 // The normals' neighbour search of one scan: the 10 nearest centroids of every centroid, the
 // index built included. PrepareScan's grid against the nanoflann k-d tree it replaced.
 void BM_NormalNeighboursGrid(benchmark::State& state) {
-    const auto centroids = QueryCentroids(state);
+    const auto centroids = test::VoxelCentroids(Scans(SensorOf(state)).query_raw);
     std::vector<std::uint32_t> neighbors;
     for (auto _ : state) {
         const registration::NeighborGrid grid(centroids, 0.5F);
@@ -110,7 +95,7 @@ void BM_NormalNeighboursGrid(benchmark::State& state) {
 }
 
 void BM_NormalNeighboursTree(benchmark::State& state) {
-    const auto centroids = QueryCentroids(state);
+    const auto centroids = test::VoxelCentroids(Scans(SensorOf(state)).query_raw);
     std::vector<std::uint32_t> neighbors;
     for (auto _ : state) {
         const registration::PointTree tree(&centroids);

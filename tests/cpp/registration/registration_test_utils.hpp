@@ -3,9 +3,29 @@
 #include <cmath>
 #include <random>
 
+#include <vector>
+
 #include "lidarloop/core/point_cloud.hpp"
+#include "lidarloop/core/voxel_grid.hpp"
+#include "lidarloop/registration/verification_config.hpp"
 
 namespace lidarloop::test {
+
+/// The voxel centroids PrepareScan reduces `scan` to (range filter, voxels), for tests and
+/// benchmarks of what it does with them.
+inline std::vector<Eigen::Vector3f> VoxelCentroids(
+    const core::PointCloud& scan, const registration::ScanReductionConfig& reduction = {}) {
+    core::VoxelGrid voxels(reduction.voxel_m);
+    for (const Eigen::Vector3f& point : scan) {
+        const double range_m = point.cast<double>().norm();
+        if (range_m >= reduction.min_range_m && range_m <= reduction.max_range_m)
+            voxels.Add(point.cast<double>());
+    }
+    std::vector<Eigen::Vector3f> centroids;
+    for (const core::Voxel& voxel : voxels.Voxels())
+        centroids.push_back(voxel.centroid.cast<float>());
+    return centroids;
+}
 
 /// T_match_query = Translation(x, y, z) * Rz(yaw_deg).
 inline core::Transform PlanarTransform(double x_m, double y_m, double yaw_deg, double z_m = 0.0) {

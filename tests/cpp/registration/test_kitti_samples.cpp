@@ -12,11 +12,11 @@
 
 #include <gtest/gtest.h>
 
-#include "lidarloop/core/voxel_grid.hpp"
 #include "lidarloop/io/kitti_bin.hpp"
 #include "lidarloop/registration/neighbor_grid.hpp"
 #include "lidarloop/registration/point_tree.hpp"
 #include "lidarloop/registration/verification.hpp"
+#include "registration_test_utils.hpp"
 
 namespace lidarloop::registration {
 namespace {
@@ -221,14 +221,8 @@ TEST_F(KittiSamples, ScansThatCannotPinAPoseAreRejectedWithAReason) {
 // neighbours, in the same order, for the normals (k = 10) and distinctiveness (k = 30).
 TEST_F(KittiSamples, TheNeighbourGridFindsWhatTheTreeFinds) {
     for (const int frame : {209, 1684}) {
-        core::VoxelGrid voxels(0.5);
-        for (const Eigen::Vector3f& point : Scan("08", frame)) {
-            const double range_m = point.cast<double>().norm();
-            if (range_m >= 3.0 && range_m <= 60.0) voxels.Add(point.cast<double>());
-        }
-        std::vector<Eigen::Vector3f> centroids;
-        for (const core::Voxel& voxel : voxels.Voxels())
-            centroids.push_back(voxel.centroid.cast<float>());
+        // PrepareScan's defaults: 3-60 m, 0.5 m voxels.
+        const std::vector<Eigen::Vector3f> centroids = test::VoxelCentroids(Scan("08", frame));
         ASSERT_GT(centroids.size(), 10000u);
         const PointTree tree(&centroids);
         const NeighborGrid grid(centroids, 0.5F);

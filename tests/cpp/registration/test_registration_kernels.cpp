@@ -10,7 +10,6 @@
 #include <Eigen/Eigenvalues>
 #include <unsupported/Eigen/FFT>
 
-#include "lidarloop/core/voxel_grid.hpp"
 #include "lidarloop/registration/coarse_alignment.hpp"
 #include "lidarloop/registration/detail/fft2d.hpp"
 #include "lidarloop/registration/neighbor_grid.hpp"
@@ -324,15 +323,7 @@ TEST(PrepareScan, SplitsWallsFromGroundWithUnitNormalsFacingTheSensor) {
 TEST(PrepareScan, NormalsAndFlagsEqualTheTreeAndOuterProductPath) {
     const core::PointCloud scan = test::SyntheticPlace(4);
     const ScanReductionConfig config;
-    core::VoxelGrid voxels(config.voxel_m);
-    for (const Eigen::Vector3f& point : scan) {
-        const double range_m = point.cast<double>().norm();
-        if (range_m >= config.min_range_m && range_m <= config.max_range_m)
-            voxels.Add(point.cast<double>());
-    }
-    std::vector<Eigen::Vector3f> centroids;
-    for (const core::Voxel& voxel : voxels.Voxels())
-        centroids.push_back(voxel.centroid.cast<float>());
+    const std::vector<Eigen::Vector3f> centroids = test::VoxelCentroids(scan, config);
     const PointTree tree(&centroids);
     std::vector<std::uint32_t> neighbors;
     const auto eigen_solver = [&](const Eigen::Vector3f& at, int k) {
