@@ -1,11 +1,24 @@
 #include <exception>
 #include <iostream>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
 #include "lidarloop/core/error.hpp"
 #include "run_output.hpp"
+
+namespace {
+
+// How a command ends: its message on stderr and its exit code, unless an interrupt is being
+// handled, whose exit code (128 + the signal) and message are the ones the user must see.
+int End(const std::string& message, int code) {
+    if (lidarloop::cli::InterruptReceived()) lidarloop::cli::AwaitInterruptExit();
+    if (!message.empty()) std::cerr << message << "\n";
+    return code;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
     lidarloop::cli::InstallInterruptHandler(argc, argv);  // first: before any other thread
@@ -30,17 +43,14 @@ int main(int argc, char** argv) {
         // A value that fails its check (a missing input file, a folder given for a file, a name
         // not in the list) is an input error like any other: one line and exit code 1, not
         // CLI11's 105 (docs/cli.md, "Errors").
-        std::cerr << "lidarloop: error: " << e.what() << "\n";
-        return 1;
+        return End(std::string("lidarloop: error: ") + e.what(), 1);
     } catch (const CLI::ParseError& e) {
         // --help and --version exit 0; a bad command line prints CLI11's message and exits 1.
         return app.exit(e) == 0 ? 0 : 1;
     } catch (const lidarloop::core::Error& e) {
-        std::cerr << "lidarloop: error: " << e.what() << "\n";
-        return 1;
+        return End(std::string("lidarloop: error: ") + e.what(), 1);
     } catch (const std::exception& e) {
-        std::cerr << "lidarloop: internal error: " << e.what() << "\n";
-        return 2;
+        return End(std::string("lidarloop: internal error: ") + e.what(), 2);
     }
-    return 0;
+    return End("", 0);
 }

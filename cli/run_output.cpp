@@ -3,6 +3,8 @@
 #include <pthread.h>
 #include <signal.h>
 
+#include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <thread>
@@ -11,6 +13,7 @@ namespace lidarloop::cli {
 namespace {
 
 std::string command_line;
+std::atomic<bool> interrupt_received{false};
 
 sigset_t InterruptSignals() {
     sigset_t signals;
@@ -24,6 +27,7 @@ sigset_t InterruptSignals() {
     int signal = 0;
     while (sigwait(&signals, &signal) != 0) {
     }
+    interrupt_received = true;  // before the staging folder goes: see InterruptReceived
     const std::filesystem::path folder = app::AbandonActiveRun(
         app::RunStatus::kInterrupted, "interrupted by signal " + std::to_string(signal));
     if (!folder.empty()) {
@@ -49,5 +53,11 @@ void InstallInterruptHandler(int argc, char** argv) {
 }
 
 const std::string& CommandLine() { return command_line; }
+
+bool InterruptReceived() { return interrupt_received; }
+
+void AwaitInterruptExit() {
+    for (;;) std::this_thread::sleep_for(std::chrono::seconds(1));
+}
 
 }  // namespace lidarloop::cli

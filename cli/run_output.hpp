@@ -15,6 +15,15 @@ namespace lidarloop::cli {
 /// 128 + the signal.
 void InstallInterruptHandler(int argc, char** argv);
 
+/// True once SIGINT or SIGTERM has arrived. The watcher then removes the running folder's
+/// staging files, so the command may fail on them (a file it cannot open): that error and its
+/// exit code are the interrupt's, not the command's, and main leaves the exit to the watcher.
+bool InterruptReceived();
+
+/// Waits for the watcher to end the process (128 + the signal); call only after
+/// InterruptReceived() is true.
+[[noreturn]] void AwaitInterruptExit();
+
 /// The command line as typed (arguments joined by spaces), for run.json.
 const std::string& CommandLine();
 
