@@ -168,6 +168,8 @@ void VisitFields(registration::AcceptanceConfig& c, Visitor& v) {
     v.Field("min_overlapping_points", c.min_overlapping_points, "overlapping points, each way");
     v.Field("max_rmse_ratio", c.max_rmse_ratio,
             "RMS plane distance of the overlap over the scans' own roughness, at most");
+    v.Field("max_rmse_ratio_with_odometry", c.max_rmse_ratio_with_odometry,
+            "the same where the odometry judges the loop (--odometry)");
     v.Field("min_allowed_rmse_m", c.min_allowed_rmse_m, "the allowed RMS is at least this");
     v.Field("max_rmse_m", c.max_rmse_m, "and at most this");
     v.Field("min_constraining_points", c.min_constraining_points,

@@ -140,19 +140,20 @@ bool TooFewPoints(const PreparedScan& scan, const AcceptanceConfig& config) {
 }  // namespace
 
 double AllowedRmse(const PreparedScan& query, const PreparedScan& match,
-                   const AcceptanceConfig& config) {
+                   const AcceptanceConfig& config, bool odometry_judges) {
     // The RMS of the two scans' own residuals: what a right pose leaves between them.
     const double roughness_m =
         std::sqrt(0.5 * (query.structure_roughness_m * query.structure_roughness_m +
                          match.structure_roughness_m * match.structure_roughness_m));
-    return std::clamp(config.max_rmse_ratio * roughness_m, config.min_allowed_rmse_m,
-                      config.max_rmse_m);
+    const double ratio =
+        odometry_judges ? config.max_rmse_ratio_with_odometry : config.max_rmse_ratio;
+    return std::clamp(ratio * roughness_m, config.min_allowed_rmse_m, config.max_rmse_m);
 }
 
 namespace {
 
 // The first acceptance rule the registered pair breaks (kNone: none). `odometry_judges`: the
-// odometry's gate judges the pose, and fewer points need to pin it.
+// odometry's gate judges the pose: fewer points need to pin it, and it may fit a little worse.
 RejectReason Judge(const PreparedScan& query, const PreparedScan& match,
                    const Verification& verification, bool converged, const AcceptanceConfig& config,
                    bool odometry_judges) {
@@ -164,7 +165,9 @@ RejectReason Judge(const PreparedScan& query, const PreparedScan& match,
         overlap.MinDistinctive() < config.min_distinctive_overlap) {
         return RejectReason::kLowOverlap;
     }
-    if (overlap.rmse_m > AllowedRmse(query, match, config)) return RejectReason::kHighRmse;
+    if (overlap.rmse_m > AllowedRmse(query, match, config, odometry_judges)) {
+        return RejectReason::kHighRmse;
+    }
     const int min_constraining = odometry_judges ? config.min_constraining_points_with_odometry
                                                  : config.min_constraining_points;
     if (overlap.constraining_points < static_cast<std::size_t>(min_constraining) ||

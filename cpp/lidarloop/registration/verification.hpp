@@ -91,11 +91,12 @@ bool OverlapReaches(const PreparedScan& query, const PreparedScan& match,
                     const core::Transform& T_match_query, const AcceptanceConfig& config,
                     double min_overlap, std::size_t stride = 1);
 
-/// The largest RMSE a pair may have: max_rmse_ratio times the RMS of the two scans' roughness
+/// The largest RMSE a pair may have: max_rmse_ratio (max_rmse_ratio_with_odometry where
+/// `odometry_judges`) times the RMS of the two scans' roughness
 /// (PreparedScan::structure_roughness_m: how well each fits itself), within
 /// [min_allowed_rmse_m, max_rmse_m].
 double AllowedRmse(const PreparedScan& query, const PreparedScan& match,
-                   const AcceptanceConfig& config);
+                   const AcceptanceConfig& config, bool odometry_judges = false);
 
 /// Whether another source of the pose, the odometry's gate, allows T_match_query for a loop of
 /// two scans (app::OdometryLoopCheck). Empty where no such source judges the pair.
@@ -107,8 +108,8 @@ using PoseAllowed = std::function<bool(const core::Transform& T_match_query)>;
 /// with its reason. Thread-safe.
 /// Given `allowed` (the odometry judges the loop's pose and will reject what it does not allow),
 /// the degeneracy test asks for acceptance.min_constraining_points_with_odometry points instead of
-/// min_constraining_points, and only a rival pose it allows makes the place ambiguous
-/// (docs/verification.md, "The odometry pins the road").
+/// min_constraining_points, the RMSE may reach max_rmse_ratio_with_odometry, and only a rival pose
+/// it allows makes the place ambiguous (docs/verification.md, "The odometry pins the road").
 Verification Verify(const PreparedScan& query, const CoarseQuery& coarse, const PreparedScan& match,
                     const VerificationConfig& config, const PoseAllowed& allowed = {});
 

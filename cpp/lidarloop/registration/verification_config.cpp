@@ -72,6 +72,7 @@ void AcceptanceConfig::Validate() const {
     RequireIn(min_distinctive_overlap, 0.0, 1.0, "acceptance.min_distinctive_overlap");
     RequireIn(min_overlapping_points, 1, 1'000'000, "acceptance.min_overlapping_points");
     RequireIn(max_rmse_ratio, 0.0, 1000.0, "acceptance.max_rmse_ratio");
+    RequireIn(max_rmse_ratio_with_odometry, 0.0, 1000.0, "acceptance.max_rmse_ratio_with_odometry");
     RequireIn(min_allowed_rmse_m, 0.0, 100.0, "acceptance.min_allowed_rmse_m");
     RequireIn(max_rmse_m, std::max(0.001, min_allowed_rmse_m), 100.0, "acceptance.max_rmse_m");
     RequireIn(min_constraining_points, 1, 1'000'000, "acceptance.min_constraining_points");

@@ -299,6 +299,7 @@ TEST(Verification, InvalidConfigIsAConfigError) {
     expect_error([](auto& c) { c.acceptance.max_loop_distance_m = 0.0; });
     expect_error([](auto& c) { c.acceptance.min_constraining_points = 0; });
     expect_error([](auto& c) { c.acceptance.min_constraining_points_with_odometry = -1; });
+    expect_error([](auto& c) { c.acceptance.max_rmse_ratio_with_odometry = -0.5; });
 }
 
 // One place seen from 11.6 m away registers at the right pose, but a loop is a revisit of one
