@@ -21,7 +21,10 @@ import numpy as np
 
 
 def positions(poses_file):
-    poses = np.loadtxt(poses_file, ndmin=2)
+    try:
+        poses = np.loadtxt(poses_file, ndmin=2)
+    except (OSError, ValueError) as error:
+        raise SystemExit(f"{poses_file}: cannot read KITTI poses ({error})") from None
     if poses.shape[1] != 12:
         raise SystemExit(f"{poses_file}: expected KITTI poses, 12 values a line")
     return poses.reshape(-1, 3, 4)[:, :, 3]
@@ -39,26 +42,30 @@ def main():
     xyz = positions(args.poses)
     path = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xyz, axis=0), axis=1))])
 
-    def is_true(query, match):
-        return (np.linalg.norm(xyz[query] - xyz[match]) < args.distance and
-                path[query] - path[match] > args.min_path and match < query - args.min_gap)
+    def true_matches(query, matches):
+        """Which of `matches` (scan indices) are true matches of `query`: one rule for both uses."""
+        matches = np.asarray(matches, dtype=int)
+        return ((np.linalg.norm(xyz[matches] - xyz[query], axis=1) < args.distance) &
+                (path[query] - path[matches] > args.min_path) & (matches < query - args.min_gap))
 
-    def has_revisit(query):
-        earlier = np.arange(query)
-        return bool(np.any((np.linalg.norm(xyz[:query] - xyz[query], axis=1) < args.distance) &
-                           (path[query] - path[:query] > args.min_path) &
-                           (earlier < query - args.min_gap)))
-
-    revisiting = [q for q in range(len(xyz)) if has_revisit(q)]
+    revisiting = [q for q in range(len(xyz)) if true_matches(q, range(q)).any()]
     rows = collections.defaultdict(list)
-    with open(args.candidates, newline="") as f:
-        for row in csv.DictReader(f):
+    try:
+        candidates = open(args.candidates, newline="")
+    except OSError as error:
+        raise SystemExit(f"{args.candidates}: cannot open ({error.strerror})") from None
+    with candidates as f:
+        reader = csv.DictReader(f)
+        if not {"query", "rank", "match"} <= set(reader.fieldnames or []):
+            raise SystemExit(f"{args.candidates}: not a candidates.csv (needs query, rank, match)")
+        for row in reader:
             rows[int(row["query"])].append(row)
 
     best_rank, closed, without, first_reason = {}, 0, 0, collections.Counter()
     for query in revisiting:
-        true = sorted((r for r in rows[query] if is_true(query, int(r["match"]))),
-                      key=lambda r: int(r["rank"]))
+        listed = rows[query]
+        hits = true_matches(query, [int(r["match"]) for r in listed])
+        true = sorted((r for r, hit in zip(listed, hits) if hit), key=lambda r: int(r["rank"]))
         if true:
             best_rank[query] = int(true[0]["rank"])
         if any(r.get("accepted") == "1" for r in true):
