@@ -249,8 +249,12 @@ def evaluate_loop_retrieval(
     recall_k: int = 0,
     wrong_pose_m: Optional[float] = None,
     wrong_pose_deg: Optional[float] = None,
+    detector_path_m: Optional[Sequence[float]] = None,
 ) -> LoopRetrievalEvaluation:
-    """ranked: (query, [dict(match, distance, accepted, score=-distance, T_match_query=None)])."""
+    """ranked: (query, [dict(match, distance, accepted, score=-distance, T_match_query=None)]).
+
+    detector_path_m: the path (m per scan) the detector measured a gap in metres on (its
+    odometry's); None: the truth's."""
 
 def absolute_trajectory_rmse(estimate: FloatArray, truth: FloatArray) -> float:
     """ATE, metres: (N, 4, 4) positions rigidly aligned (no scale) onto the truth's."""

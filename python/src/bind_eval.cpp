@@ -533,7 +533,8 @@ void BindRetrieval(py::module_& m) {
         "evaluate_loop_retrieval",
         [](const std::vector<std::pair<std::size_t, py::list>>& ranked, const GroundTruth& truth,
            const py::handle& times_s, const py::handle& T_world_sensor, std::size_t recall_k,
-           std::optional<double> wrong_pose_m, std::optional<double> wrong_pose_deg) {
+           std::optional<double> wrong_pose_m, std::optional<double> wrong_pose_deg,
+           const std::optional<std::vector<double>>& detector_path_m) {
             std::vector<QueryCandidates> queries;
             for (const auto& [query, candidates] : ranked) {
                 QueryCandidates q{query, {}};
@@ -557,15 +558,17 @@ void BindRetrieval(py::module_& m) {
             config.Validate();
             const std::vector<core::StampedPose> poses = PosesFromArrays(times_s, T_world_sensor);
             py::gil_scoped_release release;
-            return EvaluateLoopRetrieval(queries, truth, poses, config);
+            return EvaluateLoopRetrieval(queries, truth, poses, config,
+                                         detector_path_m.value_or(std::vector<double>{}));
         },
         py::arg("ranked"), py::arg("truth"), py::arg("times_s"), py::arg("T_world_sensor"),
         py::arg("recall_k") = 0, py::arg("wrong_pose_m") = py::none(),
-        py::arg("wrong_pose_deg") = py::none(),
+        py::arg("wrong_pose_deg") = py::none(), py::arg("detector_path_m") = py::none(),
         "Scores ranked, decided candidates: `ranked` is a list of (query, [dict(match=, "
         "distance=, accepted=, score= (default -distance), T_match_query= (optional))], best "
         "first); recall@1, recall@k (0: the longest list), precision, recall at full "
-        "precision, wrong poses.");
+        "precision, wrong poses. detector_path_m: the cumulative path (m per scan) the detector "
+        "measured a gap in metres on, its odometry's (None: the truth's).");
 }
 
 void BindTrajectory(py::module_& m) {

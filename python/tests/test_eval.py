@@ -222,6 +222,33 @@ def test_loop_retrieval_recall_matches_brute_force():
     assert result.precision == pytest.approx(true_loops / (true_loops + false_loops))
 
 
+def test_loop_retrieval_checks_a_gap_in_metres_on_the_detectors_path():
+    """The detector measured its 20 m gap on an odometry twice as long as the true path."""
+    times, T, _ = random_sequence(4)
+    truth = lidarloop.build_ground_truth(times, T, distance_m=6.0, min_gap=20.0,
+                                         min_gap_unit="metres")
+    steps = np.linalg.norm(np.diff(T[:, :3, 3], axis=0), axis=1)
+    true_path = np.concatenate([[0.0], np.cumsum(steps)])
+    odometry_path = 2.0 * true_path
+    positive = (np.linalg.norm(T[:, None, :3, 3] - T[None, :, :3, 3], axis=2) < 6.0) & \
+        (np.abs(true_path[:, None] - true_path[None]) > 20.0)
+    ranked, hits, inside_true_gap = [], 0, 0
+    for q in range(N):
+        earlier = [j for j in range(q) if odometry_path[q] - odometry_path[j] > 20.0]
+        ranked.append((q, [dict(match=j, distance=float(q - j), accepted=False) for j in earlier]))
+        hits += positive[q, :q].any() and positive[q, earlier].any()
+        inside_true_gap += sum(true_path[q] - true_path[j] <= 20.0 for j in earlier)
+    assert inside_true_gap > 0
+    with pytest.raises(lidarloop.Error, match="outside the minimum gap"):
+        lidarloop.evaluate_loop_retrieval(ranked, truth, times, T)
+    result = lidarloop.evaluate_loop_retrieval(ranked, truth, times, T,
+                                               detector_path_m=odometry_path)
+    assert result.hits_at_k == hits > 0
+    with pytest.raises(lidarloop.Error, match="detector's path"):
+        lidarloop.evaluate_loop_retrieval(ranked, truth, times, T,
+                                          detector_path_m=odometry_path[:-1])
+
+
 def test_em_threshold_lies_between_two_clusters():
     rng = np.random.default_rng(5)
     sample = np.concatenate([rng.normal(0.1, 0.01, 200), rng.normal(0.5, 0.05, 300),

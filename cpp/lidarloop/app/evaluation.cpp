@@ -214,21 +214,21 @@ struct VerificationState {
     std::optional<PreparedScans> prepared;
     bool collected = false;
     pipeline::VerificationCache cache;
-    std::optional<OdometryCheck> odometry;
 };
 
 // Scan i's submap replaces it once every scan has been read (skipped scans are then known).
 void CollectPrepared(const io::Dataset& dataset, const io::RunConfig& config,
-                     const Progress& progress, VerificationState& verification) {
+                     const OdometryCheck* odometry, const Progress& progress,
+                     VerificationState& verification) {
     const auto& reduction = config.detection.verification.reduction;
-    if (reduction.submap_path_m <= 0.0 || !verification.odometry) return;
-    PrepareSubmaps(dataset, verification.odometry->odometry, reduction, *verification.prepared,
-                   progress);
+    if (reduction.submap_path_m <= 0.0 || odometry == nullptr) return;
+    PrepareSubmaps(dataset, odometry->odometry, reduction, *verification.prepared, progress);
 }
 
 MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method method,
                                 const io::Dataset& dataset, const eval::GroundTruth& truth,
-                                const io::Dataset* train_dataset, VerificationState& verification) {
+                                const io::Dataset* train_dataset, const OdometryCheck* odometry,
+                                VerificationState& verification) {
     io::RunConfig config = request.config;
     config.descriptor.method = method;
     std::optional<LearntThreshold> training;
@@ -246,7 +246,7 @@ MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method m
         verification.collected = true;
     }
     const auto described = DescribeDataset(dataset, config.descriptor, run);
-    if (collecting) CollectPrepared(dataset, config, request.progress, verification);
+    if (collecting) CollectPrepared(dataset, config, odometry, request.progress, verification);
     const pipeline::DescriptorDatabase& database = described.database;
     const bool keep_matrix = config.output.KeepsSimilarityMatrix(database.size());
     pipeline::SimilarityMatrix matrix;
@@ -268,16 +268,15 @@ MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method m
     e.ns_per_comparison = pairs > 0 ? 1e9 * comparisons_s / pairs : 0.0;
     e.matrix = std::move(matrix);
     const PreparedScans* prepared = verification.prepared ? &*verification.prepared : nullptr;
-    const OdometryCheck* odometry = verification.odometry ? &*verification.odometry : nullptr;
     e.retrieval = keep_matrix
                       ? CompareRetrieval(e.matrix, database.times_s(), config.detection, method,
                                          truth, dataset.poses(), prepared, &verification.cache,
                                          request.progress, odometry)
-                      : CompareRetrieval(
-                            pipeline::DetectStreaming(database, config.detection,
-                                                      pipeline::Execution::kParallel, truth.path_m),
-                            config.detection, method, truth, dataset.poses(), prepared,
-                            &verification.cache, request.progress, odometry);
+                      : CompareRetrieval(pipeline::DetectStreaming(database, config.detection,
+                                                                   pipeline::Execution::kParallel,
+                                                                   DetectorPathM(truth, odometry)),
+                                         config.detection, method, truth, dataset.poses(), prepared,
+                                         &verification.cache, request.progress, odometry);
     return e;
 }
 
@@ -465,16 +464,16 @@ EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequ
     const std::filesystem::path out_dir = PrepareOutputFolder(request.out);
     io::WriteConfigYaml(out_dir / "config.yaml", effective.config);
     VerificationState verification;
-    if (effective.config.detection.verify) {
-        verification.prepared.emplace(dataset.size());
-        if (!odometry.empty()) {
-            verification.odometry = OdometryCheck{odometry, core::CumulativePathM(odometry),
-                                                  effective.config.posegraph};
-        }
+    if (effective.config.detection.verify) verification.prepared.emplace(dataset.size());
+    std::optional<OdometryCheck> odometry_check;
+    if (!odometry.empty()) {
+        odometry_check =
+            OdometryCheck{odometry, core::CumulativePathM(odometry), effective.config.posegraph};
     }
     for (core::Method method : request.methods) {
         outcome.methods.push_back(
-            EvaluateMethod(effective, method, dataset, outcome.truth, train_dataset, verification));
+            EvaluateMethod(effective, method, dataset, outcome.truth, train_dataset,
+                           odometry_check ? &*odometry_check : nullptr, verification));
     }
     for (const std::string& file : request.results_files) {
         outcome.methods.push_back(EvaluateResults(request, file, dataset.size(), outcome.truth));

@@ -42,6 +42,11 @@ std::vector<eval::QueryCandidates> VerifiedCandidates(
     return result;
 }
 
+const std::vector<double>& DetectorPathM(const eval::GroundTruth& truth,
+                                         const OdometryCheck* odometry) {
+    return odometry != nullptr ? odometry->path_m : truth.path_m;
+}
+
 RetrievalComparison CompareRetrieval(const pipeline::SimilarityMatrix& matrix,
                                      const std::vector<double>& times_s,
                                      const pipeline::DetectorConfig& detector,
@@ -50,10 +55,9 @@ RetrievalComparison CompareRetrieval(const pipeline::SimilarityMatrix& matrix,
                                      const PreparedScans* prepared,
                                      pipeline::VerificationCache* cache, const Progress& progress,
                                      const OdometryCheck* odometry) {
-    // A gap in metres is measured on the ground-truth path.
-    return CompareRetrieval(
-        pipeline::DetectFromMatrix(matrix, times_s, detector, method, truth.path_m), detector,
-        method, truth, poses, prepared, cache, progress, odometry);
+    return CompareRetrieval(pipeline::DetectFromMatrix(matrix, times_s, detector, method,
+                                                       DetectorPathM(truth, odometry)),
+                            detector, method, truth, poses, prepared, cache, progress, odometry);
 }
 
 RetrievalComparison CompareRetrieval(std::vector<pipeline::LoopQuery> queries,
@@ -67,17 +71,18 @@ RetrievalComparison CompareRetrieval(std::vector<pipeline::LoopQuery> queries,
     comparison.top_k = static_cast<std::size_t>(detector.top_k);
     comparison.queries = std::move(queries);
     const eval::LoopRetrievalConfig config{comparison.top_k};
+    const std::vector<double>& detector_path_m = DetectorPathM(truth, odometry);
     comparison.descriptor = eval::EvaluateLoopRetrieval(
         DescriptorCandidates(comparison.queries, method, detector.ThresholdFor(method)), truth,
-        poses, config);
+        poses, config, detector_path_m);
     if (!detector.verify || prepared == nullptr) return comparison;
     pipeline::LoopCheck odometry_check;
     if (odometry != nullptr)
         odometry_check = OdometryLoopCheck(odometry->odometry, odometry->path_m, odometry->config);
     comparison.verification_times =
         VerifyAll(comparison.queries, *prepared, detector, method, progress, cache, odometry_check);
-    comparison.verified =
-        eval::EvaluateLoopRetrieval(VerifiedCandidates(comparison.queries), truth, poses, config);
+    comparison.verified = eval::EvaluateLoopRetrieval(VerifiedCandidates(comparison.queries), truth,
+                                                      poses, config, detector_path_m);
     return comparison;
 }
 

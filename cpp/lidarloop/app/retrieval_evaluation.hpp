@@ -51,10 +51,15 @@ std::vector<eval::QueryCandidates> DescriptorCandidates(
 /// accepted candidate.
 std::vector<eval::QueryCandidates> VerifiedCandidates(std::span<const pipeline::LoopQuery> queries);
 
+/// The path a detector measures its gap and path rule on: the odometry's when it has one, as
+/// `detect --odometry` does; else the ground truth's.
+const std::vector<double>& DetectorPathM(const eval::GroundTruth& truth,
+                                         const OdometryCheck* odometry);
+
 /// Detects the top-k candidates of every scan from `matrix` (pipeline::DetectFromMatrix with
-/// `detector`; a gap in metres on truth.path_m), verifies them when detector.verify (with
+/// `detector`; the gap and path rule on DetectorPathM), verifies them when detector.verify (with
 /// `prepared`, sharing `cache`, and rejecting what `odometry` contradicts when given), and
-/// scores both against `truth` (built from `poses`).
+/// scores both against `truth` (built from `poses`; revisits by the truth's own path).
 RetrievalComparison CompareRetrieval(const pipeline::SimilarityMatrix& matrix,
                                      const std::vector<double>& times_s,
                                      const pipeline::DetectorConfig& detector,

@@ -28,11 +28,23 @@ void CheckTransform(const core::Transform& T, const std::string& where) {
     }
 }
 
-void CheckCandidate(const QueryCandidates& q, std::size_t rank, const GroundTruth& truth) {
+// Whether the detector may give scan j for query i: outside the gap as the detector measured it,
+// along its own path (the odometry's) when the gap is in metres and that path is given.
+bool OutsideDetectorGap(const GroundTruth& truth, std::span<const double> detector_path_m,
+                        std::size_t i, std::size_t j) {
+    const core::MinGap& gap = truth.config.min_gap;
+    if (detector_path_m.empty() || gap.unit != core::MinGap::Unit::kMetres)
+        return truth.OutsideGap(i, j);
+    return i != j && gap.Allows(i, j, detector_path_m[i], detector_path_m[j]);
+}
+
+void CheckCandidate(const QueryCandidates& q, std::size_t rank, const GroundTruth& truth,
+                    std::span<const double> detector_path_m) {
     const RankedCandidate& c = q.ranked[rank];
     const std::string where = "loop retrieval: query " + std::to_string(q.query) + ", candidate " +
                               std::to_string(rank) + " (scan " + std::to_string(c.match) + ")";
-    if (c.match >= truth.size() || c.match >= q.query || !truth.OutsideGap(q.query, c.match)) {
+    if (c.match >= truth.size() || c.match >= q.query ||
+        !OutsideDetectorGap(truth, detector_path_m, q.query, c.match)) {
         throw core::Error(where + " is not an earlier scan outside the minimum gap");
     }
     if (std::isnan(c.distance)) throw core::Error(where + ": distance is NaN");
@@ -40,7 +52,8 @@ void CheckCandidate(const QueryCandidates& q, std::size_t rank, const GroundTrut
     if (c.T_match_query) CheckTransform(*c.T_match_query, where);
 }
 
-void CheckQuery(const QueryCandidates& q, const GroundTruth& truth, std::vector<bool>& seen) {
+void CheckQuery(const QueryCandidates& q, const GroundTruth& truth,
+                std::span<const double> detector_path_m, std::vector<bool>& seen) {
     const std::string where = "loop retrieval: query " + std::to_string(q.query);
     if (q.query >= truth.size()) {
         throw core::Error(where + " is out of range: the ground truth has " +
@@ -48,7 +61,8 @@ void CheckQuery(const QueryCandidates& q, const GroundTruth& truth, std::vector<
     }
     if (seen[q.query]) throw core::Error(where + " is given twice");
     seen[q.query] = true;
-    for (std::size_t rank = 0; rank < q.ranked.size(); ++rank) CheckCandidate(q, rank, truth);
+    for (std::size_t rank = 0; rank < q.ranked.size(); ++rank)
+        CheckCandidate(q, rank, truth, detector_path_m);
     std::vector<std::size_t> matches;
     for (const auto& c : q.ranked) matches.push_back(c.match);
     std::sort(matches.begin(), matches.end());
@@ -59,14 +73,19 @@ void CheckQuery(const QueryCandidates& q, const GroundTruth& truth, std::vector<
 }
 
 void CheckInput(std::span<const QueryCandidates> queries, const GroundTruth& truth,
-                std::span<const core::StampedPose> poses) {
+                std::span<const core::StampedPose> poses, std::span<const double> detector_path_m) {
     if (poses.size() != truth.size()) {
         throw core::Error("loop retrieval: " + std::to_string(poses.size()) +
                           " poses for a ground truth of " + std::to_string(truth.size()) +
                           " scans");
     }
+    if (!detector_path_m.empty() && detector_path_m.size() != truth.size()) {
+        throw core::Error("loop retrieval: the detector's path has " +
+                          std::to_string(detector_path_m.size()) + " scans, the ground truth " +
+                          std::to_string(truth.size()));
+    }
     std::vector<bool> seen(truth.size(), false);
-    for (const auto& q : queries) CheckQuery(q, truth, seen);
+    for (const auto& q : queries) CheckQuery(q, truth, detector_path_m, seen);
 }
 
 // True when a true loop is among the first `k` candidates.
@@ -193,9 +212,10 @@ bool Revisiting(const GroundTruth& truth, std::size_t scan) {
 LoopRetrievalEvaluation EvaluateLoopRetrieval(std::span<const QueryCandidates> queries,
                                               const GroundTruth& truth,
                                               std::span<const core::StampedPose> poses,
-                                              const LoopRetrievalConfig& config) {
+                                              const LoopRetrievalConfig& config,
+                                              std::span<const double> detector_path_m) {
     config.Validate();
-    CheckInput(queries, truth, poses);
+    CheckInput(queries, truth, poses, detector_path_m);
     LoopRetrievalEvaluation result;
     result.scans = truth.size();
     result.queries = queries.size();

@@ -162,14 +162,21 @@ struct LoopRetrievalEvaluation {
 /// Scores ranked, decided candidates against the ground truth. `poses` are the poses the
 /// ground truth was built from (T_world_sensor per scan; only used for pose errors).
 ///
+/// `detector_path_m`: the cumulative path (metres per scan) along which the detector measured a
+/// gap in metres, its odometry's (core::CumulativePathM); empty: the ground truth's. Scoring
+/// always uses the ground truth's path: an accepted loop within distance_m that the truth does not
+/// count as a revisit (too little path back) is neither true nor false.
+///
 /// Throws core::Error, naming the query and candidate, when: poses.size() != truth.size(); a
-/// query index is out of range or given twice; a candidate is not an earlier scan outside the
-/// minimum gap of its query (GroundTruth::OutsideGap) or appears twice in one list; a distance
-/// or score is NaN; a T_match_query is not finite or its linear part is not a rotation (within
-/// 1e-4). O(n + C log C) for n scans and C candidates. Thread-safe.
+/// non-empty detector_path_m does not have truth.size() entries; a query index is out of range
+/// or given twice; a candidate is not an earlier scan outside the minimum gap of its query (the
+/// gap's unit, on detector_path_m for metres) or appears twice in one list; a distance or score
+/// is NaN; a T_match_query is not finite or its linear part is not a rotation (within 1e-4).
+/// O(n + C log C) for n scans and C candidates. Thread-safe.
 LoopRetrievalEvaluation EvaluateLoopRetrieval(std::span<const QueryCandidates> queries,
                                               const GroundTruth& truth,
                                               std::span<const core::StampedPose> poses,
-                                              const LoopRetrievalConfig& config = {});
+                                              const LoopRetrievalConfig& config = {},
+                                              std::span<const double> detector_path_m = {});
 
 }  // namespace lidarloop::eval

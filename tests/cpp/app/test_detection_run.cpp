@@ -542,6 +542,42 @@ TEST_F(DetectionRun, PathMIsThePathBetweenQueryAndMatchOnThePosesOrTheOdometry) 
     EXPECT_THROW(app::RunDetect(*dataset_, request), io::ReadError);
 }
 
+// evaluate --odometry shortlists as detect --odometry does: the gap and the path rule on the
+// odometry's path (here twice the truth's), not the ground truth's.
+TEST_F(DetectionRun, EvaluateWithOdometryShortlistsAsDetectWithIt) {
+    app::DetectRequest detect = Request("shortlist", core::Method::kRange);
+    detect.config.detection.verify = false;
+    detect.config.detection.min_gap = {60.0, core::MinGap::Unit::kMetres};
+    std::vector<core::StampedPose> odometry = dataset_->poses();
+    for (auto& pose : odometry) pose.T_world_sensor.translation() *= 2.0;
+    io::WriteTumPoses(dir_ / "odometry.txt", odometry);
+    detect.odometry_file = dir_ / "odometry.txt";
+    const app::DetectOutcome detected = app::RunDetect(*dataset_, detect);
+
+    app::EvaluationRequest evaluate;
+    evaluate.config = detect.config;
+    evaluate.methods = {core::Method::kRange};
+    evaluate.odometry_file = detect.odometry_file;
+    evaluate.out = dir_ / "shortlist_evaluate";
+    const app::EvaluationOutcome evaluated = app::RunEvaluation(*dataset_, evaluate);
+    ASSERT_EQ(evaluated.methods.size(), 1u);
+    ASSERT_TRUE(evaluated.methods[0].retrieval);
+    const std::vector<pipeline::LoopQuery>& queries = evaluated.methods[0].retrieval->queries;
+    ASSERT_EQ(queries.size(), detected.queries.size());
+    const std::vector<double>& true_path_m = evaluated.truth.path_m;
+    std::size_t within_the_true_gap = 0;
+    for (std::size_t q = 0; q < queries.size(); ++q) {
+        ASSERT_EQ(queries[q].candidates.size(), detected.queries[q].candidates.size()) << q;
+        for (std::size_t k = 0; k < queries[q].candidates.size(); ++k) {
+            const std::size_t match = queries[q].candidates[k].index;
+            EXPECT_EQ(match, detected.queries[q].candidates[k].index) << q;
+            within_the_true_gap += true_path_m[queries[q].query] - true_path_m[match] <= 60.0;
+        }
+    }
+    // Candidates the ground truth's path would have kept out: the case that differs.
+    EXPECT_GT(within_the_true_gap, 0u);
+}
+
 TEST_F(DetectionRun, AGapInMetresWithoutPosesOrOdometryIsAClearError) {
     std::filesystem::create_directories(dir_ / "bare" / "velodyne");
     std::filesystem::copy(dir_ / "sequence" / "velodyne", dir_ / "bare" / "velodyne");

@@ -288,6 +288,42 @@ TEST(LoopRetrieval, NoRevisitingScans) {
     EXPECT_EQ(e.pose_error.count, 0u);  // poses of false loops are not scored
 }
 
+// A gap in metres is the detector's: measured on its odometry's path, which may be longer than
+// the truth's. Its candidates are checked against that path; revisits still by the truth.
+TEST(LoopRetrieval, AGapInMetresIsCheckedOnTheDetectorsPath) {
+    GroundTruthConfig config;
+    config.distance_m = 5.0;
+    config.min_gap = {50.0, core::MinGap::Unit::kMetres};
+    const auto poses = LinePoses();
+    const GroundTruth truth = BuildGroundTruth(poses, config);  // path 0 20 40 60 80 118 139 159
+    std::vector<double> odometry_path_m = truth.path_m;
+    for (double& path_m : odometry_path_m) path_m *= 2.0;
+    // Scan 4 is 38 m of true path before 5 but 76 m of the odometry's: a candidate of the
+    // detector, and the wrong place (38 m away).
+    const std::vector<QueryCandidates> queries = {
+        {5, {Candidate(4, true, 0.9), Candidate(2, true, 0.8, TrueMatchQuery(2, 5))}}};
+    EXPECT_TRUE(test::Contains(ErrorOf(queries, truth, poses), "outside the minimum gap"));
+    const auto e = EvaluateLoopRetrieval(queries, truth, poses, {}, odometry_path_m);
+    EXPECT_EQ(e.revisiting, 3u);
+    EXPECT_EQ(e.hits_at_1, 0u);
+    EXPECT_EQ(e.hits_at_k, 1u);
+    EXPECT_EQ(e.false_loops, 1u);
+    EXPECT_EQ(e.true_loops, 0u);
+
+    // A candidate within the detector's own gap is still an error, and so is a path that does
+    // not fit the truth.
+    odometry_path_m[4] = odometry_path_m[5] - 10.0;
+    EXPECT_THROW(EvaluateLoopRetrieval(queries, truth, poses, {}, odometry_path_m), core::Error);
+    odometry_path_m.pop_back();
+    try {
+        EvaluateLoopRetrieval(queries, truth, poses, {}, odometry_path_m);
+        ADD_FAILURE() << "no error";
+    } catch (const core::Error& error) {
+        EXPECT_TRUE(test::Contains(error.what(), "the detector's path has 7 scans"))
+            << error.what();
+    }
+}
+
 TEST(LoopRetrieval, EmptyInput) {
     const auto e = EvaluateLoopRetrieval({}, LineTruth(), LinePoses());
     EXPECT_EQ(e.queries, 0u);
