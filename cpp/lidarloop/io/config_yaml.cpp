@@ -155,6 +155,10 @@ void VisitFields(registration::IcpConfig& c, Visitor& v) {
     v.Field("max_ground_points", c.max_ground_points, "query ground points paired");
     v.Field("abandon_below_overlap", c.abandon_below_overlap,
             "a pose overlapping less after the first stage is abandoned");
+    v.Field("aligned_step_factor", c.aligned_step_factor,
+            "a step along the previous one moves up to this many times as far (1: plain)");
+    v.Field("rival_step_factor", c.rival_step_factor,
+            "aligned_step_factor of the ambiguity test's ICP toward a rival pose");
 }
 
 template <typename Visitor>

@@ -71,9 +71,24 @@ struct Partners {
     std::vector<std::int64_t> structure, ground;
 };
 
+// How far to move along `step` when it points within 37 degrees of the previous step (zero at a
+// stage's start): steps that shrink by a ratio r would still add r + r^2 + ... = r / (1 - r) of
+// this one, so the pose moves 1 / (1 - r) times it, at most IcpConfig::aligned_step_factor.
+double StepFactor(const Vector6d& step, const Vector6d& previous, const IcpConfig& config) {
+    constexpr double kAlignedCosine = 0.8;
+    const double norms = step.norm() * previous.norm();
+    if (config.aligned_step_factor == 1.0 || !(norms > 0.0) ||
+        step.dot(previous) <= kAlignedCosine * norms)
+        return 1.0;
+    const double ratio = step.norm() / previous.norm();
+    return ratio < 1.0 ? std::min(1.0 / (1.0 - ratio), config.aligned_step_factor)
+                       : config.aligned_step_factor;
+}
+
 // One stage at a fixed correspondence distance; returns true when it settled.
 bool RunStage(const PreparedScan& query, const PreparedScan& match, float max_distance_m,
               const IcpConfig& config, Partners& partners, IcpResult& result) {
+    Vector6d previous = Vector6d::Zero();
     for (int iteration = 0; iteration < config.max_iterations_per_stage; ++iteration) {
         NormalEquations equations;
         const Eigen::Isometry3f T = result.T_match_query.cast<float>();
@@ -91,7 +106,9 @@ bool RunStage(const PreparedScan& query, const PreparedScan& match, float max_di
         if (equations.count < 6) return false;
         const Vector6d step = equations.hessian.ldlt().solve(-equations.gradient);
         if (!step.allFinite()) return false;
-        result.T_match_query = Increment(step) * result.T_match_query;
+        result.T_match_query =
+            Increment(StepFactor(step, previous, config) * step) * result.T_match_query;
+        previous = step;
         if (step.head<3>().norm() + step.tail<3>().norm() < config.convergence_step) return true;
     }
     return false;

@@ -182,12 +182,13 @@ RejectReason Judge(const PreparedScan& query, const PreparedScan& match,
 // of the full count; it was a tenth of verification time (docs/verification.md).
 constexpr std::size_t kAbandonCheckStride = 4;
 
-// ICP from `initial`, abandoned after its first stage when the pose overlaps too little to ever
-// pass (IcpConfig::abandon_below_overlap).
+// ICP from `initial` with `icp`, abandoned after its first stage when the pose overlaps too
+// little to ever pass (IcpConfig::abandon_below_overlap).
 IcpResult Refine(const PreparedScan& query, const PreparedScan& match,
-                 const core::Transform& initial, const VerificationConfig& config) {
+                 const core::Transform& initial, const VerificationConfig& config,
+                 const IcpConfig& icp) {
     return RefinePointToPlane(
-        query, match, initial, config.icp, [&](const core::Transform& T_match_query) {
+        query, match, initial, icp, [&](const core::Transform& T_match_query) {
             return OverlapReaches(query, match, T_match_query, config.acceptance,
                                   config.icp.abandon_below_overlap, kAbandonCheckStride);
         });
@@ -197,7 +198,7 @@ IcpResult Refine(const PreparedScan& query, const PreparedScan& match,
 Verification RegisterFrom(const PreparedScan& query, const PreparedScan& match,
                           const PlanarHypothesis& hypothesis, const VerificationConfig& config,
                           bool odometry_judges) {
-    const IcpResult icp = Refine(query, match, PlanarPose(hypothesis), config);
+    const IcpResult icp = Refine(query, match, PlanarPose(hypothesis), config, config.icp);
     Verification result;
     result.T_match_query = icp.T_match_query;
     result.overlap = MeasureOverlap(query, match, icp.T_match_query, config.acceptance);
@@ -221,14 +222,18 @@ bool SamePose(const core::Transform& a, const core::Transform& b) {
 // Whether a pose other than the accepted one also fits: ICP from every other hypothesis, and a
 // rival is a different pose whose overlap reaches max_rival_overlap_ratio of the accepted one
 // within the allowed RMSE. Periodic places (rows of trees, identical corridors) have rivals. A
-// pose that `allowed` (the odometry) rules out is none: it will not be the loop.
+// pose that `allowed` (the odometry) rules out is none: it will not be the loop. Its ICP takes
+// longer steps along a sliding direction (IcpConfig::rival_step_factor), so that a pose half-way
+// to the accepted one along a road is not taken for a rival.
 bool HasRivalPose(const PreparedScan& query, const PreparedScan& match,
                   const std::vector<PlanarHypothesis>& hypotheses, std::size_t accepted_index,
                   const Verification& accepted, const VerificationConfig& config,
                   const PoseAllowed& allowed) {
+    IcpConfig toward_rival = config.icp;
+    toward_rival.aligned_step_factor = config.icp.rival_step_factor;
     for (std::size_t j = 0; j < hypotheses.size(); ++j) {
         if (j == accepted_index) continue;
-        const IcpResult icp = Refine(query, match, PlanarPose(hypotheses[j]), config);
+        const IcpResult icp = Refine(query, match, PlanarPose(hypotheses[j]), config, toward_rival);
         if (icp.abandoned || SamePose(icp.T_match_query, accepted.T_match_query)) continue;
         if (allowed && !allowed(icp.T_match_query)) continue;
         const Overlap overlap = MeasureOverlap(query, match, icp.T_match_query, config.acceptance);

@@ -80,6 +80,17 @@ struct IcpConfig {
     /// measured on simulated urban and rural sequences, every pair that was finally accepted
     /// overlapped at least 0.24 there, most wrong pairs less than 0.15 (saves the later stages).
     double abandon_below_overlap = 0.15;
+    /// Longer steps along a sliding direction: when a step points within 37 degrees (cosine 0.8)
+    /// of the previous one in the same stage, the pose moves 1 / (1 - r) times it, r the ratio of
+    /// their lengths (where a series of such steps would end), at most this many times (Besl &
+    /// McKay 1992's accelerated ICP, simplified). 1: plain Gauss-Newton steps, [1, 4]. Plain for
+    /// the registration itself: longer steps carry wrong coarse peaks into partial fits that cost
+    /// the later stages on real dense scans (docs/verification.md).
+    double aligned_step_factor = 1.0;
+    /// aligned_step_factor of the ambiguity test's ICP from the other peaks: a rival must be a
+    /// pose ICP settles at, not one where it ran out of iterations sliding toward the accepted
+    /// pose along a road. [1, 4].
+    double rival_step_factor = 2.0;
 
     void Validate() const;
     bool operator==(const IcpConfig&) const = default;

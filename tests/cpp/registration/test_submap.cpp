@@ -8,6 +8,8 @@
 #include <gtest/gtest.h>
 
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/registration/coarse_alignment.hpp"
+#include "lidarloop/registration/icp.hpp"
 #include "lidarloop/registration/verification.hpp"
 #include "lidarloop/sim/simulator.hpp"
 #include "sparse_keyframes.hpp"
@@ -275,6 +277,49 @@ TEST(Submap, VegetationFitsLooselyWhereTheOdometryJudgesThePose) {
     old_bar.acceptance.max_rmse_ratio_with_odometry = old_bar.acceptance.max_rmse_ratio;
     EXPECT_EQ(revisit.VerifySubmaps(old_bar, revisit.NearTheTruth()).reason,
               RejectReason::kHighRmse);
+}
+
+// Scan 263 back to scan 44 on a road with trees. ICP from the second coarse peak, 13 m off,
+// slides toward the right pose in plain Gauss-Newton steps and stops 3.4 m short of it after 10
+// iterations in each stage, where the road still fits (overlap 0.69 against 0.79). Longer steps
+// along the sliding direction (IcpConfig::aligned_step_factor) reach the right pose.
+TEST(Submap, LongerStepsAlongASlideReachThePoseThatPlainStepsStopShortOf) {
+    const SparseRuralRevisit revisit(263, 44);
+    const CoarseQuery coarse(*revisit.query_submap.structure, revisit.config.coarse);
+    const auto peaks = CoarseAlign(coarse, *revisit.match_submap.structure);
+    ASSERT_GE(peaks.size(), 2u);
+    core::Transform start = core::Transform::Identity();
+    start.linear() =
+        Eigen::AngleAxisd(peaks[1].yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    start.translation() << peaks[1].translation_m, 0.0;
+    ASSERT_GT((start.translation() - revisit.truth.translation()).norm(), 10.0)
+        << "pick a far peak";
+    IcpConfig icp = revisit.config.icp;
+    ASSERT_EQ(icp.aligned_step_factor, 1.0);  // the registration's default: plain steps
+    const IcpResult plain =
+        RefinePointToPlane(revisit.query_submap, revisit.match_submap, start, icp);
+    EXPECT_FALSE(plain.converged);
+    EXPECT_GT((plain.T_match_query.translation() - revisit.truth.translation()).norm(), 1.0);
+    icp.aligned_step_factor = 2.0;
+    const IcpResult longer =
+        RefinePointToPlane(revisit.query_submap, revisit.match_submap, start, icp);
+    EXPECT_TRUE(longer.converged);
+    EXPECT_LT((longer.T_match_query.translation() - revisit.truth.translation()).norm(), 0.1);
+    EXPECT_LT(longer.iterations, plain.iterations);
+}
+
+// The same pair verified: with plain steps in the ambiguity test that half-way pose is a rival
+// within the odometry's reach, and the loop is rejected as ambiguous; with the test's longer steps
+// (IcpConfig::rival_step_factor) its ICP reaches the accepted pose, and the loop is accepted there.
+TEST(Submap, TheAmbiguityTestTakesNoHalfwayPoseForARival) {
+    const SparseRuralRevisit revisit(263, 44);
+    const Verification verified = revisit.VerifySubmaps(revisit.NearTheTruth());
+    EXPECT_TRUE(verified.accepted) << ToString(verified.reason);
+    EXPECT_LT(revisit.ErrorM(verified), 0.1);
+    VerificationConfig plain = revisit.config;
+    plain.icp.rival_step_factor = 1.0;
+    EXPECT_EQ(revisit.VerifySubmaps(plain, revisit.NearTheTruth()).reason, RejectReason::kAmbiguous)
+        << "pick a pair plain steps reject";
 }
 
 }  // namespace

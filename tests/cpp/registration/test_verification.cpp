@@ -300,6 +300,9 @@ TEST(Verification, InvalidConfigIsAConfigError) {
     expect_error([](auto& c) { c.acceptance.min_constraining_points = 0; });
     expect_error([](auto& c) { c.acceptance.min_constraining_points_with_odometry = -1; });
     expect_error([](auto& c) { c.acceptance.max_rmse_ratio_with_odometry = -0.5; });
+    expect_error([](auto& c) { c.icp.aligned_step_factor = 0.5; });
+    expect_error([](auto& c) { c.icp.aligned_step_factor = std::nan(""); });
+    expect_error([](auto& c) { c.icp.rival_step_factor = 4.5; });
 }
 
 // One place seen from 11.6 m away registers at the right pose, but a loop is a revisit of one
