@@ -129,6 +129,23 @@ protected:
         request.out = dir_ / out;
         return request;
     }
+    // The evaluation of one method with `detect`'s config and odometry, into `out`.
+    app::EvaluationRequest EvaluationLike(const app::DetectRequest& detect,
+                                          const std::string& out) const {
+        app::EvaluationRequest evaluate;
+        evaluate.config = detect.config;
+        evaluate.methods = {detect.config.descriptor.method};
+        evaluate.odometry_file = detect.odometry_file;
+        evaluate.out = dir_ / out;
+        return evaluate;
+    }
+    // An odometry twice as far apart as the sequence's poses, written to odometry.txt.
+    std::vector<core::StampedPose> WriteDoubledOdometry() const {
+        std::vector<core::StampedPose> odometry = dataset_->poses();
+        for (auto& pose : odometry) pose.T_world_sensor.translation() *= 2.0;
+        io::WriteTumPoses(dir_ / "odometry.txt", odometry);
+        return odometry;
+    }
 
     test::TempDir dir_;
     std::optional<io::Dataset> dataset_;
@@ -526,9 +543,7 @@ TEST_F(DetectionRun, PathMIsThePathBetweenQueryAndMatchOnThePosesOrTheOdometry) 
         ExpectPathColumn(request.out / file, poses);
 
     // Odometry twice as far apart, gap in metres: measured on the odometry, outside the gap.
-    std::vector<core::StampedPose> odometry = poses;
-    for (auto& pose : odometry) pose.T_world_sensor.translation() *= 2.0;
-    io::WriteTumPoses(dir_ / "odometry.txt", odometry);
+    std::vector<core::StampedPose> odometry = WriteDoubledOdometry();
     request.out = dir_ / "odometry";
     request.odometry_file = dir_ / "odometry.txt";
     request.config.detection.min_gap = {60.0, core::MinGap::Unit::kMetres};
@@ -548,17 +563,11 @@ TEST_F(DetectionRun, EvaluateWithOdometryShortlistsAsDetectWithIt) {
     app::DetectRequest detect = Request("shortlist", core::Method::kRange);
     detect.config.detection.verify = false;
     detect.config.detection.min_gap = {60.0, core::MinGap::Unit::kMetres};
-    std::vector<core::StampedPose> odometry = dataset_->poses();
-    for (auto& pose : odometry) pose.T_world_sensor.translation() *= 2.0;
-    io::WriteTumPoses(dir_ / "odometry.txt", odometry);
+    WriteDoubledOdometry();
     detect.odometry_file = dir_ / "odometry.txt";
     const app::DetectOutcome detected = app::RunDetect(*dataset_, detect);
 
-    app::EvaluationRequest evaluate;
-    evaluate.config = detect.config;
-    evaluate.methods = {core::Method::kRange};
-    evaluate.odometry_file = detect.odometry_file;
-    evaluate.out = dir_ / "shortlist_evaluate";
+    const app::EvaluationRequest evaluate = EvaluationLike(detect, "shortlist_evaluate");
     const app::EvaluationOutcome evaluated = app::RunEvaluation(*dataset_, evaluate);
     ASSERT_EQ(evaluated.methods.size(), 1u);
     ASSERT_TRUE(evaluated.methods[0].retrieval);
@@ -649,11 +658,7 @@ TEST_F(DetectionRun, EvaluateWithOdometryVerifiesAsDetectWithIt) {
     detect.odometry_file = dir_ / "sequence" / "poses_odometry.txt";
     const app::DetectOutcome detected = app::RunDetect(*dataset_, detect);
 
-    app::EvaluationRequest evaluate;
-    evaluate.config = detect.config;
-    evaluate.methods = {core::Method::kRange};
-    evaluate.odometry_file = detect.odometry_file;
-    evaluate.out = dir_ / "evaluate";
+    app::EvaluationRequest evaluate = EvaluationLike(detect, "evaluate");
     const app::EvaluationOutcome evaluated = app::RunEvaluation(*dataset_, evaluate);
     EXPECT_TRUE(evaluated.notes.empty()) << evaluated.notes.front();
     EXPECT_EQ(io::LoadConfigYaml(evaluate.out / "config.yaml")
