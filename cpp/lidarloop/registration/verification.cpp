@@ -90,37 +90,57 @@ Eigen::Vector2d WeakestDirection(const std::vector<Eigen::Vector2f>& normals_xy)
     return solver.eigenvectors().col(0);  // eigenvalues ascending
 }
 
-// The degeneracy test (docs/verification.md): the overlapping query points whose surfaces face
-// the weakest direction (normals within 60 degrees of it) pin the position along it; shifted by
-// degeneracy_shift_m both ways, the share of them still on a surface, the larger of the two.
-void MeasureDegeneracy(const SurfacePoints& query, const SurfacePoints& match,
-                       const Eigen::Isometry3f& T_match_query, const OneWay& forward,
-                       const AcceptanceConfig& config, Overlap& overlap) {
-    overlap.weakest_direction = WeakestDirection(forward.overlapping_partner_xy);
-    const Eigen::Vector2f d = overlap.weakest_direction.cast<float>();
-    std::vector<std::uint32_t> constraining;
+// The overlapping query points whose surfaces face d by at least `min_facing` (|n . d|).
+std::vector<std::uint32_t> PointsFacing(const OneWay& forward, const Eigen::Vector2f& d,
+                                        float min_facing) {
+    std::vector<std::uint32_t> facing;
     for (std::size_t k = 0; k < forward.overlapping_points.size(); ++k) {
-        if (std::abs(forward.overlapping_partner_xy[k].dot(d)) >= 0.5F)
-            constraining.push_back(forward.overlapping_points[k]);
+        if (std::abs(forward.overlapping_partner_xy[k].dot(d)) >= min_facing)
+            facing.push_back(forward.overlapping_points[k]);
     }
-    overlap.constraining_points = constraining.size();
-    overlap.shifted_overlap_ratio = 1.0;
-    if (constraining.empty()) return;
+    return facing;
+}
+
+// Shifted by degeneracy_shift_m along d both ways, the share of `points` still on a surface, the
+// larger of the two; 1 when there are none.
+double ShiftedOverlapRatio(const SurfacePoints& query, const SurfacePoints& match,
+                           const Eigen::Isometry3f& T_match_query, const Eigen::Vector2f& d,
+                           const std::vector<std::uint32_t>& points,
+                           const AcceptanceConfig& config) {
+    if (points.empty()) return 1.0;
     double worst = 0.0;
     for (const float sign : {-1.0F, 1.0F}) {
         Eigen::Isometry3f shifted = T_match_query;
         shifted.translation().head<2>() += sign * static_cast<float>(config.degeneracy_shift_m) * d;
         std::size_t still = 0;
-        for (const std::uint32_t i : constraining) {
+        for (const std::uint32_t i : points) {
             const Eigen::Vector3f moved = shifted * query.points()[i];
             still +=
                 HitOnSurface(moved, shifted.linear() * query.normals()[i], match, config).on_surface
                     ? 1
                     : 0;
         }
-        worst = std::max(worst, Fraction(still, constraining.size()));
+        worst = std::max(worst, Fraction(still, points.size()));
     }
-    overlap.shifted_overlap_ratio = worst;
+    return worst;
+}
+
+// The degeneracy test (docs/verification.md): the overlapping query points whose surfaces face
+// the weakest direction pin the position along it; shifted along it, most must stop fitting.
+// They are those within 60 degrees of it; where the odometry judges the pose and those are too
+// few, every point the shift moves off its plane (SlantThatAShiftBreaks).
+void MeasureDegeneracy(const SurfacePoints& query, const SurfacePoints& match,
+                       const Eigen::Isometry3f& T_match_query, const OneWay& forward,
+                       const AcceptanceConfig& config, bool odometry_judges, Overlap& overlap) {
+    overlap.weakest_direction = WeakestDirection(forward.overlapping_partner_xy);
+    const Eigen::Vector2f d = overlap.weakest_direction.cast<float>();
+    std::vector<std::uint32_t> constraining = PointsFacing(forward, d, kFacingWithin60Degrees);
+    if (odometry_judges && constraining.size() < MinConstrainingPoints(config, true)) {
+        constraining = PointsFacing(forward, d, static_cast<float>(SlantThatAShiftBreaks(config)));
+    }
+    overlap.constraining_points = constraining.size();
+    overlap.shifted_overlap_ratio =
+        ShiftedOverlapRatio(query, match, T_match_query, d, constraining, config);
 }
 
 core::Transform PlanarPose(const PlanarHypothesis& hypothesis) {
@@ -168,9 +188,7 @@ RejectReason Judge(const PreparedScan& query, const PreparedScan& match,
     if (overlap.rmse_m > AllowedRmse(query, match, config, odometry_judges)) {
         return RejectReason::kHighRmse;
     }
-    const int min_constraining = odometry_judges ? config.min_constraining_points_with_odometry
-                                                 : config.min_constraining_points;
-    if (overlap.constraining_points < static_cast<std::size_t>(min_constraining) ||
+    if (overlap.constraining_points < MinConstrainingPoints(config, odometry_judges) ||
         overlap.shifted_overlap_ratio > config.max_shifted_overlap_ratio) {
         return RejectReason::kDegenerate;
     }
@@ -201,7 +219,8 @@ Verification RegisterFrom(const PreparedScan& query, const PreparedScan& match,
     const IcpResult icp = Refine(query, match, PlanarPose(hypothesis), config, config.icp);
     Verification result;
     result.T_match_query = icp.T_match_query;
-    result.overlap = MeasureOverlap(query, match, icp.T_match_query, config.acceptance);
+    result.overlap =
+        MeasureOverlap(query, match, icp.T_match_query, config.acceptance, odometry_judges);
     result.coarse_score = hypothesis.score;
     result.icp_iterations = icp.iterations;
     result.shifted_overlap_ratio = result.overlap.shifted_overlap_ratio;
@@ -277,8 +296,18 @@ std::string ToString(RejectReason reason) {
     return "unknown";
 }
 
+double SlantThatAShiftBreaks(const AcceptanceConfig& config) {
+    return config.overlap_plane_m / config.degeneracy_shift_m;
+}
+
+std::size_t MinConstrainingPoints(const AcceptanceConfig& config, bool odometry_judges) {
+    return static_cast<std::size_t>(odometry_judges ? config.min_constraining_points_with_odometry
+                                                    : config.min_constraining_points);
+}
+
 Overlap MeasureOverlap(const PreparedScan& query, const PreparedScan& match,
-                       const core::Transform& T_match_query, const AcceptanceConfig& config) {
+                       const core::Transform& T_match_query, const AcceptanceConfig& config,
+                       bool odometry_judges) {
     const Eigen::Isometry3f T = T_match_query.cast<float>();
     const OneWay forward = OverlapOneWay(*query.structure, query.structure_distinctive,
                                          *match.structure, T, config, true);
@@ -297,7 +326,8 @@ Overlap MeasureOverlap(const PreparedScan& query, const PreparedScan& match,
     overlap.rmse_m = both == 0 ? 0.0
                                : std::sqrt((forward.squared_sum_m2 + backward.squared_sum_m2) /
                                            static_cast<double>(both));
-    MeasureDegeneracy(*query.structure, *match.structure, T, forward, config, overlap);
+    MeasureDegeneracy(*query.structure, *match.structure, T, forward, config, odometry_judges,
+                      overlap);
     return overlap;
 }
 

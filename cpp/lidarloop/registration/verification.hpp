@@ -49,7 +49,8 @@ struct Overlap {
     double rmse_m = 0.0;  ///< RMS plane distance of the overlapping points, both ways
     /// Horizontal direction (match frame) the overlapping structure constrains least.
     Eigen::Vector2d weakest_direction = Eigen::Vector2d::UnitX();
-    /// Overlapping query points whose surfaces face the weakest direction (they pin it).
+    /// Overlapping query points whose surfaces face the weakest direction (they pin it;
+    /// MinConstrainingFacing).
     std::size_t constraining_points = 0;
     /// Share of those still on a surface after shifting by degeneracy_shift_m along the weakest
     /// direction (the worse sign); 1 when there are none.
@@ -79,9 +80,24 @@ struct Verification {
     double score() const { return overlap.Min(); }
 };
 
-/// The overlap of `query` on `match` at T_match_query (see AcceptanceConfig). Thread-safe.
+/// The overlap of `query` on `match` at T_match_query (see AcceptanceConfig), its degeneracy
+/// measured as the acceptance rule does where `odometry_judges` says (Verify). Thread-safe.
 Overlap MeasureOverlap(const PreparedScan& query, const PreparedScan& match,
-                       const core::Transform& T_match_query, const AcceptanceConfig& config);
+                       const core::Transform& T_match_query, const AcceptanceConfig& config,
+                       bool odometry_judges = false);
+
+/// The degeneracy test counts a point as pinning the position along the weakest direction d when
+/// its surface faces d within 60 degrees (|n . d| >= 0.5).
+inline constexpr float kFacingWithin60Degrees = 0.5F;
+
+/// The smallest |n . d| at which a shift by degeneracy_shift_m along d moves a point off its plane
+/// by more than overlap_plane_m (0.3 / 2 = 0.15: normals within 81 degrees of d). Where the
+/// odometry judges the pose and fewer than its floor of points face d within 60 degrees, such
+/// slanted points pin it too (docs/verification.md, "Slanted surfaces pin the road").
+double SlantThatAShiftBreaks(const AcceptanceConfig& config);
+
+/// The degeneracy test's floor: min_constraining_points, or the odometry's where it judges.
+std::size_t MinConstrainingPoints(const AcceptanceConfig& config, bool odometry_judges);
 
 /// MeasureOverlap(query, match, T_match_query, config).Min() >= min_overlap, computed without
 /// the degeneracy test and without the match side when the query side already falls short (the

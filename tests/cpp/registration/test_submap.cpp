@@ -231,6 +231,25 @@ TEST(Submap, ARoadPinnedByAFewPointsIsALoopWhereTheOdometryJudgesIt) {
     EXPECT_LT(revisit.ErrorM(judged), 0.1);
 }
 
+// Scan 170 back to scan 31, 3.5 m apart, as submaps: fewer than the odometry's floor of 5
+// overlapping points face along the road within 60 degrees, but more than that many slanted ones
+// leave their planes when the pose slides 2 m, so where the odometry judges the pose they pin it
+// and the loop is accepted at the true pose (docs/verification.md, "Slanted surfaces pin the
+// road"). Before 2026-11-28 it was rejected as degenerate.
+TEST(Submap, SlantedSurfacesPinARoadWhereTheOdometryJudgesIt) {
+    const SparseRuralRevisit revisit(170, 31);
+    const Verification judged = revisit.VerifySubmaps(revisit.NearTheTruth());
+    ASSERT_TRUE(judged.accepted) << ToString(judged.reason);
+    EXPECT_LT(revisit.ErrorM(judged), 0.1);
+    const AcceptanceConfig& acceptance = revisit.config.acceptance;
+    const Overlap within_60_degrees = MeasureOverlap(revisit.query_submap, revisit.match_submap,
+                                                     judged.T_match_query, acceptance, false);
+    EXPECT_LT(within_60_degrees.constraining_points, MinConstrainingPoints(acceptance, true))
+        << "pick a pair the 60 degree rule rejects";
+    EXPECT_GE(judged.overlap.constraining_points, MinConstrainingPoints(acceptance, true));
+    EXPECT_LE(judged.overlap.shifted_overlap_ratio, acceptance.max_shifted_overlap_ratio);
+}
+
 // Scan 135 back to scan 60, 3.9 m apart, where trees repeat along the road: a second pose 12 m
 // on fits nearly as well, so the place is ambiguous. The odometry's gate rules that pose out, and
 // then only the right one is left; a rival it allows still counts.

@@ -212,6 +212,60 @@ TEST(Verification, CorridorIsDegenerate) {
     EXPECT_LT(v.overlap.constraining_points, 20u);
 }
 
+// A street whose walls are teeth of irregular length, every face 20 degrees off the street's
+// direction: the walls face across the street, and what pins the position along it is the
+// slant of every face (sin 20 = 0.34 of each normal points along the street).
+core::PointCloud ToothedStreet() {
+    const double slope = std::tan(20.0 * M_PI / 180.0);
+    const std::vector<double> tooth_m = {2.0, 3.0, 2.5, 3.5, 1.5, 4.0, 2.2, 2.8, 3.3, 1.8};
+    core::PointCloud cloud;
+    double start = -40.0;
+    for (std::size_t k = 0; start < 40.0; ++k) {
+        const double length = tooth_m[k % tooth_m.size()] + 0.1 * static_cast<double>(k / 10);
+        for (double u = 0; u < 2.0 * length; u += 0.2) {
+            const double depth = slope * (u < length ? u : 2.0 * length - u);
+            for (double z = -1.7; z <= 2.5; z += 0.2) {
+                cloud.emplace_back(static_cast<float>(start + u), static_cast<float>(5.0 - depth),
+                                   static_cast<float>(z));
+                cloud.emplace_back(static_cast<float>(start + u), static_cast<float>(-5.0 + depth),
+                                   static_cast<float>(z));
+            }
+            for (double y = -4.0; y <= 4.0; y += 0.4)
+                cloud.emplace_back(static_cast<float>(start + u), static_cast<float>(y), -1.7F);
+        }
+        start += 2.0 * length;
+    }
+    return cloud;
+}
+
+// A point shifted along the street by degeneracy_shift_m leaves its slanted face by 2 m x 0.34 =
+// 0.68 m, over overlap_plane_m: every wall point pins the street. Where the odometry judges the
+// pose they all count, and the street is a loop at the true pose. The geometry alone counts
+// normals within 60 degrees of the street only (|n . d| >= 0.5), none here: degenerate.
+TEST(Verification, SlantedFacesPinAStreetWhereTheOdometryJudgesThePose) {
+    const core::PointCloud match = ToothedStreet();
+    const core::Transform truth = test::PlanarTransform(3.0, 0.5, 4.0);
+    const VerificationConfig config;
+    const PreparedScan q = PrepareScan(QueryOf(match, truth), config.reduction);
+    const PreparedScan t = PrepareScan(match, config.reduction);
+    const CoarseQuery coarse(*q.structure, config.coarse);
+    const PoseAllowed near_the_truth = [&truth](const core::Transform& T_match_query) {
+        return (T_match_query.translation() - truth.translation()).norm() < 5.0;
+    };
+    const Verification judged = Verify(q, coarse, t, config, near_the_truth);
+    EXPECT_TRUE(judged.accepted) << ToString(judged.reason);
+    EXPECT_LT((judged.T_match_query.translation() - truth.translation()).norm(), 0.05);
+    EXPECT_GT(std::abs(judged.overlap.weakest_direction.x()), 0.9) << "the street's direction";
+    EXPECT_GE(judged.overlap.constraining_points,
+              static_cast<std::size_t>(config.acceptance.min_constraining_points));
+    EXPECT_LE(judged.shifted_overlap_ratio, 0.5);
+
+    const Verification alone = Verify(q, coarse, t, config);
+    EXPECT_EQ(alone.reason, RejectReason::kDegenerate) << ToString(alone.reason);
+    EXPECT_EQ(alone.overlap.constraining_points, 0u);
+    EXPECT_DOUBLE_EQ(SlantThatAShiftBreaks(config.acceptance), 0.15);
+}
+
 // A corridor whose every 10 m repeat the same bay exactly (a door recess, a pillar, a box, a
 // side opening), longer than the sensor's range: a shift by the period fits as well as the truth.
 core::PointCloud PeriodicCorridor(double period_m = 10.0) {
