@@ -115,7 +115,8 @@ void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
                                    Rejected(registration::RejectReason::kTooFewPoints));
         return;
     }
-    // Pruned and cached candidates are answered at once; the others are registered.
+    // Pruned and cached candidates, and those the odometry rules out whatever their registration,
+    // are answered at once; the others are registered.
     const DescriptorMethod& definition = MethodOf(method);
     query.verifications.resize(query.candidates.size());
     std::vector<bool> answered(query.candidates.size(), false);
@@ -125,6 +126,10 @@ void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
         if (cache) cached = cache->Find(query.query, candidate.index);
         if (detector.threshold && !definition.IsMatch(candidate.distance, *detector.threshold)) {
             query.verifications[c] = Rejected(registration::RejectReason::kPruned);
+            answered[c] = true;
+        } else if (!check.MayClose(query.query, candidate.index,
+                                   detector.verification.acceptance.max_loop_distance_m)) {
+            query.verifications[c] = Rejected(registration::RejectReason::kOdometryMismatch);
             answered[c] = true;
         } else if (cached) {
             query.verifications[c] = *cached;

@@ -47,10 +47,12 @@ private:
 /// Appends to `times` when given (pairs found in `cache` are not timed); takes verdicts from and
 /// adds them to `cache` when given. The candidates are registered in parallel unless told
 /// otherwise (`match_of` is then called from worker threads); the verdicts do not depend on it.
-/// `check`, when given, runs on the verified query. With detector.stop_at_first_loop the
-/// candidates are registered one after another in rank order until one is accepted and stays so
-/// after `check`; after that only those `more` still wants are registered (none when `more` is
-/// empty), the others get kNotNeeded (pruned ones stay kPruned).
+/// `check`, when given, runs on the verified query, and a candidate it rules out whatever its
+/// pose (LoopCheck::MayClose: the odometry puts the two scans farther apart than a loop's
+/// max_loop_distance_m plus its gate) is not registered (reason kOdometryMismatch). With
+/// detector.stop_at_first_loop the candidates are registered one after another in rank order until
+/// one is accepted and stays so after `check`; after that only those `more` still wants are
+/// registered (none when `more` is empty), the others get kNotNeeded (pruned ones stay kPruned).
 void VerifyQuery(LoopQuery& query, const registration::PreparedScan& query_scan,
                  const std::function<registration::PreparedScan(std::size_t)>& match_of,
                  const DetectorConfig& detector, const core::Method& method,

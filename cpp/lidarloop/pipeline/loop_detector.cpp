@@ -154,6 +154,20 @@ registration::PoseAllowed OdometryAllowedPoses(
     };
 }
 
+bool OdometryAllowsALoop(std::size_t query, std::size_t match, double max_loop_distance_m,
+                         const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
+                         const std::function<double(std::size_t)>& path_m_of,
+                         const OdometryGate& gate) {
+    const core::Transform T_match_query_odometry =
+        T_odom_sensor_of(match).inverse() * T_odom_sensor_of(query);
+    const double path_between_m = std::abs(path_m_of(query) - path_m_of(match));
+    if (!T_match_query_odometry.matrix().allFinite() || !std::isfinite(path_between_m)) return true;
+    core::Transform nearest = T_match_query_odometry;
+    const double distance_m = nearest.translation().norm();
+    if (distance_m > max_loop_distance_m) nearest.translation() *= max_loop_distance_m / distance_m;
+    return !gate(nearest, T_match_query_odometry, path_between_m);
+}
+
 std::size_t RejectLoopsAgainstOdometry(
     LoopQuery& query, const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
     const std::function<double(std::size_t)>& path_m_of, const OdometryGate& gate) {
@@ -184,6 +198,11 @@ LoopCheck CheckAgainstOdometry(std::function<core::Transform(std::size_t)> T_odo
     check.allowed_poses = [T_odom_sensor_of, path_m_of, gate](std::size_t query,
                                                               std::size_t match) {
         return OdometryAllowedPoses(query, match, T_odom_sensor_of, path_m_of, gate);
+    };
+    check.may_close = [T_odom_sensor_of, path_m_of, gate](std::size_t query, std::size_t match,
+                                                          double max_loop_distance_m) {
+        return OdometryAllowsALoop(query, match, max_loop_distance_m, T_odom_sensor_of, path_m_of,
+                                   gate);
     };
     return check;
 }

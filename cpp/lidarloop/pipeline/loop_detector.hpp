@@ -99,10 +99,19 @@ struct LoopCheck {
     /// points that pin the position along a road. Empty: no pair is judged.
     std::function<registration::PoseAllowed(std::size_t query, std::size_t match)> allowed_poses;
 
+    /// Whether some loop from scan `query` to scan `match`, its sensors at most
+    /// `max_loop_distance_m` apart (AcceptanceConfig), is one `reject` would keep; true where it
+    /// cannot judge the pair. False lets the pair go unregistered: no registration could become
+    /// its loop. Empty: every pair may close.
+    std::function<bool(std::size_t query, std::size_t match, double max_loop_distance_m)> may_close;
+
     explicit operator bool() const { return static_cast<bool>(reject); }
     void operator()(LoopQuery& query) const { reject(query); }
     registration::PoseAllowed AllowedPoses(std::size_t query, std::size_t match) const {
         return allowed_poses ? allowed_poses(query, match) : registration::PoseAllowed{};
+    }
+    bool MayClose(std::size_t query, std::size_t match, double max_loop_distance_m) const {
+        return !may_close || may_close(query, match, max_loop_distance_m);
     }
 };
 
@@ -128,6 +137,16 @@ using OdometryGate =
 std::size_t RejectLoopsAgainstOdometry(
     LoopQuery& query, const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
     const std::function<double(std::size_t)>& path_m_of, const OdometryGate& gate);
+
+/// Whether `gate` lets some loop pose from scan `query` to scan `match` pass, its sensors at most
+/// `max_loop_distance_m` apart: it tries the one nearest to the odometry's relative pose (its
+/// rotation, its translation shortened to that distance), which a gate that judges the size of
+/// the translation and rotation discrepancy (posegraph::GateAgainstOdometry) passes if any such
+/// pose passes. True where the odometry does not know both scans' poses and path (finite).
+bool OdometryAllowsALoop(std::size_t query, std::size_t match, double max_loop_distance_m,
+                         const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
+                         const std::function<double(std::size_t)>& path_m_of,
+                         const OdometryGate& gate);
 
 /// The poses of a loop from scan `query` to scan `match` that `gate` lets pass against the
 /// odometry (as RejectLoopsAgainstOdometry judges them); an empty function when the odometry

@@ -8,6 +8,7 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <random>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -114,6 +115,63 @@ TEST(RejectLoopsAgainstOdometry, RejectsThePoseTheOdometryContradictsAndChoosesA
     odometry.resize(60);
     EXPECT_THROW(app::RejectLoopsAgainstOdometry(consistent, odometry, path_m, {}),
                  core::ConfigError);
+}
+
+// OdometryAllowsALoop against brute force with the pose graph's gate: where it says no loop
+// pose within 10 m passes, none of many tried does; where it says one does, the nearest to the
+// odometry's does. Odometry 0-80 m apart over 0-400 m of path, turned anyhow.
+TEST(OdometryAllowsALoop, EqualsTryingLoopPosesWithinReach) {
+    const pipeline::OdometryGate gate = app::OdometryGateOf(posegraph::PoseGraphConfig{});
+    constexpr double kMaxLoopM = 10.0;
+    std::mt19937 random(5);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    const auto random_turn = [&](double max_rad) {
+        return Eigen::AngleAxisd(max_rad * unit(random),
+                                 Eigen::Vector3d(unit(random), unit(random), 1.0).normalized())
+            .toRotationMatrix();
+    };
+    std::size_t ruled_out = 0;
+    std::size_t allowed = 0;
+    for (int pair = 0; pair < 200; ++pair) {
+        std::vector<core::Transform> T_odom_sensor(2, core::Transform::Identity());
+        T_odom_sensor[1].translation() =
+            40.0 * (1.0 + unit(random)) *
+            Eigen::Vector3d(unit(random), unit(random), 0.1).normalized();
+        T_odom_sensor[1].linear() = random_turn(M_PI);
+        const std::vector<double> path_m{0.0, 200.0 * (1.0 + unit(random))};
+        const auto pose_of = [&](std::size_t i) { return T_odom_sensor[i]; };
+        const auto path_of = [&](std::size_t i) { return path_m[i]; };
+        const bool may_close =
+            pipeline::OdometryAllowsALoop(1, 0, kMaxLoopM, pose_of, path_of, gate);
+        const core::Transform T_0_1 = T_odom_sensor[0].inverse() * T_odom_sensor[1];
+        if (may_close) {
+            ++allowed;
+            core::Transform nearest = T_0_1;
+            if (nearest.translation().norm() > kMaxLoopM)
+                nearest.translation() *= kMaxLoopM / nearest.translation().norm();
+            EXPECT_FALSE(gate(nearest, T_0_1, path_m[1])) << pair;
+            continue;
+        }
+        ++ruled_out;
+        for (int attempt = 0; attempt < 500; ++attempt) {
+            core::Transform loop = core::Transform::Identity();
+            loop.translation() =
+                kMaxLoopM * std::abs(unit(random)) *
+                Eigen::Vector3d(unit(random), unit(random), unit(random)).normalized();
+            loop.linear() = T_0_1.linear() * random_turn(0.3 * std::abs(unit(random)));
+            ASSERT_TRUE(gate(loop, T_0_1, path_m[1])) << pair << " " << attempt;
+        }
+    }
+    EXPECT_GT(ruled_out, 20u);  // both answers were tried
+    EXPECT_GT(allowed, 20u);
+    // Odometry that does not know a scan cannot rule its loops out.
+    const auto lost = [](std::size_t) {
+        core::Transform T = core::Transform::Identity();
+        T.translation().x() = std::numeric_limits<double>::quiet_NaN();
+        return T;
+    };
+    EXPECT_TRUE(pipeline::OdometryAllowsALoop(
+        1, 0, kMaxLoopM, lost, [](std::size_t i) { return 100.0 * static_cast<double>(i); }, gate));
 }
 
 class DetectionRun : public ::testing::Test {

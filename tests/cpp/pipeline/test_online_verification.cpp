@@ -330,6 +330,7 @@ TEST(StopAtFirstLoop, ALoopTheCheckRejectsLetsTheNextCandidateBeRegistered) {
                                }
                                checked_accepted.push_back(accepted);
                            },
+                           {},
                            {}});
     EXPECT_EQ(checked_accepted, (std::vector<std::size_t>{1, 1}));  // one new loop a call
     EXPECT_EQ(first.verifications[1].reason, registration::RejectReason::kOdometryMismatch);
@@ -385,6 +386,7 @@ TEST(StopAtFirstLoop, RegisteringSeveralAtOnceGivesTheVerdictsOfOneAfterAnother)
             if (v.accepted)
                 v.accepted = false, v.reason = registration::RejectReason::kOdometryMismatch;
         },
+        {},
         {}};
     const auto verify = [&](int threads, Execution execution, const LoopCheck& check,
                             VerificationCache* cache) {
@@ -415,6 +417,30 @@ TEST(StopAtFirstLoop, RegisteringSeveralAtOnceGivesTheVerdictsOfOneAfterAnother)
     }
 }
 
+// A candidate the odometry puts farther from the query than a loop's 10 m plus the gate allows
+// cannot become a loop whatever its registration: it is not registered (reason odometry_mismatch,
+// no hypothesis refined), and the other pairs keep their verdicts.
+TEST(OnlineVerification, ACandidateTheOdometryPutsOutOfReachIsNotRegistered) {
+    std::vector<GateCall> calls;
+    const std::vector<LoopQuery> near = ProcessWithOdometry(Odometry(0.0), calls);
+    const std::vector<LoopQuery> far = ProcessWithOdometry(Odometry(60.0), calls);
+    const auto verdict_of = [](const LoopQuery& query, std::size_t match) {
+        for (std::size_t c = 0; c < query.candidates.size(); ++c)
+            if (query.candidates[c].index == match) return query.verifications.at(c);
+        ADD_FAILURE() << "no candidate " << match << " of scan " << query.query;
+        return registration::Verification{};
+    };
+    const registration::Verification registered = verdict_of(near[3], 0);
+    EXPECT_TRUE(registered.accepted);
+    EXPECT_GE(registered.registered_hypotheses, 1);
+    const registration::Verification ruled_out = verdict_of(far[3], 0);
+    EXPECT_EQ(ruled_out.reason, registration::RejectReason::kOdometryMismatch);
+    EXPECT_EQ(ruled_out.registered_hypotheses, 0);
+    ASSERT_EQ(near[4].verifications.size(), far[4].verifications.size());
+    for (std::size_t c = 0; c < near[4].verifications.size(); ++c)
+        ExpectSameVerdict(near[4].verifications[c], far[4].verifications[c], c);
+}
+
 TEST(OnlineVerification, PreparedScansMustMatchTheDatabase) {
     core::DescriptorConfig config;
     DescriptorDatabase database(config);
@@ -437,7 +463,8 @@ TEST(OdometryFloor, OnlyTheCandidatesWhosePoseTheCheckJudges) {
             asked.emplace_back(query, match);
             if (match == 2) return any_pose;
             return {};
-        }};
+        },
+        {}};
     const LoopQuery verified = Verified(ranked, detector, judges_candidate_2);
     EXPECT_EQ(verified.verifications[1].reason, registration::RejectReason::kDegenerate);
     EXPECT_TRUE(verified.verifications[2].accepted);
