@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 
 #include <tbb/blocked_range.h>
@@ -140,17 +141,36 @@ std::optional<std::size_t> LoopQuery::loop() const {
     return best;
 }
 
+namespace {
+
+// The odometry's relative pose of two scans and the path between them.
+struct OdometryBetween {
+    core::Transform T_match_query;
+    double path_m = 0.0;
+};
+
+// Empty where the odometry does not know both scans' poses and path (finite): it cannot judge
+// their loop.
+std::optional<OdometryBetween> OdometryOfPair(
+    std::size_t query, std::size_t match,
+    const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
+    const std::function<double(std::size_t)>& path_m_of) {
+    const OdometryBetween odometry{T_odom_sensor_of(match).inverse() * T_odom_sensor_of(query),
+                                   std::abs(path_m_of(query) - path_m_of(match))};
+    if (!odometry.T_match_query.matrix().allFinite() || !std::isfinite(odometry.path_m)) return {};
+    return odometry;
+}
+
+}  // namespace
+
 registration::PoseAllowed OdometryAllowedPoses(
     std::size_t query, std::size_t match,
     const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
     const std::function<double(std::size_t)>& path_m_of, const OdometryGate& gate) {
-    const core::Transform T_match_query_odometry =
-        T_odom_sensor_of(match).inverse() * T_odom_sensor_of(query);
-    const double path_between_m = std::abs(path_m_of(query) - path_m_of(match));
-    // Odometry that does not know a scan's pose cannot judge its loop.
-    if (!T_match_query_odometry.matrix().allFinite() || !std::isfinite(path_between_m)) return {};
-    return [gate, T_match_query_odometry, path_between_m](const core::Transform& T_match_query) {
-        return !gate(T_match_query, T_match_query_odometry, path_between_m);
+    const auto odometry = OdometryOfPair(query, match, T_odom_sensor_of, path_m_of);
+    if (!odometry) return {};
+    return [gate, odometry = *odometry](const core::Transform& T_match_query) {
+        return !gate(T_match_query, odometry.T_match_query, odometry.path_m);
     };
 }
 
@@ -158,14 +178,12 @@ bool OdometryAllowsALoop(std::size_t query, std::size_t match, double max_loop_d
                          const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
                          const std::function<double(std::size_t)>& path_m_of,
                          const OdometryGate& gate) {
-    const core::Transform T_match_query_odometry =
-        T_odom_sensor_of(match).inverse() * T_odom_sensor_of(query);
-    const double path_between_m = std::abs(path_m_of(query) - path_m_of(match));
-    if (!T_match_query_odometry.matrix().allFinite() || !std::isfinite(path_between_m)) return true;
-    core::Transform nearest = T_match_query_odometry;
+    const auto odometry = OdometryOfPair(query, match, T_odom_sensor_of, path_m_of);
+    if (!odometry) return true;
+    core::Transform nearest = odometry->T_match_query;
     const double distance_m = nearest.translation().norm();
     if (distance_m > max_loop_distance_m) nearest.translation() *= max_loop_distance_m / distance_m;
-    return !gate(nearest, T_match_query_odometry, path_between_m);
+    return !gate(nearest, odometry->T_match_query, odometry->path_m);
 }
 
 std::size_t RejectLoopsAgainstOdometry(
