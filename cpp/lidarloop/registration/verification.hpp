@@ -50,7 +50,7 @@ struct Overlap {
     /// Horizontal direction (match frame) the overlapping structure constrains least.
     Eigen::Vector2d weakest_direction = Eigen::Vector2d::UnitX();
     /// Overlapping query points whose surfaces face the weakest direction (they pin it;
-    /// MinConstrainingFacing).
+    /// kFacingWithin60Degrees, or SlantThatAShiftBreaks where the odometry judges the pose).
     std::size_t constraining_points = 0;
     /// Share of those still on a surface after shifting by degeneracy_shift_m along the weakest
     /// direction (the worse sign); 1 when there are none.
