@@ -12,6 +12,7 @@
 // that this list names every installed header.
 
 // lidarloop::core: point clouds, projections, histograms, NDT, Scan Context (no I/O)
+#include "lidarloop/core/angles.hpp"
 #include "lidarloop/core/byte_codec.hpp"
 #include "lidarloop/core/descriptor.hpp"
 #include "lidarloop/core/descriptor_config.hpp"
@@ -21,6 +22,7 @@
 #include "lidarloop/core/histogram.hpp"
 #include "lidarloop/core/kd_tree.hpp"
 #include "lidarloop/core/min_gap.hpp"
+#include "lidarloop/core/number_text.hpp"
 #include "lidarloop/core/ndt/ndt_cells.hpp"
 #include "lidarloop/core/ndt/ndt_config.hpp"
 #include "lidarloop/core/ndt/ndt_descriptor.hpp"

@@ -43,7 +43,7 @@ io::Image PairImage(const eval::GroundTruth& truth, IsBlack is_black) {
     return image;
 }
 
-std::string Number(double value, int digits = 4) {
+std::string Figure(double value, int digits = 4) {
     if (!std::isfinite(value)) return value > 0 ? "∞" : "–";
     char text[64];
     std::snprintf(text, sizeof(text), "%.*g", digits, value);
@@ -170,18 +170,18 @@ void WritePairwiseTable(std::ostream& out, const std::vector<MethodEvaluation>& 
     for (const MethodEvaluation& e : evaluations) {
         const auto& p = e.pairwise;
         out << "| " << e.name << " | " << p.pairs << " (" << p.positives << ") | "
-            << Number(p.best_mcc.score, 3) << " (" << Number(p.best_mcc.threshold) << ") | "
-            << Number(p.best_f1.score, 3) << " (" << Number(p.best_f1.threshold) << ") | "
-            << (p.roc_auc ? Number(*p.roc_auc, 3) : "–") << " | ";
+            << Figure(p.best_mcc.score, 3) << " (" << Figure(p.best_mcc.threshold) << ") | "
+            << Figure(p.best_f1.score, 3) << " (" << Figure(p.best_f1.threshold) << ") | "
+            << (p.roc_auc ? Figure(*p.roc_auc, 3) : "–") << " | ";
         if (e.learnt) {
-            out << Number(e.learnt->threshold) << " → " << Number(e.learnt->test_f1, 3) << " / "
-                << Number(e.learnt->test_mcc, 3);
+            out << Figure(e.learnt->threshold) << " → " << Figure(e.learnt->test_f1, 3) << " / "
+                << Figure(e.learnt->test_mcc, 3);
         } else {
             out << "–";
         }
         out << " | "
-            << (e.at_default ? Number(eval::Mcc(*e.at_default), 3) +
-                                   " (τ = " + Number(*e.default_threshold) + ")"
+            << (e.at_default ? Figure(eval::Mcc(*e.at_default), 3) +
+                                   " (τ = " + Figure(*e.default_threshold) + ")"
                              : "–")
             << " |\n";
     }
@@ -195,13 +195,13 @@ void WritePairwiseTable(std::ostream& out, const std::vector<MethodEvaluation>& 
 void WriteFixedThresholdTable(std::ostream& out, const std::vector<MethodEvaluation>& evaluations) {
     if (evaluations.empty() || evaluations.front().fixed_thresholds.empty()) return;
     out << "\nMCC at fixed thresholds (table II):\n\n| method |";
-    for (double tau : evaluations.front().fixed_thresholds) out << " L_" << Number(tau) << " |";
+    for (double tau : evaluations.front().fixed_thresholds) out << " L_" << Figure(tau) << " |";
     out << "\n|---|";
     for (std::size_t t = 0; t < evaluations.front().fixed_thresholds.size(); ++t) out << "---|";
     out << "\n";
     for (const MethodEvaluation& e : evaluations) {
         out << "| " << e.name << " |";
-        for (const eval::Confusion& c : e.at_fixed) out << " " << Number(eval::Mcc(c), 3) << " |";
+        for (const eval::Confusion& c : e.at_fixed) out << " " << Figure(eval::Mcc(c), 3) << " |";
         out << "\n";
     }
 }
@@ -213,26 +213,26 @@ void WritePerScanTable(std::ostream& out, const std::vector<MethodEvaluation>& e
     for (const MethodEvaluation& e : evaluations) {
         const auto& z = e.per_scan.zero_error;
         out << "| " << e.name << " | " << e.per_scan.overlapping << " / "
-            << e.per_scan.non_overlapping << " | " << Number(100.0 * z.recall, 3) << " % ("
-            << Number(z.t_d) << ") | " << (e.em.t_d ? Number(*e.em.t_d) : "–") << " | "
-            << (e.distinctiveness.ratio ? Number(e.distinctiveness.ratio->median, 3) : "–")
+            << e.per_scan.non_overlapping << " | " << Figure(100.0 * z.recall, 3) << " % ("
+            << Figure(z.t_d) << ") | " << (e.em.t_d ? Figure(*e.em.t_d) : "–") << " | "
+            << (e.distinctiveness.ratio ? Figure(e.distinctiveness.ratio->median, 3) : "–")
             << " |\n";
     }
     out << "\nZero errors: no false positive and no mismatch (table I). Timings on this "
            "machine: ";
     for (const MethodEvaluation& e : evaluations) {
-        out << e.name << " " << Number(e.describe_ms_per_scan_median, 3) << " ms per scan, "
-            << Number(e.ns_per_comparison, 3) << " ns per comparison; ";
+        out << e.name << " " << Figure(e.describe_ms_per_scan_median, 3) << " ms per scan, "
+            << Figure(e.ns_per_comparison, 3) << " ns per comparison; ";
     }
 }
 
 std::string Percent(double rate) {
-    return std::isnan(rate) ? std::string("–") : Number(100.0 * rate, 3) + " %";
+    return std::isnan(rate) ? std::string("–") : Figure(100.0 * rate, 3) + " %";
 }
 
 std::string MedianMax(const std::optional<eval::Summary>& s, int digits) {
     if (!s) return "–";
-    return Number(s->median, digits) + " / " + Number(s->max, digits);
+    return Figure(s->median, digits) + " / " + Figure(s->max, digits);
 }
 
 void WriteRetrievalRow(std::ostream& out, const std::string& name, const std::string& decision,

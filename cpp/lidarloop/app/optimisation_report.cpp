@@ -12,7 +12,7 @@
 namespace lidarloop::app {
 namespace {
 
-std::string Number(double value, int digits = 4) {
+std::string Rounded(double value, int digits = 4) {
     if (!std::isfinite(value)) return "–";
     char text[64];
     std::snprintf(text, sizeof(text), "%.*g", digits, value);
@@ -188,12 +188,12 @@ void WriteOptimisationReport(const std::filesystem::path& file, const io::Datase
     if (!outcome.loop_is_true.empty()) {
         out << "- against the ground truth: " << CountTrue(outcome, false) << " of the "
             << outcome.loops.size() << " loops are true (within "
-            << Number(request.true_loop_translation_m) << " m and "
-            << Number(request.true_loop_rotation_deg) << " deg); " << CountTrue(outcome, true)
+            << Rounded(request.true_loop_translation_m) << " m and "
+            << Rounded(request.true_loop_rotation_deg) << " deg); " << CountTrue(outcome, true)
             << " of the " << r.loops_used << " used are\n";
     }
     out << "- solver: " << r.solves << " Ceres solves, " << r.iterations << " iterations, "
-        << Number(r.seconds, 3) << " s" << (r.converged ? "" : " (iteration limit reached)")
+        << Rounded(r.seconds, 3) << " s" << (r.converged ? "" : " (iteration limit reached)")
         << "\n";
     for (const std::string& note : outcome.notes) out << "- note: " << note << "\n";
     if (outcome.odometry && outcome.optimised) {
@@ -201,10 +201,11 @@ void WriteOptimisationReport(const std::filesystem::path& file, const io::Datase
         const TrajectoryMetrics& b = *outcome.optimised;
         out << "\n| trajectory | ATE RMSE (m) | RPE translation (%) | RPE rotation (deg/100 m) |\n"
             << "|---|---|---|---|\n"
-            << "| odometry | " << Number(a.ate_rmse_m) << " | " << Number(a.rpe.translation_percent)
-            << " | " << Number(a.rpe.rotation_deg_per_100m) << " |\n"
-            << "| optimised | " << Number(b.ate_rmse_m) << " | "
-            << Number(b.rpe.translation_percent) << " | " << Number(b.rpe.rotation_deg_per_100m)
+            << "| odometry | " << Rounded(a.ate_rmse_m) << " | "
+            << Rounded(a.rpe.translation_percent) << " | " << Rounded(a.rpe.rotation_deg_per_100m)
+            << " |\n"
+            << "| optimised | " << Rounded(b.ate_rmse_m) << " | "
+            << Rounded(b.rpe.translation_percent) << " | " << Rounded(b.rpe.rotation_deg_per_100m)
             << " |\n\n"
             << "ATE: RMSE of positions after the best rigid alignment (Umeyama without scale). "
             << "RPE: KITTI's segments of 100..800 m from every 10th scan (" << b.rpe.segments
@@ -218,7 +219,7 @@ void WriteOptimisationReport(const std::filesystem::path& file, const io::Datase
            "drifted through shows doubled walls) and with the optimised poses (right), top view, "
            "coloured by scan time: `map_odometry.ply` ("
         << maps.odometry_points << " points) and `map_optimised.ply` (" << maps.optimised_points
-        << " points), voxels of " << Number(maps.voxel_m, 3) << " m.\n\n![maps](map.png)\n";
+        << " points), voxels of " << Rounded(maps.voxel_m, 3) << " m.\n\n![maps](map.png)\n";
     if (!out) throw io::WriteError(file, "writing failed");
 }
 

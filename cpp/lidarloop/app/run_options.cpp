@@ -1,9 +1,8 @@
 #include "lidarloop/app/run_options.hpp"
 
-#include <charconv>
-
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/core/min_gap.hpp"
+#include "lidarloop/core/number_text.hpp"
 
 namespace lidarloop::app {
 namespace {
@@ -16,13 +15,6 @@ constexpr std::uint8_t kDetecting = kDetect | kEvaluate | kOptimise | kBench;
 constexpr std::uint8_t kRunning = kDetect | kEvaluate | kOptimise;  // read a whole dataset
 constexpr RunCommand kCommands[] = {RunCommand::kDetect, RunCommand::kEvaluate,
                                     RunCommand::kOptimise, RunCommand::kBench};
-
-// The shortest text that reads back to the same number.
-std::string Number(double value) {
-    char buffer[64];
-    const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-    return std::string(buffer, result.ptr);
-}
 
 std::string Code(std::string_view text) { return "`" + std::string(text) + "`"; }
 
@@ -54,7 +46,7 @@ std::vector<RunOption> MakeRunOptions() {
          },
          [] {
              const auto t = io::RunConfig{}.detection.threshold;
-             return t ? Number(*t) : std::string("the method's");
+             return t ? core::NumberText(*t) : std::string("the method's");
          }},
         {"min_gap", "--min-gap", "S", T::kNumber,
          "S: candidates at least this far back (evaluate: pairs closer in the sequence are not "
@@ -63,7 +55,7 @@ std::vector<RunOption> MakeRunOptions() {
          [](const RunTargets& t, const RunOptionValue& v) {
              t.config->detection.min_gap.value = AsNumber(v);
          },
-         [] { return Number(io::RunConfig{}.detection.min_gap.value); }},
+         [] { return core::NumberText(io::RunConfig{}.detection.min_gap.value); }},
         {"min_gap_unit", "--min-gap-unit", "UNIT", T::kName,
          "unit of the gap: scans | seconds | metres (of path, from the poses or odometry)",
          "detection.min_gap_unit", kDetecting,
@@ -78,7 +70,7 @@ std::vector<RunOption> MakeRunOptions() {
          [](const RunTargets& t, const RunOptionValue& v) {
              t.config->detection.min_path_m = AsNumber(v);
          },
-         [] { return Number(io::RunConfig{}.detection.min_path_m); }},
+         [] { return core::NumberText(io::RunConfig{}.detection.min_path_m); }},
         {"top_k", "--top-k", "K", T::kInt, "candidates per query scan, each verified",
          "detection.top_k", kDetecting,
          [](const RunTargets& t, const RunOptionValue& v) {
@@ -114,27 +106,27 @@ std::vector<RunOption> MakeRunOptions() {
          [](const RunTargets& t, const RunOptionValue& v) {
              t.config->posegraph.max_odometry_step_m = AsNumber(v);
          },
-         [] { return Number(io::RunConfig{}.posegraph.max_odometry_step_m); }},
+         [] { return core::NumberText(io::RunConfig{}.posegraph.max_odometry_step_m); }},
         {"distance_m", "--distance", "D", T::kNumber,
          "same place when the sensors are closer than this, metres (Roehling 10, Magnusson 3-10)",
          "the ground truth", kEvaluate,
          [](const RunTargets& t, const RunOptionValue& v) {
              Evaluation(t).distance_m = AsNumber(v);
          },
-         [] { return Number(EvaluationRequest{}.distance_m); }},
+         [] { return core::NumberText(EvaluationRequest{}.distance_m); }},
         {"max_heading_deg", "--max-heading", "DEG", T::kNumber,
          "and their headings differ by less than this, degrees (0: any; Kvarntorp 20)",
          "the ground truth", kEvaluate,
          [](const RunTargets& t, const RunOptionValue& v) {
              Evaluation(t).max_heading_deg = AsNumber(v);
          },
-         [] { return Number(EvaluationRequest{}.max_heading_deg); }},
+         [] { return core::NumberText(EvaluationRequest{}.max_heading_deg); }},
         {"train_fraction", "--train-fraction", "F", T::kNumber,
          "share of the sequence a threshold is learnt on", "threshold learning", kEvaluate,
          [](const RunTargets& t, const RunOptionValue& v) {
              Evaluation(t).learning.train_fraction = AsNumber(v);
          },
-         [] { return Number(EvaluationRequest{}.learning.train_fraction); }},
+         [] { return core::NumberText(EvaluationRequest{}.learning.train_fraction); }},
         {"criterion", "--criterion", "mcc|f1", T::kName,
          "what the learnt threshold maximises: mcc | f1", "threshold learning", kEvaluate,
          [](const RunTargets& t, const RunOptionValue& v) {
@@ -149,7 +141,7 @@ std::vector<RunOption> MakeRunOptions() {
          [] {
              std::string text;
              for (const double t : EvaluationRequest{}.fixed_thresholds)
-                 text += (text.empty() ? "" : ", ") + Number(t);
+                 text += (text.empty() ? "" : ", ") + core::NumberText(t);
              return text.empty() ? std::string("none") : text;
          }},
     };

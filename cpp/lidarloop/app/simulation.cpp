@@ -1,7 +1,6 @@
 #include "lidarloop/app/simulation.hpp"
 
 #include <atomic>
-#include <charconv>
 #include <chrono>
 #include <fstream>
 #include <limits>
@@ -11,6 +10,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "lidarloop/core/number_text.hpp"
 #include "lidarloop/io/kitti_sequence.hpp"
 #include "lidarloop/io/read_error.hpp"
 #include "lidarloop/io/run_record.hpp"
@@ -19,12 +19,6 @@ namespace lidarloop::app {
 namespace {
 
 constexpr std::size_t kPoseChunk = 4096;
-
-std::string Number(double value) {
-    char buffer[64];
-    const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-    return std::string(buffer, result.ptr);
-}
 
 // The effective parameters, so that a sequence can be made again and its origin is known.
 void WriteSimulationYaml(const std::filesystem::path& file, const sim::Simulator& simulator) {
@@ -37,30 +31,30 @@ void WriteSimulationYaml(const std::filesystem::path& file, const sim::Simulator
         << "seed: " << c.seed << "\n"
         << "route:\n"
         << "  type: " << sim::ToString(c.route.type) << "\n"
-        << "  spacing_min_m: " << Number(c.route.spacing_min_m) << "\n"
-        << "  spacing_max_m: " << Number(c.route.spacing_max_m) << "\n"
+        << "  spacing_min_m: " << core::NumberText(c.route.spacing_min_m) << "\n"
+        << "  spacing_max_m: " << core::NumberText(c.route.spacing_max_m) << "\n"
         << "  uturn_blocks: " << c.route.uturn_blocks << "\n"
-        << "  lap_length_m: " << Number(simulator.route().lap_length_m()) << "\n"
+        << "  lap_length_m: " << core::NumberText(simulator.route().lap_length_m()) << "\n"
         << "trajectory_poses: " << c.trajectory.size()
         << "  # > 0: a given trajectory, not the route\n"
         << "sensor:\n"
         << "  model: " << sim::ToString(s.model) << "\n"
         << "  beams: " << s.beams << "\n"
         << "  horizontal_steps: " << s.horizontal_steps << "\n"
-        << "  min_range_m: " << Number(s.min_range_m) << "\n"
-        << "  max_range_m: " << Number(s.max_range_m) << "\n"
-        << "  mount_height_m: " << Number(s.mount_height_m) << "\n"
-        << "  scan_period_s: " << Number(s.scan_period_s) << "\n"
-        << "  noise_m: " << Number(s.noise_m) << "\n"
-        << "  dropout: " << Number(s.dropout) << "\n"
+        << "  min_range_m: " << core::NumberText(s.min_range_m) << "\n"
+        << "  max_range_m: " << core::NumberText(s.max_range_m) << "\n"
+        << "  mount_height_m: " << core::NumberText(s.mount_height_m) << "\n"
+        << "  scan_period_s: " << core::NumberText(s.scan_period_s) << "\n"
+        << "  noise_m: " << core::NumberText(s.noise_m) << "\n"
+        << "  dropout: " << core::NumberText(s.dropout) << "\n"
         << "front_end:\n"
         << "  keep_every: " << c.front_end.keep_every
         << "  # every N-th returned point of a scan kept\n"
         << "odometry:\n"
-        << "  yaw_noise_deg: " << Number(c.odometry.yaw_noise_deg) << "\n"
-        << "  translation_noise: " << Number(c.odometry.translation_noise) << "\n"
-        << "  yaw_bias_deg_per_100m: " << Number(c.odometry.yaw_bias_deg_per_100m) << "\n"
-        << "  length_bias: " << Number(c.odometry.length_bias) << "\n"
+        << "  yaw_noise_deg: " << core::NumberText(c.odometry.yaw_noise_deg) << "\n"
+        << "  translation_noise: " << core::NumberText(c.odometry.translation_noise) << "\n"
+        << "  yaw_bias_deg_per_100m: " << core::NumberText(c.odometry.yaw_bias_deg_per_100m) << "\n"
+        << "  length_bias: " << core::NumberText(c.odometry.length_bias) << "\n"
         << "files:\n"
         << "  scans: velodyne/NNNNNN.bin  # KITTI float32 x y z intensity(0), sensor frame\n"
         << "  poses: poses.txt  # ground truth T_world_sensor, 3x4 row-major, LiDAR frame\n"

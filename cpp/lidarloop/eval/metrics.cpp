@@ -3,15 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include "lidarloop/eval/detail/ratio.hpp"
+
 namespace lidarloop::eval {
-namespace {
 
-double Ratio(std::uint64_t numerator, std::uint64_t denominator) {
-    return denominator == 0 ? 0.0
-                            : static_cast<double>(numerator) / static_cast<double>(denominator);
-}
-
-}  // namespace
+using detail::Ratio;
 
 double Precision(const Confusion& c) { return Ratio(c.tp, c.tp + c.fp); }
 

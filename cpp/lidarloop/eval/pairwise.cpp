@@ -22,14 +22,10 @@ struct Scored {
     bool loop;
 };
 
-std::string PairName(std::size_t i, std::size_t j) {
-    return "(" + std::to_string(i) + ", " + std::to_string(j) + ")";
-}
-
 void CheckDistance(const ScoredPair& pair) {
     if (std::isnan(pair.distance)) {
-        throw core::Error("pair-wise evaluation: distance of pair " + PairName(pair.i, pair.j) +
-                          " is NaN");
+        throw core::Error("pair-wise evaluation: distance of pair " +
+                          detail::PairName(pair.i, pair.j) + " is NaN");
     }
 }
 
@@ -125,8 +121,8 @@ std::vector<ScoredPair> CollectPairs(std::span<const float> condensed, const Gro
             if (!truth.Comparable(i, j)) continue;
             const float distance = condensed[at];
             if (std::isnan(distance)) {
-                throw core::Error("pair-wise evaluation: distance of pair " + PairName(i, j) +
-                                  " is NaN");
+                throw core::Error("pair-wise evaluation: distance of pair " +
+                                  detail::PairName(i, j) + " is NaN");
             }
             pairs.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j), distance,
                              truth.IsLoop(i, j)});

@@ -7,6 +7,7 @@
 
 #include "lidarloop/core/enum_names.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/eval/detail/ratio.hpp"
 #include "lidarloop/eval/pairwise.hpp"
 
 namespace lidarloop::eval {
@@ -59,11 +60,6 @@ std::size_t& Slot(TaxonomyCounts& counts, ScanLabel label) {
     return counts.false_negative;
 }
 
-double Ratio(std::size_t numerator, std::size_t denominator) {
-    return denominator == 0 ? 0.0
-                            : static_cast<double>(numerator) / static_cast<double>(denominator);
-}
-
 constexpr auto kScanLabelNames = std::to_array<core::EnumName<ScanLabel>>({
     {ScanLabel::kTruePositive, "true_positive"},
     {ScanLabel::kMismatch, "mismatch"},
@@ -77,9 +73,11 @@ static_assert(core::IsOneToOne(kScanLabelNames));
 
 std::string ToString(ScanLabel label) { return std::string(core::NameOf(kScanLabelNames, label)); }
 
-double TaxonomyCounts::Recall() const { return Ratio(true_positive, Overlapping()); }
+double TaxonomyCounts::Recall() const { return detail::Ratio(true_positive, Overlapping()); }
 
-double TaxonomyCounts::FalsePositiveRate() const { return Ratio(false_positive, NonOverlapping()); }
+double TaxonomyCounts::FalsePositiveRate() const {
+    return detail::Ratio(false_positive, NonOverlapping());
+}
 
 std::vector<BestMatch> BestMatchesFromCondensed(std::span<const float> condensed,
                                                 const GroundTruth& truth) {

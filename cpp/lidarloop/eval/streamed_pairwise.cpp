@@ -52,13 +52,10 @@ float FromKey(std::uint32_t key) {
     return std::bit_cast<float>(bits);
 }
 
-std::string PairName(std::size_t i, std::size_t j) {
-    return "(" + std::to_string(i) + ", " + std::to_string(j) + ")";
-}
-
 void CheckNotNan(std::size_t i, std::size_t j, float distance) {
     if (std::isnan(distance)) {
-        throw core::Error("pair-wise evaluation: distance of pair " + PairName(i, j) + " is NaN");
+        throw core::Error("pair-wise evaluation: distance of pair " + detail::PairName(i, j) +
+                          " is NaN");
     }
 }
 

@@ -6,13 +6,13 @@
 
 namespace lidarloop::io {
 namespace {
-constexpr char kMagic[] = "LLDB0001";
+constexpr char kDatabaseMagic[] = "LLDB0001";
 }  // namespace
 
 void SaveDatabase(const std::filesystem::path& file, const pipeline::DescriptorDatabase& database,
                   const pipeline::DetectorConfig& detection) {
     core::ByteWriter out;
-    out.PutMagic(kMagic);
+    out.PutMagic(kDatabaseMagic);
     RunConfig config;
     config.descriptor = database.config();
     config.detection = detection;
@@ -24,7 +24,7 @@ void SaveDatabase(const std::filesystem::path& file, const pipeline::DescriptorD
 
 StoredDatabase LoadStoredDatabase(const std::filesystem::path& file) {
     core::ByteReader in = detail::FileReader(file, detail::ReadWholeFile(file));
-    in.ExpectMagic(kMagic, "lidarloop database");
+    in.ExpectMagic(kDatabaseMagic, "lidarloop database");
     RunConfig config;
     try {
         ApplyConfigYaml(in.GetString("configuration"), "embedded config", config,

@@ -32,16 +32,14 @@
 // is a proper rotation (det +1) because C appears on both sides.
 
 #include "lidarloop/io/osnabrueck.hpp"
-
+#include <Eigen/Geometry>
 #include <cmath>
 #include <numbers>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <Eigen/Geometry>
-
+#include "lidarloop/core/angles.hpp"
 #include "lidarloop/io/detail/binary_io.hpp"
 #include "lidarloop/io/detail/rotation_check.hpp"
 #include "lidarloop/io/detail/text_parsing.hpp"
@@ -51,7 +49,6 @@ namespace lidarloop::io {
 namespace {
 
 constexpr double kCmPerM = 100.0;
-constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 
 // The axis permutation of FromOsnabrueckCoordinates without the unit change (det -1).
 Eigen::Matrix3d AxesFromOsnabrueck() {
@@ -177,7 +174,7 @@ core::Transform ReadOsnabrueckPose(const std::filesystem::path& file) {
     }
     const Eigen::Vector3d t_cm(values[0], values[1], values[2]);
     const Eigen::Vector3d angles_deg(values[3], values[4], values[5]);
-    return FromOsnabrueckTransform(EulerToRotation(angles_deg * kRadPerDeg), t_cm);
+    return FromOsnabrueckTransform(EulerToRotation(angles_deg * core::kRadiansPerDegree), t_cm);
 }
 
 void WriteOsnabrueckPose(const std::filesystem::path& file, const core::Transform& T_world_sensor) {
@@ -185,7 +182,7 @@ void WriteOsnabrueckPose(const std::filesystem::path& file, const core::Transfor
     const Eigen::Matrix3d R_3dtk = C.transpose() * T_world_sensor.linear() * C;
     std::string text;
     AppendVector(text, ToOsnabrueckCoordinates(T_world_sensor.translation()));
-    AppendVector(text, RotationToEuler(R_3dtk) / kRadPerDeg);
+    AppendVector(text, RotationToEuler(R_3dtk) / core::kRadiansPerDegree);
     detail::WriteTextFile(file, text);
 }
 

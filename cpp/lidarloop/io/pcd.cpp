@@ -37,12 +37,12 @@ using detail::ToFloat;
 constexpr std::uint64_t kMaxLzfExpansion = 88;
 
 // The DATA line's names, read and written.
-constexpr auto kEncodingNames = std::to_array<core::EnumName<PcdEncoding>>({
+constexpr auto kPcdEncodingNames = std::to_array<core::EnumName<PcdEncoding>>({
     {PcdEncoding::kAscii, "ascii"},
     {PcdEncoding::kBinary, "binary"},
     {PcdEncoding::kBinaryCompressed, "binary_compressed"},
 });
-static_assert(core::IsOneToOne(kEncodingNames));
+static_assert(core::IsOneToOne(kPcdEncodingNames));
 
 struct PcdField {
     std::string name;
@@ -127,11 +127,11 @@ void CheckVersion(const LineReader& reader, std::span<const std::string_view> to
 
 PcdEncoding ParseDataType(const LineReader& reader, std::span<const std::string_view> tokens) {
     if (tokens.size() == 1) {
-        if (const auto encoding = core::FindEnum(kEncodingNames, tokens[0])) return *encoding;
+        if (const auto encoding = core::FindEnum(kPcdEncodingNames, tokens[0])) return *encoding;
     }
     const std::string_view type = tokens.empty() ? std::string_view() : tokens[0];
     reader.Fail("unknown DATA type " + Quoted(type) + " (expected " +
-                core::JoinNames(kEncodingNames, " or ") + ")");
+                core::JoinNames(kPcdEncodingNames, " or ") + ")");
 }
 
 // Stores one header line in `raw`; returns the encoding when the line is DATA, the last one.
@@ -266,7 +266,7 @@ PcdHeader BuildHeader(const LineReader& reader, RawPcdHeader raw, PcdEncoding en
     return header;
 }
 
-PcdHeader ReadHeader(LineReader& reader) {
+PcdHeader ReadPcdHeader(LineReader& reader) {
     RawPcdHeader raw;
     std::string line;
     while (reader.Next(line)) {
@@ -448,7 +448,7 @@ core::PointCloud ReadCompressedData(const std::filesystem::path& file, DataStrea
 // Writing
 
 std::string_view EncodingName(PcdEncoding encoding) {
-    return core::NameOf(kEncodingNames, encoding, "ascii");
+    return core::NameOf(kPcdEncodingNames, encoding, "ascii");
 }
 
 void WriteHeader(std::ostream& out, std::size_t points, PcdEncoding encoding) {
@@ -501,7 +501,7 @@ void WriteCompressedPoints(const std::filesystem::path& file, std::ostream& out,
 
 core::PointCloud ReadPcd(const std::filesystem::path& file) {
     LineReader reader(file);
-    const PcdHeader header = ReadHeader(reader);
+    const PcdHeader header = ReadPcdHeader(reader);
     if (header.encoding == PcdEncoding::kAscii) return ReadAsciiData(reader, header);
     DataStream data = detail::OpenDataAfterHeader(file, header.line_count);
     if (header.encoding == PcdEncoding::kBinary) return ReadBinaryData(file, data, header);

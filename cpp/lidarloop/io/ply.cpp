@@ -49,12 +49,12 @@ constexpr auto kTypeNames = std::to_array<core::EnumName<PlyType>>({
     {PlyType::kFloat64, "float64"},
 });
 
-constexpr auto kEncodingNames = std::to_array<core::EnumName<PlyEncoding>>({
+constexpr auto kPlyEncodingNames = std::to_array<core::EnumName<PlyEncoding>>({
     {PlyEncoding::kAscii, "ascii"},
     {PlyEncoding::kBinaryLittleEndian, "binary_little_endian"},
     {PlyEncoding::kBinaryBigEndian, "binary_big_endian"},
 });
-static_assert(core::IsOneToOne(kEncodingNames));
+static_assert(core::IsOneToOne(kPlyEncodingNames));
 
 std::size_t TypeSize(PlyType type) {
     switch (type) {
@@ -149,9 +149,9 @@ PlyEncoding ParseFormat(const LineReader& reader, const std::vector<std::string_
     if (tokens.size() != 3) reader.Fail("expected 'format <encoding> 1.0'");
     const auto version = detail::ParseDouble(tokens[2]);
     if (!version || *version != 1.0) reader.Fail("unsupported PLY version " + Quoted(tokens[2]));
-    if (const auto encoding = core::FindEnum(kEncodingNames, tokens[1])) return *encoding;
+    if (const auto encoding = core::FindEnum(kPlyEncodingNames, tokens[1])) return *encoding;
     reader.Fail("unknown format " + Quoted(tokens[1]) + " (expected " +
-                core::JoinNames(kEncodingNames, " or ") + ")");
+                core::JoinNames(kPlyEncodingNames, " or ") + ")");
 }
 
 PlyElement ParseElement(const LineReader& reader, const std::vector<std::string_view>& tokens) {
@@ -215,7 +215,7 @@ PlyHeader FinishHeader(const LineReader& reader, std::optional<PlyEncoding> enco
     return header;
 }
 
-PlyHeader ReadHeader(LineReader& reader) {
+PlyHeader ReadPlyHeader(LineReader& reader) {
     std::string line;
     if (!reader.Next(line) || detail::SplitFields(line) != std::vector<std::string_view>{"ply"}) {
         throw ReadError(reader.file(), "does not start with 'ply' (not a PLY file)");
@@ -411,7 +411,7 @@ private:
 // Writing
 
 std::string_view EncodingName(PlyEncoding encoding) {
-    return core::NameOf(kEncodingNames, encoding, "ascii");
+    return core::NameOf(kPlyEncodingNames, encoding, "ascii");
 }
 
 void WriteHeader(std::ostream& out, std::size_t count, PlyEncoding encoding, PlyScalar scalar) {
@@ -451,7 +451,7 @@ void WriteVertices(std::ostream& out, const core::PointCloud& cloud, PlyEncoding
 
 core::PointCloud ReadPly(const std::filesystem::path& file) {
     LineReader reader(file);
-    const PlyHeader header = ReadHeader(reader);
+    const PlyHeader header = ReadPlyHeader(reader);
     if (header.encoding == PlyEncoding::kAscii) return ReadAsciiPly(reader, header);
     detail::DataStream data = detail::OpenDataAfterHeader(file, header.line_count);
     BinaryReader binary(file, detail::ReadDataBytes(file, data, data.remaining),

@@ -16,7 +16,7 @@ namespace {
 
 // 0002: structure_roughness_m is the scan's self-residual (issue 24); 0001 stored a median
 // plane residual that the acceptance rule no longer understands.
-constexpr char kMagic[] = "LLPS0002";
+constexpr char kPreparedScansMagic[] = "LLPS0002";
 constexpr char kOldMagic[] = "LLPS0001";
 constexpr std::size_t kPointBytes = 6 * sizeof(float);  // x y z and the normal
 
@@ -90,7 +90,7 @@ void SaveScans(const std::filesystem::path& file, std::size_t count,
                const registration::ScanReductionConfig& reduction) {
     std::ofstream out = detail::OpenForWriting(file, /*binary=*/true);
     core::ByteWriter header;
-    header.PutMagic(kMagic);
+    header.PutMagic(kPreparedScansMagic);
     RunConfig config;
     config.detection.verification.reduction = reduction;
     header.PutString(DumpConfigYaml(config));
@@ -132,7 +132,7 @@ StoredPreparedScans LoadPreparedScans(const std::filesystem::path& file) {
             "written by an earlier lidarloop (another roughness measure); run detect again "
             "to rebuild it");
     }
-    in.ExpectMagic(kMagic, "lidarloop prepared scans");
+    in.ExpectMagic(kPreparedScansMagic, "lidarloop prepared scans");
     RunConfig config;
     try {
         ApplyConfigYaml(in.GetString("configuration"), "embedded config", config);

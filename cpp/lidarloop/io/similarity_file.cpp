@@ -11,13 +11,13 @@
 
 namespace lidarloop::io {
 namespace {
-constexpr char kMagic[] = "LLSIM001";
+constexpr char kSimilarityMagic[] = "LLSIM001";
 }  // namespace
 
 void WriteSimilarityMatrix(const std::filesystem::path& file,
                            const pipeline::SimilarityMatrix& matrix, core::Method method) {
     detail::ByteWriter header;
-    header.PutMagic(kMagic);
+    header.PutMagic(kSimilarityMagic);
     header.PutString(core::ToString(method));
     header.Put<std::uint64_t>(matrix.size());
     // The distances in blocks, not assembled in memory: they can be gigabytes.
@@ -40,7 +40,7 @@ void WriteSimilarityMatrix(const std::filesystem::path& file,
 
 StoredSimilarity ReadSimilarityMatrix(const std::filesystem::path& file) {
     core::ByteReader in = detail::FileReader(file, detail::ReadWholeFile(file));
-    in.ExpectMagic(kMagic, "lidarloop similarity matrix");
+    in.ExpectMagic(kSimilarityMagic, "lidarloop similarity matrix");
     StoredSimilarity stored;
     try {
         stored.method = pipeline::ParseMethod(in.GetString("method name"));

@@ -1,5 +1,12 @@
-#include "lidarloop/posegraph/optimiser.hpp"
 
+#include "lidarloop/posegraph/optimiser.hpp"
+#include <ceres/autodiff_cost_function.h>
+#include <ceres/loss_function.h>
+#include <ceres/manifold.h>
+#include <ceres/problem.h>
+#include <ceres/product_manifold.h>
+#include <ceres/solver.h>
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -8,21 +15,12 @@
 #include <limits>
 #include <numbers>
 #include <string>
-
-#include <ceres/autodiff_cost_function.h>
-#include <ceres/loss_function.h>
-#include <ceres/manifold.h>
-#include <ceres/problem.h>
-#include <ceres/product_manifold.h>
-#include <ceres/solver.h>
-#include <Eigen/Cholesky>
-
+#include "lidarloop/core/angles.hpp"
 #include "lidarloop/core/error.hpp"
 
 namespace lidarloop::posegraph {
 namespace {
 
-constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 // Relative cost change that ends an intermediate graduated round (Ceres' default: 1e-6).
 constexpr double kRoughFunctionTolerance = 1e-3;
 
@@ -233,7 +231,7 @@ void Accumulate(const SolveStats& stats, OptimisationResult& result) {
 // Sigmas (translation m, rotation deg) of a loop from its information.
 Eigen::Vector2d LoopSigmas(const Edge& edge) {
     return {1.0 / std::sqrt(edge.information(0, 0)),
-            2.0 / std::sqrt(edge.information(3, 3)) / kRadPerDeg};
+            2.0 / std::sqrt(edge.information(3, 3)) / core::kRadiansPerDegree};
 }
 
 // Whether loops a and b agree: T_m1_q1 * T_q1_q2 against T_m1_m2 * T_m2_q2, with the odometry
@@ -248,7 +246,7 @@ bool Consistent(const Edge& a, const Edge& b, const PoseGraph& graph,
     const InformationConfig& info = config.information;
     const RobustConfig& robust = config.robust;
     const double a_t = info.odometry_translation_sigma_m_per_sqrt_m;
-    const double a_r = info.odometry_rotation_sigma_deg_per_sqrt_m * kRadPerDeg;
+    const double a_r = info.odometry_rotation_sigma_deg_per_sqrt_m * core::kRadiansPerDegree;
     const Eigen::Vector2d loops =
         (LoopSigmas(a).array().square() + LoopSigmas(b).array().square()).sqrt().matrix();
     const double sigma_t =
@@ -260,7 +258,7 @@ bool Consistent(const Edge& a, const Edge& b, const PoseGraph& graph,
     const double tolerance_r =
         robust.gate_sigmas * sigma_r_deg + robust.gate_rotation_deg_per_100m / 100.0 * d;
     return error.translation().norm() <= tolerance_t &&
-           Eigen::AngleAxisd(error.linear()).angle() / kRadPerDeg <= tolerance_r;
+           Eigen::AngleAxisd(error.linear()).angle() / core::kRadiansPerDegree <= tolerance_r;
 }
 
 // Counts each gated loop's consistent neighbours (loops whose ends both lie within
@@ -361,12 +359,12 @@ LoopResult GateAgainstOdometry(const core::Transform& T_from_to_loop,
     const core::Transform discrepancy = T_from_to_loop.inverse() * T_from_to_odometry;
     result.odometry_translation_error_m = discrepancy.translation().norm();
     result.odometry_rotation_error_deg =
-        Eigen::AngleAxisd(discrepancy.linear()).angle() / kRadPerDeg;
+        Eigen::AngleAxisd(discrepancy.linear()).angle() / core::kRadiansPerDegree;
     const InformationConfig& info = config.information;
     const RobustConfig& robust = config.robust;
     const double d = path_m;
     const double a_t = info.odometry_translation_sigma_m_per_sqrt_m;
-    const double a_r = info.odometry_rotation_sigma_deg_per_sqrt_m * kRadPerDeg;
+    const double a_r = info.odometry_rotation_sigma_deg_per_sqrt_m * core::kRadiansPerDegree;
     const double sigma_t = std::sqrt(a_t * a_t * d + a_r * a_r * d * d * d / 3.0);
     const double sigma_r_deg = info.odometry_rotation_sigma_deg_per_sqrt_m * std::sqrt(d);
     result.gate_translation_m = robust.gate_sigmas * sigma_t + robust.gate_min_translation_m +

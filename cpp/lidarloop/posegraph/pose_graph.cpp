@@ -1,18 +1,14 @@
-#include "lidarloop/posegraph/pose_graph.hpp"
 
+#include "lidarloop/posegraph/pose_graph.hpp"
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
-
+#include "lidarloop/core/angles.hpp"
 #include "lidarloop/core/error.hpp"
 
 namespace lidarloop::posegraph {
-namespace {
-
-constexpr double kRadPerDeg = std::numbers::pi / 180.0;
-
-}  // namespace
+namespace {}  // namespace
 
 Vector6d EdgeError(const core::Transform& T_from_to, const core::Transform& T_world_from,
                    const core::Transform& T_world_to) {
@@ -36,9 +32,9 @@ Matrix6d DiagonalInformation(double sigma_t_m, double sigma_r_rad) {
 Matrix6d OdometryInformation(const core::Transform& T_prev_next, const InformationConfig& config) {
     const double length_m = T_prev_next.translation().norm();
     const double a_t = config.odometry_translation_sigma_m_per_sqrt_m;
-    const double a_r = config.odometry_rotation_sigma_deg_per_sqrt_m * kRadPerDeg;
+    const double a_r = config.odometry_rotation_sigma_deg_per_sqrt_m * core::kRadiansPerDegree;
     const double min_t = config.odometry_min_translation_sigma_m;
-    const double min_r = config.odometry_min_rotation_sigma_deg * kRadPerDeg;
+    const double min_r = config.odometry_min_rotation_sigma_deg * core::kRadiansPerDegree;
     return DiagonalInformation(std::sqrt(min_t * min_t + a_t * a_t * length_m),
                                std::sqrt(min_r * min_r + a_r * a_r * length_m));
 }
@@ -49,7 +45,8 @@ Matrix6d LoopInformation(const LoopConstraint& loop, const InformationConfig& co
         std::isfinite(loop.overlap) ? loop.overlap : config.loop_reference_overlap;
     const double weight = std::clamp(overlap / config.loop_reference_overlap, 0.2, 2.0);
     const double sigma_t = std::hypot(config.loop_translation_sigma_m, rmse_m);
-    return weight * DiagonalInformation(sigma_t, config.loop_rotation_sigma_deg * kRadPerDeg);
+    return weight *
+           DiagonalInformation(sigma_t, config.loop_rotation_sigma_deg * core::kRadiansPerDegree);
 }
 
 PoseGraph BuildPoseGraph(const std::vector<core::Transform>& odometry,

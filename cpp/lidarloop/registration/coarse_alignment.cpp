@@ -1,19 +1,17 @@
-#include "lidarloop/registration/coarse_alignment.hpp"
 
+#include "lidarloop/registration/coarse_alignment.hpp"
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
 #include <optional>
-
+#include "lidarloop/core/angles.hpp"
 #include "lidarloop/registration/detail/fft2d.hpp"
 
 namespace lidarloop::registration {
 namespace {
 
 using Spectrum = std::vector<std::complex<float>>;
-
-constexpr double kDegToRad = std::numbers::pi / 180.0;
 
 Spectrum ToSpectrum(const std::vector<float>& image, int n) {
     Spectrum spectrum(image.begin(), image.end());
@@ -131,7 +129,7 @@ std::vector<PlanarHypothesis> Distinct(std::vector<PlanarHypothesis> peaks,
         if (peak.score <= 0.0) break;
         const bool distinct = std::all_of(kept.begin(), kept.end(), [&](const auto& other) {
             return YawDistance(peak.yaw_rad, other.yaw_rad) >
-                       2.5 * config.yaw_step_deg * kDegToRad ||
+                       2.5 * config.yaw_step_deg * core::kRadiansPerDegree ||
                    (peak.translation_m - other.translation_m).norm() > 3.0 * config.cell_m;
         });
         if (distinct) kept.push_back(peak);

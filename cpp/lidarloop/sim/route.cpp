@@ -8,19 +8,17 @@
 
 #include "lidarloop/core/enum_names.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/core/number_text.hpp"
 #include "lidarloop/sim/detail/random.hpp"
-#include "lidarloop/sim/detail/text.hpp"
 
 namespace lidarloop::sim {
 namespace {
-
-constexpr double kPi = std::numbers::pi;
 
 double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
     return a.x() * b.y() - a.y() * b.x();
 }
 
-double WrapAngle(double angle) { return std::remainder(angle, 2.0 * kPi); }
+double WrapAngle(double angle) { return std::remainder(angle, 2.0 * std::numbers::pi); }
 
 std::string NodeText(const Eigen::Vector2i& node) {
     return "(" + std::to_string(node.x()) + ", " + std::to_string(node.y()) + ")";
@@ -169,11 +167,11 @@ RouteType ParseRouteType(std::string_view name) {
 void RouteConfig::Validate() const {
     if (!(spacing_min_m > 0.0 && spacing_min_m <= 50.0)) {
         throw core::ConfigError("route.spacing_min_m must be in (0, 50], got " +
-                                detail::NumberText(spacing_min_m));
+                                core::NumberText(spacing_min_m));
     }
     if (!(spacing_max_m >= spacing_min_m && spacing_max_m <= 50.0)) {
         throw core::ConfigError("route.spacing_max_m must be in [spacing_min_m, 50], got " +
-                                detail::NumberText(spacing_max_m));
+                                core::NumberText(spacing_max_m));
     }
     if (uturn_blocks < 0 || uturn_blocks > 100) {
         throw core::ConfigError("route.uturn_blocks must be in [0, 100], got " +
@@ -269,10 +267,10 @@ SpacingProfile::SpacingProfile(double spacing_min_m, double spacing_max_m, std::
     const double periods[2] = {rng.Uniform(40.0, 80.0), rng.Uniform(150.0, 300.0)};
     const double shares[2] = {0.6, 0.4};
     for (int k = 0; k < 2; ++k) {
-        frequency_[k] = 2.0 * kPi / periods[k];
+        frequency_[k] = 2.0 * std::numbers::pi / periods[k];
         // The step's deviation from the mean is at most amplitude * frequency (|sin x| <= |x|).
         amplitude_m_[k] = shares[k] * half_range / frequency_[k];
-        phase_[k] = rng.Uniform(0.0, 2.0 * kPi);
+        phase_[k] = rng.Uniform(0.0, 2.0 * std::numbers::pi);
     }
 }
 

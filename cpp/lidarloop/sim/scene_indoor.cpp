@@ -7,6 +7,7 @@
 #include <numbers>
 #include <vector>
 
+#include "lidarloop/core/angles.hpp"
 #include "lidarloop/sim/detail/scene_builder.hpp"
 
 namespace lidarloop::sim::detail {
@@ -15,7 +16,6 @@ namespace {
 constexpr double kWall_m = 0.15;
 constexpr double kDoorWidth_m = 0.9;
 constexpr double kDoorHeight_m = 2.05;
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 // A wall along a -> b (centre line) with doors centred at the given distances from a. Door
 // leaves are hinged at the gap's end nearer to a and open towards `inward`.
@@ -34,7 +34,8 @@ void WallWithDoors(const Eigen::Vector2d& a, const Eigen::Vector2d& b, std::vect
         builder.RaisedBox(a + centre * u, wall_yaw, kDoorWidth_m, kWall_m, kDoorHeight_m,
                           ceiling + 0.5);
         const Eigen::Vector2d hinge = a + gap0 * u;
-        const double angle = rng.Bernoulli(0.15) ? 0.0 : rng.Uniform(20.0, 100.0) * kDeg;
+        const double angle =
+            rng.Bernoulli(0.15) ? 0.0 : rng.Uniform(20.0, 100.0) * core::kRadiansPerDegree;
         const double turn = (u.x() * inward.y() - u.y() * inward.x()) > 0.0 ? angle : -angle;
         const Eigen::Vector2d leaf(std::cos(wall_yaw + turn), std::sin(wall_yaw + turn));
         builder.RaisedBox(hinge + 0.5 * kDoorWidth_m * leaf, wall_yaw + turn, kDoorWidth_m, 0.04,

@@ -5,12 +5,11 @@
 #include <cmath>
 #include <numbers>
 
+#include "lidarloop/core/angles.hpp"
 #include "lidarloop/sim/detail/scene_builder.hpp"
 
 namespace lidarloop::sim::detail {
 namespace {
-
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 // Rock bulging out of a pillar face: a box reaching 1 m into the pillar and up to 0.5 m out.
 void Bulge(const Rect& pillar, Random& rng, SceneBuilder& builder) {
@@ -27,7 +26,8 @@ void Bulge(const Rect& pillar, Random& rng, SceneBuilder& builder) {
                                         {c.x() + along, pillar.y1 + out},
                                         {pillar.x0 - out, c.y() + along},
                                         {pillar.x1 + out, c.y() + along}};
-    const double yaw = (along_x ? 0.0 : 0.5 * std::numbers::pi) + rng.Uniform(-6.0, 6.0) * kDeg;
+    const double yaw =
+        (along_x ? 0.0 : 0.5 * std::numbers::pi) + rng.Uniform(-6.0, 6.0) * core::kRadiansPerDegree;
     const double top =
         rng.Bernoulli(0.5) ? builder.layout().ceiling_height_m + 1.0 : rng.Uniform(0.8, 3.5);
     builder.RaisedBox(centers[face], yaw, length, depth, -1.0, top);
@@ -40,8 +40,8 @@ void FillMineBlock(const Rect& block, Random& rng, SceneBuilder& builder) {
     // roughened by bulges that stay within 0.6 m of the block edge (the drift side band).
     const Rect pillar{block.x0 + rng.Uniform(0.45, 0.7), block.y0 + rng.Uniform(0.45, 0.7),
                       block.x1 - rng.Uniform(0.45, 0.7), block.y1 - rng.Uniform(0.45, 0.7)};
-    builder.SolidBox(pillar.Center(), rng.Uniform(-1.5, 1.5) * kDeg, pillar.Width(),
-                     pillar.Height());
+    builder.SolidBox(pillar.Center(), rng.Uniform(-1.5, 1.5) * core::kRadiansPerDegree,
+                     pillar.Width(), pillar.Height());
     for (int k = rng.UniformInt(3, 6); k > 0; --k) Bulge(pillar, rng, builder);
 }
 

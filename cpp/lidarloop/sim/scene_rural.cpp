@@ -4,12 +4,11 @@
 #include <cmath>
 #include <numbers>
 
+#include "lidarloop/core/angles.hpp"
 #include "lidarloop/sim/detail/scene_builder.hpp"
 
 namespace lidarloop::sim::detail {
 namespace {
-
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 Eigen::Vector2d RandomPoint(const Rect& r, Random& rng) {
     return {rng.Uniform(r.x0, r.x1), rng.Uniform(r.y0, r.y1)};
@@ -26,7 +25,7 @@ Rect RandomPatch(const Rect& r, double min_side, double max_side, Random& rng) {
 
 void Farm(const Rect& block, Random& rng, SceneBuilder& builder) {
     const Rect yard = RandomPatch(block.Inset(4.0), 45.0, 70.0, rng);
-    const double yaw = rng.Uniform(-10.0, 10.0) * kDeg;
+    const double yaw = rng.Uniform(-10.0, 10.0) * core::kRadiansPerDegree;
     const Rect house_area{yard.x0, yard.y0, yard.Center().x() - 4.0, yard.Center().y() - 4.0};
     builder.StandingBox(house_area.Center(), yaw, rng.Uniform(10.0, 15.0), rng.Uniform(8.0, 11.0),
                         rng.Uniform(6.0, 9.0));

@@ -5,12 +5,12 @@
 #include <numbers>
 #include <vector>
 
+#include "lidarloop/core/angles.hpp"
 #include "lidarloop/sim/detail/scene_builder.hpp"
 
 namespace lidarloop::sim::detail {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kParkingOffset_m = 8.3;  // car centres; the driven road ends at 7.2 m
 constexpr double kLightOffset_m = 9.9;
 constexpr double kTreeOffset_m = 11.0;
@@ -38,7 +38,8 @@ void LShapedBuilding(const Rect& f, double height, Random& rng, SceneBuilder& bu
 }
 
 void TurnedBuilding(const Rect& f, double height, Random& rng, SceneBuilder& builder) {
-    const double yaw = (rng.Bernoulli(0.5) ? 1.0 : -1.0) * rng.Uniform(5.0, 20.0) * kDeg;
+    const double yaw =
+        (rng.Bernoulli(0.5) ? 1.0 : -1.0) * rng.Uniform(5.0, 20.0) * core::kRadiansPerDegree;
     double length = f.Width() * rng.Uniform(0.7, 0.95);
     double width = f.Height() * rng.Uniform(0.7, 0.95);
     const double c = std::cos(yaw);
@@ -127,7 +128,7 @@ void FillUrbanStreet(const StreetFrame& street, Random& rng, SceneBuilder& build
             if (!rng.Bernoulli(0.45)) continue;
             const double jitter = rng.Uniform(-0.4, 0.4);
             builder.Car(street.At(along + jitter, side * kParkingOffset_m),
-                        car_yaw + rng.Uniform(-2.0, 2.0) * kDeg, rng);
+                        car_yaw + rng.Uniform(-2.0, 2.0) * core::kRadiansPerDegree, rng);
         }
         for (double along = rng.Uniform(2.0, 8.0); along < street.length_m; along += 24.0) {
             StreetLight(street, along, side, rng, builder);

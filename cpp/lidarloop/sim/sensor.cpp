@@ -1,27 +1,24 @@
-#include "lidarloop/sim/sensor.hpp"
 
+#include "lidarloop/sim/sensor.hpp"
+#include <Eigen/Geometry>
 #include <array>
 #include <cmath>
 #include <numbers>
 #include <string>
-
-#include <Eigen/Geometry>
-
+#include "lidarloop/core/angles.hpp"
 #include "lidarloop/core/enum_names.hpp"
 #include "lidarloop/core/error.hpp"
-#include "lidarloop/sim/detail/text.hpp"
+#include "lidarloop/core/number_text.hpp"
 
 namespace lidarloop::sim {
 namespace {
-
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 void CheckRange(const char* field, double value, double lo, double hi, bool lo_open) {
     const bool ok = std::isfinite(value) && (lo_open ? value > lo : value >= lo) && value <= hi;
     if (!ok) {
         throw core::ConfigError(std::string("sensor.") + field + " must be in " +
-                                (lo_open ? "(" : "[") + detail::NumberText(lo) + ", " +
-                                detail::NumberText(hi) + "], got " + detail::NumberText(value));
+                                (lo_open ? "(" : "[") + core::NumberText(lo) + ", " +
+                                core::NumberText(hi) + "], got " + core::NumberText(value));
     }
 }
 
@@ -81,7 +78,8 @@ std::vector<Eigen::Vector3d> SpinningDirections(const SensorSpec& spec) {
     for (int k = 0; k < spec.horizontal_steps; ++k) {
         const double azimuth = std::numbers::pi - 2.0 * std::numbers::pi * k / steps;
         for (const double elevation_deg : elevations) {
-            directions.push_back(FromAzimuthElevation(azimuth, elevation_deg * kDeg));
+            directions.push_back(
+                FromAzimuthElevation(azimuth, elevation_deg * core::kRadiansPerDegree));
         }
     }
     return directions;
@@ -92,10 +90,11 @@ std::vector<Eigen::Vector3d> TiltDirections(const SensorSpec& spec) {
     std::vector<Eigen::Vector3d> directions;
     const double steps = spec.horizontal_steps;
     for (const double tilt_deg : BeamElevationsDeg(spec.model)) {
-        const double tilt = tilt_deg * kDeg;
+        const double tilt = tilt_deg * core::kRadiansPerDegree;
         for (int k = 0; k < spec.horizontal_steps; ++k) {
             // In-plane angle from +90 (left) to -90 degrees (right); one sample when 1 step.
-            const double alpha = steps > 1 ? (90.0 - 180.0 * k / (steps - 1.0)) * kDeg : 0.0;
+            const double alpha =
+                steps > 1 ? (90.0 - 180.0 * k / (steps - 1.0)) * core::kRadiansPerDegree : 0.0;
             directions.emplace_back(std::cos(alpha) * std::cos(tilt), std::sin(alpha),
                                     std::cos(alpha) * std::sin(tilt));
         }
@@ -123,8 +122,9 @@ std::vector<Eigen::Vector3d> RosetteDirections(const SensorSpec& spec, std::size
         for (int laser = 0; laser < kRosetteLasers; ++laser) {
             const double turn = std::numbers::pi * laser / kRosetteLasers;
             const Eigen::Vector2d d = Eigen::Rotation2Dd(turn) * deflection;
-            directions.push_back(FromAzimuthElevation(d.x() * kRosetteHalfWidthDeg * kDeg,
-                                                      d.y() * kRosetteHalfHeightDeg * kDeg));
+            directions.push_back(
+                FromAzimuthElevation(d.x() * kRosetteHalfWidthDeg * core::kRadiansPerDegree,
+                                     d.y() * kRosetteHalfHeightDeg * core::kRadiansPerDegree));
         }
     }
     return directions;
@@ -145,7 +145,7 @@ void SensorConfig::Validate() const {
     CheckRange("noise_m", noise_m, 0.0, 10.0, false);
     if (!(dropout >= 0.0 && dropout < 1.0)) {
         throw core::ConfigError("sensor.dropout must be in [0, 1), got " +
-                                detail::NumberText(dropout));
+                                core::NumberText(dropout));
     }
     if (horizontal_steps && (*horizontal_steps < 1 || *horizontal_steps > 20000)) {
         throw core::ConfigError("sensor.horizontal_steps must be in [1, 20000], got " +
@@ -189,9 +189,9 @@ SensorSpec Resolve(const SensorConfig& config) {
     spec.mount_height_m = config.mount_height_m.value_or(spec.mount_height_m);
     spec.scan_period_s = config.scan_period_s.value_or(spec.scan_period_s);
     if (spec.min_range_m >= spec.max_range_m) {
-        throw core::ConfigError("sensor.min_range_m (" + detail::NumberText(spec.min_range_m) +
+        throw core::ConfigError("sensor.min_range_m (" + core::NumberText(spec.min_range_m) +
                                 ") must be smaller than sensor.max_range_m (" +
-                                detail::NumberText(spec.max_range_m) + ")");
+                                core::NumberText(spec.max_range_m) + ")");
     }
     return spec;
 }

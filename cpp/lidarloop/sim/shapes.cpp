@@ -10,13 +10,13 @@ namespace {
 
 // Hits closer than this are the surface the ray starts on, not a new crossing.
 constexpr double kMinT = 1e-9;
-constexpr double kTiny = 1e-15;
+constexpr double kTinyRayTerm = 1e-15;
 
 // The smaller accepted root of a t^2 + 2 h t + c = 0 (half-b form), kNoHit if none.
 template <typename Accept>
 double SmallestRoot(double a, double h, double c, Accept accept) {
-    if (std::abs(a) < kTiny) {
-        if (std::abs(h) < kTiny) return kNoHit;
+    if (std::abs(a) < kTinyRayTerm) {
+        if (std::abs(h) < kTinyRayTerm) return kNoHit;
         const double t = -c / (2.0 * h);
         return t > kMinT && accept(t) ? t : kNoHit;
     }
@@ -33,7 +33,7 @@ double SmallestRoot(double a, double h, double c, Accept accept) {
 
 // The crossing of the horizontal disk of radius r about (cx, cy) at height z, kNoHit if none.
 double IntersectDisk(const Ray& ray, double cx, double cy, double z, double r) {
-    if (std::abs(ray.direction.z()) < kTiny) return kNoHit;
+    if (std::abs(ray.direction.z()) < kTinyRayTerm) return kNoHit;
     const double t = (z - ray.origin.z()) / ray.direction.z();
     if (t <= kMinT) return kNoHit;
     const double x = ray.origin.x() + t * ray.direction.x() - cx;
@@ -57,7 +57,7 @@ double IntersectBox(const Ray& ray, const Box& box, double cos_yaw, double sin_y
     double t_far = kNoHit;
     for (int axis = 0; axis < 3; ++axis) {
         const double half = box.half_extent_m[axis];
-        if (std::abs(direction[axis]) < kTiny) {
+        if (std::abs(direction[axis]) < kTinyRayTerm) {
             if (std::abs(origin[axis]) > half) return kNoHit;
             continue;
         }

@@ -11,8 +11,8 @@
 #include <Eigen/Eigenvalues>
 
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/core/number_text.hpp"
 #include "lidarloop/sim/detail/random.hpp"
-#include "lidarloop/sim/detail/text.hpp"
 
 namespace lidarloop::sim {
 namespace {
@@ -58,9 +58,9 @@ SensorSpec ResolveFor(const SimulationConfig& config, const SceneLayout& layout)
     config.Validate();
     SensorSpec spec = Resolve(config.sensor);
     if (layout.ceiling_height_m > 0.0 && spec.mount_height_m > layout.ceiling_height_m - 0.2) {
-        throw core::ConfigError("sensor.mount_height_m " + detail::NumberText(spec.mount_height_m) +
+        throw core::ConfigError("sensor.mount_height_m " + core::NumberText(spec.mount_height_m) +
                                 " m does not fit under the " +
-                                detail::NumberText(layout.ceiling_height_m) + " m ceiling of the " +
+                                core::NumberText(layout.ceiling_height_m) + " m ceiling of the " +
                                 ToString(config.scene) + " scene");
     }
     return spec;

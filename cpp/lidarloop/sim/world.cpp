@@ -6,13 +6,13 @@
 #include <utility>
 
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/core/number_text.hpp"
 #include "lidarloop/sim/detail/intersect.hpp"
-#include "lidarloop/sim/detail/text.hpp"
 
 namespace lidarloop::sim {
 namespace {
 
-constexpr double kTiny = 1e-12;
+constexpr double kTinyRayComponent = 1e-12;
 constexpr double kMaxCells = 1 << 24;  // 16M cells: a coarser grid beyond that
 
 }  // namespace
@@ -25,11 +25,11 @@ World::World(Terrain ground, double ceiling_height_m, std::vector<Shape> objects
       cell_m_(grid_cell_m) {
     if (!(grid_cell_m > 0.0) || !std::isfinite(grid_cell_m)) {
         throw core::ConfigError("world grid cell size must be > 0 m, got " +
-                                detail::NumberText(grid_cell_m));
+                                core::NumberText(grid_cell_m));
     }
     if (!(ceiling_height_m >= 0.0) || !std::isfinite(ceiling_height_m)) {
         throw core::ConfigError("world ceiling height must be >= 0 m (0: open sky), got " +
-                                detail::NumberText(ceiling_height_m));
+                                core::NumberText(ceiling_height_m));
     }
     box_cos_sin_.resize(objects_.size(), Eigen::Vector2d(1.0, 0.0));
     for (std::size_t i = 0; i < objects_.size(); ++i) {
@@ -115,7 +115,7 @@ bool World::ClipToGrid(const Ray& ray, double& t_in, double& t_out) const {
         const double hi = lo + n[axis] * cell_m_;
         const double o = ray.origin[axis];
         const double d = ray.direction[axis];
-        if (std::abs(d) < kTiny) {
+        if (std::abs(d) < kTinyRayComponent) {
             if (o < lo || o > hi) return false;
             continue;
         }
@@ -144,7 +144,7 @@ double World::CastObjects(const Ray& ray, double max_range_m) const {
         const double p = o[axis] + t_in * d[axis];
         cell[axis] =
             std::clamp(static_cast<int>(std::floor((p - origin) / cell_m_)), 0, n[axis] - 1);
-        step[axis] = std::abs(d[axis]) < kTiny ? 0 : (d[axis] > 0.0 ? 1 : -1);
+        step[axis] = std::abs(d[axis]) < kTinyRayComponent ? 0 : (d[axis] > 0.0 ? 1 : -1);
         const double boundary = origin + (cell[axis] + (step[axis] > 0 ? 1 : 0)) * cell_m_;
         t_next[axis] = step[axis] == 0 ? kNoHit : (boundary - o[axis]) / d[axis];
         t_delta[axis] = step[axis] == 0 ? kNoHit : cell_m_ / std::abs(d[axis]);

@@ -12,16 +12,15 @@
 namespace lidarloop::core {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-constexpr double kHalfPi = kPi / 2.0;
-constexpr double kTwoPi = 2.0 * kPi;
+constexpr double kHalfPi = std::numbers::pi / 2.0;
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr int kMaxRegions = 10000;
 
 // Area of the polar cap of the given colatitude on the unit sphere, 2*pi*(1 - cos theta), written
 // with sin^2(theta/2) so that small caps keep their relative accuracy.
 double CapArea(double colatitude) {
     const double s = std::sin(colatitude / 2.0);
-    return 4.0 * kPi * s * s;
+    return 4.0 * std::numbers::pi * s * s;
 }
 
 // Colatitude of the polar cap that holds `cumulative` of the n equal regions of the half sphere:

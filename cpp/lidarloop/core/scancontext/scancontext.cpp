@@ -3,13 +3,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numbers>
 
 #include "lidarloop/core/error.hpp"
 
 namespace lidarloop::core {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Bound on the error of PolarCoordinates: 0.00151 rad measured over [0, 1] in float, plus the
 // float rounding of the unfolding (< 1e-6 rad), rounded up.
 constexpr double kAzimuthErrorRad = 0.002;
@@ -57,10 +57,10 @@ class SectorBinner {
 public:
     explicit SectorBinner(int sectors)
         : sectors_(sectors),
-          per_radian_(static_cast<float>(sectors / (2.0 * kPi))),
-          margin_(static_cast<float>(kAzimuthErrorRad * sectors / (2.0 * kPi))) {
+          per_radian_(static_cast<float>(sectors / (2.0 * std::numbers::pi))),
+          margin_(static_cast<float>(kAzimuthErrorRad * sectors / (2.0 * std::numbers::pi))) {
         for (int j = 0; j <= sectors; ++j) {
-            const double angle_rad = 2.0 * kPi * j / sectors;
+            const double angle_rad = 2.0 * std::numbers::pi * j / sectors;
             border_x_.push_back(std::cos(angle_rad));
             border_y_.push_back(std::sin(angle_rad));
         }

@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cmath>
+#include <numbers>
 #include <string>
 
 #include "lidarloop/core/error.hpp"
@@ -9,7 +10,6 @@
 namespace lidarloop::core {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kMaxSectors = 720;  // ScanContextConfig::Validate
 // The float sums of up to 720 products of unit columns are exact to about 1e-7 each: a smaller
 // distance is rounding of equal columns, and reads 0 (equal descriptors are at 0).
@@ -47,8 +47,8 @@ void SumOverShifts(const ScanContextColumns& query, const ScanContextColumns& ca
 }
 
 double YawOfShift(int shift, int sectors) {
-    const double yaw_rad = 2.0 * kPi * shift / sectors;
-    return yaw_rad > kPi ? yaw_rad - 2.0 * kPi : yaw_rad;
+    const double yaw_rad = 2.0 * std::numbers::pi * shift / sectors;
+    return yaw_rad > std::numbers::pi ? yaw_rad - 2.0 * std::numbers::pi : yaw_rad;
 }
 
 }  // namespace

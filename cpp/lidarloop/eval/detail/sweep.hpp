@@ -4,8 +4,10 @@
 // StreamedPairwise (pairs streamed), so that both produce the same curve, AUC and optima.
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <string>
 
 #include "lidarloop/eval/metrics.hpp"
 #include "lidarloop/eval/pairwise.hpp"
@@ -16,6 +18,11 @@ namespace lidarloop::eval::detail {
 // file leaves out. No threshold, not even +inf, detects it; otherwise the sweep would end at
 // +inf calling every pair a loop, and a learnt threshold could be +inf.
 inline bool IsScored(float distance) { return distance != std::numeric_limits<float>::infinity(); }
+
+// "(i, j)", for errors about a pair.
+inline std::string PairName(std::size_t i, std::size_t j) {
+    return "(" + std::to_string(i) + ", " + std::to_string(j) + ")";
+}
 
 inline CurvePoint MakePoint(double threshold, const Confusion& c) {
     return {threshold, c, Recall(c), FalsePositiveRate(c), Precision(c)};

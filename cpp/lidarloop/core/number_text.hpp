@@ -1,11 +1,11 @@
 #pragma once
 
-// Internal: numbers in error messages. Not installed.
+// Numbers in messages and written parameters.
 
 #include <charconv>
 #include <string>
 
-namespace lidarloop::sim::detail {
+namespace lidarloop::core {
 
 /// The shortest text that reads back as `value` ("0.02", "1e+06", "nan").
 inline std::string NumberText(double value) {
@@ -14,4 +14,4 @@ inline std::string NumberText(double value) {
     return std::string(buffer, result.ptr);
 }
 
-}  // namespace lidarloop::sim::detail
+}  // namespace lidarloop::core
