@@ -38,6 +38,14 @@ function(lidarloop_add_library name)
         $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/cpp> $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
     target_link_libraries(${target} PUBLIC ${ARG_PUBLIC_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
     lidarloop_target_defaults(${target})
+    if(LIDARLOOP_UNITY_LIBRARIES)
+        lidarloop_unity_build(${target})
+        # GCC takes a file included by the batch for a header, and warns of every member whose
+        # type is in the .cpp's anonymous namespace; file by file it says nothing.
+        if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+            target_compile_options(${target} PRIVATE -Wno-subobject-linkage)
+        endif()
+    endif()
     install(TARGETS ${target} EXPORT lidarloopTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
     # Public headers only: detail/ holds the module's internal helpers.
@@ -47,7 +55,8 @@ endfunction()
 
 # lidarloop_unity_build(<target>): compile the target's files in batches of 8 (LIDARLOOP_UNITY_BUILD);
 # 8 keeps both cores busy and a batch's recompile short. Files with their own compile options or
-# definitions are left out by CMake. The libraries stay file by file: what they are is what ships.
+# definitions are left out by CMake. The libraries stay file by file, what ships, unless
+# LIDARLOOP_UNITY_LIBRARIES (the test builds).
 function(lidarloop_unity_build target)
     if(LIDARLOOP_UNITY_BUILD)
         set_target_properties(${target} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE 8)
