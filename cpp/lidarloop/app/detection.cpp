@@ -197,6 +197,11 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     PrepareSubmapsIfAsked(dataset, config, poses, request, prepared);
     const double describe_s = describe_clock.Seconds();
 
+    // Where the odometry judges the loops, the scans out of a loop's reach are no candidates.
+    std::atomic<std::size_t> rejected{0};
+    pipeline::LoopCheck odometry_check;
+    if (verify && !poses.empty())
+        odometry_check = OdometryLoopCheck(poses, path_m, config.posegraph, &rejected);
     // All pairs either way; the matrix only when it fits the budget (same results without).
     Stopwatch matrix_clock;
     std::optional<pipeline::SimilarityMatrix> matrix;
@@ -206,19 +211,16 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
         matrix = pipeline::ComputeSimilarityMatrix(described.database);
         outcome.queries =
             pipeline::DetectFromMatrix(*matrix, described.database.times_s(), config.detection,
-                                       config.descriptor.method, path_m);
+                                       config.descriptor.method, path_m, odometry_check);
     } else {
-        outcome.queries = pipeline::DetectStreaming(described.database, config.detection,
-                                                    pipeline::Execution::kParallel, path_m);
+        outcome.queries =
+            pipeline::DetectStreaming(described.database, config.detection,
+                                      pipeline::Execution::kParallel, path_m, odometry_check);
     }
     const double matrix_s = matrix_clock.Seconds();
     Stopwatch verify_clock;
     pipeline::VerificationTimes verification_times;
     if (verify) {
-        std::atomic<std::size_t> rejected{0};
-        pipeline::LoopCheck odometry_check;
-        if (!poses.empty())
-            odometry_check = OdometryLoopCheck(poses, path_m, config.posegraph, &rejected);
         pipeline::MoreLoopsWanted more;
         if (request.pose_graph_loops) more = PoseGraphLoopsWanted(path_m, config.posegraph);
         verification_times =

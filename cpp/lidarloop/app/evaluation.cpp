@@ -268,15 +268,16 @@ MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method m
     e.ns_per_comparison = pairs > 0 ? 1e9 * comparisons_s / pairs : 0.0;
     e.matrix = std::move(matrix);
     const PreparedScans* prepared = verification.prepared ? &*verification.prepared : nullptr;
-    e.retrieval = keep_matrix
-                      ? CompareRetrieval(e.matrix, database.times_s(), config.detection, method,
-                                         truth, dataset.poses(), prepared, &verification.cache,
-                                         request.progress, odometry)
-                      : CompareRetrieval(pipeline::DetectStreaming(database, config.detection,
-                                                                   pipeline::Execution::kParallel,
-                                                                   DetectorPathM(truth, odometry)),
-                                         config.detection, method, truth, dataset.poses(), prepared,
-                                         &verification.cache, request.progress, odometry);
+    e.retrieval = keep_matrix ? CompareRetrieval(e.matrix, database.times_s(), config.detection,
+                                                 method, truth, dataset.poses(), prepared,
+                                                 &verification.cache, request.progress, odometry)
+                              : CompareRetrieval(
+                                    pipeline::DetectStreaming(
+                                        database, config.detection, pipeline::Execution::kParallel,
+                                        DetectorPathM(truth, odometry),
+                                        VerificationCheckOf(odometry, config.detection, prepared)),
+                                    config.detection, method, truth, dataset.poses(), prepared,
+                                    &verification.cache, request.progress, odometry);
     return e;
 }
 

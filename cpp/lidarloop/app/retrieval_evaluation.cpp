@@ -47,6 +47,13 @@ const std::vector<double>& DetectorPathM(const eval::GroundTruth& truth,
     return odometry != nullptr ? odometry->path_m : truth.path_m;
 }
 
+pipeline::LoopCheck VerificationCheckOf(const OdometryCheck* odometry,
+                                        const pipeline::DetectorConfig& detector,
+                                        const PreparedScans* prepared) {
+    if (odometry == nullptr || !detector.verify || prepared == nullptr) return {};
+    return OdometryLoopCheck(odometry->odometry, odometry->path_m, odometry->config);
+}
+
 RetrievalComparison CompareRetrieval(const pipeline::SimilarityMatrix& matrix,
                                      const std::vector<double>& times_s,
                                      const pipeline::DetectorConfig& detector,
@@ -55,8 +62,9 @@ RetrievalComparison CompareRetrieval(const pipeline::SimilarityMatrix& matrix,
                                      const PreparedScans* prepared,
                                      pipeline::VerificationCache* cache, const Progress& progress,
                                      const OdometryCheck* odometry) {
-    return CompareRetrieval(pipeline::DetectFromMatrix(matrix, times_s, detector, method,
-                                                       DetectorPathM(truth, odometry)),
+    return CompareRetrieval(pipeline::DetectFromMatrix(
+                                matrix, times_s, detector, method, DetectorPathM(truth, odometry),
+                                VerificationCheckOf(odometry, detector, prepared)),
                             detector, method, truth, poses, prepared, cache, progress, odometry);
 }
 
@@ -76,11 +84,9 @@ RetrievalComparison CompareRetrieval(std::vector<pipeline::LoopQuery> queries,
         DescriptorCandidates(comparison.queries, method, detector.ThresholdFor(method)), truth,
         poses, config, detector_path_m);
     if (!detector.verify || prepared == nullptr) return comparison;
-    pipeline::LoopCheck odometry_check;
-    if (odometry != nullptr)
-        odometry_check = OdometryLoopCheck(odometry->odometry, odometry->path_m, odometry->config);
     comparison.verification_times =
-        VerifyAll(comparison.queries, *prepared, detector, method, progress, cache, odometry_check);
+        VerifyAll(comparison.queries, *prepared, detector, method, progress, cache,
+                  VerificationCheckOf(odometry, detector, prepared));
     comparison.verified = eval::EvaluateLoopRetrieval(VerifiedCandidates(comparison.queries), truth,
                                                       poses, config, detector_path_m);
     return comparison;

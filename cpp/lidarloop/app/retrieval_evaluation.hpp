@@ -56,8 +56,17 @@ std::vector<eval::QueryCandidates> VerifiedCandidates(std::span<const pipeline::
 const std::vector<double>& DetectorPathM(const eval::GroundTruth& truth,
                                          const OdometryCheck* odometry);
 
+/// The check `odometry` puts on candidates and loops where a run verifies them
+/// (OdometryLoopCheck): detection leaves out the scans it puts out of a loop's reach, and
+/// verification rejects the loops it contradicts. None without odometry, without
+/// detector.verify or without `prepared` scans. It refers to `odometry`, which must outlive it.
+pipeline::LoopCheck VerificationCheckOf(const OdometryCheck* odometry,
+                                        const pipeline::DetectorConfig& detector,
+                                        const PreparedScans* prepared);
+
 /// Detects the top-k candidates of every scan from `matrix` (pipeline::DetectFromMatrix with
-/// `detector`; the gap and path rule on DetectorPathM), verifies them when detector.verify (with
+/// `detector`; the gap and path rule on DetectorPathM; with `odometry` and verification, only
+/// the scans within its reach, VerificationCheckOf), verifies them when detector.verify (with
 /// `prepared`, sharing `cache`, and rejecting what `odometry` contradicts when given), and
 /// scores both against `truth` (built from `poses`; revisits by the truth's own path).
 RetrievalComparison CompareRetrieval(const pipeline::SimilarityMatrix& matrix,

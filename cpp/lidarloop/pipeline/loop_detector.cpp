@@ -72,20 +72,50 @@ using Filter = std::function<bool(std::size_t)>;
 // holds (rounded to float).
 using CandidateSearch = std::function<std::vector<Neighbor>(std::size_t count, const Filter&)>;
 
+// search(count, eligible && reachable), asking `search` for growing lists and judging them in
+// rank order: `reachable` (the odometry's reach, LoopCheck::MayClose) costs far more than the
+// gap, so it judges only the scans that rank high enough to matter. A ranking by (distance,
+// index) is a total order, so a longer list starts with the shorter one.
+std::vector<Neighbor> SearchReachable(const CandidateSearch& search, std::size_t count,
+                                      const Filter& eligible, const Filter& reachable) {
+    if (!reachable) return search(count, eligible);
+    std::vector<Neighbor> kept;
+    std::size_t judged = 0;
+    for (std::size_t asked = count;; asked *= 2) {
+        const std::vector<Neighbor> found = search(asked, eligible);
+        for (; judged < found.size() && kept.size() < count; ++judged) {
+            if (reachable(found[judged].index)) kept.push_back(found[judged]);
+        }
+        if (kept.size() == count || found.size() < asked) return kept;
+    }
+}
+
+// The scans `check` lets query scan `i` close a loop with (empty: all).
+Filter ReachableFrom(std::size_t i, const LoopCheck& check, const DetectorConfig& detector) {
+    if (!check.may_close) return {};
+    const double max_loop_distance_m = detector.verification.acceptance.max_loop_distance_m;
+    return [i, &check, max_loop_distance_m](std::size_t j) {
+        return check.MayClose(i, j, max_loop_distance_m);
+    };
+}
+
 // Scan i's candidates among the scans j < i outside the gap (and the path rule, when `path_m` is
 // known), as LoopDetector::Process gives them online.
 LoopQuery DetectOne(std::size_t i, const CandidateSearch& search, const std::vector<double>& along,
                     const std::vector<double>& path_m, const DetectorConfig& detector,
-                    const DescriptorMethod& method, double threshold) {
+                    const DescriptorMethod& method, double threshold, const LoopCheck& check) {
     const auto eligible = [&](std::size_t j) {
         return j < i && detector.min_gap.Allows(i, j, along[i], along[j]) &&
                (path_m.empty() || detector.PathAllows(path_m[i], path_m[j]));
     };
+    const Filter reachable = ReachableFrom(i, check, detector);
     LoopQuery result;
     result.query = i;
-    result.candidates = search(static_cast<std::size_t>(detector.top_k), eligible);
+    result.candidates =
+        SearchReachable(search, static_cast<std::size_t>(detector.top_k), eligible, reachable);
     Finish(result, detector.min_gap, along, method, threshold, [&](const Filter& other_place) {
-        return search(1, [&](std::size_t j) { return eligible(j) && other_place(j); });
+        return SearchReachable(
+            search, 1, [&](std::size_t j) { return eligible(j) && other_place(j); }, reachable);
     });
     return result;
 }
@@ -277,22 +307,24 @@ LoopDetector::LoopDetector(DescriptorDatabase database, const DetectorConfig& de
 
 LoopQuery LoopDetector::Search(const PreparedQuery& query, std::size_t query_index,
                                const std::function<bool(std::size_t)>& eligible,
-                               const std::vector<double>& path_m) const {
+                               const std::vector<double>& path_m, const LoopCheck& check) const {
     const auto k = static_cast<std::size_t>(detector_.top_k);
-    const auto search = [&](std::size_t count, const std::function<bool(std::size_t)>& filter) {
+    const CandidateSearch search = [&](std::size_t count, const Filter& filter) {
         if (index_) return index_->Search(query, count, filter);
         return NearestCandidates(
             database_.size(), count, [&](std::size_t j) { return database_.Distance(query, j); },
             filter);
     };
+    const Filter reachable = ReachableFrom(query_index, check, detector_);
     LoopQuery result;
     result.query = query_index;
-    result.candidates = search(k, eligible);
+    result.candidates = SearchReachable(search, k, eligible, reachable);
     // Without the path (no odometry, or localisation) a gap in metres leaves second_ratio NaN.
     Finish(result, detector_.min_gap, detector_.min_gap.Along(database_.times_s(), path_m),
-           database_.definition(), threshold_,
-           [&](const std::function<bool(std::size_t)>& other_place) {
-               return search(1, [&](std::size_t j) { return eligible(j) && other_place(j); });
+           database_.definition(), threshold_, [&](const Filter& other_place) {
+               return SearchReachable(
+                   search, 1, [&](std::size_t j) { return eligible(j) && other_place(j); },
+                   reachable);
            });
     return result;
 }
@@ -370,6 +402,9 @@ LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_
         if (j == query_index) return *query_path_m;
         return j < session_start_ ? kNan : path_m_[j - session_start_];
     };
+    LoopCheck odometry_check;
+    if (odometry_gate_ && query_path_m)
+        odometry_check = CheckAgainstOdometry(pose_of, path_of, odometry_gate_);
     LoopQuery result = Search(
         *query, query_index,
         [&](std::size_t j) {
@@ -380,11 +415,9 @@ LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_
                 return j < session_start_ || gap.Allows(query_index, j, *query_path_m, path_of(j));
             return gap.Allows(query_index, j, time_s, times_s[j]);
         },
-        session_start_ == 0 ? path_m_ : std::vector<double>{});
+        session_start_ == 0 ? path_m_ : std::vector<double>{},
+        detector_.verify ? odometry_check : LoopCheck{});
     registration::CompactPreparedScan compact(scan);
-    LoopCheck odometry_check;
-    if (odometry_gate_ && query_path_m)
-        odometry_check = CheckAgainstOdometry(pose_of, path_of, odometry_gate_);
     Verify(result, compact, odometry_check);
     database_.Add(descriptor, time_s);
     scans_.push_back(std::move(compact));
@@ -437,7 +470,7 @@ std::vector<LoopQuery> LocaliseSequence(
 std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,
                                         const std::vector<double>& times_s,
                                         const DetectorConfig& detector, const core::Method& method,
-                                        const std::vector<double>& path_m) {
+                                        const std::vector<double>& path_m, const LoopCheck& check) {
     const double threshold =
         CheckOfflineDetection(detector, method, times_s, path_m, matrix.size());
     const std::vector<double>& along = detector.min_gap.Along(times_s, path_m);
@@ -449,14 +482,14 @@ std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,
             [&](std::size_t count, const Filter& filter) {
                 return NearestCandidates(i, count, distance_of, filter);
             },
-            along, path_m, detector, MethodOf(method), threshold);
+            along, path_m, detector, MethodOf(method), threshold, check);
     }
     return results;
 }
 
 std::vector<LoopQuery> DetectStreaming(const DescriptorDatabase& database,
                                        const DetectorConfig& detector, Execution execution,
-                                       const std::vector<double>& path_m) {
+                                       const std::vector<double>& path_m, const LoopCheck& check) {
     const std::vector<double>& times_s = database.times_s();
     const std::size_t n = database.size();
     const double threshold = CheckOfflineDetection(detector, database.method(), times_s, path_m, n);
@@ -492,8 +525,8 @@ std::vector<LoopQuery> DetectStreaming(const DescriptorDatabase& database,
                 return NearestCandidates(
                     i, count, [&](std::size_t j) { return double{row[j]}; }, filter);
             };
-            results[i] =
-                DetectOne(i, search, along, path_m, detector, database.definition(), threshold);
+            results[i] = DetectOne(i, search, along, path_m, detector, database.definition(),
+                                   threshold, check);
         }
     };
     const tbb::blocked_range<std::size_t> all(0, n);

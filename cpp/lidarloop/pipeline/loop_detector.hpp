@@ -199,7 +199,8 @@ public:
     LoopDetector& operator=(const LoopDetector&) = delete;
 
     /// Describes `scan`, finds its candidates among the stored scans (and verifies them when
-    /// verify is on, then applies the odometry gate), then stores it. `T_odom_sensor`: the
+    /// verify is on, then applies the odometry gate; with the gate, a scan the odometry puts out
+    /// of a loop's reach is then no candidate), then stores it. `T_odom_sensor`: the
     /// scan's pose by the odometry, given for every scan or for none. ConfigError for a gap in
     /// metres without it, for a pose on some scans only, and for a pose that is not finite.
     LoopQuery Process(const core::PointCloud& scan, double time_s,
@@ -236,7 +237,7 @@ public:
 private:
     LoopQuery Search(const PreparedQuery& query, std::size_t query_index,
                      const std::function<bool(std::size_t)>& eligible,
-                     const std::vector<double>& path_m = {}) const;
+                     const std::vector<double>& path_m = {}, const LoopCheck& check = {}) const;
     void Verify(LoopQuery& result, const registration::CompactPreparedScan& scan,
                 const LoopCheck& check = {}) const;
     // The next scan's cumulative path (m) from its odometry pose; nullopt without odometry.
@@ -272,11 +273,14 @@ std::vector<LoopQuery> LocaliseSequence(
 /// Offline detection from a full similarity matrix: for every scan i, the candidates among the
 /// scans j < i outside the gap, exactly as LoopDetector::Process would give them online.
 /// `path_m`: per scan, the cumulative path length (core::CumulativePathM), needed (one per scan,
-/// else ConfigError) only for a gap in metres.
+/// else ConfigError) only for a gap in metres. A scan `check` says cannot close a loop with the
+/// query (LoopCheck::MayClose within the verification's max_loop_distance_m: the odometry puts it
+/// out of reach) is no candidate, so that the top k are k scans verification can use; as online.
 std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,
                                         const std::vector<double>& times_s,
                                         const DetectorConfig& detector, const core::Method& method,
-                                        const std::vector<double>& path_m = {});
+                                        const std::vector<double>& path_m = {},
+                                        const LoopCheck& check = {});
 
 /// Offline detection without the similarity matrix: exactly DetectFromMatrix on
 /// ComputeSimilarityMatrix(database) (distances rounded to float as the matrix holds them) when
@@ -285,10 +289,12 @@ std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,
 /// from the method's index where it has one (histograms: a few more than asked, re-ranked by the
 /// float distance; when a float tie at the last place could hide another scan, from comparing them
 /// all), else from comparing every eligible scan (NDT). Memory: the results, the index and one row
-/// of n floats per thread, instead of the matrix's 2 n^2 bytes. `path_m` as DetectFromMatrix's.
+/// of n floats per thread, instead of the matrix's 2 n^2 bytes. `path_m` and `check` as
+/// DetectFromMatrix's.
 std::vector<LoopQuery> DetectStreaming(const DescriptorDatabase& database,
                                        const DetectorConfig& detector,
                                        Execution execution = Execution::kParallel,
-                                       const std::vector<double>& path_m = {});
+                                       const std::vector<double>& path_m = {},
+                                       const LoopCheck& check = {});
 
 }  // namespace lidarloop::pipeline

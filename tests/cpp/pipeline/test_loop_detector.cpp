@@ -1,3 +1,5 @@
+#include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <random>
 
@@ -300,6 +302,111 @@ TEST(DetectStreaming, EqualsDetectFromMatrixExactly) {
         ExpectIdenticalQueries(DetectStreaming(database, detector), expected);
         ExpectIdenticalQueries(DetectStreaming(database, detector, Execution::kSerial), expected);
     }
+}
+
+// A check that says some scans cannot close a loop with the query (the odometry puts them out of
+// reach) makes them no candidates: the top k are the best k the check keeps, as brute force over
+// the matrix ranks them. The check judges only the scans that rank high enough to matter.
+TEST(DetectFromMatrix, ScansOutOfTheChecksReachAreNoCandidates) {
+    const auto histograms = test::ClusteredHistograms(300, 40, 20, 3);
+    DescriptorDatabase database(HeightConfig(40));
+    for (std::size_t i = 0; i < histograms.size(); ++i)
+        database.Add(test::HistogramDescriptor(histograms[i]), 0.1 * static_cast<double>(i));
+    const SimilarityMatrix matrix = ComputeSimilarityMatrix(database);
+    DetectorConfig detector = Deciding(DetectorConfig{}, 0.01);
+    detector.top_k = 4;
+    const double max_loop_m = detector.verification.acceptance.max_loop_distance_m;
+    std::atomic<std::size_t> judged{0};
+    LoopCheck check;
+    check.may_close = [&](std::size_t query, std::size_t match, double max_loop_distance_m) {
+        EXPECT_EQ(max_loop_distance_m, max_loop_m);
+        ++judged;
+        return (query + 2 * match) % 3 != 0;
+    };
+    const std::vector<LoopQuery> detected =
+        DetectFromMatrix(matrix, database.times_s(), detector, core::Method::kHeight, {}, check);
+    const std::size_t judged_by_matrix = judged;
+    std::size_t eligible_pairs = 0;
+    std::size_t differ_from_unchecked = 0;
+    const std::vector<LoopQuery> unchecked =
+        DetectFromMatrix(matrix, database.times_s(), detector, core::Method::kHeight);
+    for (std::size_t i = 0; i < matrix.size(); ++i) {
+        std::vector<Neighbor> expected;
+        for (std::size_t j = 0; j + 30 < i; ++j) {
+            ++eligible_pairs;
+            if ((i + 2 * j) % 3 != 0) expected.push_back({j, double{matrix.at(i, j)}});
+        }
+        std::sort(expected.begin(), expected.end(), [](const Neighbor& a, const Neighbor& b) {
+            return a.distance < b.distance || (a.distance == b.distance && a.index < b.index);
+        });
+        expected.resize(std::min<std::size_t>(expected.size(), 4));
+        ASSERT_EQ(detected[i].candidates.size(), expected.size()) << i;
+        for (std::size_t r = 0; r < expected.size(); ++r)
+            EXPECT_EQ(detected[i].candidates[r].index, expected[r].index) << i << " rank " << r;
+        differ_from_unchecked +=
+            unchecked[i].candidates.size() == expected.size() &&
+                    !std::equal(
+                        expected.begin(), expected.end(), unchecked[i].candidates.begin(),
+                        [](const Neighbor& a, const Neighbor& b) { return a.index == b.index; })
+                ? 1
+                : 0;
+    }
+    EXPECT_GT(differ_from_unchecked, 100u);  // the check changed the candidates
+    EXPECT_LT(judged_by_matrix, eligible_pairs / 4);
+    ExpectIdenticalQueries(DetectStreaming(database, detector, Execution::kParallel, {}, check),
+                           detected);
+    ExpectIdenticalQueries(DetectStreaming(database, detector, Execution::kSerial, {}, check),
+                           detected);
+}
+
+// Online with an odometry gate, the scans the odometry puts out of a loop's reach are no
+// candidates, as offline with the same gate's check (CheckAgainstOdometry).
+TEST(LoopDetector, TheOdometrysReachLimitsTheCandidatesAsOffline) {
+    const auto histograms = test::ClusteredHistograms(240, 40, 12, 8);
+    std::vector<core::Transform> T_odom_sensor;
+    std::vector<double> path_m;
+    for (std::size_t i = 0; i < histograms.size(); ++i) {
+        // Three laps of a circle of 50 m radius, 100 scans a lap.
+        const double angle = 2.0 * M_PI * static_cast<double>(i) / 100.0;
+        core::Transform T = core::Transform::Identity();
+        T.translation() = Eigen::Vector3d(50.0 * std::cos(angle), 50.0 * std::sin(angle), 0.0);
+        T_odom_sensor.push_back(T);
+        path_m.push_back(50.0 * angle);
+    }
+    // The loop must put the query within 3 m of where the odometry does.
+    const OdometryGate gate = [](const core::Transform& T_loop, const core::Transform& T_odometry,
+                                 double) {
+        return (T_loop.translation() - T_odometry.translation()).norm() > 3.0;
+    };
+    DetectorConfig detector = Deciding(DetectorConfig{}, 0.01);
+    detector.top_k = 3;
+    detector.min_path_m = 0.0;
+    LoopDetector online(HeightConfig(40), detector);
+    online.SetOdometryGate(gate);
+    std::vector<LoopQuery> online_results;
+    std::vector<double> times;
+    for (std::size_t i = 0; i < histograms.size(); ++i) {
+        times.push_back(0.1 * static_cast<double>(i));
+        online_results.push_back(online.Process(test::HistogramDescriptor(histograms[i]), times[i],
+                                                {}, T_odom_sensor[i]));
+    }
+    const SimilarityMatrix matrix = ComputeSimilarityMatrix(online.database());
+    const LoopCheck check = CheckAgainstOdometry([&](std::size_t j) { return T_odom_sensor[j]; },
+                                                 [&](std::size_t j) { return path_m[j]; }, gate);
+    const auto offline = DetectFromMatrix(matrix, times, Deciding(detector, online.threshold()),
+                                          core::Method::kHeight, path_m, check);
+    std::size_t with_candidates = 0;
+    for (std::size_t i = 0; i < offline.size(); ++i) {
+        ExpectSameQueries(online_results[i], offline[i]);
+        with_candidates += offline[i].has_match() ? 1 : 0;
+        for (const Neighbor& n : offline[i].candidates) {
+            EXPECT_LE(
+                (T_odom_sensor[i].translation() - T_odom_sensor[n.index].translation()).norm(),
+                detector.verification.acceptance.max_loop_distance_m + 3.0)
+                << i << " " << n.index;
+        }
+    }
+    EXPECT_GT(with_candidates, 100u);  // the second and third laps
 }
 
 // Many scans with equal descriptors: ties at the k-th place, where the index's answer is not

@@ -191,15 +191,22 @@ TEST(OnlineVerification, TheOdometryGateRejectsOnlyTheLoopsItContradicts) {
     EXPECT_TRUE(first.T_match_query_odometry.isApprox(odometry[0].inverse() * odometry[3], 1e-12));
     EXPECT_NEAR(first.path_m, path_0_to_3_m, 1e-9);
 
-    // 60 m off: the revisit of place 0 is rejected, that of place 1 kept.
+    // 8 m off (within a loop's 10 m of scan 0, so still a candidate): the revisit of place 0
+    // is registered and rejected, that of place 1 kept.
     calls.clear();
-    const std::vector<LoopQuery> contradicted = ProcessWithOdometry(Odometry(60.0), calls);
+    const std::vector<LoopQuery> contradicted = ProcessWithOdometry(Odometry(8.0), calls);
     EXPECT_FALSE(contradicted[3].accepted);
     EXPECT_FALSE(contradicted[3].loop());
     const auto& verdicts = contradicted[3].verifications;
-    EXPECT_TRUE(std::any_of(verdicts.begin(), verdicts.end(), [](const auto& v) {
-        return v.reason == registration::RejectReason::kOdometryMismatch;
-    }));
+    ASSERT_EQ(verdicts.size(), contradicted[3].candidates.size());
+    bool rejected_scan_0 = false;
+    for (std::size_t c = 0; c < verdicts.size(); ++c) {
+        rejected_scan_0 = rejected_scan_0 ||
+                          (contradicted[3].candidates[c].index == 0 &&
+                           verdicts[c].reason == registration::RejectReason::kOdometryMismatch &&
+                           verdicts[c].registered_hypotheses > 0);
+    }
+    EXPECT_TRUE(rejected_scan_0);
     ASSERT_TRUE(contradicted[4].loop());
     EXPECT_EQ(contradicted[4].candidates[*contradicted[4].loop()].index, 1U);
 }
@@ -420,25 +427,41 @@ TEST(StopAtFirstLoop, RegisteringSeveralAtOnceGivesTheVerdictsOfOneAfterAnother)
 // A candidate the odometry puts farther from the query than a loop's 10 m plus the gate allows
 // cannot become a loop whatever its registration: it is not registered (reason odometry_mismatch,
 // no hypothesis refined), and the other pairs keep their verdicts.
-TEST(OnlineVerification, ACandidateTheOdometryPutsOutOfReachIsNotRegistered) {
+// 60 m off, the odometry puts scan 3 out of reach of a loop with scan 0: scan 0 is no
+// candidate of scan 3, and scan 4's verdicts are unchanged.
+TEST(OnlineVerification, AScanTheOdometryPutsOutOfReachIsNoCandidate) {
     std::vector<GateCall> calls;
     const std::vector<LoopQuery> near = ProcessWithOdometry(Odometry(0.0), calls);
     const std::vector<LoopQuery> far = ProcessWithOdometry(Odometry(60.0), calls);
-    const auto verdict_of = [](const LoopQuery& query, std::size_t match) {
-        for (std::size_t c = 0; c < query.candidates.size(); ++c)
-            if (query.candidates[c].index == match) return query.verifications.at(c);
-        ADD_FAILURE() << "no candidate " << match << " of scan " << query.query;
-        return registration::Verification{};
+    const auto has_candidate = [](const LoopQuery& query, std::size_t match) {
+        return std::any_of(query.candidates.begin(), query.candidates.end(),
+                           [match](const Neighbor& n) { return n.index == match; });
     };
-    const registration::Verification registered = verdict_of(near[3], 0);
-    EXPECT_TRUE(registered.accepted);
-    EXPECT_GE(registered.registered_hypotheses, 1);
-    const registration::Verification ruled_out = verdict_of(far[3], 0);
-    EXPECT_EQ(ruled_out.reason, registration::RejectReason::kOdometryMismatch);
-    EXPECT_EQ(ruled_out.registered_hypotheses, 0);
+    ASSERT_TRUE(has_candidate(near[3], 0));
+    ASSERT_TRUE(near[3].loop());
+    EXPECT_EQ(near[3].candidates[*near[3].loop()].index, 0U);
+    EXPECT_FALSE(has_candidate(far[3], 0));
+    EXPECT_FALSE(far[3].loop());
     ASSERT_EQ(near[4].verifications.size(), far[4].verifications.size());
     for (std::size_t c = 0; c < near[4].verifications.size(); ++c)
         ExpectSameVerdict(near[4].verifications[c], far[4].verifications[c], c);
+}
+
+// A candidate the check says cannot close (given to VerifyQuery all the same) is answered
+// odometry_mismatch without a registration; the others are verified as without the check.
+TEST(OnlineVerification, ACandidateTheCheckSaysCannotCloseIsNotRegistered) {
+    DetectorConfig detector = Verifying();
+    detector.stop_at_first_loop = false;
+    const RankedCandidates ranked = MakeRankedCandidates(detector);
+    LoopCheck rules_out_2;
+    rules_out_2.may_close = [](std::size_t, std::size_t match, double) { return match != 2; };
+    const LoopQuery checked = Verified(ranked, detector, rules_out_2);
+    const LoopQuery unchecked = Verified(ranked, detector);
+    ASSERT_TRUE(unchecked.verifications[2].accepted);
+    EXPECT_EQ(checked.verifications[2].reason, registration::RejectReason::kOdometryMismatch);
+    EXPECT_EQ(checked.verifications[2].registered_hypotheses, 0);
+    for (const std::size_t c : {0U, 1U, 3U})
+        ExpectSameVerdict(checked.verifications[c], unchecked.verifications[c], c);
 }
 
 TEST(OnlineVerification, PreparedScansMustMatchTheDatabase) {
