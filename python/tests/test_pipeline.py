@@ -223,8 +223,9 @@ def test_online_detector_with_odometry_counts_the_gap_in_metres(cli, sequence, t
 
 
 def test_online_detector_rejects_the_loops_its_odometry_contradicts(sequence):
-    """The pose graph's gate online: with the true poses as odometry the verified loops stay;
-    with the revisits' odometry 100 m off they are rejected as odometry_mismatch."""
+    """The pose graph's gate online: with the true poses as odometry the verified loops stay; with
+    the revisits' odometry turned 30 degrees they are registered and rejected as odometry_mismatch;
+    with it 100 m off their earlier scans are out of a loop's reach and no candidates at all."""
     times, truth = sequence.poses
 
     def run(odometry):
@@ -234,14 +235,19 @@ def test_online_detector_rejects_the_loops_its_odometry_contradicts(sequence):
     agreeing = run(truth)
     across = [q for q in agreeing if q.query >= 40 and q.loop is not None and q.match < 40]
     assert across, "the sequence has verified loops from scans 40.. back to scans before 40"
-    shifted = truth.copy()
-    shifted[40:, 0, 3] += 100.0  # the odometry jumps 100 m at scan 40
-    contradicted = run(shifted)
+    turned = truth.copy()
+    c, s = np.cos(np.radians(30.0)), np.sin(np.radians(30.0))
+    turned[40:, :3, :3] = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ truth[40:, :3, :3]
+    contradicted = run(turned)
     for query in contradicted[40:]:
         assert query.loop is None or query.match >= 40, query.query
     for query in across:
         reasons = [v.reason for v in contradicted[query.query].verifications]
         assert "odometry_mismatch" in reasons, query.query
+    shifted = truth.copy()
+    shifted[40:, 0, 3] += 100.0  # the odometry jumps 100 m at scan 40
+    for query in run(shifted)[40:]:
+        assert all(c.index >= 40 for c in query.candidates), query.query
     with pytest.raises(lidarloop.ShapeError):
         lidarloop.LoopDetector(method="range").process(sequence[0], odometry=np.eye(3))
 
