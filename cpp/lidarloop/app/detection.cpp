@@ -201,7 +201,7 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     std::atomic<std::size_t> rejected{0};
     pipeline::LoopCheck odometry_check;
     if (verify && !poses.empty())
-        odometry_check = OdometryLoopCheck(poses, path_m, config.posegraph, &rejected);
+        odometry_check = OdometryLoopCheck(poses, path_m, config.posegraph, &rejected, &prepared);
     // All pairs either way; the matrix only when it fits the budget (same results without).
     Stopwatch matrix_clock;
     std::optional<pipeline::SimilarityMatrix> matrix;

@@ -51,7 +51,8 @@ pipeline::LoopCheck VerificationCheckOf(const OdometryCheck* odometry,
                                         const pipeline::DetectorConfig& detector,
                                         const PreparedScans* prepared) {
     if (odometry == nullptr || !detector.verify || prepared == nullptr) return {};
-    return OdometryLoopCheck(odometry->odometry, odometry->path_m, odometry->config);
+    return OdometryLoopCheck(odometry->odometry, odometry->path_m, odometry->config, nullptr,
+                             prepared);
 }
 
 RetrievalComparison CompareRetrieval(const pipeline::SimilarityMatrix& matrix,

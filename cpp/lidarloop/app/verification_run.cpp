@@ -176,7 +176,8 @@ pipeline::OdometryGate OdometryGateOf(const posegraph::PoseGraphConfig& config) 
 pipeline::LoopCheck OdometryLoopCheck(const std::vector<core::StampedPose>& odometry,
                                       const std::vector<double>& path_m,
                                       const posegraph::PoseGraphConfig& config,
-                                      std::atomic<std::size_t>* rejected) {
+                                      std::atomic<std::size_t>* rejected,
+                                      const PreparedScans* prepared) {
     const auto require_pose = [&odometry, &path_m](std::size_t scan) {
         if (scan >= odometry.size() || scan >= path_m.size()) {
             throw core::ConfigError("scan " + std::to_string(scan) + " has no odometry (" +
@@ -191,7 +192,14 @@ pipeline::LoopCheck OdometryLoopCheck(const std::vector<core::StampedPose>& odom
         require_pose(scan);
         return path_m[scan];
     };
-    return pipeline::CheckAgainstOdometry(pose_of, path_of, OdometryGateOf(config), rejected);
+    std::function<Eigen::Vector3d(std::size_t)> view_centre_of;
+    if (prepared != nullptr) {
+        view_centre_of = [prepared](std::size_t scan) {
+            return prepared->scans.at(scan).view_centre();
+        };
+    }
+    return pipeline::CheckAgainstOdometry(pose_of, path_of, OdometryGateOf(config), rejected,
+                                          view_centre_of);
 }
 
 std::size_t RejectLoopsAgainstOdometry(std::vector<pipeline::LoopQuery>& queries,

@@ -115,12 +115,15 @@ std::size_t RejectLoopsAgainstOdometry(std::vector<pipeline::LoopQuery>& queries
 
 /// RejectLoopsAgainstOdometry for one query at a time, as verification runs it (VerifyAll):
 /// with detection.stop_at_first_loop a loop the odometry rejects lets the next candidate be
-/// registered. Adds the rejections to `rejected` when given (thread-safe). The vectors are
+/// registered. Adds the rejections to `rejected` when given (thread-safe). With `prepared`, a
+/// query's candidates are ordered by the odometry's distance of their view centres
+/// (pipeline::LoopCheck::view_distance_m, detection.odometry_shortlist). The vectors are
 /// referenced, not copied: they must outlive the check.
 pipeline::LoopCheck OdometryLoopCheck(const std::vector<core::StampedPose>& odometry,
                                       const std::vector<double>& path_m,
                                       const posegraph::PoseGraphConfig& config,
-                                      std::atomic<std::size_t>* rejected = nullptr);
+                                      std::atomic<std::size_t>* rejected = nullptr,
+                                      const PreparedScans* prepared = nullptr);
 
 /// The figures of a verification run for timings.json: per scan preparation (ms) and memory
 /// (bytes), per query coarse images (ms), per candidate pair (ms), counts.

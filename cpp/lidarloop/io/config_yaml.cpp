@@ -105,6 +105,8 @@ void VisitFields(pipeline::DetectorConfig& c, Visitor& v) {
     v.Field("min_path_m", c.min_path_m,
             "and more than this much path back (metres), where the odometry or poses give it");
     v.Field("top_k", c.top_k, "candidates reported per query scan");
+    v.Field("odometry_shortlist", c.odometry_shortlist,
+            "with the odometry: top_k nearest view centres of this many best-ranked scans");
     v.Field("threshold", c.threshold, ThresholdHelp());
     v.Field("verify", c.verify,
             "register candidates and accept only verified loops (section verification)");

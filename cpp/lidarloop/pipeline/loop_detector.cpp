@@ -99,6 +99,39 @@ Filter ReachableFrom(std::size_t i, const LoopCheck& check, const DetectorConfig
     };
 }
 
+// How many best-ranked scans a query's top_k are taken from: odometry_shortlist where `check`
+// orders them by the odometry's view distance, else top_k.
+std::size_t ShortlistSize(const DetectorConfig& detector, const LoopCheck& check) {
+    const int size = check.view_distance_m ? std::max(detector.top_k, detector.odometry_shortlist)
+                                           : detector.top_k;
+    return static_cast<std::size_t>(size);
+}
+
+// The top_k of `result`'s shortlist: where `check` knows the view distances, the nearest first
+// (a scan the odometry does not know last; equal ones in rank order).
+void NearestViewsFirst(LoopQuery& result, const LoopCheck& check, const DetectorConfig& detector) {
+    auto& candidates = result.candidates;
+    if (check.view_distance_m) {
+        std::vector<double> distance_m;
+        distance_m.reserve(candidates.size());
+        for (const Neighbor& c : candidates) {
+            const double d = check.view_distance_m(result.query, c.index);
+            distance_m.push_back(std::isnan(d) ? std::numeric_limits<double>::infinity() : d);
+        }
+        std::vector<std::size_t> order(candidates.size());
+        for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+        std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+            return distance_m[a] < distance_m[b];
+        });
+        std::vector<Neighbor> nearest;
+        nearest.reserve(candidates.size());
+        for (const std::size_t k : order) nearest.push_back(candidates[k]);
+        candidates = std::move(nearest);
+    }
+    if (candidates.size() > static_cast<std::size_t>(detector.top_k))
+        candidates.resize(static_cast<std::size_t>(detector.top_k));
+}
+
 // Scan i's candidates among the scans j < i outside the gap (and the path rule, when `path_m` is
 // known), as LoopDetector::Process gives them online.
 LoopQuery DetectOne(std::size_t i, const CandidateSearch& search, const std::vector<double>& along,
@@ -112,11 +145,12 @@ LoopQuery DetectOne(std::size_t i, const CandidateSearch& search, const std::vec
     LoopQuery result;
     result.query = i;
     result.candidates =
-        SearchReachable(search, static_cast<std::size_t>(detector.top_k), eligible, reachable);
+        SearchReachable(search, ShortlistSize(detector, check), eligible, reachable);
     Finish(result, detector.min_gap, along, method, threshold, [&](const Filter& other_place) {
         return SearchReachable(
             search, 1, [&](std::size_t j) { return eligible(j) && other_place(j); }, reachable);
     });
+    NearestViewsFirst(result, check, detector);
     return result;
 }
 
@@ -155,6 +189,10 @@ void DetectorConfig::Validate() const {
     if (top_k < 1 || top_k > 1000) {
         throw core::ConfigError("detection.top_k must be in [1, 1000], got " +
                                 std::to_string(top_k));
+    }
+    if (odometry_shortlist < 1 || odometry_shortlist > 1000) {
+        throw core::ConfigError("detection.odometry_shortlist must be in [1, 1000], got " +
+                                std::to_string(odometry_shortlist));
     }
     verification.Validate();
 }
@@ -236,8 +274,17 @@ std::size_t RejectLoopsAgainstOdometry(
 
 LoopCheck CheckAgainstOdometry(std::function<core::Transform(std::size_t)> T_odom_sensor_of,
                                std::function<double(std::size_t)> path_m_of, OdometryGate gate,
-                               std::atomic<std::size_t>* rejected) {
+                               std::atomic<std::size_t>* rejected,
+                               std::function<Eigen::Vector3d(std::size_t)> view_centre_of) {
     LoopCheck check;
+    if (view_centre_of) {
+        check.view_distance_m = [T_odom_sensor_of, view_centre_of](std::size_t query,
+                                                                   std::size_t match) {
+            return (T_odom_sensor_of(query) * view_centre_of(query) -
+                    T_odom_sensor_of(match) * view_centre_of(match))
+                .norm();
+        };
+    }
     check.reject = [T_odom_sensor_of, path_m_of, gate, rejected](LoopQuery& query) {
         const std::size_t count =
             RejectLoopsAgainstOdometry(query, T_odom_sensor_of, path_m_of, gate);
@@ -308,7 +355,6 @@ LoopDetector::LoopDetector(DescriptorDatabase database, const DetectorConfig& de
 LoopQuery LoopDetector::Search(const PreparedQuery& query, std::size_t query_index,
                                const std::function<bool(std::size_t)>& eligible,
                                const std::vector<double>& path_m, const LoopCheck& check) const {
-    const auto k = static_cast<std::size_t>(detector_.top_k);
     const CandidateSearch search = [&](std::size_t count, const Filter& filter) {
         if (index_) return index_->Search(query, count, filter);
         return NearestCandidates(
@@ -318,7 +364,8 @@ LoopQuery LoopDetector::Search(const PreparedQuery& query, std::size_t query_ind
     const Filter reachable = ReachableFrom(query_index, check, detector_);
     LoopQuery result;
     result.query = query_index;
-    result.candidates = SearchReachable(search, k, eligible, reachable);
+    result.candidates =
+        SearchReachable(search, ShortlistSize(detector_, check), eligible, reachable);
     // Without the path (no odometry, or localisation) a gap in metres leaves second_ratio NaN.
     Finish(result, detector_.min_gap, detector_.min_gap.Along(database_.times_s(), path_m),
            database_.definition(), threshold_, [&](const Filter& other_place) {
@@ -326,6 +373,7 @@ LoopQuery LoopDetector::Search(const PreparedQuery& query, std::size_t query_ind
                    search, 1, [&](std::size_t j) { return eligible(j) && other_place(j); },
                    reachable);
            });
+    NearestViewsFirst(result, check, detector_);
     return result;
 }
 
@@ -402,9 +450,13 @@ LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_
         if (j == query_index) return *query_path_m;
         return j < session_start_ ? kNan : path_m_[j - session_start_];
     };
+    // Where the scans look, for the order of the candidates (NaN for a scan given unprepared).
+    const auto view_of = [&](std::size_t j) {
+        return j == query_index ? scan.view_centre : scans_[j].view_centre();
+    };
     LoopCheck odometry_check;
     if (odometry_gate_ && query_path_m)
-        odometry_check = CheckAgainstOdometry(pose_of, path_of, odometry_gate_);
+        odometry_check = CheckAgainstOdometry(pose_of, path_of, odometry_gate_, nullptr, view_of);
     LoopQuery result = Search(
         *query, query_index,
         [&](std::size_t j) {

@@ -77,7 +77,8 @@ CompactPreparedScan::CompactPreparedScan(const PreparedScan& scan)
       distinctive_count_(scan.structure_distinctive.size()),
       input_points_(scan.input_points),
       usable_points_(scan.usable_points),
-      structure_roughness_m_(scan.structure_roughness_m) {
+      structure_roughness_m_(scan.structure_roughness_m),
+      view_centre_(scan.view_centre) {
     if (scan.structure) structure_ = Encode(*scan.structure);
     if (scan.ground) ground_ = Encode(*scan.ground);
     distinctive_bits_.assign((scan.structure_distinctive.size() + 7) / 8, 0);
@@ -93,6 +94,7 @@ PreparedScan CompactPreparedScan::Expand() const {
     scan.input_points = input_points_;
     scan.usable_points = usable_points_;
     scan.structure_roughness_m = structure_roughness_m_;
+    scan.view_centre = view_centre_;
     if (!prepared_) return scan;
     scan.structure = Decode(structure_);
     scan.ground = Decode(ground_);

@@ -2,6 +2,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "lidarloop/registration/prepared_scan.hpp"
@@ -23,6 +24,8 @@ public:
     PreparedScan Expand() const;
     /// Whether the scan was prepared (an empty PreparedScan has no structure).
     bool prepared() const { return prepared_; }
+    /// PreparedScan::view_centre, kept as it was (NaN for an empty scan).
+    const Eigen::Vector3d& view_centre() const { return view_centre_; }
     /// Heap bytes held (the figure bench and LoopDetector::prepared_bytes report).
     std::size_t MemoryBytes() const;
 
@@ -45,6 +48,8 @@ private:
     std::size_t input_points_ = 0;
     std::size_t usable_points_ = 0;
     double structure_roughness_m_ = 0.0;
+    Eigen::Vector3d view_centre_ =
+        Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
 };
 
 /// Octahedral encoding of a unit normal in two integers of [-32767, 32767] and back (the

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <numbers>
 
 #include <Eigen/Eigenvalues>
@@ -19,17 +20,29 @@ bool Usable(const Eigen::Vector3f& point, const ScanReductionConfig& config) {
     return range_m >= config.min_range_m && range_m <= config.max_range_m;
 }
 
-// Voxel centroids, in order of first appearance (deterministic for a given scan).
+// A sum of `count` points over their count; NaN for none.
+Eigen::Vector3d MeanOf(const Eigen::Vector3d& sum, std::size_t count) {
+    if (count == 0) return Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+    return sum / static_cast<double>(count);
+}
+
+// The voxel centroids of the usable points, in order of first appearance (deterministic for a
+// given scan); counts the points and, in the same pass, finds their mean (the view centre).
 std::vector<Eigen::Vector3f> VoxelCentroids(const core::PointCloud& scan,
                                             const ScanReductionConfig& config,
-                                            std::size_t& usable_points) {
+                                            std::size_t& usable_points,
+                                            Eigen::Vector3d& view_centre) {
     core::VoxelGrid grid(config.voxel_m);
     grid.Reserve(scan.size() / 4);
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     for (const auto& point : scan) {
         if (!Usable(point, config)) continue;
         ++usable_points;
-        grid.Add(point.cast<double>());
+        const Eigen::Vector3d p = point.cast<double>();
+        sum += p;
+        grid.Add(p);
     }
+    view_centre = MeanOf(sum, usable_points);
     std::vector<Eigen::Vector3f> centroids;
     centroids.reserve(grid.size());
     for (const core::Voxel& voxel : grid.Voxels())
@@ -166,7 +179,8 @@ std::size_t PreparedScan::MemoryBytes() const {
 PreparedScan PrepareScan(const core::PointCloud& scan, const ScanReductionConfig& config) {
     PreparedScan prepared;
     prepared.input_points = scan.size();
-    const auto centroids = VoxelCentroids(scan, config, prepared.usable_points);
+    const auto centroids =
+        VoxelCentroids(scan, config, prepared.usable_points, prepared.view_centre);
     const NeighborGrid grid(centroids, static_cast<float>(config.voxel_m));
     NeighborGrid::Scratch scratch;
     const float max_vertical_z =
@@ -201,6 +215,17 @@ PreparedScan PrepareScan(const core::PointCloud& scan, const ScanReductionConfig
         std::make_shared<const SurfacePoints>(std::move(ground), std::move(ground_normals));
     prepared.structure_roughness_m = SelfResidual(*prepared.structure);
     return prepared;
+}
+
+Eigen::Vector3d ViewCentre(const core::PointCloud& scan, const ScanReductionConfig& config) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    std::size_t usable = 0;
+    for (const auto& point : scan) {
+        if (!Usable(point, config)) continue;
+        sum += point.cast<double>();
+        ++usable;
+    }
+    return MeanOf(sum, usable);
 }
 
 }  // namespace lidarloop::registration

@@ -2,6 +2,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -57,6 +58,10 @@ struct PreparedScan {
     /// facade) at the scale of distinctive_neighbors voxels; poles, trunks, cars, door leaves,
     /// corners. Walls look alike in every street and corridor; these tell places apart.
     std::vector<std::uint8_t> structure_distinctive;
+    /// Where the scan looks (ViewCentre of the raw scan; a submap keeps its centre scan's): the
+    /// odometry orders a query's candidates by it (pipeline::LoopCheck::view_distance_m).
+    Eigen::Vector3d view_centre =
+        Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
 
     /// Heap bytes held by the prepared scan (the figure bench reports per stored scan).
     std::size_t MemoryBytes() const;
@@ -67,5 +72,10 @@ struct PreparedScan {
 /// caps. Never throws on bad points: non-finite ones are skipped, and a scan with too little
 /// left gives an almost empty result that Verify rejects with the reason. Thread-safe.
 PreparedScan PrepareScan(const core::PointCloud& scan, const ScanReductionConfig& config);
+
+/// Where `scan` looks: the mean of its usable points (finite, within the range limits of
+/// `config`), sensor frame, metres; NaN without any. Near the sensor for a 360-degree scan, ahead
+/// of it for a narrow field of view.
+Eigen::Vector3d ViewCentre(const core::PointCloud& scan, const ScanReductionConfig& config);
 
 }  // namespace lidarloop::registration

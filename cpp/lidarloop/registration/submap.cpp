@@ -86,12 +86,17 @@ PreparedScan PrepareSubmap(std::size_t centre, const std::vector<core::StampedPo
     if (members.size() == 1) return PrepareScan(load(centre), config);
     std::vector<core::PointCloud> scans;
     std::vector<core::Transform> T_world_scans;
+    Eigen::Vector3d centre_view =
+        Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
     for (const std::size_t k : members) {
         scans.push_back(load(k));
         T_world_scans.push_back(poses.at(k).T_world_sensor);
+        if (k == centre) centre_view = ViewCentre(scans.back(), config);
     }
-    return PrepareScan(
+    PreparedScan submap = PrepareScan(
         MergeIntoFrame(scans, T_world_scans, poses.at(centre).T_world_sensor, config), config);
+    submap.view_centre = centre_view;  // where the centre scan looks, not its neighbours
+    return submap;
 }
 
 }  // namespace lidarloop::registration

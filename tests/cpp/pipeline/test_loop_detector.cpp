@@ -1,11 +1,15 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <functional>
+#include <limits>
+#include <memory>
 #include <random>
 
 #include <gtest/gtest.h>
 
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/pipeline/descriptor_method.hpp"
 #include "lidarloop/pipeline/histogram_method.hpp"
 #include "lidarloop/pipeline/loop_detector.hpp"
 #include "lidarloop/pipeline/sequence.hpp"
@@ -361,54 +365,202 @@ TEST(DetectFromMatrix, ScansOutOfTheChecksReachAreNoCandidates) {
                            detected);
 }
 
+// Three laps of a circle of 50 m radius, 100 scans a lap, each facing along the circle, with
+// clustered histograms; the gate wants a loop's pose within 3 m of the odometry's. Fed to an
+// online detector with the odometry, and the same as an offline check.
+struct OdometryLaps {
+    OdometryLaps() : histograms(test::ClusteredHistograms(240, 40, 12, 8)) {
+        for (std::size_t i = 0; i < histograms.size(); ++i) {
+            const double angle = 2.0 * M_PI * static_cast<double>(i) / 100.0;
+            core::Transform T = core::Transform::Identity();
+            T.linear() = Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+            T.translation() = Eigen::Vector3d(50.0 * std::cos(angle), 50.0 * std::sin(angle), 0.0);
+            T_odom_sensor.push_back(T);
+            path_m.push_back(50.0 * angle);
+            times_s.push_back(0.1 * static_cast<double>(i));
+        }
+    }
+
+    // Every scan through `online` with its odometry pose; `prepared_of(i)`: scan i prepared.
+    std::vector<LoopQuery> RunOnline(
+        LoopDetector& online,
+        const std::function<registration::PreparedScan(std::size_t)>& prepared_of) const {
+        online.SetOdometryGate(gate);
+        std::vector<LoopQuery> results;
+        for (std::size_t i = 0; i < histograms.size(); ++i) {
+            results.push_back(online.Process(test::HistogramDescriptor(histograms[i]), times_s[i],
+                                             prepared_of(i), T_odom_sensor[i]));
+        }
+        return results;
+    }
+
+    LoopCheck Check(std::function<Eigen::Vector3d(std::size_t)> view_centre_of = {}) const {
+        return CheckAgainstOdometry([this](std::size_t j) { return T_odom_sensor[j]; },
+                                    [this](std::size_t j) { return path_m[j]; }, gate, nullptr,
+                                    std::move(view_centre_of));
+    }
+
+    std::vector<std::vector<double>> histograms;
+    std::vector<core::Transform> T_odom_sensor;
+    std::vector<double> path_m;
+    std::vector<double> times_s;
+    OdometryGate gate = [](const core::Transform& T_loop, const core::Transform& T_odometry,
+                           double) {
+        return (T_loop.translation() - T_odometry.translation()).norm() > 3.0;
+    };
+};
+
 // Online with an odometry gate, the scans the odometry puts out of a loop's reach are no
 // candidates, as offline with the same gate's check (CheckAgainstOdometry).
 TEST(LoopDetector, TheOdometrysReachLimitsTheCandidatesAsOffline) {
-    const auto histograms = test::ClusteredHistograms(240, 40, 12, 8);
-    std::vector<core::Transform> T_odom_sensor;
-    std::vector<double> path_m;
-    for (std::size_t i = 0; i < histograms.size(); ++i) {
-        // Three laps of a circle of 50 m radius, 100 scans a lap.
-        const double angle = 2.0 * M_PI * static_cast<double>(i) / 100.0;
-        core::Transform T = core::Transform::Identity();
-        T.translation() = Eigen::Vector3d(50.0 * std::cos(angle), 50.0 * std::sin(angle), 0.0);
-        T_odom_sensor.push_back(T);
-        path_m.push_back(50.0 * angle);
-    }
-    // The loop must put the query within 3 m of where the odometry does.
-    const OdometryGate gate = [](const core::Transform& T_loop, const core::Transform& T_odometry,
-                                 double) {
-        return (T_loop.translation() - T_odometry.translation()).norm() > 3.0;
-    };
+    const OdometryLaps laps;
     DetectorConfig detector = Deciding(DetectorConfig{}, 0.01);
     detector.top_k = 3;
     detector.min_path_m = 0.0;
     LoopDetector online(HeightConfig(40), detector);
-    online.SetOdometryGate(gate);
-    std::vector<LoopQuery> online_results;
-    std::vector<double> times;
-    for (std::size_t i = 0; i < histograms.size(); ++i) {
-        times.push_back(0.1 * static_cast<double>(i));
-        online_results.push_back(online.Process(test::HistogramDescriptor(histograms[i]), times[i],
-                                                {}, T_odom_sensor[i]));
-    }
+    const auto online_results =
+        laps.RunOnline(online, [](std::size_t) { return registration::PreparedScan{}; });
     const SimilarityMatrix matrix = ComputeSimilarityMatrix(online.database());
-    const LoopCheck check = CheckAgainstOdometry([&](std::size_t j) { return T_odom_sensor[j]; },
-                                                 [&](std::size_t j) { return path_m[j]; }, gate);
-    const auto offline = DetectFromMatrix(matrix, times, Deciding(detector, online.threshold()),
-                                          core::Method::kHeight, path_m, check);
+    const auto offline =
+        DetectFromMatrix(matrix, laps.times_s, Deciding(detector, online.threshold()),
+                         core::Method::kHeight, laps.path_m, laps.Check());
     std::size_t with_candidates = 0;
     for (std::size_t i = 0; i < offline.size(); ++i) {
         ExpectSameQueries(online_results[i], offline[i]);
         with_candidates += offline[i].has_match() ? 1 : 0;
         for (const Neighbor& n : offline[i].candidates) {
             EXPECT_LE(
-                (T_odom_sensor[i].translation() - T_odom_sensor[n.index].translation()).norm(),
+                (laps.T_odom_sensor[i].translation() - laps.T_odom_sensor[n.index].translation())
+                    .norm(),
                 detector.verification.acceptance.max_loop_distance_m + 3.0)
                 << i << " " << n.index;
         }
     }
     EXPECT_GT(with_candidates, 100u);  // the second and third laps
+}
+
+// Where the check knows the view distances, the top k are the k nearest views among the
+// odometry_shortlist best-ranked scans within reach, nearest first (a scan of unknown distance
+// last, ties in rank order): brute force over the matrix.
+TEST(DetectFromMatrix, TheOdometryOrdersTheShortlistByViewDistance) {
+    const auto histograms = test::ClusteredHistograms(300, 40, 20, 3);
+    DescriptorDatabase database(HeightConfig(40));
+    for (std::size_t i = 0; i < histograms.size(); ++i)
+        database.Add(test::HistogramDescriptor(histograms[i]), 0.1 * static_cast<double>(i));
+    const SimilarityMatrix matrix = ComputeSimilarityMatrix(database);
+    DetectorConfig detector = Deciding(DetectorConfig{}, 0.01);
+    detector.top_k = 4;
+    detector.odometry_shortlist = 12;
+    const auto reachable = [](std::size_t query, std::size_t match) {
+        return (query + 2 * match) % 3 != 0;
+    };
+    const auto view_distance_m = [](std::size_t query, std::size_t match) {
+        if (match % 7 == 0) return std::numeric_limits<double>::quiet_NaN();
+        return static_cast<double>((query * 31 + match * 17) % 10);  // many ties
+    };
+    LoopCheck check;
+    check.may_close = [&](std::size_t query, std::size_t match, double) {
+        return reachable(query, match);
+    };
+    check.view_distance_m = view_distance_m;
+    const std::vector<LoopQuery> detected =
+        DetectFromMatrix(matrix, database.times_s(), detector, core::Method::kHeight, {}, check);
+    std::size_t reordered = 0;
+    for (std::size_t i = 0; i < matrix.size(); ++i) {
+        std::vector<Neighbor> ranked;
+        for (std::size_t j = 0; j + 30 < i; ++j) {
+            if (reachable(i, j)) ranked.push_back({j, double{matrix.at(i, j)}});
+        }
+        std::sort(ranked.begin(), ranked.end(), [](const Neighbor& a, const Neighbor& b) {
+            return a.distance < b.distance || (a.distance == b.distance && a.index < b.index);
+        });
+        ranked.resize(std::min<std::size_t>(ranked.size(), 12));
+        const auto key = [&](const Neighbor& n) {
+            const double d = view_distance_m(i, n.index);
+            return std::isnan(d) ? 1e9 : d;
+        };
+        std::vector<Neighbor> expected = ranked;
+        std::stable_sort(expected.begin(), expected.end(),
+                         [&](const Neighbor& a, const Neighbor& b) { return key(a) < key(b); });
+        expected.resize(std::min<std::size_t>(expected.size(), 4));
+        ASSERT_EQ(IndicesOf(detected[i].candidates), IndicesOf(expected)) << i;
+        ranked.resize(std::min<std::size_t>(ranked.size(), 4));
+        if (IndicesOf(ranked) != IndicesOf(expected)) ++reordered;
+        // The best match (second_ratio, the descriptor's decision) is still the best-ranked.
+        if (!ranked.empty()) {
+            EXPECT_EQ(detected[i].accepted,
+                      MethodOf(core::Method::kHeight).IsMatch(ranked.front().distance, 0.01))
+                << i;
+        }
+    }
+    EXPECT_GT(reordered, 100u);  // the order changed what is registered
+    ExpectIdenticalQueries(DetectStreaming(database, detector, Execution::kParallel, {}, check),
+                           detected);
+    // A shortlist of top_k: the rank order, as without the view distances.
+    detector.odometry_shortlist = 4;
+    LoopCheck reach_only = check;
+    reach_only.view_distance_m = {};
+    const auto ranked_only = DetectFromMatrix(matrix, database.times_s(), detector,
+                                              core::Method::kHeight, {}, reach_only);
+    const auto shortlist_of_k =
+        DetectFromMatrix(matrix, database.times_s(), detector, core::Method::kHeight, {}, check);
+    for (std::size_t i = 0; i < matrix.size(); ++i) {
+        const auto& a = shortlist_of_k[i].candidates;
+        std::vector<std::size_t> sorted_a = IndicesOf(a),
+                                 sorted_b = IndicesOf(ranked_only[i].candidates);
+        std::sort(sorted_a.begin(), sorted_a.end());
+        std::sort(sorted_b.begin(), sorted_b.end());
+        EXPECT_EQ(sorted_a, sorted_b) << i;  // the same scans, nearest view first
+    }
+}
+
+// A prepared scan that looks at `centre`, with a few structure points there (too few to
+// register: verification rejects it at once).
+registration::PreparedScan LookingAt(const Eigen::Vector3d& centre) {
+    const Eigen::Vector3f c = centre.cast<float>();
+    std::vector<Eigen::Vector3f> points{c + Eigen::Vector3f(1, 0, 0), c - Eigen::Vector3f(1, 0, 0),
+                                        c};
+    std::vector<Eigen::Vector3f> normals(points.size(), Eigen::Vector3f::UnitX());
+    registration::PreparedScan scan;
+    scan.structure =
+        std::make_shared<const registration::SurfacePoints>(std::move(points), std::move(normals));
+    scan.view_centre = centre;
+    return scan;
+}
+
+// Online with an odometry gate, a query's candidates are ordered by the odometry's distance of
+// the scans' view centres, as offline with the same check (CheckAgainstOdometry with the view
+// centres).
+TEST(LoopDetector, TheOdometryOrdersTheCandidatesByViewAsOffline) {
+    const OdometryLaps laps;
+    std::vector<Eigen::Vector3d> view_centres;  // looking 0-20 m ahead
+    for (std::size_t i = 0; i < laps.histograms.size(); ++i)
+        view_centres.emplace_back(static_cast<double>((i * 7) % 21), 0.0, 0.0);
+    DetectorConfig detector = Deciding(DetectorConfig{}, 0.01);
+    detector.top_k = 3;
+    detector.odometry_shortlist = 8;
+    detector.min_path_m = 0.0;
+    LoopDetector online(HeightConfig(40), detector);
+    const auto online_results =
+        laps.RunOnline(online, [&](std::size_t i) { return LookingAt(view_centres[i]); });
+    const SimilarityMatrix matrix = ComputeSimilarityMatrix(online.database());
+    const auto offline = DetectFromMatrix(
+        matrix, laps.times_s, Deciding(detector, online.threshold()), core::Method::kHeight,
+        laps.path_m, laps.Check([&](std::size_t j) { return view_centres[j]; }));
+    std::size_t ordered = 0;
+    for (std::size_t i = 0; i < offline.size(); ++i) {
+        EXPECT_EQ(IndicesOf(online_results[i].candidates), IndicesOf(offline[i].candidates)) << i;
+        const auto view_distance = [&](const Neighbor& n) {
+            return (laps.T_odom_sensor[i] * view_centres[i] -
+                    laps.T_odom_sensor[n.index] * view_centres[n.index])
+                .norm();
+        };
+        const auto& candidates = offline[i].candidates;
+        for (std::size_t r = 1; r < candidates.size(); ++r)
+            EXPECT_LE(view_distance(candidates[r - 1]), view_distance(candidates[r])) << i;
+        ordered += candidates.size() > 1 ? 1 : 0;
+    }
+    EXPECT_GT(ordered, 100u);
 }
 
 // Many scans with equal descriptors: ties at the k-th place, where the index's answer is not

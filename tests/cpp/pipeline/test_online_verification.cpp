@@ -338,6 +338,7 @@ TEST(StopAtFirstLoop, ALoopTheCheckRejectsLetsTheNextCandidateBeRegistered) {
                                checked_accepted.push_back(accepted);
                            },
                            {},
+                           {},
                            {}});
     EXPECT_EQ(checked_accepted, (std::vector<std::size_t>{1, 1}));  // one new loop a call
     EXPECT_EQ(first.verifications[1].reason, registration::RejectReason::kOdometryMismatch);
@@ -393,6 +394,7 @@ TEST(StopAtFirstLoop, RegisteringSeveralAtOnceGivesTheVerdictsOfOneAfterAnother)
             if (v.accepted)
                 v.accepted = false, v.reason = registration::RejectReason::kOdometryMismatch;
         },
+        {},
         {},
         {}};
     const auto verify = [&](int threads, Execution execution, const LoopCheck& check,
@@ -487,6 +489,7 @@ TEST(OdometryFloor, OnlyTheCandidatesWhosePoseTheCheckJudges) {
             if (match == 2) return any_pose;
             return {};
         },
+        {},
         {}};
     const LoopQuery verified = Verified(ranked, detector, judges_candidate_2);
     EXPECT_EQ(verified.verifications[1].reason, registration::RejectReason::kDegenerate);

@@ -47,6 +47,8 @@ TEST(CompactPreparedScan, ExpandsToThePreparedScanWithinTheQuantum) {
     EXPECT_EQ(expanded.usable_points, scan.usable_points);
     EXPECT_EQ(expanded.structure_roughness_m, scan.structure_roughness_m);
     EXPECT_EQ(expanded.structure_distinctive, scan.structure_distinctive);
+    EXPECT_EQ(compact.view_centre(), scan.view_centre);
+    EXPECT_EQ(expanded.view_centre, scan.view_centre);
     for (const auto& [original, decoded] :
          {std::pair{scan.structure.get(), expanded.structure.get()},
           std::pair{scan.ground.get(), expanded.ground.get()}}) {
@@ -79,6 +81,7 @@ TEST(CompactPreparedScan, AnEmptyScanStaysEmpty) {
     const PreparedScan expanded = compact.Expand();
     EXPECT_FALSE(expanded.structure);
     EXPECT_FALSE(expanded.ground);
+    EXPECT_TRUE(compact.view_centre().hasNaN());
     EXPECT_FALSE(CompactPreparedScan{}.Expand().structure);
 }
 

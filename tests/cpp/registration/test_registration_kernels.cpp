@@ -378,6 +378,26 @@ TEST(PrepareScan, DropsNonFiniteAndOutOfRangePoints) {
     for (const auto& p : scan.structure->points()) EXPECT_TRUE(p.allFinite());
 }
 
+// The view centre is the mean of the usable points, whatever else the scan holds: known answer.
+TEST(PrepareScan, TheViewCentreIsTheMeanOfTheUsablePoints) {
+    const ScanReductionConfig config;
+    core::PointCloud cloud{{10.0F, 0.0F, 0.0F}, {20.0F, 4.0F, -2.0F}, {30.0F, -4.0F, 2.0F}};
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    cloud.emplace_back(nan, 0.0F, 0.0F);
+    cloud.emplace_back(0.5F, 0.0F, 0.0F);     // inside min_range_m
+    cloud.emplace_back(-500.0F, 0.0F, 0.0F);  // beyond max_range_m
+    const Eigen::Vector3d expected(20.0, 0.0, 0.0);
+    EXPECT_TRUE(ViewCentre(cloud, config).isApprox(expected, 1e-12));
+    EXPECT_TRUE(PrepareScan(cloud, config).view_centre.isApprox(expected, 1e-12));
+    // A scene ahead of the sensor (a narrow field of view) is looked at ahead.
+    core::PointCloud ahead = test::SyntheticPlace();
+    std::erase_if(ahead, [](const Eigen::Vector3f& p) { return p.x() < 1.0F; });
+    EXPECT_GT(PrepareScan(ahead, config).view_centre.x(), 5.0);
+    EXPECT_TRUE(ViewCentre({}, config).hasNaN());
+    EXPECT_TRUE(PrepareScan(core::PointCloud(10, Eigen::Vector3f::Constant(nan)), config)
+                    .view_centre.hasNaN());
+}
+
 TEST(PrepareScan, DegenerateScansGiveAlmostNothingAndNoCrash) {
     ScanReductionConfig config;
     EXPECT_EQ(PrepareScan({}, config).structure->size(), 0u);

@@ -119,6 +119,9 @@ TEST(Submap, PrepareSubmapIsPrepareScanOfTheMerge) {
     EXPECT_EQ(submap.structure->points(), expected.structure->points());
     EXPECT_EQ(submap.ground->points(), expected.ground->points());
     EXPECT_GT(submap.usable_points, PrepareScan(scans[2], config).usable_points);
+    // It looks where its centre scan looks, not where its neighbours do.
+    EXPECT_EQ(submap.view_centre, PrepareScan(scans[2], config).view_centre);
+    EXPECT_FALSE(submap.view_centre.isApprox(expected.view_centre, 1e-3));
 }
 
 TEST(Submap, WithoutAPoseTheScanIsPreparedAlone) {
