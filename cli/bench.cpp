@@ -11,6 +11,7 @@
 #include "lidarloop/app/bench.hpp"
 #include "lidarloop/app/results_folder.hpp"
 #include "lidarloop/app/run_folder.hpp"
+#include "odometry_options.hpp"
 #include "progress.hpp"
 #include "run_options.hpp"
 
@@ -20,7 +21,8 @@ namespace {
 struct BenchFlags {
     DatasetOptions dataset;
     DescriptorOptions descriptor;
-    RunOptionFlags options;  // app/run_options.hpp: --threshold, --top-k, --min-gap, ...
+    RunOptionFlags options;    // app/run_options.hpp: --threshold, --top-k, --min-gap, ...
+    OdometryOptions odometry;  // the reach, order and gate of the timed verification
     app::BenchRequest request;
     std::string json;
     bool overwrite = false;
@@ -71,7 +73,8 @@ void PrintSummary(const nlohmann::json& figures) {
                  verification["verify_ms_per_pair"]["thread_cpu"]);
         const std::string verified =
             "top " + std::to_string(verification.value("top_k", 0)) +
-            (verification.value("stop_at_first_loop", false) ? " until a loop" : " verified");
+            (verification.value("stop_at_first_loop", false) ? " until a loop" : " verified") +
+            (verification.value("odometry", false) ? " (odometry)" : "");
         PrintRow("online step, " + verified, "scan", verification["online_step_ms_per_scan"]);
         online_ms = verification["online_step_ms_per_scan"].value("median", 0.0);
         std::printf(
@@ -100,10 +103,14 @@ void RunBench(BenchFlags& flags) {
     flags.request.config = flags.descriptor.Resolve();
     flags.options.ApplyTo({&flags.request.config});
     flags.request.progress = progress.Callback();
+    flags.request.odometry_file = flags.odometry.file();
+    flags.request.odometry_topic = flags.odometry.topic();
+    std::vector<std::filesystem::path> inputs = flags.dataset.Inputs();
+    inputs.push_back(flags.odometry.Input());
     // The file is checked before the run, so that a refused --json costs no measurement.
     const bool json_to_stdout = flags.json == "-";
     if (!flags.json.empty() && !json_to_stdout)
-        app::CheckOutputFile(flags.json, flags.dataset.Inputs(), flags.overwrite);
+        app::CheckOutputFile(flags.json, inputs, flags.overwrite);
     const nlohmann::json figures = app::RunBench(flags.dataset.Open(), flags.request);
     if (json_to_stdout) {
         std::cout << figures.dump(2) << "\n";
@@ -111,8 +118,7 @@ void RunBench(BenchFlags& flags) {
     }
     std::cout.flush();
     PrintSummary(figures);
-    if (!flags.json.empty())
-        app::WriteOutputJson(flags.json, figures, flags.dataset.Inputs(), flags.overwrite);
+    if (!flags.json.empty()) app::WriteOutputJson(flags.json, figures, inputs, flags.overwrite);
 }
 
 }  // namespace
@@ -130,6 +136,10 @@ void AddBenchCommand(CLI::App& app) {
                         "query scans whose top-k candidates are verified and timed (default 50; "
                         "0: none)");
     flags->options.AddTo(*command, app::RunCommand::kBench);
+    flags->odometry.AddTo(*command,
+                          "the timed queries then keep only the scans within its reach, register "
+                          "the nearest views first and gate the loops, as the online detector "
+                          "with a gate");
     command->add_option("--json", flags->json,
                         "also write the figures as JSON to this file (replaced only when "
                         "lidarloop wrote it, or with --overwrite); '-': JSON to stdout instead of "

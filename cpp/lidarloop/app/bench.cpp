@@ -8,6 +8,7 @@
 #include <random>
 
 #include "lidarloop/app/describe_run.hpp"
+#include "lidarloop/app/detection.hpp"
 #include "lidarloop/app/results_folder.hpp"
 #include "lidarloop/app/verification_run.hpp"
 #include "lidarloop/core/error.hpp"
@@ -115,17 +116,26 @@ double OnlineStepMs(const pipeline::SequenceDescriptors& described, const Prepar
            1e3 * prepared.prepare_cpu_seconds.at(scan) + verification_cpu_ms;
 }
 
+// Whether an accepted verdict of `query` and `match` is one the odometry (`check`) keeps.
+bool KeptByTheOdometry(const registration::Verification& verdict, std::size_t query,
+                       std::size_t match, const pipeline::LoopCheck& check) {
+    const registration::PoseAllowed allowed = check.AllowedPoses(query, match);
+    return verdict.accepted && (!allowed || allowed(verdict.T_match_query));
+}
+
 // Verifies the top-k candidates of `queries` evenly spaced scans that have candidates, one pair
 // at a time on this thread (in rank order up to the first accepted with
-// detection.stop_at_first_loop; no odometry gate), and sums each query's online step. `path_m`:
-// per scan, for a gap in metres (empty: none known); `retrieval_ms`: the median candidate search.
+// detection.stop_at_first_loop), and sums each query's online step. `path_m`: per scan, for a gap
+// in metres (empty: none known); `check`: the odometry's reach, order and gate (empty: none), as
+// the online detector with a gate applies them; `retrieval_ms`: the median candidate search.
 nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
                                 const pipeline::SimilarityMatrix& matrix,
                                 const PreparedScans& prepared, const io::RunConfig& config,
                                 std::size_t queries, const std::vector<double>& path_m,
-                                double retrieval_ms) {
-    std::vector<pipeline::LoopQuery> all = pipeline::DetectFromMatrix(
-        matrix, described.database.times_s(), config.detection, config.descriptor.method, path_m);
+                                const pipeline::LoopCheck& check, double retrieval_ms) {
+    std::vector<pipeline::LoopQuery> all =
+        pipeline::DetectFromMatrix(matrix, described.database.times_s(), config.detection,
+                                   config.descriptor.method, path_m, check);
     std::erase_if(all, [](const pipeline::LoopQuery& q) { return !q.has_match(); });
     const registration::VerificationConfig& verification = config.detection.verification;
     StepTimes coarse_times;
@@ -146,11 +156,13 @@ nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
         for (const pipeline::Neighbor& candidate : all[q].candidates) {
             const registration::Verification verdict = pair_times.Time([&] {
                 return registration::Verify(
-                    query, *coarse, expanded.Get(prepared.scans, candidate.index), verification);
+                    query, *coarse, expanded.Get(prepared.scans, candidate.index), verification,
+                    check.AllowedPoses(all[q].query, candidate.index));
             });
             verification_cpu_ms += pair_times.cpu_ms.back();
-            accepted += verdict.accepted ? 1 : 0;
-            if (verdict.accepted && config.detection.stop_at_first_loop) break;
+            const bool kept = KeptByTheOdometry(verdict, all[q].query, candidate.index, check);
+            accepted += kept ? 1 : 0;
+            if (kept && config.detection.stop_at_first_loop) break;
         }
         online_ms.push_back(
             OnlineStepMs(described, prepared, all[q].query, retrieval_ms, verification_cpu_ms));
@@ -161,6 +173,7 @@ nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
     json["pairs_accepted"] = accepted;
     json["top_k"] = config.detection.top_k;
     json["stop_at_first_loop"] = config.detection.stop_at_first_loop;
+    json["odometry"] = static_cast<bool>(check);
     json["prepare_ms_per_scan"] = SummaryJson(prepared.prepare_seconds, 1e3);
     json["prepare_cpu_ms_per_scan"] = SummaryJson(prepared.prepare_cpu_seconds, 1e3);
     json["bytes_per_prepared_scan"] = SummaryJson(prepared.BytesPerScan());
@@ -218,11 +231,19 @@ nlohmann::json RunBench(const io::Dataset& dataset, const BenchRequest& request)
             4 * rows->stride() + 4 * pipeline::HistogramIndex::kBlocks + 16 + 9;
     }
     if (verify) {
-        const std::vector<double> path_m =
-            dataset.HasPoses() ? core::CumulativePathM(dataset.poses()) : std::vector<double>{};
+        // The path on the odometry when given (as detect takes it), else on the poses.
+        const std::vector<core::StampedPose> odometry =
+            request.odometry_file.empty() && request.odometry_topic.empty()
+                ? std::vector<core::StampedPose>{}
+                : ReadOdometry(request.odometry_file, request.odometry_topic, dataset);
+        const std::vector<double> path_m = core::CumulativePathM(
+            odometry.empty() && dataset.HasPoses() ? dataset.poses() : odometry);
+        pipeline::LoopCheck check;
+        if (!odometry.empty())
+            check = OdometryLoopCheck(odometry, path_m, config.posegraph, nullptr, &prepared);
         json["verification"] =
             TimeVerification(described, matrix, prepared, config, request.verify_queries, path_m,
-                             RetrievalMs(json["queries"]));
+                             check, RetrievalMs(json["queries"]));
     }
     json["peak_memory_mib"] = PeakMemoryMiB();
     return json;

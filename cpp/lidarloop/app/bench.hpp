@@ -1,6 +1,8 @@
 #pragma once
 
 #include <cstddef>
+#include <filesystem>
+#include <string>
 
 #include <nlohmann/json.hpp>
 
@@ -18,6 +20,11 @@ struct BenchRequest {
     /// Query scans whose top-k candidates (config.detection.top_k) are verified on one core, to
     /// time verification per pair; 0: verification is not timed.
     std::size_t verify_queries = 50;
+    /// The scans' odometry (a file, or a topic of the dataset's bag), as `detect --odometry`
+    /// takes it: the timed queries then shortlist, register and gate with it (reach, view order,
+    /// the odometry gate), as the online detector with a gate does; empty: none.
+    std::filesystem::path odometry_file;
+    std::string odometry_topic;
     Progress progress;
 };
 
@@ -25,7 +32,8 @@ struct BenchRequest {
 /// queries through the index and by brute force on `dataset`; with scale_to, also queries
 /// against a synthetic database of that many perturbed histograms; and geometric verification on
 /// one core: preparing a scan, the query's coarse images, and each candidate pair (wall and
-/// thread CPU time), with the bytes kept per prepared scan. The figures as JSON (keys in
+/// thread CPU time), with the bytes kept per prepared scan (with the odometry as detect uses it,
+/// when given). The figures as JSON (keys in
 /// docs/cli.md), with the peak memory of the process.
 nlohmann::json RunBench(const io::Dataset& dataset, const BenchRequest& request);
 

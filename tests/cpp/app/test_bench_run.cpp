@@ -2,6 +2,7 @@
 // pairs alone, the bytes per prepared scan recomputed from freshly prepared scans, the times
 // positive and consistent (thread CPU time cannot exceed the wall time of the same step).
 #include <algorithm>
+#include <fstream>
 
 #include <gtest/gtest.h>
 
@@ -120,6 +121,36 @@ TEST(BenchRun, VerificationFiguresAreRecountedIndependently) {
     }
     ExpectTimes(v["coarse_images_ms_per_query"], "coarse images");
     ExpectTimes(v["verify_ms_per_pair"], "pairs");
+}
+
+// With the odometry, the timed queries shortlist, register and gate with it: here it puts each
+// second-lap scan on its first-lap twin (0 m) and every other scan 50 m or more away, and drifts
+// by 1 km after scan 17, so that only scans 12-17 have a candidate within reach, each its twin.
+TEST(BenchRun, WithTheOdometryOnlyTheScansWithinItsReachAreTimed) {
+    test::TempDir dir;
+    const io::Dataset dataset = TinyRevisit(dir / "sequence");
+    {
+        std::ofstream odometry(dir / "odometry.txt");
+        for (std::size_t i = 0; i < dataset.size(); ++i) {
+            const double x_m = 50.0 * static_cast<double>(i % 12) + (i >= 18 ? 1000.0 : 0.0);
+            odometry << "1 0 0 " << x_m << " 0 1 0 0 0 0 1 0\n";
+        }
+    }
+    app::BenchRequest request;
+    request.config.descriptor.method = core::Method::kRange;
+    request.config.detection.min_gap.value = 10;
+    request.config.detection.top_k = 2;
+    request.queries = 3;
+    request.verify_queries = 12;
+    const nlohmann::json without = app::RunBench(dataset, request)["verification"];
+    request.odometry_file = dir / "odometry.txt";
+    const nlohmann::json with = app::RunBench(dataset, request)["verification"];
+    EXPECT_FALSE(without["odometry"].get<bool>());
+    EXPECT_EQ(without["queries"].get<std::size_t>(), 12U);
+    EXPECT_TRUE(with["odometry"].get<bool>());
+    EXPECT_EQ(with["queries"].get<std::size_t>(), 6U);
+    EXPECT_EQ(with["pairs"].get<std::size_t>(), 6U);
+    EXPECT_EQ(with["pairs_accepted"].get<std::size_t>(), 6U);
 }
 
 }  // namespace
