@@ -314,14 +314,38 @@ std::vector<std::size_t> IndicesOf(const std::vector<Neighbor>& candidates) {
     return indices;
 }
 
-// A check that says some scans cannot close a loop with the query (the odometry puts them out of
-// reach) makes them no candidates: the top k are the best k the check keeps, as brute force over
-// the matrix ranks them. The check judges only the scans that rank high enough to matter.
-TEST(DetectFromMatrix, ScansOutOfTheChecksReachAreNoCandidates) {
+// 300 height histograms of 20 places, 0.1 s apart, described.
+DescriptorDatabase ClusteredDatabase() {
     const auto histograms = test::ClusteredHistograms(300, 40, 20, 3);
     DescriptorDatabase database(HeightConfig(40));
     for (std::size_t i = 0; i < histograms.size(); ++i)
         database.Add(test::HistogramDescriptor(histograms[i]), 0.1 * static_cast<double>(i));
+    return database;
+}
+
+// A synthetic odometry's reach: about a third of the pairs are out of it.
+bool InSyntheticReach(std::size_t query, std::size_t match) { return (query + 2 * match) % 3 != 0; }
+
+// Brute force over the matrix: the scans more than 30 before `query` in the synthetic reach, by
+// (distance, index), at most `count`.
+std::vector<Neighbor> RankedInReach(const SimilarityMatrix& matrix, std::size_t query,
+                                    std::size_t count) {
+    std::vector<Neighbor> ranked;
+    for (std::size_t j = 0; j + 30 < query; ++j) {
+        if (InSyntheticReach(query, j)) ranked.push_back({j, double{matrix.at(query, j)}});
+    }
+    std::sort(ranked.begin(), ranked.end(), [](const Neighbor& a, const Neighbor& b) {
+        return a.distance < b.distance || (a.distance == b.distance && a.index < b.index);
+    });
+    ranked.resize(std::min(ranked.size(), count));
+    return ranked;
+}
+
+// A check that says some scans cannot close a loop with the query (the odometry puts them out of
+// reach) makes them no candidates: the top k are the best k the check keeps, as brute force over
+// the matrix ranks them. The check judges only the scans that rank high enough to matter.
+TEST(DetectFromMatrix, ScansOutOfTheChecksReachAreNoCandidates) {
+    const DescriptorDatabase database = ClusteredDatabase();
     const SimilarityMatrix matrix = ComputeSimilarityMatrix(database);
     DetectorConfig detector = Deciding(DetectorConfig{}, 0.01);
     detector.top_k = 4;
@@ -331,7 +355,7 @@ TEST(DetectFromMatrix, ScansOutOfTheChecksReachAreNoCandidates) {
     check.may_close = [&](std::size_t query, std::size_t match, double max_loop_distance_m) {
         EXPECT_EQ(max_loop_distance_m, max_loop_m);
         ++judged;
-        return (query + 2 * match) % 3 != 0;
+        return InSyntheticReach(query, match);
     };
     const std::vector<LoopQuery> detected =
         DetectFromMatrix(matrix, database.times_s(), detector, core::Method::kHeight, {}, check);
@@ -341,15 +365,8 @@ TEST(DetectFromMatrix, ScansOutOfTheChecksReachAreNoCandidates) {
     const std::vector<LoopQuery> unchecked =
         DetectFromMatrix(matrix, database.times_s(), detector, core::Method::kHeight);
     for (std::size_t i = 0; i < matrix.size(); ++i) {
-        std::vector<Neighbor> expected;
-        for (std::size_t j = 0; j + 30 < i; ++j) {
-            ++eligible_pairs;
-            if ((i + 2 * j) % 3 != 0) expected.push_back({j, double{matrix.at(i, j)}});
-        }
-        std::sort(expected.begin(), expected.end(), [](const Neighbor& a, const Neighbor& b) {
-            return a.distance < b.distance || (a.distance == b.distance && a.index < b.index);
-        });
-        expected.resize(std::min<std::size_t>(expected.size(), 4));
+        eligible_pairs += i > 30 ? i - 30 : 0;
+        const std::vector<Neighbor> expected = RankedInReach(matrix, i, 4);
         ASSERT_EQ(detected[i].candidates.size(), expected.size()) << i;
         for (std::size_t r = 0; r < expected.size(); ++r)
             EXPECT_EQ(detected[i].candidates[r].index, expected[r].index) << i << " rank " << r;
@@ -443,38 +460,25 @@ TEST(LoopDetector, TheOdometrysReachLimitsTheCandidatesAsOffline) {
 // odometry_shortlist best-ranked scans within reach, nearest first (a scan of unknown distance
 // last, ties in rank order): brute force over the matrix.
 TEST(DetectFromMatrix, TheOdometryOrdersTheShortlistByViewDistance) {
-    const auto histograms = test::ClusteredHistograms(300, 40, 20, 3);
-    DescriptorDatabase database(HeightConfig(40));
-    for (std::size_t i = 0; i < histograms.size(); ++i)
-        database.Add(test::HistogramDescriptor(histograms[i]), 0.1 * static_cast<double>(i));
+    const DescriptorDatabase database = ClusteredDatabase();
     const SimilarityMatrix matrix = ComputeSimilarityMatrix(database);
     DetectorConfig detector = Deciding(DetectorConfig{}, 0.01);
     detector.top_k = 4;
     detector.odometry_shortlist = 12;
-    const auto reachable = [](std::size_t query, std::size_t match) {
-        return (query + 2 * match) % 3 != 0;
-    };
     const auto view_distance_m = [](std::size_t query, std::size_t match) {
         if (match % 7 == 0) return std::numeric_limits<double>::quiet_NaN();
         return static_cast<double>((query * 31 + match * 17) % 10);  // many ties
     };
     LoopCheck check;
-    check.may_close = [&](std::size_t query, std::size_t match, double) {
-        return reachable(query, match);
+    check.may_close = [](std::size_t query, std::size_t match, double) {
+        return InSyntheticReach(query, match);
     };
     check.view_distance_m = view_distance_m;
     const std::vector<LoopQuery> detected =
         DetectFromMatrix(matrix, database.times_s(), detector, core::Method::kHeight, {}, check);
     std::size_t reordered = 0;
     for (std::size_t i = 0; i < matrix.size(); ++i) {
-        std::vector<Neighbor> ranked;
-        for (std::size_t j = 0; j + 30 < i; ++j) {
-            if (reachable(i, j)) ranked.push_back({j, double{matrix.at(i, j)}});
-        }
-        std::sort(ranked.begin(), ranked.end(), [](const Neighbor& a, const Neighbor& b) {
-            return a.distance < b.distance || (a.distance == b.distance && a.index < b.index);
-        });
-        ranked.resize(std::min<std::size_t>(ranked.size(), 12));
+        std::vector<Neighbor> ranked = RankedInReach(matrix, i, 12);
         const auto key = [&](const Neighbor& n) {
             const double d = view_distance_m(i, n.index);
             return std::isnan(d) ? 1e9 : d;
@@ -505,12 +509,11 @@ TEST(DetectFromMatrix, TheOdometryOrdersTheShortlistByViewDistance) {
     const auto shortlist_of_k =
         DetectFromMatrix(matrix, database.times_s(), detector, core::Method::kHeight, {}, check);
     for (std::size_t i = 0; i < matrix.size(); ++i) {
-        const auto& a = shortlist_of_k[i].candidates;
-        std::vector<std::size_t> sorted_a = IndicesOf(a),
-                                 sorted_b = IndicesOf(ranked_only[i].candidates);
-        std::sort(sorted_a.begin(), sorted_a.end());
-        std::sort(sorted_b.begin(), sorted_b.end());
-        EXPECT_EQ(sorted_a, sorted_b) << i;  // the same scans, nearest view first
+        std::vector<std::size_t> reordered_scans = IndicesOf(shortlist_of_k[i].candidates);
+        std::vector<std::size_t> ranked_scans = IndicesOf(ranked_only[i].candidates);
+        std::sort(reordered_scans.begin(), reordered_scans.end());
+        std::sort(ranked_scans.begin(), ranked_scans.end());
+        EXPECT_EQ(reordered_scans, ranked_scans) << i;  // the same scans, nearest view first
     }
 }
 
