@@ -116,13 +116,6 @@ double OnlineStepMs(const pipeline::SequenceDescriptors& described, const Prepar
            1e3 * prepared.prepare_cpu_seconds.at(scan) + verification_cpu_ms;
 }
 
-// Whether an accepted verdict of `query` and `match` is one the odometry (`check`) keeps.
-bool KeptByTheOdometry(const registration::Verification& verdict, std::size_t query,
-                       std::size_t match, const pipeline::LoopCheck& check) {
-    const registration::PoseAllowed allowed = check.AllowedPoses(query, match);
-    return verdict.accepted && (!allowed || allowed(verdict.T_match_query));
-}
-
 // Verifies the top-k candidates of `queries` evenly spaced scans that have candidates, one pair
 // at a time on this thread (in rank order up to the first accepted with
 // detection.stop_at_first_loop), and sums each query's online step. `path_m`: per scan, for a gap
@@ -154,13 +147,16 @@ nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
         });
         double verification_cpu_ms = coarse_times.cpu_ms.back();
         for (const pipeline::Neighbor& candidate : all[q].candidates) {
+            // The poses the odometry's gate keeps (empty: it does not judge the pair).
+            const registration::PoseAllowed allowed =
+                check.AllowedPoses(all[q].query, candidate.index);
             const registration::Verification verdict = pair_times.Time([&] {
-                return registration::Verify(
-                    query, *coarse, expanded.Get(prepared.scans, candidate.index), verification,
-                    check.AllowedPoses(all[q].query, candidate.index));
+                return registration::Verify(query, *coarse,
+                                            expanded.Get(prepared.scans, candidate.index),
+                                            verification, allowed);
             });
             verification_cpu_ms += pair_times.cpu_ms.back();
-            const bool kept = KeptByTheOdometry(verdict, all[q].query, candidate.index, check);
+            const bool kept = verdict.accepted && (!allowed || allowed(verdict.T_match_query));
             accepted += kept ? 1 : 0;
             if (kept && config.detection.stop_at_first_loop) break;
         }
