@@ -91,6 +91,11 @@ TEST(ConfigYaml, BadInputNamesFileKeyAndProblem) {
     expect_error("- a\n- b\n", "expected a map");
     expect_error("detection:\n  min_gap_unit: hours\n", "unknown gap unit 'hours'");
     expect_error("detection:\n  top_k: 0\n", "detection.top_k must be in [1, 1000]");
+    expect_error("detection:\n  odometry_shortlist: 0\n",
+                 "detection.odometry_shortlist must be in [1, 1000], got 0");
+    expect_error("detection:\n  odometry_shortlist: 1001\n",
+                 "detection.odometry_shortlist must be in [1, 1000], got 1001");
+    expect_error("detection:\n  odometry_shortlist: many\n", "odometry_shortlist");
     expect_error("detection:\n  min_gap: -3\n", "detection.min_gap must be");
 }
 
