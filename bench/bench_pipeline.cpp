@@ -10,6 +10,7 @@
 #include "lidarloop/pipeline/cumulative_histograms.hpp"
 #include "lidarloop/pipeline/descriptor_database.hpp"
 #include "lidarloop/pipeline/histogram_index.hpp"
+#include "lidarloop/pipeline/loop_detector.hpp"
 #include "lidarloop/pipeline/similarity_matrix.hpp"
 
 namespace lidarloop::bench {
@@ -111,6 +112,76 @@ void BM_QueryTop1(benchmark::State& state) {
     state.counters["stored"] = static_cast<double>(store.size());
 }
 BENCHMARK(BM_QueryTop1)->Arg(0)->Arg(1)->ArgName("brute_force")->Unit(benchmark::kMillisecond);
+
+// The search a query with few scans within the odometry's reach makes of the online index
+// (SearchReachable doubles its request until k reachable ones are found): the k best of an
+// hour at 10 Hz (36,000 scans), up to the whole ranking.
+void BM_QueryDeep(benchmark::State& state) {
+    static const pipeline::CumulativeHistograms store = SyntheticStore(36'000, 5);
+    static const pipeline::HistogramIndex index = [&] {
+        pipeline::HistogramIndex built(store);
+        built.InsertAll();
+        return built;
+    }();
+    const auto queries = SyntheticStore(64, 6);
+    const auto k = static_cast<std::size_t>(state.range(0));
+    std::size_t q = 0;
+    for (auto _ : state) benchmark::DoNotOptimize(index.Search(queries.Row(q++ % 64), k));
+    state.counters["stored"] = static_cast<double>(store.size());
+}
+BENCHMARK(BM_QueryDeep)
+    ->Arg(10)
+    ->Arg(1280)
+    ->Arg(40960)
+    ->ArgName("k")
+    ->Unit(benchmark::kMillisecond);
+
+// The online detector's candidate search with the odometry after an hour at 10 Hz: 36,000
+// scans 1.5 m apart along a straight road (no revisit: no scan within reach, the worst case),
+// a gate that passes a loop within 3 m of the odometry's pose; Process of one more scan (verify
+// on, as the reach applies only then, but the scans come unprepared: nothing is registered).
+// bounded 0: the gate does not say its allowance, so the search ranks the whole
+// run before it finds that nothing is in reach.
+void BM_OnlineSearchWithOdometry(benchmark::State& state) {
+    core::DescriptorConfig config;
+    config.method = core::Method::kHeight;
+    config.histogram.bins = kBins;
+    pipeline::DetectorConfig detector;
+    pipeline::LoopDetector online(config, detector);
+    const auto pose_of = [](std::size_t i) {
+        core::Transform T = core::Transform::Identity();
+        T.translation().x() = 1.5 * static_cast<double>(i);
+        return T;
+    };
+    const auto descriptor_of = [](std::vector<double> mass) {
+        core::Histogram histogram;
+        histogram.mass = std::move(mass);
+        return core::Descriptor{core::Method::kHeight, std::move(histogram)};
+    };
+    const std::vector<std::vector<double>> histograms = SyntheticHistograms(36'064, 7);
+    std::size_t i = 0;
+    for (; i < 36'000; ++i)  // without the gate: cheap to fill
+        online.Process(descriptor_of(histograms[i]), 0.1 * static_cast<double>(i), {}, pose_of(i));
+    pipeline::OdometryGate gate{
+        [](const core::Transform& T_loop, const core::Transform& T_odometry, double) {
+            return (T_loop.translation() - T_odometry.translation()).norm() > 3.0;
+        },
+        {}};
+    if (state.range(0) != 0) gate.translation_allowance_m = [](double) { return 3.0; };
+    online.SetOdometryGate(gate);
+    for (auto _ : state) {
+        const std::size_t next = i++;
+        benchmark::DoNotOptimize(online.Process(descriptor_of(histograms[next % histograms.size()]),
+                                                0.1 * static_cast<double>(next), {},
+                                                pose_of(next)));
+    }
+}
+BENCHMARK(BM_OnlineSearchWithOdometry)
+    ->Arg(0)
+    ->Arg(1)
+    ->ArgName("bounded")
+    ->Iterations(50)
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace lidarloop::bench

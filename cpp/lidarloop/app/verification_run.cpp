@@ -165,12 +165,17 @@ pipeline::VerificationTimes VerifyAll(std::vector<pipeline::LoopQuery>& queries,
 }
 
 pipeline::OdometryGate OdometryGateOf(const posegraph::PoseGraphConfig& config) {
-    return [config](const core::Transform& T_match_query_loop,
-                    const core::Transform& T_match_query_odometry, double path_m) {
+    pipeline::OdometryGate gate;
+    gate.rejects = [config](const core::Transform& T_match_query_loop,
+                            const core::Transform& T_match_query_odometry, double path_m) {
         return posegraph::GateAgainstOdometry(T_match_query_loop, T_match_query_odometry, path_m,
                                               config)
                    .verdict == posegraph::LoopVerdict::kRejectedByOdometry;
     };
+    gate.translation_allowance_m = [config](double path_m) {
+        return posegraph::GateTranslationM(path_m, config);
+    };
+    return gate;
 }
 
 pipeline::LoopCheck OdometryLoopCheck(const std::vector<core::StampedPose>& odometry,

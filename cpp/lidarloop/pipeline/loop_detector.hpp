@@ -114,6 +114,11 @@ struct LoopCheck {
     /// cannot judge the pair. False lets the pair go unregistered: no registration could become
     /// its loop. Empty: every pair may close.
     std::function<bool(std::size_t query, std::size_t match, double max_loop_distance_m)> may_close;
+    /// A cheap bound of may_close for the candidate search (positions and path only, a few
+    /// nanoseconds): false only where may_close is false. It lets a query with few scans in reach
+    /// skip the rest of a long run without ranking them. Empty: none.
+    std::function<bool(std::size_t query, std::size_t match, double max_loop_distance_m)>
+        in_reach_bound;
     /// How far apart the odometry puts the view centres (registration::PreparedScan::view_centre)
     /// of two scans, metres; NaN where it does not know both. A query's candidates are registered
     /// nearest first (DetectorConfig::odometry_shortlist). Empty: in rank order.
@@ -139,9 +144,22 @@ using MoreLoopsWanted = std::function<bool(const LoopQuery& query, std::size_t c
 /// Whether the odometry contradicts a verified loop: given the loop's registered T_match_query,
 /// the odometry's T_match_query and the path between the two scans (m); true rejects the loop.
 /// app::OdometryGateOf makes the pose graph's gate (posegraph::GateAgainstOdometry) one.
-using OdometryGate =
+struct OdometryGate {
     std::function<bool(const core::Transform& T_match_query_loop,
-                       const core::Transform& T_match_query_odometry, double path_m)>;
+                       const core::Transform& T_match_query_odometry, double path_m)>
+        rejects;
+    /// The largest translation discrepancy (metres) `rejects` lets pass over `path_m` of path,
+    /// whatever the rotation: a scan the odometry puts farther from the query than a loop's
+    /// distance plus this cannot close a loop with it, which the candidate search tests before
+    /// it ranks the scan (LoopCheck::in_reach_bound). Nondecreasing in path_m. Empty: unknown.
+    std::function<double(double path_m)> translation_allowance_m;
+
+    explicit operator bool() const { return static_cast<bool>(rejects); }
+    bool operator()(const core::Transform& T_match_query_loop,
+                    const core::Transform& T_match_query_odometry, double path_m) const {
+        return rejects(T_match_query_loop, T_match_query_odometry, path_m);
+    }
+};
 
 /// Rejects (RejectReason::kOdometryMismatch) each accepted verification of `query` that `gate`
 /// says the odometry contradicts, and chooses the query's loop again among the rest.

@@ -347,10 +347,23 @@ void RejectAndResolve(const PoseGraph& graph, LoopSet& loops, const PoseGraphCon
     }
 }
 
+// The drift in position the information model allows over `d` metres of path: a random walk in
+// position and heading (the heading's walk moves the position by about a_r * sqrt(d^3 / 3)).
+double TranslationSigmaM(double d, const InformationConfig& info) {
+    const double a_t = info.odometry_translation_sigma_m_per_sqrt_m;
+    const double a_r = info.odometry_rotation_sigma_deg_per_sqrt_m * core::kRadiansPerDegree;
+    return std::sqrt(a_t * a_t * d + a_r * a_r * d * d * d / 3.0);
+}
+
 }  // namespace
 
-// The drift the information model allows over the path: a random walk in position and heading
-// (the heading's walk moves the position by about a_r * sqrt(d^3 / 3)).
+double GateTranslationM(double path_m, const PoseGraphConfig& config) {
+    const RobustConfig& robust = config.robust;
+    return robust.gate_sigmas * TranslationSigmaM(path_m, config.information) +
+           robust.gate_min_translation_m + robust.gate_translation_percent / 100.0 * path_m;
+}
+
+// The rotation's tolerance from the heading's random walk alone.
 LoopResult GateAgainstOdometry(const core::Transform& T_from_to_loop,
                                const core::Transform& T_from_to_odometry, double path_m,
                                const PoseGraphConfig& config) {
@@ -363,12 +376,8 @@ LoopResult GateAgainstOdometry(const core::Transform& T_from_to_loop,
     const InformationConfig& info = config.information;
     const RobustConfig& robust = config.robust;
     const double d = path_m;
-    const double a_t = info.odometry_translation_sigma_m_per_sqrt_m;
-    const double a_r = info.odometry_rotation_sigma_deg_per_sqrt_m * core::kRadiansPerDegree;
-    const double sigma_t = std::sqrt(a_t * a_t * d + a_r * a_r * d * d * d / 3.0);
     const double sigma_r_deg = info.odometry_rotation_sigma_deg_per_sqrt_m * std::sqrt(d);
-    result.gate_translation_m = robust.gate_sigmas * sigma_t + robust.gate_min_translation_m +
-                                robust.gate_translation_percent / 100.0 * d;
+    result.gate_translation_m = GateTranslationM(d, config);
     result.gate_rotation_deg = robust.gate_sigmas * sigma_r_deg + robust.gate_min_rotation_deg +
                                robust.gate_rotation_deg_per_100m / 100.0 * d;
     const bool passes = result.odometry_translation_error_m <= result.gate_translation_m &&

@@ -57,6 +57,10 @@ struct OptimisationResult {
     std::string note;  ///< e.g. why the odometry came back unchanged; empty otherwise
 };
 
+/// The translation discrepancy (metres) GateAgainstOdometry lets pass over `path_m` of path:
+/// nondecreasing in path_m.
+double GateTranslationM(double path_m, const PoseGraphConfig& config);
+
 /// The odometry gate (RobustConfig) for one loop: `T_from_to_loop`, the loop's transform between
 /// two scans, against `T_from_to_odometry`, the odometry's relative pose of the same scans, with
 /// the drift the information model allows over `path_m` of path between them. Fills path_m, the

@@ -28,6 +28,7 @@
 #include "lidarloop/io/read_error.hpp"
 #include "lidarloop/io/results_csv.hpp"
 #include "lidarloop/pipeline/scancontext_method.hpp"
+#include "lidarloop/posegraph/optimiser.hpp"
 #include "lidarloop/registration/compact_prepared_scan.hpp"
 #include "lidarloop/registration/submap.hpp"
 #include "lidarloop/registration/verification.hpp"
@@ -172,6 +173,59 @@ TEST(OdometryAllowsALoop, EqualsTryingLoopPosesWithinReach) {
     };
     EXPECT_TRUE(pipeline::OdometryAllowsALoop(
         1, 0, kMaxLoopM, lost, [](std::size_t i) { return 100.0 * static_cast<double>(i); }, gate));
+}
+
+// The candidate search's cheap bound of the pose graph's gate (LoopCheck::in_reach_bound: the
+// sensors' distance against the loop's plus the gate's translation allowance) says what
+// OdometryAllowsALoop says, also within a millimetre of the reach, and lets through a scan the
+// odometry does not know. Odometry turned anyhow, 0-2 km of path.
+TEST(OdometryAllowsALoop, TheSearchsBoundSaysTheSame) {
+    const posegraph::PoseGraphConfig config;
+    const pipeline::OdometryGate gate = app::OdometryGateOf(config);
+    constexpr double kMaxLoopM = 10.0;
+    std::mt19937 random(6);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    std::vector<core::Transform> T_odom_sensor(2, core::Transform::Identity());
+    std::vector<double> path_m{0.0, 0.0};
+    const pipeline::LoopCheck check =
+        pipeline::CheckAgainstOdometry([&](std::size_t i) { return T_odom_sensor[i]; },
+                                       [&](std::size_t i) { return path_m[i]; }, gate);
+    ASSERT_TRUE(check.in_reach_bound);
+    std::size_t in_reach = 0;
+    for (int pair = 0; pair < 2000; ++pair) {
+        path_m[1] = 1000.0 * (1.0 + unit(random));
+        const double reach_m = kMaxLoopM + posegraph::GateTranslationM(path_m[1], config);
+        // A quarter within a millimetre of the reach, the rest anywhere up to twice it.
+        const double distance_m =
+            pair % 4 == 0 ? reach_m + 1e-3 * unit(random) : reach_m * (1.0 + unit(random));
+        T_odom_sensor[1].linear() =
+            Eigen::AngleAxisd(M_PI * unit(random),
+                              Eigen::Vector3d(unit(random), unit(random), 1.0).normalized())
+                .toRotationMatrix();
+        T_odom_sensor[1].translation() =
+            distance_m * Eigen::Vector3d(unit(random), unit(random), 0.2).normalized();
+        const bool may_close = pipeline::OdometryAllowsALoop(
+            1, 0, kMaxLoopM, [&](std::size_t i) { return T_odom_sensor[i]; },
+            [&](std::size_t i) { return path_m[i]; }, gate);
+        // Never ruling out a scan that may close; ruling out the others but within a hair's
+        // breadth of the reach, where rounding may go either way. The reach is exactly where
+        // OdometryAllowsALoop changes its answer.
+        const bool bound = check.in_reach_bound(1, 0, kMaxLoopM);
+        if (may_close) {
+            EXPECT_TRUE(bound) << pair << ": " << distance_m << " m of " << reach_m;
+        }
+        if (distance_m > reach_m + 1e-6) {
+            EXPECT_FALSE(bound || may_close) << pair;
+        }
+        if (distance_m < reach_m - 1e-6) {
+            EXPECT_TRUE(may_close) << pair;
+        }
+        in_reach += may_close ? 1 : 0;
+    }
+    EXPECT_GT(in_reach, 500u);  // both answers were tried
+    EXPECT_LT(in_reach, 1500u);
+    T_odom_sensor[1].translation().x() = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_TRUE(check.in_reach_bound(1, 0, kMaxLoopM));
 }
 
 class DetectionRun : public ::testing::Test {

@@ -421,10 +421,12 @@ struct OdometryLaps {
     std::vector<core::Transform> T_odom_sensor;
     std::vector<double> path_m;
     std::vector<double> times_s;
-    OdometryGate gate = [](const core::Transform& T_loop, const core::Transform& T_odometry,
-                           double) {
-        return (T_loop.translation() - T_odometry.translation()).norm() > 3.0;
-    };
+    // Passes a loop within 3 m of the odometry's pose, which it says (the candidate search
+    // then skips the scans out of reach without ranking them).
+    OdometryGate gate{[](const core::Transform& T_loop, const core::Transform& T_odometry, double) {
+                          return (T_loop.translation() - T_odometry.translation()).norm() > 3.0;
+                      },
+                      [](double) { return 3.0; }};
 };
 
 // Online with an odometry gate, the scans the odometry puts out of a loop's reach are no
@@ -454,6 +456,29 @@ TEST(LoopDetector, TheOdometrysReachLimitsTheCandidatesAsOffline) {
         }
     }
     EXPECT_GT(with_candidates, 100u);  // the second and third laps
+    // The gate's allowance lets the search skip the scans out of reach before ranking them
+    // (LoopCheck::in_reach_bound): the same candidates as judging every ranked scan exactly,
+    // with fewer exact judgements.
+    std::size_t judged_bounded = 0;
+    std::size_t judged_exactly = 0;
+    const auto counting = [&laps](std::size_t& judged, bool bounded) {
+        LoopCheck check = laps.Check();
+        if (!bounded) check.in_reach_bound = nullptr;
+        check.may_close = [&judged, exact = check.may_close](std::size_t q, std::size_t m,
+                                                             double max_loop_distance_m) {
+            ++judged;
+            return exact(q, m, max_loop_distance_m);
+        };
+        return check;
+    };
+    const DetectorConfig serial = Deciding(detector, online.threshold());
+    const auto bounded = DetectFromMatrix(matrix, laps.times_s, serial, core::Method::kHeight,
+                                          laps.path_m, counting(judged_bounded, true));
+    const auto exactly = DetectFromMatrix(matrix, laps.times_s, serial, core::Method::kHeight,
+                                          laps.path_m, counting(judged_exactly, false));
+    ExpectIdenticalQueries(bounded, exactly);
+    ExpectIdenticalQueries(bounded, offline);
+    EXPECT_LT(judged_bounded, judged_exactly / 2);
 }
 
 // Where the check knows the view distances, the top k are the k nearest views among the

@@ -144,11 +144,12 @@ struct GateCall {
 
 // A gate that rejects a loop more than 5 m from the odometry's pose, and records each call.
 OdometryGate FiveMetreGate(std::vector<GateCall>& calls) {
-    return
+    return {
         [&calls](const core::Transform& T_loop, const core::Transform& T_odometry, double path_m) {
             calls.push_back({T_odometry, path_m});
             return (T_loop.inverse() * T_odometry).translation().norm() > 5.0;
-        };
+        },
+        {}};
 }
 
 // A detector whose degeneracy floor no registration passes on its own, but every one passes
@@ -339,6 +340,7 @@ TEST(StopAtFirstLoop, ALoopTheCheckRejectsLetsTheNextCandidateBeRegistered) {
                            },
                            {},
                            {},
+                           {},
                            {}});
     EXPECT_EQ(checked_accepted, (std::vector<std::size_t>{1, 1}));  // one new loop a call
     EXPECT_EQ(first.verifications[1].reason, registration::RejectReason::kOdometryMismatch);
@@ -394,6 +396,7 @@ TEST(StopAtFirstLoop, RegisteringSeveralAtOnceGivesTheVerdictsOfOneAfterAnother)
             if (v.accepted)
                 v.accepted = false, v.reason = registration::RejectReason::kOdometryMismatch;
         },
+        {},
         {},
         {},
         {}};
@@ -489,6 +492,7 @@ TEST(OdometryFloor, OnlyTheCandidatesWhosePoseTheCheckJudges) {
             if (match == 2) return any_pose;
             return {};
         },
+        {},
         {},
         {}};
     const LoopQuery verified = Verified(ranked, detector, judges_candidate_2);
