@@ -250,8 +250,9 @@ std::optional<OdometryBetween> OdometryOfPair(
 
 // LoopCheck::in_reach_bound of the odometry: OdometryAllowsALoop tries the loop pose nearest to
 // the odometry's (its rotation, its translation shortened to the loop's distance), whose
-// discrepancy is a pure translation of the sensors' distance minus the loop's. A relative slack
-// keeps rounding from ruling out a scan OdometryAllowsALoop keeps.
+// discrepancy is a pure translation of the sensors' distance minus the loop's. A slack relative
+// to the reach and to the coordinates (their difference rounds at their scale) keeps rounding
+// from ruling out a scan OdometryAllowsALoop keeps; an allowance that is NaN rules out nothing.
 bool MayBeInReach(std::size_t query, std::size_t match, double max_loop_distance_m,
                   const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
                   const std::function<double(std::size_t)>& path_m_of,
@@ -265,9 +266,11 @@ bool MayBeInReach(std::size_t query, std::size_t match, double max_loop_distance
         !std::isfinite(path_m)) {
         return true;
     }
-    const double distance_m = (T_odom_query.translation() - T_odom_match.translation()).norm();
+    const Eigen::Vector3d& query_m = T_odom_query.translation();
+    const Eigen::Vector3d& match_m = T_odom_match.translation();
     const double reach_m = max_loop_distance_m + translation_allowance_m(path_m);
-    return distance_m <= reach_m + kSlack * (1.0 + reach_m);
+    const double slack_m = kSlack * (1.0 + reach_m + query_m.norm() + match_m.norm());
+    return !((query_m - match_m).norm() > reach_m + slack_m);
 }
 
 }  // namespace

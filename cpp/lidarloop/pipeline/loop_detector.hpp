@@ -151,7 +151,8 @@ struct OdometryGate {
     /// The largest translation discrepancy (metres) `rejects` lets pass over `path_m` of path,
     /// whatever the rotation: a scan the odometry puts farther from the query than a loop's
     /// distance plus this cannot close a loop with it, which the candidate search tests before
-    /// it ranks the scan (LoopCheck::in_reach_bound). Nondecreasing in path_m. Empty: unknown.
+    /// it ranks the scan (LoopCheck::in_reach_bound). Nondecreasing in path_m; NaN or empty:
+    /// unknown (nothing is ruled out before it is ranked).
     std::function<double(double path_m)> translation_allowance_m;
 
     explicit operator bool() const { return static_cast<bool>(rejects); }

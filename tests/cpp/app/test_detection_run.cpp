@@ -178,7 +178,7 @@ TEST(OdometryAllowsALoop, EqualsTryingLoopPosesWithinReach) {
 // The candidate search's cheap bound of the pose graph's gate (LoopCheck::in_reach_bound: the
 // sensors' distance against the loop's plus the gate's translation allowance) says what
 // OdometryAllowsALoop says, also within a millimetre of the reach, and lets through a scan the
-// odometry does not know. Odometry turned anyhow, 0-2 km of path.
+// odometry does not know. Odometry turned anyhow, anywhere within 3 km, 0-2 km of path apart.
 TEST(OdometryAllowsALoop, TheSearchsBoundSaysTheSame) {
     const posegraph::PoseGraphConfig config;
     const pipeline::OdometryGate gate = app::OdometryGateOf(config);
@@ -192,32 +192,40 @@ TEST(OdometryAllowsALoop, TheSearchsBoundSaysTheSame) {
                                        [&](std::size_t i) { return path_m[i]; }, gate);
     ASSERT_TRUE(check.in_reach_bound);
     std::size_t in_reach = 0;
+    const auto random_turn = [&] {
+        return Eigen::AngleAxisd(M_PI * unit(random),
+                                 Eigen::Vector3d(unit(random), unit(random), 1.0).normalized())
+            .toRotationMatrix();
+    };
     for (int pair = 0; pair < 2000; ++pair) {
-        path_m[1] = 1000.0 * (1.0 + unit(random));
-        const double reach_m = kMaxLoopM + posegraph::GateTranslationM(path_m[1], config);
+        path_m[0] = 5000.0 * (1.0 + unit(random));
+        path_m[1] = path_m[0] + 1000.0 * (1.0 + unit(random));
+        const double reach_m =
+            kMaxLoopM + posegraph::GateTranslationM(path_m[1] - path_m[0], config);
         // A quarter within a millimetre of the reach, the rest anywhere up to twice it.
         const double distance_m =
             pair % 4 == 0 ? reach_m + 1e-3 * unit(random) : reach_m * (1.0 + unit(random));
-        T_odom_sensor[1].linear() =
-            Eigen::AngleAxisd(M_PI * unit(random),
-                              Eigen::Vector3d(unit(random), unit(random), 1.0).normalized())
-                .toRotationMatrix();
+        T_odom_sensor[0].linear() = random_turn();
+        T_odom_sensor[0].translation() =
+            3000.0 * Eigen::Vector3d(unit(random), unit(random), 0.01 * unit(random));
+        T_odom_sensor[1].linear() = random_turn();
         T_odom_sensor[1].translation() =
+            T_odom_sensor[0].translation() +
             distance_m * Eigen::Vector3d(unit(random), unit(random), 0.2).normalized();
         const bool may_close = pipeline::OdometryAllowsALoop(
             1, 0, kMaxLoopM, [&](std::size_t i) { return T_odom_sensor[i]; },
             [&](std::size_t i) { return path_m[i]; }, gate);
-        // Never ruling out a scan that may close; ruling out the others but within a hair's
-        // breadth of the reach, where rounding may go either way. The reach is exactly where
-        // OdometryAllowsALoop changes its answer.
+        // Never ruling out a scan that may close; ruling out the others but within a tenth of
+        // a millimetre of the reach, where rounding and the bound's slack may go either way.
+        // The reach is exactly where OdometryAllowsALoop changes its answer.
         const bool bound = check.in_reach_bound(1, 0, kMaxLoopM);
         if (may_close) {
             EXPECT_TRUE(bound) << pair << ": " << distance_m << " m of " << reach_m;
         }
-        if (distance_m > reach_m + 1e-6) {
+        if (distance_m > reach_m + 1e-4) {
             EXPECT_FALSE(bound || may_close) << pair;
         }
-        if (distance_m < reach_m - 1e-6) {
+        if (distance_m < reach_m - 1e-4) {
             EXPECT_TRUE(may_close) << pair;
         }
         in_reach += may_close ? 1 : 0;
@@ -226,6 +234,14 @@ TEST(OdometryAllowsALoop, TheSearchsBoundSaysTheSame) {
     EXPECT_LT(in_reach, 1500u);
     T_odom_sensor[1].translation().x() = std::numeric_limits<double>::quiet_NaN();
     EXPECT_TRUE(check.in_reach_bound(1, 0, kMaxLoopM));
+    // Nor does an allowance that is not a number rule a scan out.
+    T_odom_sensor[1].translation() = Eigen::Vector3d(1e6, 0.0, 0.0);
+    pipeline::OdometryGate unknown = gate;
+    unknown.translation_allowance_m = [](double) { return std::nan(""); };
+    EXPECT_TRUE(pipeline::CheckAgainstOdometry([&](std::size_t i) { return T_odom_sensor[i]; },
+                                               [&](std::size_t i) { return path_m[i]; }, unknown)
+                    .in_reach_bound(1, 0, kMaxLoopM));
+    EXPECT_FALSE(check.in_reach_bound(1, 0, kMaxLoopM));
 }
 
 class DetectionRun : public ::testing::Test {
