@@ -257,7 +257,7 @@ bool MayBeInReach(std::size_t query, std::size_t match, double max_loop_distance
                   const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
                   const std::function<double(std::size_t)>& path_m_of,
                   const std::function<double(double)>& translation_allowance_m) {
-    constexpr double kSlack = 1e-9;
+    constexpr double kRoundingSlack = 1e-9;
     const core::Transform T_odom_query = T_odom_sensor_of(query);
     const core::Transform T_odom_match = T_odom_sensor_of(match);
     const double path_m = std::abs(path_m_of(query) - path_m_of(match));
@@ -269,7 +269,7 @@ bool MayBeInReach(std::size_t query, std::size_t match, double max_loop_distance
     const Eigen::Vector3d& query_m = T_odom_query.translation();
     const Eigen::Vector3d& match_m = T_odom_match.translation();
     const double reach_m = max_loop_distance_m + translation_allowance_m(path_m);
-    const double slack_m = kSlack * (1.0 + reach_m + query_m.norm() + match_m.norm());
+    const double slack_m = kRoundingSlack * (1.0 + reach_m + query_m.norm() + match_m.norm());
     return !((query_m - match_m).norm() > reach_m + slack_m);
 }
 
