@@ -363,7 +363,8 @@ double GateTranslationM(double path_m, const PoseGraphConfig& config) {
            robust.gate_min_translation_m + robust.gate_translation_percent / 100.0 * path_m;
 }
 
-// The rotation's tolerance from the heading's random walk alone.
+// The translation's tolerance is GateTranslationM; the rotation's comes from the heading's
+// random walk alone.
 LoopResult GateAgainstOdometry(const core::Transform& T_from_to_loop,
                                const core::Transform& T_from_to_odometry, double path_m,
                                const PoseGraphConfig& config) {
