@@ -152,18 +152,16 @@ void NearestViewsFirst(LoopQuery& result, const LoopCheck& check, const Detector
         candidates.resize(static_cast<std::size_t>(detector.top_k));
 }
 
-// Scan i's candidates among the scans j < i outside the gap (and the path rule, when `path_m` is
-// known), as LoopDetector::Process gives them online.
-LoopQuery DetectOne(std::size_t i, const CandidateSearch& search, const std::vector<double>& along,
-                    const std::vector<double>& path_m, const DetectorConfig& detector,
-                    const DescriptorMethod& method, double threshold, const LoopCheck& check) {
-    const auto eligible = [&](std::size_t j) {
-        return j < i && detector.min_gap.Allows(i, j, along[i], along[j]) &&
-               (path_m.empty() || detector.PathAllows(path_m[i], path_m[j]));
-    };
-    const Reach reach = ReachFrom(i, check, detector);
+// The candidates of query scan `query` among the scans `eligible` admits, offline (DetectOne)
+// and online (LoopDetector::Search) alike: the shortlist within `check`'s reach, the decision and
+// second_ratio (Finish; `along`: the scans' positions in the gap's unit, empty when unknown),
+// then the top_k, nearest views first where `check` orders them.
+LoopQuery RankCandidates(std::size_t query, const CandidateSearch& search, const Filter& eligible,
+                         const std::vector<double>& along, const DetectorConfig& detector,
+                         const DescriptorMethod& method, double threshold, const LoopCheck& check) {
+    const Reach reach = ReachFrom(query, check, detector);
     LoopQuery result;
-    result.query = i;
+    result.query = query;
     result.candidates = SearchReachable(search, ShortlistSize(detector, check), eligible, reach);
     Finish(result, detector.min_gap, along, method, threshold, [&](const Filter& other_place) {
         return SearchReachable(
@@ -171,6 +169,18 @@ LoopQuery DetectOne(std::size_t i, const CandidateSearch& search, const std::vec
     });
     NearestViewsFirst(result, check, detector);
     return result;
+}
+
+// Scan i's candidates among the scans j < i outside the gap (and the path rule, when `path_m` is
+// known), as LoopDetector::Process gives them online.
+LoopQuery DetectOne(std::size_t i, const CandidateSearch& search, const std::vector<double>& along,
+                    const std::vector<double>& path_m, const DetectorConfig& detector,
+                    const DescriptorMethod& method, double threshold, const LoopCheck& check) {
+    const Filter eligible = [&](std::size_t j) {
+        return j < i && detector.min_gap.Allows(i, j, along[i], along[j]) &&
+               (path_m.empty() || detector.PathAllows(path_m[i], path_m[j]));
+    };
+    return RankCandidates(i, search, eligible, along, detector, method, threshold, check);
 }
 
 // Extra neighbours asked of the index, so that float ties at the k-th place can be seen.
@@ -413,18 +423,10 @@ LoopQuery LoopDetector::Search(const PreparedQuery& query, std::size_t query_ind
             database_.size(), count, [&](std::size_t j) { return database_.Distance(query, j); },
             filter);
     };
-    const Reach reach = ReachFrom(query_index, check, detector_);
-    LoopQuery result;
-    result.query = query_index;
-    result.candidates = SearchReachable(search, ShortlistSize(detector_, check), eligible, reach);
     // Without the path (no odometry, or localisation) a gap in metres leaves second_ratio NaN.
-    Finish(result, detector_.min_gap, detector_.min_gap.Along(database_.times_s(), path_m),
-           database_.definition(), threshold_, [&](const Filter& other_place) {
-               return SearchReachable(
-                   search, 1, [&](std::size_t j) { return eligible(j) && other_place(j); }, reach);
-           });
-    NearestViewsFirst(result, check, detector_);
-    return result;
+    return RankCandidates(query_index, search, eligible,
+                          detector_.min_gap.Along(database_.times_s(), path_m), detector_,
+                          database_.definition(), threshold_, check);
 }
 
 void LoopDetector::Verify(LoopQuery& result, const registration::CompactPreparedScan& scan,
