@@ -162,11 +162,10 @@ void BM_OnlineSearchWithOdometry(benchmark::State& state) {
     std::size_t i = 0;
     for (; i < 36'000; ++i)  // without the gate: cheap to fill
         online.Process(descriptor_of(histograms[i]), 0.1 * static_cast<double>(i), {}, pose_of(i));
-    pipeline::OdometryGate gate{
-        [](const core::Transform& T_loop, const core::Transform& T_odometry, double) {
-            return (T_loop.translation() - T_odometry.translation()).norm() > 3.0;
-        },
-        {}};
+    pipeline::OdometryGate gate;
+    gate.rejects = [](const core::Transform& T_loop, const core::Transform& T_odometry, double) {
+        return (T_loop.translation() - T_odometry.translation()).norm() > 3.0;
+    };
     if (state.range(0) != 0) gate.translation_allowance_m = [](double) { return 3.0; };
     online.SetOdometryGate(gate);
     for (auto _ : state) {

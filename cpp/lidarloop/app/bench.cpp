@@ -141,9 +141,12 @@ nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
     for (std::size_t q = 0; q < all.size() && coarse_times.wall_ms.size() < queries; q += step) {
         const registration::PreparedScan query = prepared.scans[all[q].query].Expand();
         if (!query.structure) continue;
+        std::vector<registration::YawWindow> windows;  // as the online detector's VerifyQuery
+        for (const pipeline::Neighbor& candidate : all[q].candidates)
+            windows.push_back(check.YawWindow(all[q].query, candidate.index));
         const auto coarse = coarse_times.Time([&] {
             return std::make_optional<registration::CoarseQuery>(*query.structure,
-                                                                 verification.coarse);
+                                                                 verification.coarse, windows);
         });
         double verification_cpu_ms = coarse_times.cpu_ms.back();
         for (const pipeline::Neighbor& candidate : all[q].candidates) {
@@ -151,9 +154,9 @@ nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
             const registration::PoseAllowed allowed =
                 check.AllowedPoses(all[q].query, candidate.index);
             const registration::Verification verdict = pair_times.Time([&] {
-                return registration::Verify(query, *coarse,
-                                            expanded.Get(prepared.scans, candidate.index),
-                                            verification, allowed);
+                return registration::Verify(
+                    query, *coarse, expanded.Get(prepared.scans, candidate.index), verification,
+                    allowed, check.YawWindow(all[q].query, candidate.index));
             });
             verification_cpu_ms += pair_times.cpu_ms.back();
             const bool kept = verdict.accepted && (!allowed || allowed(verdict.T_match_query));

@@ -175,6 +175,9 @@ pipeline::OdometryGate OdometryGateOf(const posegraph::PoseGraphConfig& config) 
     gate.translation_allowance_m = [config](double path_m) {
         return posegraph::GateTranslationM(path_m, config);
     };
+    gate.rotation_allowance_deg = [config](double path_m) {
+        return posegraph::GateRotationDeg(path_m, config);
+    };
     return gate;
 }
 

@@ -141,15 +141,21 @@ void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
     const auto register_one = [&](std::size_t c) {
         const std::size_t match = query.candidates[c].index;
         const auto pair_start = Clock::now();
-        query.verifications[c] =
-            registration::Verify(prepared, *coarse, match_of(match), detector.verification,
-                                 check.AllowedPoses(query.query, match));
+        query.verifications[c] = registration::Verify(
+            prepared, *coarse, match_of(match), detector.verification,
+            check.AllowedPoses(query.query, match), check.YawWindow(query.query, match));
         pair_seconds[c] = SecondsSince(pair_start);
         if (cache) cache->Store(query.query, match, query.verifications[c]);
     };
     const auto make_coarse = [&] {
         const auto query_start = Clock::now();
-        coarse.emplace(*prepared.structure, detector.verification.coarse);
+        // The images of the yaws some candidate still to be registered may take.
+        std::vector<registration::YawWindow> windows;
+        for (std::size_t c = 0; c < query.candidates.size(); ++c) {
+            if (!answered[c])
+                windows.push_back(check.YawWindow(query.query, query.candidates[c].index));
+        }
+        coarse.emplace(*prepared.structure, detector.verification.coarse, windows);
         if (times) times->query_seconds.push_back(SecondsSince(query_start));
     };
     if (detector.stop_at_first_loop) {

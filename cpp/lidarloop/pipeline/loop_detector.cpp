@@ -9,6 +9,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "lidarloop/core/angles.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/pipeline/candidate_verification.hpp"
 
@@ -296,6 +297,17 @@ registration::PoseAllowed OdometryAllowedPoses(
     };
 }
 
+registration::YawWindow OdometryYawWindow(
+    std::size_t query, std::size_t match,
+    const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
+    const std::function<double(std::size_t)>& path_m_of, const OdometryGate& gate) {
+    const auto odometry = OdometryOfPair(query, match, T_odom_sensor_of, path_m_of);
+    if (!odometry || !gate.rotation_allowance_deg) return {};
+    const Eigen::Matrix3d R = odometry->T_match_query.linear();
+    return {std::atan2(R(1, 0), R(0, 0)),
+            gate.rotation_allowance_deg(odometry->path_m) * core::kRadiansPerDegree};
+}
+
 bool OdometryAllowsALoop(std::size_t query, std::size_t match, double max_loop_distance_m,
                          const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
                          const std::function<double(std::size_t)>& path_m_of,
@@ -348,6 +360,12 @@ LoopCheck CheckAgainstOdometry(std::function<core::Transform(std::size_t)> T_odo
                                                               std::size_t match) {
         return OdometryAllowedPoses(query, match, T_odom_sensor_of, path_m_of, gate);
     };
+    if (gate.rotation_allowance_deg) {
+        check.yaw_window = [T_odom_sensor_of, path_m_of, gate](std::size_t query,
+                                                               std::size_t match) {
+            return OdometryYawWindow(query, match, T_odom_sensor_of, path_m_of, gate);
+        };
+    }
     check.may_close = [T_odom_sensor_of, path_m_of, gate](std::size_t query, std::size_t match,
                                                           double max_loop_distance_m) {
         return OdometryAllowsALoop(query, match, max_loop_distance_m, T_odom_sensor_of, path_m_of,

@@ -123,6 +123,10 @@ struct LoopCheck {
     /// of two scans, metres; NaN where it does not know both. A query's candidates are registered
     /// nearest first (DetectorConfig::odometry_shortlist). Empty: in rank order.
     std::function<double(std::size_t query, std::size_t match)> view_distance_m;
+    /// The yaws of a loop from scan `query` to scan `match` that `reject` may keep: the coarse
+    /// search looks there only (registration::Verify's `yaws`). The whole circle where it cannot
+    /// judge the pair. Empty: every yaw.
+    std::function<registration::YawWindow(std::size_t query, std::size_t match)> yaw_window;
 
     explicit operator bool() const { return static_cast<bool>(reject); }
     void operator()(LoopQuery& query) const { reject(query); }
@@ -131,6 +135,9 @@ struct LoopCheck {
     }
     bool MayClose(std::size_t query, std::size_t match, double max_loop_distance_m) const {
         return !may_close || may_close(query, match, max_loop_distance_m);
+    }
+    registration::YawWindow YawWindow(std::size_t query, std::size_t match) const {
+        return yaw_window ? yaw_window(query, match) : registration::YawWindow{};
     }
 };
 
@@ -154,6 +161,10 @@ struct OdometryGate {
     /// it ranks the scan (LoopCheck::in_reach_bound). Nondecreasing in path_m; NaN or empty:
     /// unknown (nothing is ruled out before it is ranked).
     std::function<double(double path_m)> translation_allowance_m;
+    /// The largest rotation discrepancy (degrees) `rejects` lets pass over `path_m` of path: the
+    /// coarse search of a pair looks for yaws within it of the odometry's (LoopCheck::
+    /// yaw_window). NaN or empty: unknown (every yaw is searched).
+    std::function<double(double path_m)> rotation_allowance_deg;
 
     explicit operator bool() const { return static_cast<bool>(rejects); }
     bool operator()(const core::Transform& T_match_query_loop,
@@ -189,11 +200,20 @@ registration::PoseAllowed OdometryAllowedPoses(
     const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
     const std::function<double(std::size_t)>& path_m_of, const OdometryGate& gate);
 
+/// The yaws of a loop from scan `query` to scan `match` that `gate` may let pass: within its
+/// rotation allowance of the odometry's relative yaw. Whole where the odometry does not know both
+/// scans' poses and path, or the gate has no allowance.
+registration::YawWindow OdometryYawWindow(
+    std::size_t query, std::size_t match,
+    const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
+    const std::function<double(std::size_t)>& path_m_of, const OdometryGate& gate);
+
 /// The odometry as a LoopCheck: RejectLoopsAgainstOdometry on each verified query, and for each
-/// pair the poses OdometryAllowedPoses lets pass. Adds the rejections to `rejected` when given
-/// (thread-safe). With `view_centre_of(j)` (scan j's PreparedScan::view_centre, sensor frame),
-/// also the distance of two scans' view centres in the odometry's frame (view_distance_m). The
-/// functions are copied; what they refer to must outlive the check.
+/// pair the poses OdometryAllowedPoses lets pass and the yaws OdometryYawWindow holds. Adds the
+/// rejections to `rejected` when given (thread-safe). With `view_centre_of(j)` (scan j's
+/// PreparedScan::view_centre, sensor frame), also the distance of two scans' view centres in the
+/// odometry's frame (view_distance_m). The functions are copied; what they refer to must outlive
+/// the check.
 LoopCheck CheckAgainstOdometry(std::function<core::Transform(std::size_t)> T_odom_sensor_of,
                                std::function<double(std::size_t)> path_m_of, OdometryGate gate,
                                std::atomic<std::size_t>* rejected = nullptr,

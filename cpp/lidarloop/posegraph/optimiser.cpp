@@ -363,8 +363,15 @@ double GateTranslationM(double path_m, const PoseGraphConfig& config) {
            robust.gate_min_translation_m + robust.gate_translation_percent / 100.0 * path_m;
 }
 
-// The translation's tolerance is GateTranslationM; the rotation's comes from the heading's
-// random walk alone.
+// The heading's random walk alone.
+double GateRotationDeg(double path_m, const PoseGraphConfig& config) {
+    const RobustConfig& robust = config.robust;
+    const double sigma_r_deg =
+        config.information.odometry_rotation_sigma_deg_per_sqrt_m * std::sqrt(path_m);
+    return robust.gate_sigmas * sigma_r_deg + robust.gate_min_rotation_deg +
+           robust.gate_rotation_deg_per_100m / 100.0 * path_m;
+}
+
 LoopResult GateAgainstOdometry(const core::Transform& T_from_to_loop,
                                const core::Transform& T_from_to_odometry, double path_m,
                                const PoseGraphConfig& config) {
@@ -374,13 +381,8 @@ LoopResult GateAgainstOdometry(const core::Transform& T_from_to_loop,
     result.odometry_translation_error_m = discrepancy.translation().norm();
     result.odometry_rotation_error_deg =
         Eigen::AngleAxisd(discrepancy.linear()).angle() / core::kRadiansPerDegree;
-    const InformationConfig& info = config.information;
-    const RobustConfig& robust = config.robust;
-    const double d = path_m;
-    const double sigma_r_deg = info.odometry_rotation_sigma_deg_per_sqrt_m * std::sqrt(d);
-    result.gate_translation_m = GateTranslationM(d, config);
-    result.gate_rotation_deg = robust.gate_sigmas * sigma_r_deg + robust.gate_min_rotation_deg +
-                               robust.gate_rotation_deg_per_100m / 100.0 * d;
+    result.gate_translation_m = GateTranslationM(path_m, config);
+    result.gate_rotation_deg = GateRotationDeg(path_m, config);
     const bool passes = result.odometry_translation_error_m <= result.gate_translation_m &&
                         result.odometry_rotation_error_deg <= result.gate_rotation_deg;
     if (!passes) result.verdict = LoopVerdict::kRejectedByOdometry;

@@ -60,6 +60,9 @@ struct OptimisationResult {
 /// The translation discrepancy (metres) GateAgainstOdometry lets pass over `path_m` of path:
 /// nondecreasing in path_m.
 double GateTranslationM(double path_m, const PoseGraphConfig& config);
+/// The rotation discrepancy (degrees) GateAgainstOdometry lets pass over `path_m` of path:
+/// nondecreasing in path_m.
+double GateRotationDeg(double path_m, const PoseGraphConfig& config);
 
 /// The odometry gate (RobustConfig) for one loop: `T_from_to_loop`, the loop's transform between
 /// two scans, against `T_from_to_odometry`, the odometry's relative pose of the same scans, with

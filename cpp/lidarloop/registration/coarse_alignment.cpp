@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <numbers>
 #include <optional>
+#include <stdexcept>
 #include "lidarloop/core/angles.hpp"
 #include "lidarloop/registration/detail/fft2d.hpp"
 
@@ -138,7 +139,37 @@ std::vector<PlanarHypothesis> Distinct(std::vector<PlanarHypothesis> peaks,
     return kept;
 }
 
+// The yaws of `query` that some of `windows` holds, as SearchedYaws widens them.
+std::vector<bool> YawsWithin(const std::vector<YawWindow>& windows, const CoarseConfig& config,
+                             int yaws) {
+    const bool every = windows.empty() || std::any_of(windows.begin(), windows.end(),
+                                                      [](const auto& w) { return w.Whole(); });
+    std::vector<bool> within(static_cast<std::size_t>(yaws), every);
+    for (const YawWindow& window : windows) {
+        const YawWindow searched = SearchedYaws(window, config);
+        for (int i = 0; i < yaws; ++i) {
+            if (searched.Contains(i * 2.0 * std::numbers::pi / yaws))
+                within[static_cast<std::size_t>(i)] = true;
+        }
+    }
+    return within;
+}
+
 }  // namespace
+
+bool YawWindow::Whole() const {
+    return !(half_width_rad < std::numbers::pi) || !std::isfinite(centre_rad);
+}
+
+bool YawWindow::Contains(double yaw_rad) const {
+    return Whole() || YawDistance(yaw_rad, centre_rad) <= half_width_rad;
+}
+
+YawWindow SearchedYaws(const YawWindow& allowed, const CoarseConfig& config) {
+    YawWindow searched = allowed;
+    searched.half_width_rad += 2.0 * config.yaw_step_deg * core::kRadiansPerDegree;
+    return searched;
+}
 
 std::vector<float> OccupancyImage(const std::vector<Eigen::Vector3f>& points, double yaw_rad,
                                   const CoarseConfig& config) {
@@ -156,7 +187,8 @@ std::vector<float> OccupancyImage(const std::vector<Eigen::Vector3f>& points, do
     return image;
 }
 
-CoarseQuery::CoarseQuery(const SurfacePoints& query_structure, const CoarseConfig& config)
+CoarseQuery::CoarseQuery(const SurfacePoints& query_structure, const CoarseConfig& config,
+                         const std::vector<YawWindow>& windows)
     : config_(config) {
     const int n = config.grid_cells;
     const double max_cells = config.max_translation_m / config.cell_m;
@@ -175,9 +207,12 @@ CoarseQuery::CoarseQuery(const SurfacePoints& query_structure, const CoarseConfi
     const auto image_at = [&](int i) {
         return OccupancyImage(query_structure.points(), i * 2.0 * std::numbers::pi / yaws, config);
     };
-    // Two yaws per transform: the images are real (detail::Fft2dForwardRealPair).
+    const std::vector<bool> wanted = YawsWithin(windows, config, yaws);
+    // Two yaws per transform: the images are real (detail::Fft2dForwardRealPair). The pairs are
+    // fixed, so that a yaw's spectrum does not depend on the windows.
     for (int a = 0; a < yaws; a += 2) {
         const int b = std::min(a + 1, yaws - 1);
+        if (!wanted[static_cast<std::size_t>(a)] && !wanted[static_cast<std::size_t>(b)]) continue;
         detail::Fft2dForwardRealPair(image_at(a), image_at(b), n, spectra_[a], spectra_[b]);
     }
     for (auto& spectrum : spectra_) {
@@ -188,7 +223,8 @@ CoarseQuery::CoarseQuery(const SurfacePoints& query_structure, const CoarseConfi
 double CoarseQuery::YawOf(int index) const { return index * 2.0 * std::numbers::pi / yaw_count(); }
 
 std::vector<PlanarHypothesis> CoarseAlign(const CoarseQuery& query,
-                                          const SurfacePoints& match_structure) {
+                                          const SurfacePoints& match_structure,
+                                          const YawWindow& allowed) {
     const CoarseConfig& config = query.config();
     const int n = config.grid_cells;
     if (match_structure.size() == 0 || query.yaw_count() == 0) return {};
@@ -200,8 +236,14 @@ std::vector<PlanarHypothesis> CoarseAlign(const CoarseQuery& query,
     // Two yaws per inverse FFT: both correlations are real, so yaw b rides in the imaginary part:
     // product = qa m + i qb m (written out: std::complex's product checks for NaN and does not
     // vectorise).
+    const YawWindow searched = SearchedYaws(allowed, config);
     for (int a = 0; a < query.yaw_count(); a += 2) {
         const int b = std::min(a + 1, query.yaw_count() - 1);
+        const bool want_a = searched.Contains(query.YawOf(a));
+        const bool want_b = b != a && searched.Contains(query.YawOf(b));
+        if (!want_a && !want_b) continue;
+        if (!query.Has(a) || !query.Has(b))
+            throw std::invalid_argument("CoarseAlign: the query's images lack a searched yaw");
         const Spectrum& qa = query.spectrum(a);
         const Spectrum& qb = query.spectrum(b);
         for (std::size_t i = 0; i < match.size(); ++i) {
@@ -211,8 +253,8 @@ std::vector<PlanarHypothesis> CoarseAlign(const CoarseQuery& query,
             product.im[i] = (ar * mi + ai * mr) + (br * mr - bi * mi);
         }
         detail::Fft2dInverseRows(product, n, rows);
-        AddPeaks(product.re, query, query.YawOf(a), config.peaks_per_yaw, peaks);
-        if (b != a) AddPeaks(product.im, query, query.YawOf(b), config.peaks_per_yaw, peaks);
+        if (want_a) AddPeaks(product.re, query, query.YawOf(a), config.peaks_per_yaw, peaks);
+        if (want_b) AddPeaks(product.im, query, query.YawOf(b), config.peaks_per_yaw, peaks);
     }
     return Distinct(std::move(peaks), config);
 }

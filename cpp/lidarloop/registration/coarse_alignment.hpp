@@ -2,6 +2,7 @@
 
 #include <complex>
 #include <cstdint>
+#include <numbers>
 #include <vector>
 
 #include <Eigen/Core>
@@ -18,15 +19,36 @@ struct PlanarHypothesis {
     double score = 0.0;  ///< correlation of the occupancy images at the peak (higher: better)
 };
 
+/// The yaws of T_match_query (radians) that another source of the pose, the odometry's gate,
+/// allows a loop: within half_width_rad of centre_rad. The default, and a window with a NaN, is
+/// every yaw.
+struct YawWindow {
+    double centre_rad = 0.0;
+    double half_width_rad = std::numbers::pi;
+
+    bool Whole() const;
+    /// Whether `yaw_rad` lies within the window (angles wrapped).
+    bool Contains(double yaw_rad) const;
+};
+
+/// The window the coarse search looks in for `allowed`: wider by two yaw steps, because a
+/// peak's yaw is off by up to half a step and ICP turns the pose by a few degrees.
+YawWindow SearchedYaws(const YawWindow& allowed, const CoarseConfig& config);
+
 /// The query's side of the coarse search, computed once per query scan and shared by all its
 /// candidates: the spectrum of its top-down structure image at every searched yaw.
 class CoarseQuery {
 public:
-    CoarseQuery(const SurfacePoints& query_structure, const CoarseConfig& config);
+    /// The spectra of the yaws SearchedYaws of some of `windows` holds (the candidates'
+    /// windows), of every yaw when `windows` is empty or one of them is whole.
+    CoarseQuery(const SurfacePoints& query_structure, const CoarseConfig& config,
+                const std::vector<YawWindow>& windows = {});
 
     const CoarseConfig& config() const { return config_; }
     int yaw_count() const { return static_cast<int>(spectra_.size()); }
     double YawOf(int index) const;
+    /// Whether the spectrum of yaw `index` was computed.
+    bool Has(int index) const { return !spectra_[index].empty(); }
     const std::vector<std::complex<float>>& spectrum(int index) const { return spectra_[index]; }
     /// Cells of the correlation grid within max_translation_m (wrapped indices), and their rows.
     const std::vector<std::uint32_t>& search_cells() const { return search_cells_; }
@@ -47,9 +69,12 @@ std::vector<float> OccupancyImage(const std::vector<Eigen::Vector3f>& points, do
 /// The best distinct planar poses of the query in the match's frame, best first (at most
 /// config.TotalHypotheses()): for every yaw, the translations (up to peaks_per_yaw, 3 cells
 /// apart) that maximise the cross-correlation of the query's rotated structure image with the
-/// match's (FFT), within max_translation_m.
-/// Empty when either scan has no structure points. Thread-safe.
+/// match's (FFT), within max_translation_m, at the yaws SearchedYaws(`allowed`) holds. A yaw's
+/// peaks do not depend on the window, so a window only drops hypotheses.
+/// Empty when either scan has no structure points. Throws std::invalid_argument when `query`
+/// lacks a searched yaw (it was built for other windows). Thread-safe.
 std::vector<PlanarHypothesis> CoarseAlign(const CoarseQuery& query,
-                                          const SurfacePoints& match_structure);
+                                          const SurfacePoints& match_structure,
+                                          const YawWindow& allowed = {});
 
 }  // namespace lidarloop::registration

@@ -344,13 +344,14 @@ bool OverlapReaches(const PreparedScan& query, const PreparedScan& match,
 }
 
 Verification Verify(const PreparedScan& query, const CoarseQuery& coarse, const PreparedScan& match,
-                    const VerificationConfig& config, const PoseAllowed& allowed) {
+                    const VerificationConfig& config, const PoseAllowed& allowed,
+                    const YawWindow& yaws) {
     Verification best;
     if (TooFewPoints(query, config.acceptance) || TooFewPoints(match, config.acceptance)) {
         best.reason = RejectReason::kTooFewPoints;
         return best;
     }
-    const auto hypotheses = CoarseAlign(coarse, *match.structure);
+    const auto hypotheses = CoarseAlign(coarse, *match.structure, yaws);
     if (hypotheses.empty()) {
         best.reason = RejectReason::kNoAlignment;
         return best;

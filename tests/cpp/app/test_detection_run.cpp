@@ -19,6 +19,7 @@
 #include "lidarloop/app/detection.hpp"
 #include "lidarloop/app/evaluation.hpp"
 #include "lidarloop/app/verification_run.hpp"
+#include "lidarloop/core/angles.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/io/config_yaml.hpp"
 #include "lidarloop/io/kitti_bin.hpp"
@@ -173,6 +174,77 @@ TEST(OdometryAllowsALoop, EqualsTryingLoopPosesWithinReach) {
     };
     EXPECT_TRUE(pipeline::OdometryAllowsALoop(
         1, 0, kMaxLoopM, lost, [](std::size_t i) { return 100.0 * static_cast<double>(i); }, gate));
+}
+
+// The coarse search's yaw window (OdometryYawWindow) holds the yaw of every loop pose the pose
+// graph's gate lets pass: the discrepancy's angle bounds the yaw's, up to the relative tilt of
+// the two scans (at most 0.33 degrees more for 10 degrees of it). Random odometry and loops.
+TEST(OdometryYawWindow, HoldsTheYawOfEveryLoopTheGatePasses) {
+    const posegraph::PoseGraphConfig config;
+    const pipeline::OdometryGate gate = app::OdometryGateOf(config);
+    std::mt19937 random(9);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    const auto turn = [&](double max_rad, double axis_z) {
+        return Eigen::AngleAxisd(max_rad * unit(random),
+                                 Eigen::Vector3d(unit(random), unit(random), axis_z).normalized())
+            .toRotationMatrix();
+    };
+    const auto yaw_of = [](const core::Transform& T) {
+        return std::atan2(T.linear()(1, 0), T.linear()(0, 0));
+    };
+    std::size_t passed = 0;
+    for (int pair = 0; pair < 300; ++pair) {
+        std::vector<core::Transform> T_odom_sensor(2, core::Transform::Identity());
+        T_odom_sensor[1].translation() = 30.0 * Eigen::Vector3d(unit(random), unit(random), 0.0);
+        // Any heading, tilted by up to 10 degrees.
+        T_odom_sensor[1].linear() =
+            Eigen::AngleAxisd(M_PI * unit(random), Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+            turn(10.0 * core::kRadiansPerDegree, 0.0);
+        const std::vector<double> path_m{0.0, 500.0 * (1.0 + unit(random))};
+        const auto pose_of = [&](std::size_t i) { return T_odom_sensor[i]; };
+        const auto path_of = [&](std::size_t i) { return path_m[i]; };
+        const registration::YawWindow window =
+            pipeline::OdometryYawWindow(1, 0, pose_of, path_of, gate);
+        const core::Transform T_0_1 = T_odom_sensor[0].inverse() * T_odom_sensor[1];
+        ASSERT_FALSE(window.Whole());
+        ASSERT_NEAR(window.centre_rad, yaw_of(T_0_1), 1e-12);
+        ASSERT_EQ(window.half_width_rad,
+                  posegraph::GateRotationDeg(path_m[1], config) * core::kRadiansPerDegree);
+        const registration::YawWindow slack{window.centre_rad,
+                                            window.half_width_rad + 0.4 * core::kRadiansPerDegree};
+        for (int attempt = 0; attempt < 50; ++attempt) {
+            core::Transform loop = T_0_1;
+            loop.linear() = T_0_1.linear() * turn(0.7, unit(random));  // up to 40 degrees
+            if (gate(loop, T_0_1, path_m[1])) continue;
+            ++passed;
+            ASSERT_TRUE(slack.Contains(yaw_of(loop))) << pair << " " << attempt;
+        }
+    }
+    EXPECT_GT(passed, 1000u);
+    // Where the odometry does not know a scan, or the gate says no allowance: every yaw.
+    const auto lost = [](std::size_t) {
+        core::Transform T = core::Transform::Identity();
+        T.translation().x() = std::numeric_limits<double>::quiet_NaN();
+        return T;
+    };
+    const auto path_of = [](std::size_t i) { return 100.0 * static_cast<double>(i); };
+    EXPECT_TRUE(pipeline::OdometryYawWindow(1, 0, lost, path_of, gate).Whole());
+    pipeline::OdometryGate without = gate;
+    without.rotation_allowance_deg = {};
+    const auto level = [](std::size_t) { return core::Transform::Identity(); };
+    EXPECT_TRUE(pipeline::OdometryYawWindow(1, 0, level, path_of, without).Whole());
+    EXPECT_FALSE(pipeline::OdometryYawWindow(1, 0, level, path_of, gate).Whole());
+    EXPECT_TRUE(pipeline::LoopCheck{}.YawWindow(1, 0).Whole());
+    // The check of `detect --odometry` asks the same.
+    std::vector<core::StampedPose> odometry(2);
+    odometry[1].T_world_sensor.linear() =
+        Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const std::vector<double> path_m{0.0, 100.0};
+    const registration::YawWindow asked =
+        app::OdometryLoopCheck(odometry, path_m, config).YawWindow(1, 0);
+    EXPECT_NEAR(asked.centre_rad, 0.7, 1e-12);
+    EXPECT_EQ(asked.half_width_rad,
+              posegraph::GateRotationDeg(100.0, config) * core::kRadiansPerDegree);
 }
 
 // The candidate search's cheap bound of the pose graph's gate (LoopCheck::in_reach_bound: the

@@ -426,7 +426,8 @@ struct OdometryLaps {
     OdometryGate gate{[](const core::Transform& T_loop, const core::Transform& T_odometry, double) {
                           return (T_loop.translation() - T_odometry.translation()).norm() > 3.0;
                       },
-                      [](double) { return 3.0; }};
+                      [](double) { return 3.0; },
+                      {}};
 };
 
 // Online with an odometry gate, the scans the odometry puts out of a loop's reach are no

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include "lidarloop/core/angles.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/pipeline/candidate_verification.hpp"
 #include "lidarloop/pipeline/loop_detector.hpp"
@@ -149,6 +150,7 @@ OdometryGate FiveMetreGate(std::vector<GateCall>& calls) {
             calls.push_back({T_odometry, path_m});
             return (T_loop.inverse() * T_odometry).translation().norm() > 5.0;
         },
+        {},
         {}};
 }
 
@@ -294,6 +296,31 @@ void ExpectSameVerdict(const registration::Verification& a, const registration::
     EXPECT_TRUE(a.T_match_query.isApprox(b.T_match_query, 1e-12)) << candidate;
 }
 
+// The check's yaw window reaches the coarse search: around the truth (the query is the place
+// turned by 170 degrees) the verdicts are those of the full search; a quarter turn off, the
+// true loops are not found.
+TEST(VerifyQuery, TheChecksYawWindowLimitsTheCoarseSearch) {
+    DetectorConfig detector = Verifying();
+    detector.stop_at_first_loop = false;
+    const RankedCandidates ranked = MakeRankedCandidates(detector);
+    const LoopQuery full = Verified(ranked, detector);
+    ASSERT_TRUE(full.verifications[1].accepted && full.verifications[2].accepted);
+    const auto window_at = [](double centre_deg) {
+        LoopCheck check;
+        check.yaw_window = [centre_deg](std::size_t, std::size_t) {
+            return registration::YawWindow{centre_deg * core::kRadiansPerDegree,
+                                           10.0 * core::kRadiansPerDegree};
+        };
+        return check;
+    };
+    const LoopQuery around_truth = Verified(ranked, detector, window_at(-170.0));
+    for (std::size_t c = 1; c <= 2; ++c)
+        ExpectSameVerdict(around_truth.verifications[c], full.verifications[c], c);
+    const LoopQuery quarter_off = Verified(ranked, detector, window_at(100.0));
+    EXPECT_FALSE(quarter_off.verifications[1].accepted);
+    EXPECT_FALSE(quarter_off.verifications[2].accepted);
+}
+
 // stop_at_first_loop registers in rank order up to the first accepted candidate, with the
 // verdicts of registering every one, and leaves the rest kNotNeeded.
 TEST(StopAtFirstLoop, RegistersInRankOrderUpToTheFirstAcceptedCandidate) {
@@ -338,6 +365,7 @@ TEST(StopAtFirstLoop, ALoopTheCheckRejectsLetsTheNextCandidateBeRegistered) {
                                }
                                checked_accepted.push_back(accepted);
                            },
+                           {},
                            {},
                            {},
                            {},
@@ -396,6 +424,7 @@ TEST(StopAtFirstLoop, RegisteringSeveralAtOnceGivesTheVerdictsOfOneAfterAnother)
             if (v.accepted)
                 v.accepted = false, v.reason = registration::RejectReason::kOdometryMismatch;
         },
+        {},
         {},
         {},
         {},
@@ -492,6 +521,7 @@ TEST(OdometryFloor, OnlyTheCandidatesWhosePoseTheCheckJudges) {
             if (match == 2) return any_pose;
             return {};
         },
+        {},
         {},
         {},
         {}};

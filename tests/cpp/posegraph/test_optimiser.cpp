@@ -203,6 +203,8 @@ TEST(GateAgainstOdometry, ToleranceGrowsWithThePathAsTheInformationModelSays) {
     EXPECT_NEAR(inside.gate_translation_m, tolerance_m, 1e-9);
     EXPECT_NEAR(inside.odometry_translation_error_m, tolerance_m - 0.01, 1e-9);
     EXPECT_NEAR(inside.gate_rotation_deg, 5.0 * 0.03 * 10.0 + 10.0 + 1.0, 1e-9);
+    EXPECT_EQ(GateTranslationM(d, {}), inside.gate_translation_m);
+    EXPECT_EQ(GateRotationDeg(d, {}), inside.gate_rotation_deg);
     EXPECT_EQ(inside.path_m, d);
     EXPECT_EQ(shifted_by(tolerance_m + 0.01).verdict, LoopVerdict::kRejectedByOdometry);
     // A street that repeats itself every 45 m: registered a period off, 54 m of path apart.

@@ -3,7 +3,9 @@
 #include <cmath>
 #include <complex>
 #include <limits>
+#include <numbers>
 #include <random>
+#include <stdexcept>
 #include <utility>
 
 #include <gtest/gtest.h>
@@ -298,6 +300,68 @@ TEST(CoarseAlign, ScoresAreExactMultiplesOfAHalf) {
     }
     EXPECT_NEAR(hypotheses.front().translation_m.norm(), 0.0, 0.2);  // the scan onto itself
     EXPECT_NEAR(hypotheses.front().yaw_rad, 0.0, 1e-9);
+}
+
+TEST(YawWindow, WrapsAroundAndANanWindowIsWhole) {
+    const double deg = std::numbers::pi / 180.0;
+    const YawWindow window{179.0 * deg, 5.0 * deg};
+    EXPECT_TRUE(window.Contains(-177.0 * deg));
+    EXPECT_TRUE(window.Contains(175.0 * deg));
+    EXPECT_FALSE(window.Contains(-175.0 * deg));
+    EXPECT_FALSE(window.Contains(0.0));
+    EXPECT_TRUE(YawWindow{}.Whole());
+    EXPECT_TRUE((YawWindow{std::numeric_limits<double>::quiet_NaN(), 5.0 * deg}.Whole()));
+    EXPECT_TRUE((YawWindow{0.0, std::numeric_limits<double>::quiet_NaN()}.Contains(2.0)));
+    EXPECT_NEAR(SearchedYaws(window, CoarseConfig{}).half_width_rad, 15.0 * deg, 1e-12);
+}
+
+// The query turned by 60 degrees: the full search's best peak lies at 60 degrees. A window
+// there finds the same peak, bit for bit; a window elsewhere never looks at 60 degrees.
+TEST(CoarseAlign, AYawWindowSearchesWithinItAndFindsWhatTheFullSearchFindsThere) {
+    const double deg = std::numbers::pi / 180.0;
+    const core::PointCloud place = test::SyntheticPlace();
+    const PreparedScan match = PrepareScan(place, ScanReductionConfig{});
+    const PreparedScan query = PrepareScan(
+        test::Transformed(place, test::PlanarTransform(0.0, 0.0, -60.0)), ScanReductionConfig{});
+    const CoarseConfig config;
+    const CoarseQuery full(*query.structure, config);
+    const auto everywhere = CoarseAlign(full, *match.structure);
+    ASSERT_FALSE(everywhere.empty());
+    ASSERT_NEAR(everywhere.front().yaw_rad, 60.0 * deg, 1e-9);
+    // Searched: within 12 + 10 degrees, the yaws 40-80 and 130-170 degrees, 9 each.
+    const YawWindow right{60.0 * deg, 12.0 * deg}, wrong{150.0 * deg, 12.0 * deg};
+    const CoarseQuery windowed(*query.structure, config, {wrong, right});
+    for (const YawWindow& window : {right, wrong}) {
+        const auto found = CoarseAlign(windowed, *match.structure, window);
+        ASSERT_FALSE(found.empty());
+        for (const PlanarHypothesis& h : found)
+            EXPECT_TRUE(SearchedYaws(window, config).Contains(h.yaw_rad)) << h.yaw_rad / deg;
+        // The same peaks from the query's images for every yaw.
+        const auto from_full = CoarseAlign(full, *match.structure, window);
+        ASSERT_EQ(found.size(), from_full.size());
+        for (std::size_t i = 0; i < found.size(); ++i) {
+            EXPECT_EQ(found[i].yaw_rad, from_full[i].yaw_rad);
+            EXPECT_EQ(found[i].translation_m, from_full[i].translation_m);
+            EXPECT_EQ(found[i].score, from_full[i].score);
+        }
+    }
+    const auto there = CoarseAlign(windowed, *match.structure, right);
+    EXPECT_EQ(there.front().yaw_rad, everywhere.front().yaw_rad);
+    EXPECT_EQ(there.front().translation_m, everywhere.front().translation_m);
+    EXPECT_EQ(there.front().score, everywhere.front().score);
+    // Only the windows' yaws and their partners in the paired transforms (8-9 ... 16-17,
+    // 26-27 ... 34-35) were computed.
+    int computed = 0;
+    for (int i = 0; i < windowed.yaw_count(); ++i) computed += windowed.Has(i) ? 1 : 0;
+    EXPECT_EQ(computed, 20);
+    EXPECT_TRUE(windowed.Has(17) && windowed.Has(26));
+    EXPECT_FALSE(windowed.Has(0));
+    EXPECT_THROW(CoarseAlign(windowed, *match.structure, YawWindow{}), std::invalid_argument);
+    EXPECT_THROW(CoarseAlign(windowed, *match.structure, YawWindow{-90.0 * deg, 10.0 * deg}),
+                 std::invalid_argument);
+    // A whole window is the full search.
+    const CoarseQuery whole(*query.structure, config, {right, YawWindow{}});
+    for (int i = 0; i < whole.yaw_count(); ++i) ASSERT_TRUE(whole.Has(i));
 }
 
 TEST(PrepareScan, SplitsWallsFromGroundWithUnitNormalsFacingTheSensor) {
