@@ -19,9 +19,9 @@ constexpr double kReachMargin = 1e-5;
 // The next query starts from the last one's k-th distance times this: near enough to succeed
 // at once most of the time, small enough not to read many extra points.
 constexpr float kRadiusCarry = 1.2F;
-// Up to this many candidates are ordered by counting ranks (quadratic, but without branches to
-// mispredict: faster than a sort for the 10 or so of a normal's neighbourhood).
-constexpr std::size_t kRankedAtMost = 32;
+// Up to this many candidates are ordered by counting ranks (quadratic, but vectorised and without
+// branches to mispredict: faster than a selection and a sort for the 15-50 of a neighbourhood).
+constexpr std::size_t kRankedAtMost = 64;
 
 std::int64_t ColumnOf(double coordinate, double origin, double cell_m, std::int64_t count) {
     const double column = std::floor((coordinate - origin) / cell_m);
@@ -84,9 +84,11 @@ NeighborGrid::Span NeighborGrid::ColumnsWithin(float low, float high, float orig
             std::min<std::int64_t>(count - 1, ColumnOf(high + reach, origin, cell_m_, count))};
 }
 
-bool NeighborGrid::Collect(const Eigen::Vector3f& query, float radius_m, std::size_t wanted,
-                           std::vector<std::uint64_t>& nearest) const {
-    nearest.clear();
+bool NeighborGrid::Collect(const Eigen::Vector3f& query, float radius_m, Scratch& scratch) const {
+    auto& distance_m2 = scratch.distance_m2;
+    auto& index = scratch.index;
+    distance_m2.clear();
+    index.clear();
     const Span x = ColumnsWithin(query.x() - radius_m, query.x() + radius_m, min_x_, columns_x_);
     const Span y = ColumnsWithin(query.y() - radius_m, query.y() + radius_m, min_y_, columns_y_);
     const bool whole_grid =
@@ -97,7 +99,8 @@ bool NeighborGrid::Collect(const Eigen::Vector3f& query, float radius_m, std::si
     std::size_t readable = 0;
     for (std::int64_t row = y.first; row <= y.last; ++row)
         readable += RowEnd(row, x) - RowBegin(row, x);
-    nearest.resize(readable);
+    distance_m2.resize(readable);
+    index.resize(readable);
     std::size_t found = 0;
     for (std::int64_t row = y.first; row <= y.last; ++row) {
         for (std::uint32_t i = RowBegin(row, x), end = RowEnd(row, x); i < end; ++i) {
@@ -107,33 +110,63 @@ bool NeighborGrid::Collect(const Eigen::Vector3f& query, float radius_m, std::si
             const float dz = points_[i].z() - query.z();
             const float squared_m2 = dx * dx + dy * dy + dz * dz;
             // Written always, kept when within: no branch to mispredict.
-            nearest[found] =
-                std::uint64_t{std::bit_cast<std::uint32_t>(squared_m2)} << 32 | original_[i];
+            distance_m2[found] = squared_m2;
+            index[found] = original_[i];
             found += squared_m2 <= bound_m2 ? 1 : 0;
         }
     }
-    nearest.resize(found);
-    if (found <= kRankedAtMost) {
-        // Few: each key's rank by counting the smaller ones, without a branch per comparison.
-        std::array<std::uint64_t, kRankedAtMost> ranked;
-        for (std::size_t i = 0; i < found; ++i) {
-            std::size_t rank = 0;
-            for (std::size_t j = 0; j < found; ++j) rank += nearest[j] < nearest[i] ? 1 : 0;
-            ranked[rank] = nearest[i];
-        }
-        const std::size_t kept = std::min(found, wanted);
-        std::copy(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(kept),
-                  nearest.begin());
-        nearest.resize(kept);
-        return whole_grid;
-    }
-    if (nearest.size() >= wanted) {
-        const auto kept = nearest.begin() + static_cast<std::ptrdiff_t>(wanted);
-        std::nth_element(nearest.begin(), kept - 1, nearest.end());
-        nearest.erase(kept, nearest.end());
-    }
-    std::sort(nearest.begin(), nearest.end());
+    distance_m2.resize(found);
+    index.resize(found);
     return whole_grid;
+}
+
+namespace {
+
+// The `kept` nearest of the candidates, nearest first (equal distances by index), by counting
+// for each the ones before it: quadratic, but vectorised and without a branch per comparison.
+void RankByCounting(const std::vector<float>& distance_m2, const std::vector<std::uint32_t>& index,
+                    std::size_t kept, std::vector<std::uint32_t>& ranked) {
+    const std::size_t found = distance_m2.size();
+    ranked.resize(found);
+    for (std::size_t i = 0; i < found; ++i) {
+        const float d = distance_m2[i];
+        const std::uint32_t id = index[i];
+        std::uint32_t before = 0;
+        for (std::size_t j = 0; j < found; ++j) {
+            before += static_cast<std::uint32_t>(distance_m2[j] < d) |
+                      (static_cast<std::uint32_t>(distance_m2[j] == d) &
+                       static_cast<std::uint32_t>(index[j] < id));
+        }
+        ranked[before] = static_cast<std::uint32_t>(i);
+    }
+    ranked.resize(kept);
+}
+
+}  // namespace
+
+float NeighborGrid::Nearest(std::size_t wanted, Scratch& scratch,
+                            std::vector<std::uint32_t>& indices) {
+    const auto& distance_m2 = scratch.distance_m2;
+    const auto& index = scratch.index;
+    const std::size_t found = distance_m2.size();
+    const std::size_t kept = std::min(found, wanted);
+    indices.resize(kept);
+    if (found <= kRankedAtMost) {
+        RankByCounting(distance_m2, index, kept, scratch.ranked);
+        for (std::size_t r = 0; r < kept; ++r) indices[r] = index[scratch.ranked[r]];
+        return kept == 0 ? 0.0F : distance_m2[scratch.ranked[kept - 1]];
+    }
+    // Many candidates: a squared distance's bits (>= 0, so ordered as the
+    // floats are) over the point's index, which breaks ties.
+    auto& keys = scratch.keys;
+    keys.resize(found);
+    for (std::size_t i = 0; i < found; ++i)
+        keys[i] = std::uint64_t{std::bit_cast<std::uint32_t>(distance_m2[i])} << 32 | index[i];
+    const auto last = keys.begin() + static_cast<std::ptrdiff_t>(kept);
+    std::nth_element(keys.begin(), last - 1, keys.end());
+    std::sort(keys.begin(), last);
+    for (std::size_t r = 0; r < kept; ++r) indices[r] = static_cast<std::uint32_t>(keys[r]);
+    return std::bit_cast<float>(static_cast<std::uint32_t>(keys[kept - 1] >> 32));
 }
 
 void NeighborGrid::Knn(const Eigen::Vector3f& query, int k, Scratch& scratch,
@@ -141,14 +174,12 @@ void NeighborGrid::Knn(const Eigen::Vector3f& query, int k, Scratch& scratch,
     indices.clear();
     if (k <= 0 || points_.empty() || !query.allFinite()) return;
     const std::size_t wanted = std::min(static_cast<std::size_t>(k), points_.size());
-    auto& nearest = scratch.nearest;
     float radius_m = scratch.radius_m > 0.0F ? scratch.radius_m : cell_m_;
     // Every point outside the columns read is farther than the radius: once `wanted` lie within
     // it, they are the nearest.
-    while (!Collect(query, radius_m, wanted, nearest) && nearest.size() < wanted) radius_m *= 2.0F;
-    indices.reserve(wanted);
-    for (const std::uint64_t key : nearest) indices.push_back(static_cast<std::uint32_t>(key));
-    const float kth_m2 = std::bit_cast<float>(static_cast<std::uint32_t>(nearest.back() >> 32));
+    while (!Collect(query, radius_m, scratch) && scratch.distance_m2.size() < wanted)
+        radius_m *= 2.0F;
+    const float kth_m2 = Nearest(wanted, scratch, indices);
     scratch.radius_m = std::max(kRadiusCarry * std::sqrt(kth_m2), 0.5F * cell_m_);
 }
 

@@ -19,9 +19,12 @@ public:
     /// A query's working memory, and the radius that served the last query: queries near each
     /// other need about the same (so ask in SpatialOrder when all points are queried).
     struct Scratch {
-        // Candidates: a squared distance's bits (metres², >= 0, so ordered as the floats are)
-        // over the point's index, which breaks ties.
-        std::vector<std::uint64_t> nearest;
+        // Candidates within the radius: squared distances (metres²) and the points' indices,
+        // which break ties.
+        std::vector<float> distance_m2;
+        std::vector<std::uint32_t> index;
+        std::vector<std::uint32_t> ranked;  // positions in those, nearest first
+        std::vector<std::uint64_t> keys;    // many candidates: distance bits over index, sorted
         float radius_m = 0.0F;
     };
 
@@ -50,11 +53,13 @@ private:
         return column_start_[static_cast<std::size_t>(row * columns_x_ + x.last + 1)];
     }
     Span ColumnsWithin(float low, float high, float origin, std::int64_t count) const;
-    // The `wanted` nearest of the points within `radius_m` of `query` (of all points, when the
-    // columns within it are the whole grid), ascending, or all of them when there are fewer;
-    // returns whether the whole grid was read.
-    bool Collect(const Eigen::Vector3f& query, float radius_m, std::size_t wanted,
-                 std::vector<std::uint64_t>& nearest) const;
+    // The points within `radius_m` of `query` (all points, when the columns within it are the
+    // whole grid) into scratch.distance_m2 and scratch.index, in column order; returns whether
+    // the whole grid was read.
+    bool Collect(const Eigen::Vector3f& query, float radius_m, Scratch& scratch) const;
+    // The `wanted` nearest of the collected points, nearest first (equal distances by index),
+    // or all of them when there are fewer; returns the squared distance of the last.
+    static float Nearest(std::size_t wanted, Scratch& scratch, std::vector<std::uint32_t>& indices);
 
     float cell_m_ = 1.0F;
     float min_x_ = 0.0F, min_y_ = 0.0F;

@@ -128,8 +128,19 @@ void ExpectGridKnnIsExact(const std::vector<Eigen::Vector3f>& points, float cell
         grid.Knn(query, k, scratch, found);
         const auto expected = NearestSquaredDistances(points, query, static_cast<std::size_t>(k));
         ASSERT_EQ(found.size(), expected.size());
-        for (std::size_t i = 0; i < found.size(); ++i)
-            ASSERT_FLOAT_EQ((points[found[i]] - query).squaredNorm(), expected[i]) << i;
+        for (std::size_t i = 0; i < found.size(); ++i) {
+            const float squared_m2 = (points[found[i]] - query).squaredNorm();
+            ASSERT_FLOAT_EQ(squared_m2, expected[i]) << i;
+            // Equal distances (summed x, y, z in turn, as the grid and nanoflann sum them) by
+            // index, as PointTree::Knn orders them.
+            const auto summed_m2 = [&](std::uint32_t j) {
+                const Eigen::Vector3f d = points[j] - query;
+                return d.x() * d.x() + d.y() * d.y() + d.z() * d.z();
+            };
+            if (i > 0 && summed_m2(found[i]) == summed_m2(found[i - 1])) {
+                ASSERT_LT(found[i - 1], found[i]) << i;
+            }
+        }
     }
 }
 
@@ -159,6 +170,7 @@ TEST(NeighborGrid, KnnIsExactOnAScanWithFarOutliers) {
 TEST(NeighborGrid, EqualPointsAndOneColumnAreHandled) {
     const std::vector<Eigen::Vector3f> same(50, Eigen::Vector3f(1.0F, 2.0F, 3.0F));
     ExpectGridKnnIsExact(same, 0.5F, {Eigen::Vector3f(1.0F, 2.0F, 3.0F)}, 10);
+    ExpectGridKnnIsExact(same, 0.5F, {Eigen::Vector3f(1.0F, 2.0F, 3.0F)}, 50);  // many candidates
     std::vector<Eigen::Vector3f> pole;
     for (int i = 0; i < 200; ++i) pole.emplace_back(0.0F, 0.0F, 0.1F * static_cast<float>(i));
     ExpectGridKnnIsExact(pole, 0.5F, RandomPoints(50, 13, 5.0F), 7);
