@@ -376,6 +376,37 @@ TEST(CoarseAlign, AYawWindowSearchesWithinItAndFindsWhatTheFullSearchFindsThere)
     for (int i = 0; i < whole.yaw_count(); ++i) ASSERT_TRUE(whole.Has(i));
 }
 
+// 45 yaws of 8 degrees: the last one has no partner in the paired transforms, and a window
+// around it wraps past 0. Searched: within 1 + 16 degrees of 352, the yaws 336-360 and 0-8.
+TEST(CoarseAlign, AWindowWrapsAroundAnOddYawCount) {
+    const double deg = std::numbers::pi / 180.0;
+    const core::PointCloud place = test::SyntheticPlace();
+    const PreparedScan match = PrepareScan(place, ScanReductionConfig{});
+    const PreparedScan query = PrepareScan(
+        test::Transformed(place, test::PlanarTransform(0.0, 0.0, 8.0)), ScanReductionConfig{});
+    CoarseConfig config;
+    config.yaw_step_deg = 8.0;
+    const YawWindow window{352.0 * deg, 1.0 * deg};
+    const CoarseQuery windowed(*query.structure, config, {window});
+    ASSERT_EQ(windowed.yaw_count(), 45);
+    std::vector<int> computed;
+    for (int i = 0; i < windowed.yaw_count(); ++i) {
+        if (windowed.Has(i)) computed.push_back(i);
+    }
+    EXPECT_EQ(computed, (std::vector<int>{0, 1, 42, 43, 44}));
+    const auto found = CoarseAlign(windowed, *match.structure, window);
+    const auto from_full =
+        CoarseAlign(CoarseQuery(*query.structure, config), *match.structure, window);
+    ASSERT_FALSE(found.empty());
+    ASSERT_EQ(found.size(), from_full.size());
+    for (std::size_t i = 0; i < found.size(); ++i) {
+        EXPECT_TRUE(SearchedYaws(window, config).Contains(found[i].yaw_rad));
+        EXPECT_EQ(found[i].yaw_rad, from_full[i].yaw_rad);
+        EXPECT_EQ(found[i].translation_m, from_full[i].translation_m);
+        EXPECT_EQ(found[i].score, from_full[i].score);
+    }
+}
+
 TEST(PrepareScan, SplitsWallsFromGroundWithUnitNormalsFacingTheSensor) {
     ScanReductionConfig config;
     const PreparedScan scan = PrepareScan(test::SyntheticPlace(), config);
