@@ -139,6 +139,9 @@ std::vector<PlanarHypothesis> Distinct(std::vector<PlanarHypothesis> peaks,
     return kept;
 }
 
+// The yaw of the `index`-th of `yaws` equal steps around the circle, radians.
+double YawAt(int index, int yaws) { return index * 2.0 * std::numbers::pi / yaws; }
+
 // The yaws of `query` that some of `windows` holds, as SearchedYaws widens them.
 std::vector<bool> YawsWithin(const std::vector<YawWindow>& windows, const CoarseConfig& config,
                              int yaws) {
@@ -148,8 +151,7 @@ std::vector<bool> YawsWithin(const std::vector<YawWindow>& windows, const Coarse
     for (const YawWindow& window : windows) {
         const YawWindow searched = SearchedYaws(window, config);
         for (int i = 0; i < yaws; ++i) {
-            if (searched.Contains(i * 2.0 * std::numbers::pi / yaws))
-                within[static_cast<std::size_t>(i)] = true;
+            if (searched.Contains(YawAt(i, yaws))) within[static_cast<std::size_t>(i)] = true;
         }
     }
     return within;
@@ -205,7 +207,7 @@ CoarseQuery::CoarseQuery(const SurfacePoints& query_structure, const CoarseConfi
     const int yaws = static_cast<int>(std::lround(360.0 / config.yaw_step_deg));
     spectra_.resize(static_cast<std::size_t>(yaws));
     const auto image_at = [&](int i) {
-        return OccupancyImage(query_structure.points(), i * 2.0 * std::numbers::pi / yaws, config);
+        return OccupancyImage(query_structure.points(), YawAt(i, yaws), config);
     };
     const std::vector<bool> wanted = YawsWithin(windows, config, yaws);
     // Two yaws per transform: the images are real (detail::Fft2dForwardRealPair). The pairs are
@@ -220,7 +222,7 @@ CoarseQuery::CoarseQuery(const SurfacePoints& query_structure, const CoarseConfi
     }
 }
 
-double CoarseQuery::YawOf(int index) const { return index * 2.0 * std::numbers::pi / yaw_count(); }
+double CoarseQuery::YawOf(int index) const { return YawAt(index, yaw_count()); }
 
 std::vector<PlanarHypothesis> CoarseAlign(const CoarseQuery& query,
                                           const SurfacePoints& match_structure,
