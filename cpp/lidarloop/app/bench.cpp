@@ -141,7 +141,8 @@ nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
     for (std::size_t q = 0; q < all.size() && coarse_times.wall_ms.size() < queries; q += step) {
         const registration::PreparedScan query = prepared.scans[all[q].query].Expand();
         if (!query.structure) continue;
-        std::vector<registration::YawWindow> windows;  // as the online detector's VerifyQuery
+        // Every candidate's yaws (VerifyQuery leaves out those it answers without registering).
+        std::vector<registration::YawWindow> windows;
         for (const pipeline::Neighbor& candidate : all[q].candidates)
             windows.push_back(check.YawWindow(all[q].query, candidate.index));
         const auto coarse = coarse_times.Time([&] {

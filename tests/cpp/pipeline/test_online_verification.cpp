@@ -321,6 +321,52 @@ TEST(VerifyQuery, TheChecksYawWindowLimitsTheCoarseSearch) {
     EXPECT_FALSE(quarter_off.verifications[2].accepted);
 }
 
+// Candidates with windows apart (1 and 2 around the truth, 0 and 3 half a turn away): the
+// query's images cover every candidate still to be registered, also the one a batch skipped
+// before the check rejected the loop ahead of it, and each pair's verdict is that of a search
+// of its own window alone.
+TEST(VerifyQuery, EachCandidateIsSearchedInItsOwnYawWindow) {
+    DetectorConfig detector = Verifying();
+    const RankedCandidates ranked = MakeRankedCandidates(detector);
+    LoopCheck check;
+    check.yaw_window = [](std::size_t, std::size_t match) {
+        const double centre_deg = match == 1 || match == 2 ? -170.0 : 10.0;
+        return registration::YawWindow{centre_deg * core::kRadiansPerDegree,
+                                       10.0 * core::kRadiansPerDegree};
+    };
+    check.reject = [](LoopQuery& query) {  // the first loop is one the odometry contradicts
+        registration::Verification& v = query.verifications[1];
+        if (v.accepted)
+            v.accepted = false, v.reason = registration::RejectReason::kOdometryMismatch;
+    };
+    std::vector<registration::Verification> alone;
+    for (std::size_t j = 0; j < ranked.scans.size(); ++j) {
+        const registration::YawWindow window = check.YawWindow(ranked.query.query, j);
+        const registration::CoarseQuery coarse(*ranked.query_scan.structure,
+                                               detector.verification.coarse, {window});
+        alone.push_back(registration::Verify(ranked.query_scan, coarse, ranked.scans[j],
+                                             detector.verification, {}, window));
+    }
+    ASSERT_TRUE(alone[1].accepted && alone[2].accepted);
+    for (const bool stop : {false, true}) {
+        detector.stop_at_first_loop = stop;
+        for (const int threads : {1, 2}) {
+            LoopQuery query = ranked.query;
+            tbb::task_arena(threads).execute([&] {
+                VerifyQuery(
+                    query, ranked.query_scan, [&](std::size_t j) { return ranked.scans.at(j); },
+                    detector, core::Method::kRange, nullptr, nullptr,
+                    threads > 1 ? Execution::kParallel : Execution::kSerial, check);
+            });
+            ASSERT_EQ(query.loop(), 2u) << stop << threads;
+            EXPECT_EQ(query.verifications[1].reason, registration::RejectReason::kOdometryMismatch);
+            for (const std::size_t c : {0u, 2u})
+                ExpectSameVerdict(query.verifications[c], alone[c], c);
+            if (!stop) ExpectSameVerdict(query.verifications[3], alone[3], 3);
+        }
+    }
+}
+
 // stop_at_first_loop registers in rank order up to the first accepted candidate, with the
 // verdicts of registering every one, and leaves the rest kNotNeeded.
 TEST(StopAtFirstLoop, RegistersInRankOrderUpToTheFirstAcceptedCandidate) {
