@@ -136,14 +136,17 @@ void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
             answered[c] = true;
         }
     }
+    std::vector<registration::YawWindow> yaws;  // each candidate's, where the check gives them
+    for (const Neighbor& candidate : query.candidates)
+        yaws.push_back(check.YawWindow(query.query, candidate.index));
     std::optional<registration::CoarseQuery> coarse;  // the query's images, shared by its pairs
     std::vector<double> pair_seconds(query.candidates.size(), -1.0);
     const auto register_one = [&](std::size_t c) {
         const std::size_t match = query.candidates[c].index;
         const auto pair_start = Clock::now();
-        query.verifications[c] = registration::Verify(
-            prepared, *coarse, match_of(match), detector.verification,
-            check.AllowedPoses(query.query, match), check.YawWindow(query.query, match));
+        query.verifications[c] =
+            registration::Verify(prepared, *coarse, match_of(match), detector.verification,
+                                 check.AllowedPoses(query.query, match), yaws[c]);
         pair_seconds[c] = SecondsSince(pair_start);
         if (cache) cache->Store(query.query, match, query.verifications[c]);
     };
@@ -152,8 +155,7 @@ void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
         // The images of the yaws some candidate still to be registered may take.
         std::vector<registration::YawWindow> windows;
         for (std::size_t c = 0; c < query.candidates.size(); ++c) {
-            if (!answered[c])
-                windows.push_back(check.YawWindow(query.query, query.candidates[c].index));
+            if (!answered[c]) windows.push_back(yaws[c]);
         }
         coarse.emplace(*prepared.structure, detector.verification.coarse, windows);
         if (times) times->query_seconds.push_back(SecondsSince(query_start));

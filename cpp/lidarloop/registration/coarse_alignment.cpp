@@ -148,6 +148,7 @@ std::vector<bool> YawsWithin(const std::vector<YawWindow>& windows, const Coarse
     const bool every = windows.empty() || std::any_of(windows.begin(), windows.end(),
                                                       [](const auto& w) { return w.Whole(); });
     std::vector<bool> within(static_cast<std::size_t>(yaws), every);
+    if (every) return within;
     for (const YawWindow& window : windows) {
         const YawWindow searched = SearchedYaws(window, config);
         for (int i = 0; i < yaws; ++i) {

@@ -156,8 +156,8 @@ float NeighborGrid::Nearest(std::size_t wanted, Scratch& scratch,
         for (std::size_t r = 0; r < kept; ++r) indices[r] = index[scratch.ranked[r]];
         return kept == 0 ? 0.0F : distance_m2[scratch.ranked[kept - 1]];
     }
-    // Many candidates: a squared distance's bits (>= 0, so ordered as the
-    // floats are) over the point's index, which breaks ties.
+    // Many candidates: a squared distance's bits (>= 0, so ordered as the floats are) over the
+    // point's index, which breaks ties.
     auto& keys = scratch.keys;
     keys.resize(found);
     for (std::size_t i = 0; i < found; ++i)
