@@ -107,6 +107,40 @@ void BM_NormalNeighboursTree(benchmark::State& state) {
     state.counters["centroids"] = static_cast<double>(centroids.size());
 }
 
+// ICP's partner searches on one pair: every structure point of the query, moved by the true pose
+// plus 0.3 m, looks for its nearest revisit point within 3 m without a hint (a first
+// iteration), then moved back by the offset within 0.6 m from that partner (a later one).
+// The surfaces' grid against the nanoflann k-d tree it replaced; the index is built once.
+template <class Nearest>
+void SearchPartners(benchmark::State& state, const Nearest& nearest) {
+    const PairScans& scans = Scans(SensorOf(state));
+    const Eigen::Isometry3f T = scans.T_revisit_query.cast<float>();
+    const Eigen::Vector3f offset(0.3F, 0.0F, 0.0F);
+    for (auto _ : state) {
+        for (const Eigen::Vector3f& point : scans.query.structure->points()) {
+            const Eigen::Vector3f moved = T * point;
+            const std::int64_t first = nearest(moved + offset, 3.0F, -1);
+            benchmark::DoNotOptimize(nearest(moved, 0.6F, first));
+        }
+    }
+    state.counters["searches"] = 2.0 * static_cast<double>(scans.query.structure->size());
+}
+
+void BM_IcpPartnersGrid(benchmark::State& state) {
+    const auto& grid = Scans(SensorOf(state)).revisit.structure->grid();
+    SearchPartners(state, [&](const Eigen::Vector3f& at, float bound_m, std::int64_t hint) {
+        return grid.NearestWithin(at, bound_m, hint);
+    });
+}
+
+void BM_IcpPartnersTree(benchmark::State& state) {
+    const auto& points = Scans(SensorOf(state)).revisit.structure->points();
+    const registration::PointTree tree(&points);
+    SearchPartners(state, [&](const Eigen::Vector3f& at, float bound_m, std::int64_t hint) {
+        return tree.Nearest(at, bound_m, hint);
+    });
+}
+
 // The query's side of the coarse search: its rotated images' spectra, once per query.
 void BM_CoarseQuery(benchmark::State& state) {
     const PairScans& scans = Scans(SensorOf(state));
@@ -176,6 +210,8 @@ void BM_VerifyDifferentPlaces(benchmark::State& state) {
 LIDARLOOP_SENSORS(BM_PrepareScan);
 LIDARLOOP_SENSORS(BM_NormalNeighboursGrid);
 LIDARLOOP_SENSORS(BM_NormalNeighboursTree);
+LIDARLOOP_SENSORS(BM_IcpPartnersGrid);
+LIDARLOOP_SENSORS(BM_IcpPartnersTree);
 LIDARLOOP_SENSORS(BM_CoarseQuery);
 LIDARLOOP_SENSORS(BM_CoarseAlign);
 LIDARLOOP_SENSORS(BM_IcpFromTruth);

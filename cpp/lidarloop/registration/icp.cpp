@@ -36,7 +36,7 @@ void Accumulate(const SurfacePoints& from, const SurfacePoints& onto, const Eige
         const Eigen::Vector3f& point = from.points()[i];
         ++equations.paired;
         const Eigen::Vector3f moved = T * point;
-        const auto index = onto.tree().Nearest(moved, max_distance_m, partners[k]);
+        const auto index = onto.grid().NearestWithin(moved, max_distance_m, partners[k]);
         partners[k] = index;
         if (index < 0) continue;
         const Eigen::Vector3d normal =

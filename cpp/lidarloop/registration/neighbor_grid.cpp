@@ -66,6 +66,7 @@ NeighborGrid::NeighborGrid(const std::vector<Eigen::Vector3f>& cloud, float cell
         column_of[i] = static_cast<std::uint32_t>(y * columns_x_ + x);
         ++column_start_[column_of[i] + 1];
     }
+    inverse_cell_ = 1.0 / static_cast<double>(cell_m_);
     for (std::size_t c = 0; c < columns; ++c) column_start_[c + 1] += column_start_[c];
     points_.resize(cloud.size());
     original_.resize(cloud.size());
@@ -75,13 +76,23 @@ NeighborGrid::NeighborGrid(const std::vector<Eigen::Vector3f>& cloud, float cell
         points_[slot] = cloud[i];
         original_[slot] = static_cast<std::uint32_t>(i);
     }
+    slot_of_.resize(cloud.size());
+    for (std::size_t slot = 0; slot < original_.size(); ++slot)
+        slot_of_[original_[slot]] = static_cast<std::uint32_t>(slot);
 }
 
-NeighborGrid::Span NeighborGrid::ColumnsWithin(float low, float high, float origin,
+NeighborGrid::Span NeighborGrid::ColumnsWithin(float centre, float radius_m, float origin,
                                                std::int64_t count) const {
-    const double reach = static_cast<double>(high - low) * kReachMargin + kReachMargin;
-    return {std::max<std::int64_t>(0, ColumnOf(low - reach, origin, cell_m_, count)),
-            std::min<std::int64_t>(count - 1, ColumnOf(high + reach, origin, cell_m_, count))};
+    // Without floor (a library call on baseline x86-64) and division: the columns where the
+    // constructor's ColumnOf puts points within the radius, perhaps one more at either end.
+    const auto column = [&](double at) -> std::int64_t {
+        const double t = (at - static_cast<double>(origin)) * inverse_cell_;
+        if (!(t >= 0.0)) return -1;
+        return t >= static_cast<double>(count) ? count : static_cast<std::int64_t>(t);
+    };
+    const double reach = static_cast<double>(radius_m) * (1.0 + kReachMargin) + kReachMargin;
+    return {std::max<std::int64_t>(0, column(static_cast<double>(centre) - reach)),
+            std::min<std::int64_t>(count - 1, column(static_cast<double>(centre) + reach))};
 }
 
 bool NeighborGrid::Collect(const Eigen::Vector3f& query, float radius_m, Scratch& scratch) const {
@@ -89,8 +100,8 @@ bool NeighborGrid::Collect(const Eigen::Vector3f& query, float radius_m, Scratch
     auto& index = scratch.index;
     distance_m2.clear();
     index.clear();
-    const Span x = ColumnsWithin(query.x() - radius_m, query.x() + radius_m, min_x_, columns_x_);
-    const Span y = ColumnsWithin(query.y() - radius_m, query.y() + radius_m, min_y_, columns_y_);
+    const Span x = ColumnsWithin(query.x(), radius_m, min_x_, columns_x_);
+    const Span y = ColumnsWithin(query.y(), radius_m, min_y_, columns_y_);
     const bool whole_grid =
         x.first == 0 && x.last == columns_x_ - 1 && y.first == 0 && y.last == columns_y_ - 1;
     if (x.first > x.last) return whole_grid;
@@ -167,6 +178,66 @@ float NeighborGrid::Nearest(std::size_t wanted, Scratch& scratch,
     std::sort(keys.begin(), last);
     for (std::size_t r = 0; r < kept; ++r) indices[r] = static_cast<std::uint32_t>(keys[r]);
     return std::bit_cast<float>(static_cast<std::uint32_t>(keys[kept - 1] >> 32));
+}
+
+std::int64_t NeighborGrid::NearestWithin(const Eigen::Vector3f& query, float max_distance_m,
+                                         std::int64_t hint) const {
+    if (points_.empty() || !query.allFinite() || !(max_distance_m > 0.0F)) return -1;
+    const auto squared = [&](std::uint32_t slot) {
+        // Summed as nanoflann sums (x, y, z in turn), so distances agree with PointTree's.
+        const float dx = points_[slot].x() - query.x();
+        const float dy = points_[slot].y() - query.y();
+        const float dz = points_[slot].z() - query.z();
+        return dx * dx + dy * dy + dz * dz;
+    };
+    float bound_m2 = max_distance_m * max_distance_m;
+    std::int64_t best_slot = -1;
+    if (hint >= 0 && static_cast<std::uint64_t>(hint) < slot_of_.size()) {
+        const std::uint32_t slot = slot_of_[static_cast<std::size_t>(hint)];
+        const float hint_m2 = squared(slot);
+        if (hint_m2 < bound_m2) bound_m2 = hint_m2, best_slot = slot;
+    }
+    // Rows outward from the query's while a row's edge is nearer than the bound found so far,
+    // the columns narrowed to that bound: the nearer the first points found, the less is read.
+    float spans_bound_m2 = bound_m2;
+    Span x = ColumnsWithin(query.x(), std::sqrt(bound_m2), min_x_, columns_x_);
+    const Span y = ColumnsWithin(query.y(), std::sqrt(bound_m2), min_y_, columns_y_);
+    if (x.first <= x.last && y.first <= y.last) {
+        // The query in row units; a row's edge `gap` rows away is gap * cell_m_ from it, less a
+        // margin for rounding (reading a row too many costs time, never a point).
+        const double row_at = (static_cast<double>(query.y()) - min_y_) * inverse_cell_;
+        const std::int64_t centre =
+            std::clamp(static_cast<std::int64_t>(std::max(row_at, 0.0)), y.first, y.last);
+        const auto reachable = [&](double gap_rows) {
+            const double gap_m = std::max(0.0, gap_rows * cell_m_ - kReachMargin);
+            return gap_m * gap_m <= static_cast<double>(bound_m2);
+        };
+        for (std::int64_t step = 0;; ++step) {
+            if (bound_m2 < spans_bound_m2) {
+                spans_bound_m2 = bound_m2;
+                x = ColumnsWithin(query.x(), std::sqrt(bound_m2), min_x_, columns_x_);
+            }
+            const std::int64_t low = centre - step, high = centre + step;
+            const bool below = low >= y.first && reachable(row_at - static_cast<double>(low + 1));
+            const bool above =
+                step > 0 && high <= y.last && reachable(static_cast<double>(high) - row_at);
+            if (!below && !above) break;
+            for (const std::int64_t row : {below ? low : -1, above ? high : -1}) {
+                if (row < 0) continue;
+                for (std::uint32_t i = RowBegin(row, x), end = RowEnd(row, x); i < end; ++i) {
+                    const float squared_m2 = squared(i);
+                    if (squared_m2 < bound_m2) bound_m2 = squared_m2, best_slot = i;
+                }
+            }
+        }
+    }
+    return best_slot < 0 ? -1 : std::int64_t{original_[static_cast<std::size_t>(best_slot)]};
+}
+
+std::size_t NeighborGrid::MemoryBytes() const {
+    return points_.capacity() * sizeof(Eigen::Vector3f) +
+           (original_.capacity() + slot_of_.capacity() + column_start_.capacity()) *
+               sizeof(std::uint32_t);
 }
 
 void NeighborGrid::Knn(const Eigen::Vector3f& query, int k, Scratch& scratch,

@@ -8,12 +8,13 @@
 
 namespace lidarloop::registration {
 
-/// An exact k-nearest-neighbour search for points of bounded density, such as one scan's voxel
-/// centroids: a 2-D grid of x-y columns in which the points of each grid row lie contiguously,
-/// so a query reads a few short ranges instead of walking a tree, and nothing is built but one
-/// counting sort. It finds what PointTree::Knn finds (the k nearest, nearest first; equal
-/// distances by index). Holds a copy of the points, which must be finite. Queries are const and
-/// thread-safe, each thread with its own Scratch.
+/// Exact neighbour searches for points of bounded density, such as one scan's voxel centroids or
+/// its prepared surfaces: a 2-D grid of x-y columns in which the points of each grid row lie
+/// contiguously, so a query reads a few short ranges instead of walking a tree, and nothing is
+/// built but one counting sort. It finds what PointTree finds (Knn: the k nearest, nearest first,
+/// equal distances by index; NearestWithin: the nearest within a bound). Holds a copy of the
+/// points, which must be finite. Queries are const and thread-safe, each thread with its own
+/// Scratch.
 class NeighborGrid {
 public:
     /// A query's working memory, and the radius that served the last query: queries near each
@@ -37,6 +38,16 @@ public:
     void Knn(const Eigen::Vector3f& query, int k, Scratch& scratch,
              std::vector<std::uint32_t>& indices) const;
 
+    /// The index of the point nearest to `query` when it is closer than `max_distance_m`, else
+    /// -1: what PointTree::Nearest finds. `hint` (an index, or -1) is a point likely to be near,
+    /// such as ICP's partner of the previous iteration: only points closer than it are looked
+    /// for, so a good hint leaves a column or two to read; it is returned when nothing is closer.
+    std::int64_t NearestWithin(const Eigen::Vector3f& query, float max_distance_m,
+                               std::int64_t hint = -1) const;
+
+    /// Heap bytes held: the points' copy, their order and the column offsets.
+    std::size_t MemoryBytes() const;
+
     /// The points' indices column by column: asked in this order, each query starts from about
     /// the radius it needs (the last one's), where a scan's own order jumps between near and far.
     const std::vector<std::uint32_t>& SpatialOrder() const { return original_; }
@@ -52,7 +63,9 @@ private:
     std::uint32_t RowEnd(std::int64_t row, const Span& x) const {
         return column_start_[static_cast<std::size_t>(row * columns_x_ + x.last + 1)];
     }
-    Span ColumnsWithin(float low, float high, float origin, std::int64_t count) const;
+    // The columns within `radius_m` of `centre` (an x or y coordinate), perhaps one more at
+    // either end: reading a column too many costs time, never a neighbour.
+    Span ColumnsWithin(float centre, float radius_m, float origin, std::int64_t count) const;
     // The points within `radius_m` of `query` (all points, when the columns within it are the
     // whole grid) into scratch.distance_m2 and scratch.index, in column order; returns whether
     // the whole grid was read.
@@ -62,10 +75,12 @@ private:
     static float Nearest(std::size_t wanted, Scratch& scratch, std::vector<std::uint32_t>& indices);
 
     float cell_m_ = 1.0F;
+    double inverse_cell_ = 1.0;
     float min_x_ = 0.0F, min_y_ = 0.0F;
     std::int64_t columns_x_ = 0, columns_y_ = 0;
     std::vector<Eigen::Vector3f> points_;  // in column order (row by row)
     std::vector<std::uint32_t> original_;  // points_[i] is the constructor's points[original_[i]]
+    std::vector<std::uint32_t> slot_of_;   // the inverse: points[i] is points_[slot_of_[i]]
     std::vector<std::uint32_t> column_start_;  // columns_x_ * columns_y_ + 1 offsets into points_
 };
 

@@ -8,10 +8,10 @@
 
 namespace lidarloop::registration {
 
-/// A static k-d tree over float points (metres) for the many approximate-free but
-/// single-precision nearest-neighbour queries of registration. core::KdTree3 is the exact,
-/// double-precision tree for evaluation; this one trades that for speed (float, no callbacks).
-/// nanoflann does the work behind a pimpl. Queries are const and thread-safe.
+/// A static k-d tree over float points (metres): nanoflann's, behind a pimpl. Registration
+/// searches with NeighborGrid, which finds the same neighbours faster on a scan's points; this
+/// tree is the library reference it is tested and benchmarked against. core::KdTree3 is the
+/// double-precision tree for evaluation. Queries are const and thread-safe.
 class PointTree {
 public:
     /// Refers to `points`, which must outlive the tree and stay unchanged. Points must be finite.

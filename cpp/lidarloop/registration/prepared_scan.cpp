@@ -117,12 +117,13 @@ double SelfResidual(const SurfacePoints& structure) {
     const SelfMatchGates gates;
     const std::size_t stride = std::max<std::size_t>(1, structure.size() / kSelfProbes);
     std::vector<std::uint32_t> nearest;
+    NeighborGrid::Scratch scratch;
     double squared_sum_m2 = 0.0;
     std::size_t pairs = 0;
     for (std::size_t i = 0; i < structure.size(); i += stride) {
         const Eigen::Vector3f& point = structure.points()[i];
         if (point.norm() > gates.range_m) continue;
-        structure.tree().Knn(point, kSelfPartners + 1, nearest);
+        structure.grid().Knn(point, kSelfPartners + 1, scratch, nearest);
         for (const std::uint32_t partner : nearest) {
             if (partner == i) continue;
             const Eigen::Vector3f& partner_normal = structure.normals()[partner];
@@ -138,6 +139,10 @@ double SelfResidual(const SurfacePoints& structure) {
     }
     return pairs == 0 ? 0.0 : std::sqrt(squared_sum_m2 / static_cast<double>(pairs));
 }
+
+// Columns of a surface's search grid, metres: ICP's partners and the overlap test's lie within
+// 0.6-3 m, and a registered partner's hint within centimetres, so a query reads a few columns.
+constexpr float kSearchColumnM = 1.0F;
 
 // Keeps at most `cap` of the points at an even stride.
 void Subsample(std::vector<Eigen::Vector3f>& points, std::vector<Eigen::Vector3f>& normals,
@@ -158,7 +163,9 @@ void Subsample(std::vector<Eigen::Vector3f>& points, std::vector<Eigen::Vector3f
 
 SurfacePoints::SurfacePoints(std::vector<Eigen::Vector3f> points,
                              std::vector<Eigen::Vector3f> normals)
-    : points_(std::move(points)), normals_(std::move(normals)), tree_((shrink(), &points_)) {}
+    : points_(std::move(points)),
+      normals_(std::move(normals)),
+      grid_((shrink(), points_), kSearchColumnM) {}
 
 void SurfacePoints::shrink() {
     points_.shrink_to_fit();
@@ -166,9 +173,8 @@ void SurfacePoints::shrink() {
 }
 
 std::size_t SurfacePoints::MemoryBytes() const {
-    // The tree: an index per point plus about one 64-byte node per 6 points (leaves of <= 12).
-    const std::size_t tree_bytes = points_.size() * (sizeof(std::uint32_t) + 64 / 6);
-    return (points_.capacity() + normals_.capacity()) * sizeof(Eigen::Vector3f) + tree_bytes;
+    return (points_.capacity() + normals_.capacity()) * sizeof(Eigen::Vector3f) +
+           grid_.MemoryBytes();
 }
 
 std::size_t PreparedScan::MemoryBytes() const {

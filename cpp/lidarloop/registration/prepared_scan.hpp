@@ -9,13 +9,13 @@
 #include <Eigen/Core>
 
 #include "lidarloop/core/point_cloud.hpp"
-#include "lidarloop/registration/point_tree.hpp"
+#include "lidarloop/registration/neighbor_grid.hpp"
 #include "lidarloop/registration/verification_config.hpp"
 
 namespace lidarloop::registration {
 
-/// Points of one surface class of a reduced scan, with unit normals and a search tree.
-/// Immutable; neither copyable nor movable (the tree refers to the points), so held by pointer.
+/// Points of one surface class of a reduced scan, with unit normals and a neighbour search.
+/// Immutable; neither copyable nor movable, so held by pointer.
 class SurfacePoints {
 public:
     /// `normals[i]` belongs to `points[i]`; both in the sensor frame, metres.
@@ -25,17 +25,18 @@ public:
 
     const std::vector<Eigen::Vector3f>& points() const { return points_; }
     const std::vector<Eigen::Vector3f>& normals() const { return normals_; }
-    const PointTree& tree() const { return tree_; }
+    /// The exact nearest-neighbour search over points(), by their indices.
+    const NeighborGrid& grid() const { return grid_; }
     std::size_t size() const { return points_.size(); }
-    /// Heap bytes held: points, normals and an estimate of the tree.
+    /// Heap bytes held: points, normals and the search grid.
     std::size_t MemoryBytes() const;
 
 private:
-    void shrink();  // before the tree is built: MemoryBytes counts capacity
+    void shrink();  // before the grid is built: MemoryBytes counts capacity
 
     std::vector<Eigen::Vector3f> points_;
     std::vector<Eigen::Vector3f> normals_;
-    PointTree tree_;
+    NeighborGrid grid_;
 };
 
 /// What registration keeps of a scan: voxel centroids with normals, split into structure

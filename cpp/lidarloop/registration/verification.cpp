@@ -28,7 +28,8 @@ struct SurfaceHit {
 SurfaceHit HitOnSurface(const Eigen::Vector3f& moved, const Eigen::Vector3f& moved_normal,
                         const SurfacePoints& onto, const AcceptanceConfig& config) {
     SurfaceHit hit;
-    const auto index = onto.tree().Nearest(moved, static_cast<float>(config.overlap_radius_m));
+    const auto index =
+        onto.grid().NearestWithin(moved, static_cast<float>(config.overlap_radius_m));
     if (index < 0) return hit;
     const auto partner = static_cast<std::size_t>(index);
     hit.partner_normal = onto.normals()[partner];

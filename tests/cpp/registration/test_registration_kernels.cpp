@@ -197,6 +197,93 @@ TEST(NeighborGrid, NothingToFindGivesNothing) {
     ExpectGridKnnIsExact(points, 1e-30F, RandomPoints(20, 15, 5.0F), 4);
 }
 
+// The brute-force nearest of `points` to `query` closer than `bound_m`: its squared distance,
+// or -1 when there is none.
+float BruteNearestWithin(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3f& query,
+                         float bound_m) {
+    float best_m2 = -1.0F;
+    for (const auto& p : points) {
+        const float d2 = (p - query).squaredNorm();
+        if (d2 < bound_m * bound_m && (best_m2 < 0.0F || d2 < best_m2)) best_m2 = d2;
+    }
+    return best_m2;
+}
+
+void ExpectGridNearestIsExact(const std::vector<Eigen::Vector3f>& points, float cell_m,
+                              const std::vector<Eigen::Vector3f>& queries, float bound_m) {
+    const NeighborGrid grid(points, cell_m);
+    const PointTree tree(&points);
+    std::mt19937_64 rng(21);
+    std::uniform_int_distribution<std::int64_t> any(0, static_cast<std::int64_t>(points.size()));
+    for (const auto& query : queries) {
+        const float expected_m2 = BruteNearestWithin(points, query, bound_m);
+        const auto tree_nearest = tree.Nearest(query, bound_m);
+        // Hints as ICP gives them: none, the answer, any point, out of range.
+        for (const std::int64_t hint :
+             {std::int64_t{-1}, tree_nearest, any(rng), static_cast<std::int64_t>(points.size()),
+              std::int64_t{1} << 40}) {
+            const auto found = grid.NearestWithin(query, bound_m, hint);
+            if (expected_m2 < 0.0F) {
+                ASSERT_EQ(found, -1) << hint;
+                continue;
+            }
+            ASSERT_GE(found, 0) << hint;
+            ASSERT_LT(found, static_cast<std::int64_t>(points.size()));
+            ASSERT_FLOAT_EQ((points[static_cast<std::size_t>(found)] - query).squaredNorm(),
+                            expected_m2)
+                << hint << " cell " << cell_m << " bound " << bound_m;
+        }
+    }
+}
+
+// What ICP and the overlap test ask: the nearest point within a bound, with or without the last
+// partner as a hint, queries inside and far outside the cloud, columns of any width.
+TEST(NeighborGrid, NearestWithinMatchesBruteForceWithAnyHint) {
+    const auto points = RandomPoints(1500, 16, 10.0F);
+    const auto queries = RandomPoints(150, 17, 14.0F);
+    for (const float bound_m : {0.3F, 1.5F, 3.0F, 100.0F})
+        for (const float cell_m : {0.05F, 0.5F, 1.0F, 3.0F, 100.0F})
+            ExpectGridNearestIsExact(points, cell_m, queries, bound_m);
+}
+
+// A scan's kind of cloud, with far outliers that widen the columns, queried near its own points
+// (a registered pair's partners are centimetres away) and between them.
+TEST(NeighborGrid, NearestWithinIsExactOnAScan) {
+    std::vector<Eigen::Vector3f> points;
+    for (const auto& p : test::SyntheticPlace(4)) points.push_back(p);
+    std::vector<Eigen::Vector3f> queries;
+    std::mt19937_64 rng(18);
+    std::normal_distribution<float> jitter(0.0F, 0.2F);
+    for (std::size_t i = 0; i < points.size(); i += 37)
+        queries.push_back(points[i] + Eigen::Vector3f(jitter(rng), jitter(rng), jitter(rng)));
+    for (const float bound_m : {0.6F, 1.5F, 3.0F}) {
+        ExpectGridNearestIsExact(points, 1.0F, queries, bound_m);
+        ExpectGridNearestIsExact(points, 0.3F, queries, bound_m);
+    }
+    points.emplace_back(1e6F, -1e6F, 5.0F);
+    queries.push_back(points.back() + Eigen::Vector3f(0.5F, 0.0F, 0.0F));
+    ExpectGridNearestIsExact(points, 1.0F, queries, 3.0F);
+}
+
+TEST(NeighborGrid, NearestWithinKeepsAnEquallyNearHintAndRejectsBadInput) {
+    const std::vector<Eigen::Vector3f> same(50, Eigen::Vector3f(1.0F, 2.0F, 3.0F));
+    const NeighborGrid grid(same, 0.5F);
+    const Eigen::Vector3f near(1.1F, 2.0F, 3.0F);
+    EXPECT_EQ(grid.NearestWithin(near, 1.0F, 37), 37);  // as PointTree::Nearest keeps it
+    EXPECT_GE(grid.NearestWithin(near, 1.0F), 0);
+    EXPECT_EQ(grid.NearestWithin(near, 0.05F, 37), -1);  // the hint is beyond the bound
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const float inf = std::numeric_limits<float>::infinity();
+    EXPECT_EQ(grid.NearestWithin(Eigen::Vector3f(nan, 2.0F, 3.0F), 1.0F), -1);
+    EXPECT_EQ(grid.NearestWithin(Eigen::Vector3f(inf, 2.0F, 3.0F), 1.0F), -1);
+    EXPECT_EQ(grid.NearestWithin(near, 0.0F), -1);
+    EXPECT_EQ(grid.NearestWithin(near, -1.0F), -1);
+    EXPECT_EQ(grid.NearestWithin(near, nan), -1);
+    EXPECT_EQ(grid.NearestWithin(near, inf), std::int64_t{0});
+    const std::vector<Eigen::Vector3f> none;
+    EXPECT_EQ(NeighborGrid(none, 0.5F).NearestWithin(near, 10.0F, 0), -1);
+}
+
 TEST(Fft2d, MatchesTheDefinitionAndInverts) {
     const int n = 8;
     std::mt19937_64 rng(5);
