@@ -123,8 +123,10 @@ double YawDistance(double a_rad, double b_rad) {
 // Greedily keeps the best peaks that differ from every kept one in yaw or translation.
 std::vector<PlanarHypothesis> Distinct(std::vector<PlanarHypothesis> peaks,
                                        const CoarseConfig& config) {
-    std::sort(peaks.begin(), peaks.end(),
-              [](const auto& a, const auto& b) { return a.score > b.score; });
+    // Stable: scores are multiples of 0.5 and tie often; tied peaks stay in yaw order, so the
+    // hypotheses do not depend on the standard library's sort, nor on a yaw window's cut.
+    std::stable_sort(peaks.begin(), peaks.end(),
+                     [](const auto& a, const auto& b) { return a.score > b.score; });
     std::vector<PlanarHypothesis> kept;
     for (const auto& peak : peaks) {
         if (peak.score <= 0.0) break;

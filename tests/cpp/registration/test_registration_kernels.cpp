@@ -494,6 +494,23 @@ TEST(CoarseAlign, AWindowWrapsAroundAnOddYawCount) {
     }
 }
 
+// A pole at the sensor looks the same at every yaw: 72 peaks of equal score. The hypotheses are
+// the first distinct ones in yaw order (0, 15 and 30 degrees: 5-degree steps, distinct beyond
+// 2.5 steps), whatever the sort would do with ties.
+TEST(CoarseAlign, TiedPeaksComeInYawOrder) {
+    const std::vector<Eigen::Vector3f> pole(5, Eigen::Vector3f(0.0F, 0.0F, 1.0F));
+    const SurfacePoints structure(pole, std::vector<Eigen::Vector3f>(5, Eigen::Vector3f::UnitX()));
+    const CoarseConfig config;
+    const auto found = CoarseAlign(CoarseQuery(structure, config), structure, YawWindow{});
+    ASSERT_EQ(found.size(), static_cast<std::size_t>(config.TotalHypotheses()));
+    const double step_rad = config.yaw_step_deg * std::numbers::pi / 180.0;
+    for (std::size_t i = 0; i < found.size(); ++i) {
+        EXPECT_EQ(found[i].score, found[0].score);
+        EXPECT_NEAR(found[i].yaw_rad, 3.0 * step_rad * static_cast<double>(i), 1e-9) << i;
+        EXPECT_LT(found[i].translation_m.norm(), 1e-9);
+    }
+}
+
 TEST(PrepareScan, SplitsWallsFromGroundWithUnitNormalsFacingTheSensor) {
     ScanReductionConfig config;
     const PreparedScan scan = PrepareScan(test::SyntheticPlace(), config);
