@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <limits>
-#include <optional>
 #include <random>
 
 #include "lidarloop/app/describe_run.hpp"
@@ -89,25 +88,6 @@ pipeline::DescriptorDatabase Scaled(const pipeline::DescriptorDatabase& source, 
     return scaled;
 }
 
-// Wall and thread CPU time of one step, milliseconds.
-struct StepTimes {
-    std::vector<double> wall_ms;
-    std::vector<double> cpu_ms;
-
-    template <typename F>
-    auto Time(F&& step) {
-        const Stopwatch wall;
-        const ThreadCpuStopwatch cpu;
-        auto result = step();
-        cpu_ms.push_back(1e3 * cpu.Seconds());
-        wall_ms.push_back(1e3 * wall.Seconds());
-        return result;
-    }
-    nlohmann::json Json() const {
-        return {{"wall", SummaryJson(wall_ms)}, {"thread_cpu", SummaryJson(cpu_ms)}};
-    }
-};
-
 // The online step of one scan on one core, milliseconds: what a loop closer beside a SLAM front
 // end spends on it (the file read excluded: a live system gets the cloud in memory).
 double OnlineStepMs(const pipeline::SequenceDescriptors& described, const PreparedScans& prepared,
@@ -130,46 +110,43 @@ nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
         pipeline::DetectFromMatrix(matrix, described.database.times_s(), config.detection,
                                    config.descriptor.method, path_m, check);
     std::erase_if(all, [](const pipeline::LoopQuery& q) { return !q.has_match(); });
-    const registration::VerificationConfig& verification = config.detection.verification;
-    StepTimes coarse_times;
-    StepTimes pair_times;
+    // Each timed query verified as detect verifies it (VerifyQuery: one candidate after another,
+    // those the odometry rules out answered without registering, the images of the yaws the
+    // rest may take), on this thread.
+    pipeline::VerificationTimes times;
     std::vector<double> online_ms;
     std::size_t accepted = 0;
     const std::size_t step =
         std::max<std::size_t>(1, all.size() / std::max<std::size_t>(1, queries));
     pipeline::ExpandedScans expanded;  // as the online detector keeps its candidates
-    for (std::size_t q = 0; q < all.size() && coarse_times.wall_ms.size() < queries; q += step) {
+    const auto match_of = [&](std::size_t index) { return expanded.Get(prepared.scans, index); };
+    std::size_t timed = 0;
+    for (std::size_t q = 0; q < all.size() && timed < queries; q += step) {
         const registration::PreparedScan query = prepared.scans[all[q].query].Expand();
         if (!query.structure) continue;
-        // Every candidate's yaws (VerifyQuery leaves out those it answers without registering).
-        std::vector<registration::YawWindow> windows;
-        for (const pipeline::Neighbor& candidate : all[q].candidates)
-            windows.push_back(check.YawWindow(all[q].query, candidate.index));
-        const auto coarse = coarse_times.Time([&] {
-            return std::make_optional<registration::CoarseQuery>(*query.structure,
-                                                                 verification.coarse, windows);
-        });
-        double verification_cpu_ms = coarse_times.cpu_ms.back();
-        for (const pipeline::Neighbor& candidate : all[q].candidates) {
-            // The poses the odometry's gate keeps (empty: it does not judge the pair).
-            const registration::PoseAllowed allowed =
-                check.AllowedPoses(all[q].query, candidate.index);
-            const registration::Verification verdict = pair_times.Time([&] {
-                return registration::Verify(
-                    query, *coarse, expanded.Get(prepared.scans, candidate.index), verification,
-                    allowed, check.YawWindow(all[q].query, candidate.index));
-            });
-            verification_cpu_ms += pair_times.cpu_ms.back();
-            const bool kept = verdict.accepted && (!allowed || allowed(verdict.T_match_query));
-            accepted += kept ? 1 : 0;
-            if (kept && config.detection.stop_at_first_loop) break;
-        }
+        pipeline::VerificationTimes query_times;
+        pipeline::VerifyQuery(all[q], query, match_of, config.detection, config.descriptor.method,
+                              &query_times, nullptr, pipeline::Execution::kSerial, check);
+        ++timed;
+        accepted += static_cast<std::size_t>(
+            std::count_if(all[q].verifications.begin(), all[q].verifications.end(),
+                          [](const registration::Verification& v) { return v.accepted; }));
+        double verification_cpu_ms = 0.0;
+        for (const double seconds : query_times.query_cpu_seconds)
+            verification_cpu_ms += 1e3 * seconds;
+        for (const double seconds : query_times.pair_cpu_seconds)
+            verification_cpu_ms += 1e3 * seconds;
         online_ms.push_back(
             OnlineStepMs(described, prepared, all[q].query, retrieval_ms, verification_cpu_ms));
+        times.Append(query_times);
     }
+    const auto ms = [](const std::vector<double>& wall_s, const std::vector<double>& cpu_s) {
+        return nlohmann::json{{"wall", SummaryJson(wall_s, 1e3)},
+                              {"thread_cpu", SummaryJson(cpu_s, 1e3)}};
+    };
     nlohmann::json json;
-    json["queries"] = coarse_times.wall_ms.size();
-    json["pairs"] = pair_times.wall_ms.size();
+    json["queries"] = timed;
+    json["pairs"] = times.pair_seconds.size();
     json["pairs_accepted"] = accepted;
     json["top_k"] = config.detection.top_k;
     json["stop_at_first_loop"] = config.detection.stop_at_first_loop;
@@ -177,8 +154,8 @@ nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
     json["prepare_ms_per_scan"] = SummaryJson(prepared.prepare_seconds, 1e3);
     json["prepare_cpu_ms_per_scan"] = SummaryJson(prepared.prepare_cpu_seconds, 1e3);
     json["bytes_per_prepared_scan"] = SummaryJson(prepared.BytesPerScan());
-    json["coarse_images_ms_per_query"] = coarse_times.Json();
-    json["verify_ms_per_pair"] = pair_times.Json();
+    json["coarse_images_ms_per_query"] = ms(times.query_seconds, times.query_cpu_seconds);
+    json["verify_ms_per_pair"] = ms(times.pair_seconds, times.pair_cpu_seconds);
     json["online_step_ms_per_scan"] = SummaryJson(online_ms);
     const double median_ms = Quantile(online_ms, 0.5);
     json["online_rate_hz"] = median_ms > 0.0 ? 1e3 / median_ms : 0.0;

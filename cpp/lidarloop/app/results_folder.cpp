@@ -1,7 +1,5 @@
 #include "lidarloop/app/results_folder.hpp"
 
-#include <time.h>
-
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -19,12 +17,6 @@ std::filesystem::path PrepareOutputFolder(const std::filesystem::path& folder) {
                                          (ec ? " (" + ec.message() + ")" : std::string()));
     }
     return folder;
-}
-
-double ThreadCpuStopwatch::Now() {
-    timespec now{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-    return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
 }
 
 double Quantile(std::vector<double> values, double q) {

@@ -1,12 +1,12 @@
 #pragma once
 
-#include <chrono>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "lidarloop/core/stopwatch.hpp"
 #include "lidarloop/pipeline/loop_detector.hpp"
 
 namespace lidarloop::app {
@@ -14,28 +14,9 @@ namespace lidarloop::app {
 /// Creates `folder` (and parents); io::WriteError when that is impossible.
 std::filesystem::path PrepareOutputFolder(const std::filesystem::path& folder);
 
-/// Wall-clock seconds since construction.
-class Stopwatch {
-public:
-    double Seconds() const {
-        return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-    }
-
-private:
-    std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
-};
-
-/// CPU seconds of the calling thread since construction: what a step costs on one core, whatever
-/// else the machine does (wall time is inflated by other processes).
-class ThreadCpuStopwatch {
-public:
-    ThreadCpuStopwatch() : start_(Now()) {}
-    double Seconds() const { return Now() - start_; }
-
-private:
-    static double Now();
-    double start_;
-};
+// The clocks of the run's timings (core/stopwatch.hpp).
+using core::Stopwatch;
+using core::ThreadCpuStopwatch;
 
 /// The q-quantile (0..1) of `values` (eval::Quantile after sorting); 0 for an empty list.
 double Quantile(std::vector<double> values, double q);

@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "lidarloop/core/stopwatch.hpp"
 #include "lidarloop/pipeline/descriptor_method.hpp"
 #include "lidarloop/pipeline/expanded_scans.hpp"
 
@@ -17,6 +18,10 @@ using Clock = std::chrono::steady_clock;
 
 double SecondsSince(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+void AppendTo(std::vector<double>& to, const std::vector<double>& from) {
+    to.insert(to.end(), from.begin(), from.end());
 }
 
 registration::Verification Rejected(registration::RejectReason reason) {
@@ -102,6 +107,13 @@ std::size_t VerificationCache::size() const {
     return verdicts_.size();
 }
 
+void VerificationTimes::Append(const VerificationTimes& other) {
+    AppendTo(pair_seconds, other.pair_seconds);
+    AppendTo(query_seconds, other.query_seconds);
+    AppendTo(pair_cpu_seconds, other.pair_cpu_seconds);
+    AppendTo(query_cpu_seconds, other.query_cpu_seconds);
+}
+
 void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
                  const std::function<registration::PreparedScan(std::size_t)>& match_of,
                  const DetectorConfig& detector, const core::Method& method,
@@ -141,24 +153,31 @@ void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
         yaws.push_back(check.YawWindow(query.query, candidate.index));
     std::optional<registration::CoarseQuery> coarse;  // the query's images, shared by its pairs
     std::vector<double> pair_seconds(query.candidates.size(), -1.0);
+    std::vector<double> pair_cpu_seconds(query.candidates.size(), -1.0);
     const auto register_one = [&](std::size_t c) {
         const std::size_t match = query.candidates[c].index;
         const auto pair_start = Clock::now();
+        const core::ThreadCpuStopwatch pair_cpu;
         query.verifications[c] =
             registration::Verify(prepared, *coarse, match_of(match), detector.verification,
                                  check.AllowedPoses(query.query, match), yaws[c]);
+        pair_cpu_seconds[c] = pair_cpu.Seconds();
         pair_seconds[c] = SecondsSince(pair_start);
         if (cache) cache->Store(query.query, match, query.verifications[c]);
     };
     const auto make_coarse = [&] {
         const auto query_start = Clock::now();
+        const core::ThreadCpuStopwatch query_cpu;
         // The images of the yaws some candidate still to be registered may take.
         std::vector<registration::YawWindow> windows;
         for (std::size_t c = 0; c < query.candidates.size(); ++c) {
             if (!answered[c]) windows.push_back(yaws[c]);
         }
         coarse.emplace(*prepared.structure, detector.verification.coarse, windows);
-        if (times) times->query_seconds.push_back(SecondsSince(query_start));
+        if (times) {
+            times->query_cpu_seconds.push_back(query_cpu.Seconds());
+            times->query_seconds.push_back(SecondsSince(query_start));
+        }
     };
     if (detector.stop_at_first_loop) {
         // In rank order: the first accepted candidate that the check keeps is the loop; after
@@ -190,8 +209,10 @@ void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
         if (check) check(query);
     }
     if (times) {
-        for (const double seconds : pair_seconds) {
-            if (seconds >= 0.0) times->pair_seconds.push_back(seconds);
+        for (std::size_t c = 0; c < pair_seconds.size(); ++c) {
+            if (pair_seconds[c] < 0.0) continue;  // not registered
+            times->pair_seconds.push_back(pair_seconds[c]);
+            times->pair_cpu_seconds.push_back(pair_cpu_seconds[c]);
         }
     }
     query.accepted = query.loop().has_value();
@@ -222,12 +243,7 @@ VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
         for (std::size_t i = 0; i < queries.size(); ++i) run(i);
     }
     VerificationTimes times;
-    for (const auto& t : per_query) {
-        times.pair_seconds.insert(times.pair_seconds.end(), t.pair_seconds.begin(),
-                                  t.pair_seconds.end());
-        times.query_seconds.insert(times.query_seconds.end(), t.query_seconds.begin(),
-                                   t.query_seconds.end());
-    }
+    for (const auto& t : per_query) times.Append(t);
     return times;
 }
 

@@ -19,6 +19,12 @@ namespace lidarloop::pipeline {
 struct VerificationTimes {
     std::vector<double> pair_seconds;   ///< per registered candidate pair (coarse search + ICP)
     std::vector<double> query_seconds;  ///< per query: its coarse search images (shared by pairs)
+    /// The same steps in CPU seconds of the thread that ran them (what they cost on one core).
+    std::vector<double> pair_cpu_seconds;
+    std::vector<double> query_cpu_seconds;
+
+    /// Adds `other`'s times after these.
+    void Append(const VerificationTimes& other);
 };
 
 /// Verifications already computed, by (query, match) scan pair: runs over the same prepared scans

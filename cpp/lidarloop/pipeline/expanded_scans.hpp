@@ -11,13 +11,13 @@
 namespace lidarloop::pipeline {
 
 /// The most recently used scans of a sequence, expanded from their compact form. Expanding
-/// decodes the points and builds two k-d trees, about 0.5 ms for an HDL-64E scan, and a query's
+/// decodes the points and builds two search grids, about 0.13 ms for an HDL-64E scan, and a query's
 /// candidates are mostly the previous query's: with this cache a detector expands a scan a few
 /// times in a run instead of once for every pair it is in. Thread-safe. The scan at an index
 /// must not change while the cache holds it (sequences only grow).
 class ExpandedScans {
 public:
-    /// Keeps at most `capacity` scans (> 0; about 140 kB each at the default reduction).
+    /// Keeps at most `capacity` scans (> 0; about 214 kB each at the default reduction).
     explicit ExpandedScans(std::size_t capacity = kDefaultCapacity);
 
     /// scans[index].Expand(), from the cache when it holds it.

@@ -305,7 +305,7 @@ private:
     DetectorConfig detector_;
     double threshold_;
     std::unique_ptr<NeighborIndex> index_;  // nullptr: compare every eligible scan
-    // By database index, for verification; compact (about 36 kB a scan instead of 140 kB).
+    // By database index, for verification; compact (about 36 kB a scan instead of 214 kB expanded).
     std::vector<registration::CompactPreparedScan> scans_;
     mutable ExpandedScans expanded_;  // the candidates verified lately (thread-safe)
     // The scans loaded from a map come first; this session's scans start here.

@@ -296,6 +296,34 @@ void ExpectSameVerdict(const registration::Verification& a, const registration::
     EXPECT_TRUE(a.T_match_query.isApprox(b.T_match_query, 1e-12)) << candidate;
 }
 
+// One time per registered pair and one for the query's images, each on both clocks: what
+// `lidarloop bench` sums into the online step. A pair's thread CPU time cannot exceed its wall
+// time (0.05 ms: the clocks' resolution); pruned candidates are not timed.
+TEST(VerifyQuery, TimesEachRegisteredPairOnBothClocks) {
+    DetectorConfig detector = Verifying();
+    detector.stop_at_first_loop = false;
+    RankedCandidates ranked = MakeRankedCandidates(detector);
+    detector.threshold = 0.25;  // prunes candidates 2 and 3 (distances 0.3 and 0.4)
+    VerificationTimes times;
+    VerifyQuery(
+        ranked.query, ranked.query_scan, [&](std::size_t j) { return ranked.scans.at(j); },
+        detector, core::Method::kRange, &times, nullptr, Execution::kSerial);
+    ASSERT_EQ(times.pair_seconds.size(), 2U);
+    ASSERT_EQ(times.pair_cpu_seconds.size(), 2U);
+    ASSERT_EQ(times.query_seconds.size(), 1U);
+    ASSERT_EQ(times.query_cpu_seconds.size(), 1U);
+    for (std::size_t i = 0; i < 2; ++i) {
+        EXPECT_GT(times.pair_cpu_seconds[i], 0.0) << i;
+        EXPECT_LE(times.pair_cpu_seconds[i], times.pair_seconds[i] + 5e-5) << i;
+    }
+    EXPECT_GT(times.query_cpu_seconds[0], 0.0);
+    EXPECT_LE(times.query_cpu_seconds[0], times.query_seconds[0] + 5e-5);
+    VerificationTimes appended = times;
+    appended.Append(times);
+    EXPECT_EQ(appended.pair_cpu_seconds.size(), 4U);
+    EXPECT_EQ(appended.query_cpu_seconds[1], times.query_cpu_seconds[0]);
+}
+
 // The check's yaw window reaches the coarse search: around the truth (the query is the place
 // turned by 170 degrees) the verdicts are those of the full search; a quarter turn off, the
 // true loops are not found.
