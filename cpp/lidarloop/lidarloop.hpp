@@ -36,6 +36,7 @@
 #include "lidarloop/core/scancontext/scancontext.hpp"
 #include "lidarloop/core/scancontext/scancontext_config.hpp"
 #include "lidarloop/core/scancontext/scancontext_distance.hpp"
+#include "lidarloop/core/stopwatch.hpp"
 #include "lidarloop/core/voxel_grid.hpp"
 #include "lidarloop/core/wasserstein.hpp"
 
