@@ -1,7 +1,6 @@
 #include "lidarloop/pipeline/candidate_verification.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <optional>
 
 #include <tbb/parallel_for.h>
@@ -13,12 +12,6 @@
 
 namespace lidarloop::pipeline {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 void AppendTo(std::vector<double>& to, const std::vector<double>& from) {
     to.insert(to.end(), from.begin(), from.end());
@@ -156,17 +149,17 @@ void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
     std::vector<double> pair_cpu_seconds(query.candidates.size(), -1.0);
     const auto register_one = [&](std::size_t c) {
         const std::size_t match = query.candidates[c].index;
-        const auto pair_start = Clock::now();
+        const core::Stopwatch pair_wall;
         const core::ThreadCpuStopwatch pair_cpu;
         query.verifications[c] =
             registration::Verify(prepared, *coarse, match_of(match), detector.verification,
                                  check.AllowedPoses(query.query, match), yaws[c]);
         pair_cpu_seconds[c] = pair_cpu.Seconds();
-        pair_seconds[c] = SecondsSince(pair_start);
+        pair_seconds[c] = pair_wall.Seconds();
         if (cache) cache->Store(query.query, match, query.verifications[c]);
     };
     const auto make_coarse = [&] {
-        const auto query_start = Clock::now();
+        const core::Stopwatch query_wall;
         const core::ThreadCpuStopwatch query_cpu;
         // The images of the yaws some candidate still to be registered may take.
         std::vector<registration::YawWindow> windows;
@@ -176,7 +169,7 @@ void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
         coarse.emplace(*prepared.structure, detector.verification.coarse, windows);
         if (times) {
             times->query_cpu_seconds.push_back(query_cpu.Seconds());
-            times->query_seconds.push_back(SecondsSince(query_start));
+            times->query_seconds.push_back(query_wall.Seconds());
         }
     };
     if (detector.stop_at_first_loop) {

@@ -1,21 +1,15 @@
 #include "lidarloop/pipeline/sequence.hpp"
 
-#include <chrono>
 #include <optional>
 
 #include <tbb/parallel_for.h>
 
 #include "lidarloop/core/descriptor.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/core/stopwatch.hpp"
 
 namespace lidarloop::pipeline {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 struct ScanResult {
     std::optional<core::Descriptor> descriptor;
@@ -40,12 +34,12 @@ ScanResult DescribeOne(const ScanSource& source, const core::DescriptorConfig& c
     const bool skip_bad = options.skip_bad;
     ScanResult result;
     try {
-        const auto load_start = Clock::now();
+        const core::Stopwatch load_clock;
         const core::PointCloud cloud = source.load(i);
-        result.load_seconds = SecondsSince(load_start);
-        const auto describe_start = Clock::now();
+        result.load_seconds = load_clock.Seconds();
+        const core::Stopwatch describe_clock;
         result.descriptor = DescribeNamed(source, i, cloud, config);
-        result.describe_seconds = SecondsSince(describe_start);
+        result.describe_seconds = describe_clock.Seconds();
         if (options.with_cloud) options.with_cloud(i, cloud);
     } catch (const core::ConfigError&) {
         throw;  // a bad configuration is not a bad scan

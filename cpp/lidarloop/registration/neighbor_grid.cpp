@@ -23,6 +23,15 @@ constexpr float kRadiusCarry = 1.2F;
 // branches to mispredict: faster than a selection and a sort for the 15-50 of a neighbourhood).
 constexpr std::size_t kRankedAtMost = 64;
 
+// Summed as nanoflann sums (x, y, z in turn), so distances and their order agree with
+// PointTree's.
+float SquaredDistance(const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
+    const float dx = a.x() - b.x();
+    const float dy = a.y() - b.y();
+    const float dz = a.z() - b.z();
+    return dx * dx + dy * dy + dz * dz;
+}
+
 std::int64_t ColumnOf(double coordinate, double origin, double cell_m, std::int64_t count) {
     const double column = std::floor((coordinate - origin) / cell_m);
     // Clamped before the cast: a far query must not overflow it.
@@ -115,11 +124,7 @@ bool NeighborGrid::Collect(const Eigen::Vector3f& query, float radius_m, Scratch
     std::size_t found = 0;
     for (std::int64_t row = y.first; row <= y.last; ++row) {
         for (std::uint32_t i = RowBegin(row, x), end = RowEnd(row, x); i < end; ++i) {
-            // Summed as nanoflann sums (x, y, z in turn), so distances and their order agree.
-            const float dx = points_[i].x() - query.x();
-            const float dy = points_[i].y() - query.y();
-            const float dz = points_[i].z() - query.z();
-            const float squared_m2 = dx * dx + dy * dy + dz * dz;
+            const float squared_m2 = SquaredDistance(points_[i], query);
             // Written always, kept when within: no branch to mispredict.
             distance_m2[found] = squared_m2;
             index[found] = original_[i];
@@ -183,18 +188,11 @@ float NeighborGrid::Nearest(std::size_t wanted, Scratch& scratch,
 std::int64_t NeighborGrid::NearestWithin(const Eigen::Vector3f& query, float max_distance_m,
                                          std::int64_t hint) const {
     if (points_.empty() || !query.allFinite() || !(max_distance_m > 0.0F)) return -1;
-    const auto squared = [&](std::uint32_t slot) {
-        // Summed as nanoflann sums (x, y, z in turn), so distances agree with PointTree's.
-        const float dx = points_[slot].x() - query.x();
-        const float dy = points_[slot].y() - query.y();
-        const float dz = points_[slot].z() - query.z();
-        return dx * dx + dy * dy + dz * dz;
-    };
     float bound_m2 = max_distance_m * max_distance_m;
     std::int64_t best_slot = -1;
     if (hint >= 0 && static_cast<std::uint64_t>(hint) < slot_of_.size()) {
         const std::uint32_t slot = slot_of_[static_cast<std::size_t>(hint)];
-        const float hint_m2 = squared(slot);
+        const float hint_m2 = SquaredDistance(points_[slot], query);
         if (hint_m2 < bound_m2) bound_m2 = hint_m2, best_slot = slot;
     }
     // Rows outward from the query's while a row's edge is nearer than the bound found so far,
@@ -225,7 +223,7 @@ std::int64_t NeighborGrid::NearestWithin(const Eigen::Vector3f& query, float max
             for (const std::int64_t row : {below ? low : -1, above ? high : -1}) {
                 if (row < 0) continue;
                 for (std::uint32_t i = RowBegin(row, x), end = RowEnd(row, x); i < end; ++i) {
-                    const float squared_m2 = squared(i);
+                    const float squared_m2 = SquaredDistance(points_[i], query);
                     if (squared_m2 < bound_m2) bound_m2 = squared_m2, best_slot = i;
                 }
             }
