@@ -140,20 +140,34 @@ namespace {
 
 // The `kept` nearest of the candidates, nearest first (equal distances by index), by counting
 // for each the ones before it: quadratic, but vectorised and without a branch per comparison.
+// Distances are almost never equal, so the ranks first count strictly nearer candidates alone
+// (one comparison a pair); only when two are equal, which shows as ranks summing to less than
+// 0 + 1 + ... + (found - 1), are they counted again with the index breaking ties.
 void RankByCounting(const std::vector<float>& distance_m2, const std::vector<std::uint32_t>& index,
                     std::size_t kept, std::vector<std::uint32_t>& ranked) {
     const std::size_t found = distance_m2.size();
     ranked.resize(found);
+    std::size_t rank_sum = 0;
     for (std::size_t i = 0; i < found; ++i) {
         const float d = distance_m2[i];
-        const std::uint32_t id = index[i];
         std::uint32_t before = 0;
-        for (std::size_t j = 0; j < found; ++j) {
-            before += static_cast<std::uint32_t>(distance_m2[j] < d) |
-                      (static_cast<std::uint32_t>(distance_m2[j] == d) &
-                       static_cast<std::uint32_t>(index[j] < id));
-        }
+        for (std::size_t j = 0; j < found; ++j)
+            before += static_cast<std::uint32_t>(distance_m2[j] < d);
         ranked[before] = static_cast<std::uint32_t>(i);
+        rank_sum += before;
+    }
+    if (rank_sum != found * (found - 1) / 2) {
+        for (std::size_t i = 0; i < found; ++i) {
+            const float d = distance_m2[i];
+            const std::uint32_t id = index[i];
+            std::uint32_t before = 0;
+            for (std::size_t j = 0; j < found; ++j) {
+                before += static_cast<std::uint32_t>(distance_m2[j] < d) |
+                          (static_cast<std::uint32_t>(distance_m2[j] == d) &
+                           static_cast<std::uint32_t>(index[j] < id));
+            }
+            ranked[before] = static_cast<std::uint32_t>(i);
+        }
     }
     ranked.resize(kept);
 }
