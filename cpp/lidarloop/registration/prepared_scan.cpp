@@ -6,6 +6,7 @@
 #include <limits>
 #include <numbers>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
 #include "lidarloop/core/voxel_grid.hpp"
@@ -84,17 +85,22 @@ Eigen::Vector3f NormalAt(const std::vector<Eigen::Vector3f>& points,
     return normal;
 }
 
-// Whether `point` lies on a large plane: the surface variation of its k nearest centroids.
+// Whether `point` lies on a large plane: the surface variation lambda0 / (lambda0 + lambda1 +
+// lambda2) of its k nearest centroids is at most max_plane_variation. A yes or no needs no
+// eigenvalues (their trigonometry): lambda0 exceeds t exactly when the scatter less t times the
+// identity is positive definite, which its Cholesky factorisation tells; t is the bound times
+// the trace, the eigenvalues' sum.
 bool OnLargePlane(const std::vector<Eigen::Vector3f>& centroids, const NeighborGrid& grid,
                   const Eigen::Vector3f& point, const ScanReductionConfig& config,
                   NeighborGrid::Scratch& scratch, std::vector<std::uint32_t>& neighbors) {
     grid.Knn(point, config.distinctive_neighbors, scratch, neighbors);
     if (neighbors.size() < 5) return false;
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-    solver.computeDirect(ScatterOf(centroids, neighbors), Eigen::EigenvaluesOnly);
-    const Eigen::Vector3d eigenvalues = solver.eigenvalues().cwiseMax(0.0);
-    const double total = eigenvalues.sum();
-    return total > 0.0 && eigenvalues(0) / total <= config.max_plane_variation;
+    const Eigen::Matrix3d scatter = ScatterOf(centroids, neighbors);
+    const double total = scatter.trace();
+    if (!(total > 0.0)) return false;
+    const Eigen::LLT<Eigen::Matrix3d> cholesky(scatter - config.max_plane_variation * total *
+                                                             Eigen::Matrix3d::Identity());
+    return cholesky.info() != Eigen::Success;
 }
 
 // The overlap test's gates at their defaults, with which a scan is matched to itself.
