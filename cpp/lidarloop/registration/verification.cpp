@@ -152,6 +152,14 @@ core::Transform PlanarPose(const PlanarHypothesis& hypothesis) {
     return pose;
 }
 
+// How far from the query's sensor a coarse peak may put the match's and still become a loop:
+// ICP's first stage pairs points at most initial_correspondence_m apart, so a pose moves about
+// that much; from farther it ends `too_far` (docs/verification.md, "Peaks out of a loop's
+// reach").
+double LoopReachM(const VerificationConfig& config) {
+    return config.acceptance.max_loop_distance_m + config.icp.initial_correspondence_m;
+}
+
 bool TooFewPoints(const PreparedScan& scan, const AcceptanceConfig& config) {
     return !scan.structure || !scan.ground ||
            scan.structure->size() < static_cast<std::size_t>(config.min_overlapping_points) ||
@@ -359,12 +367,16 @@ Verification Verify(const PreparedScan& query, const CoarseQuery& coarse, const 
     }
     // Hypotheses in order of coarse score; the first that passes is the answer unless another
     // fits about as well, else the one that overlapped best explains the rejection. A peak well
-    // below the best is not refined (CoarseConfig::min_hypothesis_score_ratio).
+    // below the best is not refined (CoarseConfig::min_hypothesis_score_ratio), nor one out of
+    // a loop's reach (it still counts as a rival).
     const auto tried =
         std::min(hypotheses.size(), static_cast<std::size_t>(config.coarse.hypotheses));
     const double min_score = config.coarse.min_hypothesis_score_ratio * hypotheses.front().score;
+    bool refined = false;
+    best.reason = RejectReason::kTooFar;
     for (std::size_t i = 0; i < tried; ++i) {
         if (i > 0 && hypotheses[i].score < min_score) break;  // scores descend
+        if (hypotheses[i].translation_m.norm() > LoopReachM(config)) continue;
         Verification trial =
             RegisterFrom(query, match, hypotheses[i], config, static_cast<bool>(allowed));
         trial.registered_hypotheses = static_cast<int>(i) + 1;
@@ -378,8 +390,9 @@ Verification Verify(const PreparedScan& query, const CoarseQuery& coarse, const 
             }
             return trial;
         }
-        if (i == 0 || trial.overlap.Min() > best.overlap.Min()) best = trial;
+        if (!refined || trial.overlap.Min() > best.overlap.Min()) best = trial;
         best.registered_hypotheses = trial.registered_hypotheses;
+        refined = true;
     }
     return best;
 }

@@ -147,7 +147,8 @@ TEST(Verification, MirroredPlaceIsRejected) {
 
 // A place and its mirror image (the same parts, arranged differently): every coarse peak is
 // refined and rejected, except the peaks after the best whose score is under
-// min_hypothesis_score_ratio of the best's, which are not refined.
+// min_hypothesis_score_ratio of the best's, and those out of a loop's reach (farther than
+// max_loop_distance_m + initial_correspondence_m), which are not refined.
 TEST(Verification, PeaksFarBelowTheBestAreNotRefined) {
     VerificationConfig config;
     const core::PointCloud place = test::SyntheticPlace();
@@ -158,20 +159,32 @@ TEST(Verification, PeaksFarBelowTheBestAreNotRefined) {
     const CoarseQuery coarse(*query.structure, config.coarse);
     const auto hypotheses = CoarseAlign(coarse, *match.structure);
     ASSERT_GE(hypotheses.size(), 3u);
+    const double reach_m =
+        config.acceptance.max_loop_distance_m + config.icp.initial_correspondence_m;
+    // The last of the first `considered` peaks that is within reach, counted from 1.
+    const auto last_refined = [&](int considered) {
+        int last = 0;
+        for (int i = 0; i < considered; ++i)
+            if (hypotheses[static_cast<std::size_t>(i)].translation_m.norm() <= reach_m)
+                last = i + 1;
+        return last;
+    };
+    ASSERT_GE(last_refined(1), 1);  // the best is within reach: it is always refined
     for (const double ratio : {0.0, 0.5, 0.8, 0.9, 0.95, 1.0}) {
         config.coarse.min_hypothesis_score_ratio = ratio;
-        int expected = 1;  // the best is always refined
-        while (expected < config.coarse.hypotheses &&
-               hypotheses[static_cast<std::size_t>(expected)].score >=
+        int considered = 1;
+        while (considered < config.coarse.hypotheses &&
+               hypotheses[static_cast<std::size_t>(considered)].score >=
                    ratio * hypotheses.front().score) {
-            ++expected;
+            ++considered;
         }
         const Verification v = Verify(query, coarse, match, config);
         EXPECT_FALSE(v.accepted) << ratio;
-        EXPECT_EQ(v.registered_hypotheses, expected) << ratio;
+        EXPECT_EQ(v.registered_hypotheses, last_refined(considered)) << ratio;
     }
     config.coarse.min_hypothesis_score_ratio = 0.0;
-    EXPECT_EQ(Verify(query, coarse, match, config).registered_hypotheses, config.coarse.hypotheses);
+    EXPECT_EQ(Verify(query, coarse, match, config).registered_hypotheses,
+              last_refined(config.coarse.hypotheses));
 }
 
 // A right pose from the best peak: accepted at once, whatever the ratio.
@@ -373,6 +386,32 @@ TEST(Verification, PlaceSeenFromTooFarIsNotALoop) {
     config.acceptance.max_loop_distance_m = 15.0;
     const Verification allowed = VerifyPair(query, match, config);
     EXPECT_TRUE(allowed.accepted) << ToString(allowed.reason);
+    EXPECT_LT((allowed.T_match_query.translation() - truth.translation()).norm(), 0.1);
+}
+
+// The same place seen from 16 m: the best coarse peak puts the sensors farther apart than a loop
+// (10 m) plus what ICP's first stage can move a pose (3 m), so it is not refined; the pair is too
+// far without a registration. With loops of up to 20 m it is within reach and accepted.
+TEST(Verification, PeaksOutOfALoopsReachAreNotRefined) {
+    const core::PointCloud match = test::SyntheticPlace();
+    const core::Transform truth = test::PlanarTransform(16.0, 2.0, 20.0);
+    VerificationConfig config;
+    config.coarse.min_hypothesis_score_ratio = 1.0;  // the best peak alone
+    const PreparedScan query = PrepareScan(QueryOf(match, truth), config.reduction);
+    const PreparedScan prepared_match = PrepareScan(match, config.reduction);
+    const CoarseQuery coarse(*query.structure, config.coarse);
+    const auto hypotheses = CoarseAlign(coarse, *prepared_match.structure);
+    ASSERT_FALSE(hypotheses.empty());
+    ASSERT_LT((hypotheses.front().translation_m - truth.translation().head<2>()).norm(), 1.5);
+    const Verification far = Verify(query, coarse, prepared_match, config);
+    EXPECT_FALSE(far.accepted);
+    EXPECT_EQ(far.reason, RejectReason::kTooFar);
+    EXPECT_EQ(far.icp_iterations, 0);
+    EXPECT_EQ(far.registered_hypotheses, 0);
+    config.acceptance.max_loop_distance_m = 20.0;
+    const Verification allowed = Verify(query, coarse, prepared_match, config);
+    EXPECT_TRUE(allowed.accepted) << ToString(allowed.reason);
+    EXPECT_GT(allowed.icp_iterations, 0);
     EXPECT_LT((allowed.T_match_query.translation() - truth.translation()).norm(), 0.1);
 }
 
