@@ -152,12 +152,10 @@ core::Transform PlanarPose(const PlanarHypothesis& hypothesis) {
     return pose;
 }
 
-// How far from the query's sensor a coarse peak may put the match's and still become a loop:
-// ICP's first stage pairs points at most initial_correspondence_m apart, so a pose moves about
-// that much; from farther it ends `too_far` (docs/verification.md, "Peaks out of a loop's
-// reach").
+// How far from the query's sensor a coarse peak may put the match's and still be refined
+// (CoarseConfig::max_peak_beyond_loop_m): from farther, ICP ends `too_far`.
 double LoopReachM(const VerificationConfig& config) {
-    return config.acceptance.max_loop_distance_m + config.icp.initial_correspondence_m;
+    return config.acceptance.max_loop_distance_m + config.coarse.max_peak_beyond_loop_m;
 }
 
 bool TooFewPoints(const PreparedScan& scan, const AcceptanceConfig& config) {

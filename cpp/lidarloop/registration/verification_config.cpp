@@ -50,6 +50,7 @@ void CoarseConfig::Validate() const {
     RequireIn(max_translation_m, 0.1, 1000.0, "coarse.max_translation_m");
     RequireIn(hypotheses, 1, 16, "coarse.hypotheses");
     RequireIn(min_hypothesis_score_ratio, 0.0, 1.0, "coarse.min_hypothesis_score_ratio");
+    RequireIn(max_peak_beyond_loop_m, 0.0, 1000.0, "coarse.max_peak_beyond_loop_m");
     RequireIn(rival_hypotheses, 0, 32, "coarse.rival_hypotheses");
     RequireIn(peaks_per_yaw, 1, 8, "coarse.peaks_per_yaw");
 }

@@ -49,6 +49,12 @@ struct CoarseConfig {
     /// pair accepted from a later peak had at least 0.87 of the best's score, and the ICP from
     /// the 2nd and 3rd peaks is most of the time of a rejected pair (docs/verification.md).
     double min_hypothesis_score_ratio = 0.8;
+    /// A peak is refined only when it puts the two sensors at most AcceptanceConfig::
+    /// max_loop_distance_m plus this far apart, metres, [0, 1000]: from farther it ends
+    /// `too_far`. ICP moved accepted poses 0.2-2.1 m from their peak (medians), at most 7.8 m,
+    /// and every accepted loop's peak lay within 12.5 m of the query on the gate sequences
+    /// (docs/verification.md). Peaks out of this reach still count as rivals.
+    double max_peak_beyond_loop_m = 6.0;
     /// Further peaks the ambiguity test registers after an acceptance (AcceptanceConfig::
     /// max_rival_overlap_ratio), 0..32: a repeating place fits as well elsewhere.
     int rival_hypotheses = 2;

@@ -148,7 +148,7 @@ TEST(Verification, MirroredPlaceIsRejected) {
 // A place and its mirror image (the same parts, arranged differently): every coarse peak is
 // refined and rejected, except the peaks after the best whose score is under
 // min_hypothesis_score_ratio of the best's, and those out of a loop's reach (farther than
-// max_loop_distance_m + initial_correspondence_m), which are not refined.
+// max_loop_distance_m + max_peak_beyond_loop_m), which are not refined.
 TEST(Verification, PeaksFarBelowTheBestAreNotRefined) {
     VerificationConfig config;
     const core::PointCloud place = test::SyntheticPlace();
@@ -160,7 +160,7 @@ TEST(Verification, PeaksFarBelowTheBestAreNotRefined) {
     const auto hypotheses = CoarseAlign(coarse, *match.structure);
     ASSERT_GE(hypotheses.size(), 3u);
     const double reach_m =
-        config.acceptance.max_loop_distance_m + config.icp.initial_correspondence_m;
+        config.acceptance.max_loop_distance_m + config.coarse.max_peak_beyond_loop_m;
     // The last of the first `considered` peaks that is within reach, counted from 1.
     const auto last_refined = [&](int considered) {
         int last = 0;
@@ -358,6 +358,8 @@ TEST(Verification, InvalidConfigIsAConfigError) {
     expect_error([](auto& c) { c.coarse.grid_cells = 100; });
     expect_error([](auto& c) { c.coarse.yaw_step_deg = 0.0; });
     expect_error([](auto& c) { c.coarse.min_hypothesis_score_ratio = 1.5; });
+    expect_error([](auto& c) { c.coarse.max_peak_beyond_loop_m = -1.0; });
+    expect_error([](auto& c) { c.coarse.max_peak_beyond_loop_m = std::nan(""); });
     expect_error(
         [](auto& c) { c.icp.final_correspondence_m = 2 * c.icp.initial_correspondence_m; });
     expect_error([](auto& c) { c.acceptance.min_overlap = 1.5; });
@@ -389,12 +391,12 @@ TEST(Verification, PlaceSeenFromTooFarIsNotALoop) {
     EXPECT_LT((allowed.T_match_query.translation() - truth.translation()).norm(), 0.1);
 }
 
-// The same place seen from 16 m: the best coarse peak puts the sensors farther apart than a loop
-// (10 m) plus what ICP's first stage can move a pose (3 m), so it is not refined; the pair is too
-// far without a registration. With loops of up to 20 m it is within reach and accepted.
+// The same place seen from 18 m: the best coarse peak puts the sensors farther apart than a loop
+// (10 m) plus max_peak_beyond_loop_m (6 m), so it is not refined; the pair is too far without a
+// registration. Refined when the reach allows it (too far after ICP), accepted with 25 m loops.
 TEST(Verification, PeaksOutOfALoopsReachAreNotRefined) {
     const core::PointCloud match = test::SyntheticPlace();
-    const core::Transform truth = test::PlanarTransform(16.0, 2.0, 20.0);
+    const core::Transform truth = test::PlanarTransform(18.0, 2.0, 20.0);
     VerificationConfig config;
     config.coarse.min_hypothesis_score_ratio = 1.0;  // the best peak alone
     const PreparedScan query = PrepareScan(QueryOf(match, truth), config.reduction);
@@ -408,10 +410,15 @@ TEST(Verification, PeaksOutOfALoopsReachAreNotRefined) {
     EXPECT_EQ(far.reason, RejectReason::kTooFar);
     EXPECT_EQ(far.icp_iterations, 0);
     EXPECT_EQ(far.registered_hypotheses, 0);
-    config.acceptance.max_loop_distance_m = 20.0;
+    config.coarse.max_peak_beyond_loop_m = 10.0;
+    const Verification refined = Verify(query, coarse, prepared_match, config);
+    EXPECT_EQ(refined.reason, RejectReason::kTooFar);
+    EXPECT_GT(refined.icp_iterations, 0);
+    EXPECT_LT((refined.T_match_query.translation() - truth.translation()).norm(), 0.1);
+    config.coarse.max_peak_beyond_loop_m = 6.0;
+    config.acceptance.max_loop_distance_m = 25.0;
     const Verification allowed = Verify(query, coarse, prepared_match, config);
     EXPECT_TRUE(allowed.accepted) << ToString(allowed.reason);
-    EXPECT_GT(allowed.icp_iterations, 0);
     EXPECT_LT((allowed.T_match_query.translation() - truth.translation()).norm(), 0.1);
 }
 
