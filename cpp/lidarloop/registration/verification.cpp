@@ -207,13 +207,23 @@ RejectReason Judge(const PreparedScan& query, const PreparedScan& match,
 // of the full count; it was a tenth of verification time (docs/verification.md).
 constexpr std::size_t kAbandonCheckStride = 4;
 
+// Two registered poses that are the same solution: within 1 m and 5 degrees.
+bool SamePose(const core::Transform& a, const core::Transform& b) {
+    const core::Transform difference = a.inverse() * b;
+    return difference.translation().norm() < 1.0 &&
+           Eigen::AngleAxisd(difference.linear()).angle() < 5.0 * std::numbers::pi / 180.0;
+}
+
 // ICP from `initial` with `icp`, abandoned after its first stage when the pose overlaps too
-// little to ever pass (IcpConfig::abandon_below_overlap).
+// little to ever pass (IcpConfig::abandon_below_overlap) or, searching for a rival of the
+// `accepted` pose, when it has come to that pose: the later stages only refine toward it
+// (docs/verification.md, "No half-way rivals").
 IcpResult Refine(const PreparedScan& query, const PreparedScan& match,
                  const core::Transform& initial, const VerificationConfig& config,
-                 const IcpConfig& icp) {
+                 const IcpConfig& icp, const core::Transform* accepted = nullptr) {
     return RefinePointToPlane(
         query, match, initial, icp, [&](const core::Transform& T_match_query) {
+            if (accepted != nullptr && SamePose(T_match_query, *accepted)) return false;
             return OverlapReaches(query, match, T_match_query, config.acceptance,
                                   config.icp.abandon_below_overlap, kAbandonCheckStride);
         });
@@ -238,13 +248,6 @@ Verification RegisterFrom(const PreparedScan& query, const PreparedScan& match,
     return result;
 }
 
-// Two registered poses that are the same solution: within 1 m and 5 degrees.
-bool SamePose(const core::Transform& a, const core::Transform& b) {
-    const core::Transform difference = a.inverse() * b;
-    return difference.translation().norm() < 1.0 &&
-           Eigen::AngleAxisd(difference.linear()).angle() < 5.0 * std::numbers::pi / 180.0;
-}
-
 // Whether a pose other than the accepted one also fits: ICP from every other hypothesis, and a
 // rival is a different pose whose overlap reaches max_rival_overlap_ratio of the accepted one
 // within the allowed RMSE. Periodic places (rows of trees, identical corridors) have rivals. A
@@ -259,7 +262,8 @@ bool HasRivalPose(const PreparedScan& query, const PreparedScan& match,
     toward_rival.aligned_step_factor = config.icp.rival_step_factor;
     for (std::size_t j = 0; j < hypotheses.size(); ++j) {
         if (j == accepted_index) continue;
-        const IcpResult icp = Refine(query, match, PlanarPose(hypotheses[j]), config, toward_rival);
+        const IcpResult icp = Refine(query, match, PlanarPose(hypotheses[j]), config, toward_rival,
+                                     &accepted.T_match_query);
         if (icp.abandoned || SamePose(icp.T_match_query, accepted.T_match_query)) continue;
         if (allowed && !allowed(icp.T_match_query)) continue;
         const Overlap overlap = MeasureOverlap(query, match, icp.T_match_query, config.acceptance);
