@@ -72,11 +72,7 @@ void WritePathM(std::ostream& out, const std::vector<double>& path_m, std::size_
 // (empty when not reached) and the reason ("none" when accepted).
 // A candidate rejected before registration has empty pose and fit fields.
 void WriteVerification(std::ostream& out, const registration::Verification& v) {
-    const bool registered = v.reason != registration::RejectReason::kTooFewPoints &&
-                            v.reason != registration::RejectReason::kNoAlignment &&
-                            v.reason != registration::RejectReason::kPruned &&
-                            v.reason != registration::RejectReason::kNotNeeded;
-    if (registered) {
+    if (v.Registered()) {
         const Eigen::Vector3d t = v.T_match_query.translation();
         const Eigen::Quaterniond q(v.T_match_query.rotation());
         out << t.x() << ',' << t.y() << ',' << t.z() << ',' << q.x() << ',' << q.y() << ',' << q.z()

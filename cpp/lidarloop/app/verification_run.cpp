@@ -272,7 +272,7 @@ nlohmann::json VerificationJson(const registration::Verification& verdict) {
     nlohmann::json json;
     json["accepted"] = verdict.accepted;
     json["reason"] = registration::ToString(verdict.reason);
-    json["T_match_query"] = matrix;
+    json["T_match_query"] = verdict.Registered() ? matrix : nlohmann::json(nullptr);
     json["overlap"] = overlap.Min();
     json["overlap_query"] = overlap.query_fraction;
     json["overlap_match"] = overlap.match_fraction;

@@ -142,7 +142,7 @@ void VisitFields(registration::CoarseConfig& c, Visitor& v) {
     v.Field("min_hypothesis_score_ratio", c.min_hypothesis_score_ratio,
             "a coarse pose after the best is refined only with this share of its score");
     v.Field("max_peak_beyond_loop_m", c.max_peak_beyond_loop_m,
-            "a coarse pose is refined only within max_loop_distance_m plus this");
+            "a coarse pose is refined only within max_loop_distance_m plus this (m)");
     v.Field("rival_hypotheses", c.rival_hypotheses,
             "further coarse poses the ambiguity test registers after an acceptance");
     v.Field("peaks_per_yaw", c.peaks_per_yaw, "translation peaks kept per yaw");

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <numbers>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Eigenvalues>
@@ -158,6 +159,22 @@ double LoopReachM(const VerificationConfig& config) {
     return config.acceptance.max_loop_distance_m + config.coarse.max_peak_beyond_loop_m;
 }
 
+// The hypotheses ICP refines, best first: of the first CoarseConfig::hypotheses, those whose
+// score reaches min_hypothesis_score_ratio of the best's (the best's, in reach or not) and that
+// lie within a loop's reach.
+std::vector<std::size_t> Refinable(const std::vector<PlanarHypothesis>& hypotheses,
+                                   const VerificationConfig& config) {
+    const auto tried =
+        std::min(hypotheses.size(), static_cast<std::size_t>(config.coarse.hypotheses));
+    const double min_score = config.coarse.min_hypothesis_score_ratio * hypotheses.front().score;
+    std::vector<std::size_t> refinable;
+    for (std::size_t i = 0; i < tried; ++i) {
+        if (i > 0 && hypotheses[i].score < min_score) break;  // scores descend
+        if (hypotheses[i].translation_m.norm() <= LoopReachM(config)) refinable.push_back(i);
+    }
+    return refinable;
+}
+
 bool TooFewPoints(const PreparedScan& scan, const AcceptanceConfig& config) {
     return !scan.structure || !scan.ground ||
            scan.structure->size() < static_cast<std::size_t>(config.min_overlapping_points) ||
@@ -220,10 +237,11 @@ bool SamePose(const core::Transform& a, const core::Transform& b) {
 // (docs/verification.md, "No half-way rivals").
 IcpResult Refine(const PreparedScan& query, const PreparedScan& match,
                  const core::Transform& initial, const VerificationConfig& config,
-                 const IcpConfig& icp, const core::Transform* accepted = nullptr) {
+                 const IcpConfig& icp,
+                 const std::optional<core::Transform>& accepted = std::nullopt) {
     return RefinePointToPlane(
         query, match, initial, icp, [&](const core::Transform& T_match_query) {
-            if (accepted != nullptr && SamePose(T_match_query, *accepted)) return false;
+            if (accepted && SamePose(T_match_query, *accepted)) return false;
             return OverlapReaches(query, match, T_match_query, config.acceptance,
                                   config.icp.abandon_below_overlap, kAbandonCheckStride);
         });
@@ -263,7 +281,7 @@ bool HasRivalPose(const PreparedScan& query, const PreparedScan& match,
     for (std::size_t j = 0; j < hypotheses.size(); ++j) {
         if (j == accepted_index) continue;
         const IcpResult icp = Refine(query, match, PlanarPose(hypotheses[j]), config, toward_rival,
-                                     &accepted.T_match_query);
+                                     accepted.T_match_query);
         if (icp.abandoned || SamePose(icp.T_match_query, accepted.T_match_query)) continue;
         if (allowed && !allowed(icp.T_match_query)) continue;
         const Overlap overlap = MeasureOverlap(query, match, icp.T_match_query, config.acceptance);
@@ -368,20 +386,12 @@ Verification Verify(const PreparedScan& query, const CoarseQuery& coarse, const 
         return best;
     }
     // Hypotheses in order of coarse score; the first that passes is the answer unless another
-    // fits about as well, else the one that overlapped best explains the rejection. A peak well
-    // below the best is not refined (CoarseConfig::min_hypothesis_score_ratio), nor one out of
-    // a loop's reach (it still counts as a rival).
-    const auto tried =
-        std::min(hypotheses.size(), static_cast<std::size_t>(config.coarse.hypotheses));
-    const double min_score = config.coarse.min_hypothesis_score_ratio * hypotheses.front().score;
-    bool refined = false;
-    best.reason = RejectReason::kTooFar;
-    for (std::size_t i = 0; i < tried; ++i) {
-        if (i > 0 && hypotheses[i].score < min_score) break;  // scores descend
-        if (hypotheses[i].translation_m.norm() > LoopReachM(config)) continue;
+    // fits about as well, else the one that overlapped best explains the rejection.
+    best.reason = RejectReason::kTooFar;  // when every peak is out of reach
+    for (const std::size_t i : Refinable(hypotheses, config)) {
         Verification trial =
             RegisterFrom(query, match, hypotheses[i], config, static_cast<bool>(allowed));
-        trial.registered_hypotheses = static_cast<int>(i) + 1;
+        trial.registered_hypotheses = best.registered_hypotheses + 1;
         if (trial.accepted) {
             if (trial.T_match_query.translation().norm() > config.acceptance.max_loop_distance_m) {
                 trial.accepted = false;
@@ -392,9 +402,9 @@ Verification Verify(const PreparedScan& query, const CoarseQuery& coarse, const 
             }
             return trial;
         }
-        if (!refined || trial.overlap.Min() > best.overlap.Min()) best = trial;
-        best.registered_hypotheses = trial.registered_hypotheses;
-        refined = true;
+        const int registered = trial.registered_hypotheses;
+        if (!best.Registered() || trial.overlap.Min() > best.overlap.Min()) best = trial;
+        best.registered_hypotheses = registered;
     }
     return best;
 }

@@ -22,8 +22,11 @@ enum class RejectReason {
     kHighRmse,      ///< the overlapping points sit too far from the other scan's planes
     kDegenerate,    ///< sliding along the weakest direction fits as well (street, corridor)
     kAmbiguous,     ///< another, distinct pose fits about as well (periodic structure)
-    kTooFar,        ///< registered, but the sensors are farther apart than one place
-    kPruned,        ///< not registered: the descriptor distance failed the threshold set
+    /// the sensors are farther apart than one place: registered, or every coarse peak that
+    /// could be refined put them beyond CoarseConfig::max_peak_beyond_loop_m of that (not
+    /// registered)
+    kTooFar,
+    kPruned,  ///< not registered: the descriptor distance failed the threshold set
     /// registered, but the odometry puts the two scans elsewhere beyond its drift (detect with
     /// odometry: the pose graph's gate, posegraph::GateAgainstOdometry)
     kOdometryMismatch,
@@ -73,8 +76,11 @@ struct Verification {
     double coarse_score = 0.0;  ///< the coarse correlation of the chosen hypothesis
     int icp_iterations = 0;
     /// Coarse hypotheses ICP refined before the verdict (CoarseConfig::hypotheses at most, fewer
-    /// after an acceptance or below min_hypothesis_score_ratio), rival poses not counted.
+    /// after an acceptance, below min_hypothesis_score_ratio or out of a loop's reach), rival
+    /// poses not counted. 0: not registered.
     int registered_hypotheses = 0;
+    /// Whether ICP refined some hypothesis: only then do the pose and fit fields hold a result.
+    bool Registered() const { return registered_hypotheses > 0; }
     /// Confidence for ranking accepted loops: the smaller overlap fraction (0 when rejected
     /// before registration).
     double score() const { return overlap.Min(); }
@@ -118,8 +124,9 @@ double AllowedRmse(const PreparedScan& query, const PreparedScan& match,
 /// two scans (app::OdometryLoopCheck). Empty where no such source judges the pair.
 using PoseAllowed = std::function<bool(const core::Transform& T_match_query)>;
 
-/// Registers one candidate to its query without a prior pose (coarse search, ICP from each
-/// hypothesis, the best overlap wins) and decides by AcceptanceConfig. `coarse` must be built
+/// Registers one candidate to its query without a prior pose (coarse search, ICP from the best
+/// hypotheses within a loop's reach, the first accepted or else the best overlap wins) and
+/// decides by AcceptanceConfig. `coarse` must be built
 /// from `query` with config.coarse. Never throws on bad data: degenerate input is a rejection
 /// with its reason. Thread-safe.
 /// Given `allowed` (the odometry judges the loop's pose and will reject what it does not allow),
