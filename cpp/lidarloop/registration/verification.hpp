@@ -22,9 +22,9 @@ enum class RejectReason {
     kHighRmse,      ///< the overlapping points sit too far from the other scan's planes
     kDegenerate,    ///< sliding along the weakest direction fits as well (street, corridor)
     kAmbiguous,     ///< another, distinct pose fits about as well (periodic structure)
-    /// the sensors are farther apart than one place: registered, or every coarse peak that
-    /// could be refined put them beyond CoarseConfig::max_peak_beyond_loop_m of that (not
-    /// registered)
+    /// the sensors are farther apart than one place: registered so, or (not registered) every
+    /// coarse peak that could be refined put them farther than a loop's distance plus
+    /// CoarseConfig::max_peak_beyond_loop_m
     kTooFar,
     kPruned,  ///< not registered: the descriptor distance failed the threshold set
     /// registered, but the odometry puts the two scans elsewhere beyond its drift (detect with
@@ -126,9 +126,8 @@ using PoseAllowed = std::function<bool(const core::Transform& T_match_query)>;
 
 /// Registers one candidate to its query without a prior pose (coarse search, ICP from the best
 /// hypotheses within a loop's reach, the first accepted or else the best overlap wins) and
-/// decides by AcceptanceConfig. `coarse` must be built
-/// from `query` with config.coarse. Never throws on bad data: degenerate input is a rejection
-/// with its reason. Thread-safe.
+/// decides by AcceptanceConfig. `coarse` must be built from `query` with config.coarse. Never
+/// throws on bad data: degenerate input is a rejection with its reason. Thread-safe.
 /// Given `allowed` (the odometry judges the loop's pose and will reject what it does not allow),
 /// the degeneracy test asks for acceptance.min_constraining_points_with_odometry points instead of
 /// min_constraining_points, the RMSE may reach max_rmse_ratio_with_odometry, and only a rival pose

@@ -46,9 +46,9 @@ struct CoarseConfig {
     int hypotheses = 3;               ///< best (yaw, translation) peaks refined by ICP, 1..16
     /// A peak after the best is refined only when its coarse score reaches this share of the
     /// best's (the best's even when it is out of reach, max_peak_beyond_loop_m), [0, 1] (0: all
-    /// `hypotheses`). On the real Livox and simulated sequences every
-    /// pair accepted from a later peak had at least 0.87 of the best's score, and the ICP from
-    /// the 2nd and 3rd peaks is most of the time of a rejected pair (docs/verification.md).
+    /// `hypotheses`). On the real Livox and simulated sequences every pair accepted from a later
+    /// peak had at least 0.87 of the best's score, and the ICP from the 2nd and 3rd peaks is
+    /// most of the time of a rejected pair (docs/verification.md).
     double min_hypothesis_score_ratio = 0.8;
     /// A peak is refined only when it puts the two sensors at most AcceptanceConfig::
     /// max_loop_distance_m plus this far apart, metres, [0, 1000]: from farther it ends
