@@ -388,10 +388,11 @@ Verification Verify(const PreparedScan& query, const CoarseQuery& coarse, const 
     // Hypotheses in order of coarse score; the first that passes is the answer unless another
     // fits about as well, else the one that overlapped best explains the rejection.
     best.reason = RejectReason::kTooFar;  // when every peak is out of reach
+    int refined = 0;
     for (const std::size_t i : Refinable(hypotheses, config)) {
         Verification trial =
             RegisterFrom(query, match, hypotheses[i], config, static_cast<bool>(allowed));
-        trial.registered_hypotheses = best.registered_hypotheses + 1;
+        trial.registered_hypotheses = ++refined;
         if (trial.accepted) {
             if (trial.T_match_query.translation().norm() > config.acceptance.max_loop_distance_m) {
                 trial.accepted = false;
@@ -402,9 +403,8 @@ Verification Verify(const PreparedScan& query, const CoarseQuery& coarse, const 
             }
             return trial;
         }
-        const int registered = trial.registered_hypotheses;
-        if (!best.Registered() || trial.overlap.Min() > best.overlap.Min()) best = trial;
-        best.registered_hypotheses = registered;
+        if (refined == 1 || trial.overlap.Min() > best.overlap.Min()) best = trial;
+        best.registered_hypotheses = refined;
     }
     return best;
 }
