@@ -1,8 +1,8 @@
 #include "lidarloop/io/dataset.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
-#include <set>
 
 #include "lidarloop/io/detail/text_parsing.hpp"
 #include "lidarloop/io/osnabrueck.hpp"
@@ -15,6 +15,8 @@
 namespace lidarloop::io {
 namespace fs = std::filesystem;
 namespace {
+
+constexpr std::array<const char*, 3> kSidecarPrefixes = {"poses", "times", "calib"};
 
 // "scan2" < "scan10": runs of digits compare by value, so unpadded numbering sorts as expected.
 bool NaturalLess(const std::string& a, const std::string& b) {
@@ -63,14 +65,28 @@ bool IsOsnabrueckScan(const fs::path& file) {
     return file.extension() == ".3d" && file.filename().string().rfind("scan", 0) == 0;
 }
 
-// Text files beside the scans that hold poses or calibration, not points.
+// Text files beside the scans that hold poses, times or calibration, not points: KITTI's names
+// and their variants (poses_odometry.txt, calib_00.txt).
 bool IsSidecarFile(const fs::path& file) {
-    static const std::set<std::string> kNames = {"poses.txt", "times.txt", "calib.txt"};
-    return kNames.count(file.filename().string()) != 0;
+    if (file.extension() != ".txt") return false;
+    const std::string stem = file.stem().string();
+    return std::any_of(kSidecarPrefixes.begin(), kSidecarPrefixes.end(),
+                       [&](const char* prefix) { return stem.rfind(prefix, 0) == 0; });
 }
 
 bool IsFolderScan(const fs::path& file) {
     return IsScanFile(file) && !IsSidecarFile(file) && file.extension() != ".3d";
+}
+
+// A folder's scans. Where scans of another format lie beside .txt files, those are notes or poses
+// (groundtruth.txt, odom.txt): ASCII point clouds are not mixed with binary scans.
+std::vector<fs::path> ListFolderScans(const fs::path& root) {
+    auto scans = ListFiles(root, IsFolderScan);
+    const auto is_text = [](const fs::path& file) { return file.extension() == ".txt"; };
+    if (!std::all_of(scans.begin(), scans.end(), is_text)) {
+        scans.erase(std::remove_if(scans.begin(), scans.end(), is_text), scans.end());
+    }
+    return scans;
 }
 
 fs::path ExistingOr(const fs::path& given, const fs::path& fallback) {
@@ -129,7 +145,7 @@ Dataset OpenOsnabrueck(const fs::path& root, const DatasetOptions& options) {
 }
 
 Dataset OpenFolder(const fs::path& root, const DatasetOptions& options) {
-    auto scans = ListFiles(root, IsFolderScan);
+    auto scans = ListFolderScans(root);
     std::vector<core::StampedPose> poses;
     const fs::path poses_file = ExistingOr(options.poses_file, root / "poses.txt");
     if (!poses_file.empty()) {
@@ -158,13 +174,39 @@ Dataset OpenBag(const fs::path& bag, const DatasetOptions& options) {
     return {std::move(scans), std::move(poses)};
 }
 
+// A folder of sequences (KITTI's 00/, 08/ ...) is not one: name those that are, to pick from.
+// Only a hint: a subfolder that cannot be read is left out, not an error of its own.
+std::string SubfolderDatasetsHint(const fs::path& root) try {
+    std::vector<std::string> names;
+    for (const auto& entry : fs::directory_iterator(root)) {
+        const fs::path& sub = entry.path();
+        if (!entry.is_directory() || sub.filename() == "velodyne") continue;
+        const auto scans = ListFolderScans(sub);
+        // A subfolder of .txt files alone more likely holds poses (KITTI's poses/00.txt).
+        const bool binary_scans = !scans.empty() && scans.front().extension() != ".txt";
+        if (!ListFiles(sub / "velodyne", IsKittiBin).empty() ||
+            !ListFiles(sub, IsOsnabrueckScan).empty() || binary_scans) {
+            names.push_back(sub.filename().string());
+        }
+    }
+    if (names.empty()) return {};
+    std::sort(names.begin(), names.end(), NaturalLess);
+    std::string hint = "; its subfolders ";
+    for (std::size_t i = 0; i < names.size(); ++i) hint += (i == 0 ? "" : ", ") + names[i];
+    return hint + " hold scans: give one of them";
+} catch (const fs::filesystem_error&) {
+    return {};
+}
+
 DatasetFormat DetectFormat(const fs::path& root) {
     if (!ListFiles(root / "velodyne", IsKittiBin).empty()) return DatasetFormat::kKitti;
     if (!ListFiles(root, IsOsnabrueckScan).empty()) return DatasetFormat::kOsnabrueck;
-    if (!ListFiles(root, IsFolderScan).empty()) return DatasetFormat::kFolder;
+    if (!ListFolderScans(root).empty()) return DatasetFormat::kFolder;
     throw ReadError(root,
                     "cannot tell the dataset format: found no velodyne/*.bin (KITTI), no "
-                    "scanNNN.3d (Osnabrueck) and no .pcd/.ply/.xyz/.txt/.pts/.bin scans (folder)");
+                    "scanNNN.3d (Osnabrueck) and no .pcd/.ply/.xyz/.txt/.pts/.bin scans "
+                    "(folder)" +
+                        SubfolderDatasetsHint(root));
 }
 
 }  // namespace

@@ -66,6 +66,47 @@ TEST(Dataset, OpensFolderSortedNaturallyAndSkipsSidecars) {
     EXPECT_TRUE(dataset.HasPoses());
 }
 
+TEST(Dataset, PoseAndNoteTextFilesBesideScansAreNotScans) {
+    test::TempDir dir;
+    for (int i = 0; i < 3; ++i) {
+        WriteKittiBin(dir / ("00000" + std::to_string(i) + ".bin"),
+                      test::RandomCloud(5, static_cast<unsigned>(i)));
+    }
+    WriteKittiPoses(dir / "poses.txt", LinePoses(3));
+    WriteKittiPoses(dir / "poses_odometry.txt", LinePoses(3));
+    test::WriteFile(dir / "groundtruth.txt", "1 2 3\n");
+    const Dataset dataset = OpenDataset(dir.path());
+    EXPECT_EQ(dataset.format(), DatasetFormat::kFolder);
+    ASSERT_EQ(dataset.size(), 3U);
+    EXPECT_EQ(dataset.ScanPath(2).filename(), "000002.bin");
+}
+
+TEST(Dataset, TextScansSkipPoseTimeAndCalibrationFiles) {
+    test::TempDir dir;
+    for (const char* name : {"a.txt", "b.txt"}) test::WriteFile(dir / name, "1 2 3\n4 5 6\n");
+    test::WriteFile(dir / "calib_00.txt", "Tr: 1 0 0 0 0 1 0 0 0 0 1 0\n");
+    test::WriteFile(dir / "times_lidar.txt", "0\n0.1\n");
+    WriteKittiPoses(dir / "poses_odometry.txt", LinePoses(2));
+    const Dataset dataset = OpenDataset(dir.path());
+    ASSERT_EQ(dataset.size(), 2U);
+    EXPECT_EQ(dataset.ScanPath(0).filename(), "a.txt");
+    EXPECT_EQ(dataset.ScanPath(1).filename(), "b.txt");
+}
+
+TEST(Dataset, FolderOfSequencesNamesTheSequences) {
+    test::TempDir dir;
+    for (const char* sequence : {"08", "00"}) {
+        fs::create_directories(dir / sequence / "velodyne");
+        WriteKittiBin(dir / sequence / "velodyne" / "000000.bin", test::RandomCloud(5, 1));
+    }
+    fs::create_directories(dir / "poses");
+    WriteKittiPoses(dir / "poses" / "00.txt", LinePoses(1));
+    test::WriteFile(dir / "calib_00.txt", "Tr: 1 0 0 0 0 1 0 0 0 0 1 0\n");
+    const std::string message = ErrorOf(dir.path());
+    EXPECT_NE(message.find("cannot tell the dataset format"), std::string::npos) << message;
+    EXPECT_NE(message.find("its subfolders 00, 08 hold scans"), std::string::npos) << message;
+}
+
 TEST(Dataset, OpensOsnabrueckFolderWithPoseFiles) {
     test::TempDir dir;
     for (int i = 0; i < 2; ++i) {
