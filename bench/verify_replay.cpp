@@ -149,20 +149,31 @@ std::string TruthFields(const std::vector<core::StampedPose>& poses, const Candi
                         const registration::PreparedScan& query,
                         const registration::PreparedScan& match,
                         const registration::VerificationConfig& config,
-                        const core::Transform& T_registered) {
+                        const registration::Verification& now) {
     if (poses.empty()) return ",,,,,";
     const core::Transform T_match_query = poses.at(candidate.match).T_world_sensor.inverse() *
                                           poses.at(candidate.query).T_world_sensor;
     const registration::Overlap overlap =
         registration::MeasureOverlap(query, match, T_match_query, config.acceptance);
     std::ostringstream fields;
+    fields << T_match_query.translation().norm() << ',' << overlap.Min() << ','
+           << overlap.MinDistinctive() << ','
+           << CoarseRankOfTruth(query, match, T_match_query, config) << ',';
+    // A pair never registered has no pose to be wrong: empty error fields.
+    if (!now.Registered()) return fields.str() + ',';
+    const core::Transform& T_registered = now.T_match_query;
     fields
-        << T_match_query.translation().norm() << ',' << overlap.Min() << ','
-        << overlap.MinDistinctive() << ',' << CoarseRankOfTruth(query, match, T_match_query, config)
-        << ',' << (T_registered.translation() - T_match_query.translation()).norm() << ','
+        << (T_registered.translation() - T_match_query.translation()).norm() << ','
         << Eigen::AngleAxisd(T_registered.linear().transpose() * T_match_query.linear()).angle() *
                180.0 / M_PI;
     return fields.str();
+}
+
+// The registered sensors' distance, metres; empty for a pair never registered (every coarse
+// peak out of reach), whose pose is no registration's.
+std::string RegisteredDistance(const registration::Verification& now) {
+    return now.Registered() ? std::to_string(now.T_match_query.translation().norm())
+                            : std::string();
 }
 
 // A scan's structure points, distinctive ones among them, ground points and roughness.
@@ -186,12 +197,12 @@ void WritePair(std::ofstream& out, const Candidate& candidate,
         << OccupiedCells(*query.structure, config.coarse) << ','
         << OccupiedCells(*match.structure, config.coarse) << ',' << now.overlap.Min() << ','
         << now.overlap.MinDistinctive() << ',' << now.icp_iterations << ',' << ms << ','
-        << TruthFields(poses, candidate, query, match, config, now.T_match_query) << ','
-        << ScanFields(query) << ',' << ScanFields(match) << ',' << now.overlap.query_overlapping
-        << ',' << now.overlap.match_overlapping << ',' << now.overlap.rmse_m << ','
+        << TruthFields(poses, candidate, query, match, config, now) << ',' << ScanFields(query)
+        << ',' << ScanFields(match) << ',' << now.overlap.query_overlapping << ','
+        << now.overlap.match_overlapping << ',' << now.overlap.rmse_m << ','
         << registration::AllowedRmse(query, match, config.acceptance) << ','
         << now.overlap.shifted_overlap_ratio << ',' << now.overlap.constraining_points << ','
-        << now.T_match_query.translation().norm() << ',' << coarse_ms << ','
+        << RegisteredDistance(now) << ',' << coarse_ms << ','
         << (hypotheses.empty() ? 0.0 : hypotheses.front().score) << ',' << hypotheses.size() << ','
         << ScoreRatio(hypotheses, 1) << ',' << ScoreRatio(hypotheses, 2) << ','
         << now.registered_hypotheses << ','
