@@ -18,6 +18,24 @@ int End(const std::string& message, int code) {
     return code;
 }
 
+// CLI11 2.1 reads "-1" into an unsigned flag as 2^64 - 1 (a bench that never ends, a seed that
+// is not the one asked for): every unsigned flag of every command refuses a negative number.
+void RefuseNegativeUnsigned(CLI::App& app) {
+    const CLI::Validator non_negative(
+        [](const std::string& value) {
+            const auto first = value.find_first_not_of(" \t");
+            return first != std::string::npos && value[first] == '-'
+                       ? "must not be negative, got " + value
+                       : std::string();
+        },
+        "");
+    for (CLI::Option* option : app.get_options()) {
+        if (option->get_type_name() == "UINT") option->check(non_negative);
+    }
+    for (CLI::App* command : app.get_subcommands([](CLI::App*) { return true; }))
+        RefuseNegativeUnsigned(*command);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -37,6 +55,7 @@ int main(int argc, char** argv) {
     lidarloop::cli::AddBenchCommand(app);
     lidarloop::cli::AddSimulateCommand(app);
     lidarloop::cli::AddVerifyCommand(app);
+    RefuseNegativeUnsigned(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ValidationError& e) {

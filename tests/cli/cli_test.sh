@@ -357,6 +357,16 @@ section_bench() {
         bench "$seq" --queries 3 --verify-queries 0 --quiet
     expect_ok "bench online step in the JSON" '"online_rate_hz"' "$cli" bench "$seq" --queries 3 \
         --verify-queries 2 --quiet --json -
+    # A negative count must not wrap to 2^64 - 1 (a bench that never ends), nor a huge one run
+    # out of memory.
+    expect_error "bench negative queries" "--queries: must not be negative, got -1" "$cli" \
+        bench "$seq" --queries -1 --quiet
+    expect_error "bench negative scale" "--scale-to: must not be negative" "$cli" bench "$seq" \
+        --scale-to -5 --quiet
+    expect_error "bench huge scale" "scale_to must be at most 2000000" "$cli" bench "$seq" \
+        --scale-to 100000000000 --quiet
+    expect_error "simulate negative seed" "--seed: must not be negative" "$cli" simulate \
+        --seed -1 --scans 2 --out "$work/negative_seed"
     # bench --method ndt reports the rotation candidates of each scan: copies of one scan have as
     # many as describe prints descriptors for it.
     ndt_seq="$work/ndt_seq"

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <limits>
 #include <random>
+#include <string>
 
 #include "lidarloop/app/describe_run.hpp"
 #include "lidarloop/app/detection.hpp"
@@ -172,7 +173,20 @@ double RetrievalMs(const nlohmann::json& queries) {
 
 }  // namespace
 
+void BenchRequest::Validate() const {
+    const auto check = [](const char* name, std::size_t value, std::size_t most) {
+        if (value > most) {
+            throw core::ConfigError(std::string("bench: ") + name + " must be at most " +
+                                    std::to_string(most) + ", got " + std::to_string(value));
+        }
+    };
+    check("queries", queries, kMaxQueries);
+    check("verify_queries", verify_queries, kMaxQueries);
+    check("scale_to", scale_to, kMaxScaleTo);
+}
+
 nlohmann::json RunBench(const io::Dataset& dataset, const BenchRequest& request) {
+    request.Validate();
     const io::RunConfig& config = request.config;
     config.Validate();
     // One core, so that the per-scan times are what one scan costs.

@@ -26,6 +26,12 @@ struct BenchRequest {
     std::filesystem::path odometry_file;
     std::string odometry_topic;
     Progress progress;
+
+    /// Throws core::ConfigError for counts no machine holds (queries, verify_queries over
+    /// kMaxQueries; scale_to over kMaxScaleTo histograms, gigabytes).
+    void Validate() const;
+    static constexpr std::size_t kMaxQueries = 1'000'000;
+    static constexpr std::size_t kMaxScaleTo = 2'000'000;
 };
 
 /// Times describing (one core), the similarity matrix (one core and all cores), and top-1

@@ -8,6 +8,7 @@
 
 #include "lidarloop/app/bench.hpp"
 #include "lidarloop/app/describe_run.hpp"
+#include "lidarloop/core/error.hpp"
 #include "lidarloop/io/kitti_bin.hpp"
 #include "lidarloop/pipeline/similarity_matrix.hpp"
 #include "lidarloop/registration/compact_prepared_scan.hpp"
@@ -70,6 +71,24 @@ void ExpectTimes(const nlohmann::json& step, const std::string& name) {
                   step["wall"][statistic].get<double>() + 0.05)
             << name << " " << statistic;
     }
+}
+
+// Counts no machine holds are refused before any work, not run until memory runs out.
+TEST(BenchRun, AbsurdCountsAreRefusedBeforeAnyWork) {
+    test::TempDir dir;
+    const io::Dataset dataset = TinyRevisit(dir / "seq");
+    const auto refused = [&](auto set) {
+        app::BenchRequest request;
+        set(request);
+        EXPECT_THROW(app::RunBench(dataset, request), core::ConfigError);
+    };
+    refused([](app::BenchRequest& r) { r.scale_to = app::BenchRequest::kMaxScaleTo + 1; });
+    refused([](app::BenchRequest& r) { r.queries = std::size_t(-1); });
+    refused([](app::BenchRequest& r) { r.verify_queries = app::BenchRequest::kMaxQueries + 1; });
+    app::BenchRequest largest;
+    largest.scale_to = app::BenchRequest::kMaxScaleTo;
+    largest.queries = app::BenchRequest::kMaxQueries;
+    EXPECT_NO_THROW(largest.Validate());
 }
 
 TEST(BenchRun, VerificationFiguresAreRecountedIndependently) {
