@@ -92,7 +92,7 @@ void RunDemo(const DemoFlags& flags) {
     const std::filesystem::path out(flags.out);
     ProgressPrinter progress(flags.quiet);
     const app::DemoSequence demo = app::PrepareDemoSequence(
-        out / "sequence", {CommandLine(), {}, flags.overwrite}, progress.Callback());
+        out / "sequence", CommandRun({}, flags.overwrite), progress.Callback());
     const io::Dataset dataset = io::OpenDataset(demo.folder);
     PrintSequence(demo, dataset.size());
     app::EvaluationRequest request;

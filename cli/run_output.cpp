@@ -13,6 +13,7 @@ namespace lidarloop::cli {
 namespace {
 
 std::string command_line;
+std::string command_name;
 std::atomic<bool> interrupt_received{false};
 
 sigset_t InterruptSignals() {
@@ -45,6 +46,10 @@ sigset_t InterruptSignals() {
 
 void InstallInterruptHandler(int argc, char** argv) {
     for (int a = 0; a < argc; ++a) command_line += (a > 0 ? " " : "") + std::string(argv[a]);
+    // The first word that is no flag: lidarloop has no global option that takes a value.
+    for (int a = 1; a < argc && command_name.empty(); ++a) {
+        if (argv[a][0] != '-') command_name = argv[a];
+    }
     const sigset_t signals = InterruptSignals();
     // Blocked here, before any thread starts, so every later thread (oneTBB's workers) inherits
     // the mask and only the watcher receives them.
@@ -53,6 +58,8 @@ void InstallInterruptHandler(int argc, char** argv) {
 }
 
 const std::string& CommandLine() { return command_line; }
+
+const std::string& CommandName() { return command_name; }
 
 bool InterruptReceived() { return interrupt_received; }
 

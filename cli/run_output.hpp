@@ -26,14 +26,25 @@ bool InterruptReceived();
 
 /// The command line as typed (arguments joined by spaces), for run.json.
 const std::string& CommandLine();
+/// The command's name (detect, evaluate, ...), for run.json.
+const std::string& CommandName();
+
+/// The RunInfo of this command line.
+inline app::RunInfo CommandRun(std::vector<std::filesystem::path> inputs, bool overwrite) {
+    app::RunInfo info;
+    info.command_line = CommandLine();
+    info.inputs = std::move(inputs);
+    info.overwrite = overwrite;
+    info.command = CommandName();
+    return info;
+}
 
 /// app::RunInFolder for a command: `inputs` are the files and folders it reads, which `out` may
 /// neither lie inside nor hold; `overwrite` allows a non-empty folder of other files.
 template <typename Run>
 auto RunInFolder(const std::filesystem::path& out, std::vector<std::filesystem::path> inputs,
                  bool overwrite, Run&& run) {
-    return app::RunInFolder(out, {CommandLine(), std::move(inputs), overwrite},
-                            std::forward<Run>(run));
+    return app::RunInFolder(out, CommandRun(std::move(inputs), overwrite), std::forward<Run>(run));
 }
 
 }  // namespace lidarloop::cli

@@ -85,9 +85,9 @@ std::string Number(double value) {
 void RunSimulate(const SimulateFlags& flags) {
     const sim::Simulator simulator(ToConfig(flags));
     ProgressPrinter progress(flags.quiet);
-    const app::SimulationSummary summary = app::WriteSimulation(
-        simulator, flags.out, {CommandLine(), {flags.trajectory}, flags.overwrite}, flags.threads,
-        progress.Callback());
+    const app::SimulationSummary summary =
+        app::WriteSimulation(simulator, flags.out, CommandRun({flags.trajectory}, flags.overwrite),
+                             flags.threads, progress.Callback());
     const sim::SimulationConfig& c = simulator.config();
     char timing[32];
     std::snprintf(timing, sizeof(timing), "%.2f s", summary.seconds);

@@ -112,16 +112,20 @@ std::string CallText(const std::string& function, const py::object& first, const
 /// too, with its exception. Python's KeyboardInterrupt waits until the run returns.
 template <typename Run>
 auto RunInFolder(const fs::path& out, std::vector<fs::path> inputs, bool overwrite,
-                 const std::string& command_line, const PythonProgress& progress, Run&& run) {
+                 const std::string& command, const std::string& command_line,
+                 const PythonProgress& progress, Run&& run) {
     try {
         py::gil_scoped_release release;
-        return app::RunInFolder(
-            out, {command_line, std::move(inputs), overwrite}, [&](const fs::path& staging) {
-                auto result = run(staging);
-                if (progress.Failed())
-                    throw core::Error("the progress callback raised an exception");
-                return result;
-            });
+        app::RunInfo info;
+        info.command_line = command_line;
+        info.inputs = std::move(inputs);
+        info.overwrite = overwrite;
+        info.command = command;
+        return app::RunInFolder(out, std::move(info), [&](const fs::path& staging) {
+            auto result = run(staging);
+            if (progress.Failed()) throw core::Error("the progress callback raised an exception");
+            return result;
+        });
     } catch (const core::Error&) {
         progress.Rethrow();  // the callback's own exception, when it raised one
         throw;
@@ -265,13 +269,13 @@ void BindDetect(py::module_& m) {
             std::vector<fs::path> inputs = InputsOf(data, poses, calib);
             if (odometry) inputs.push_back(*odometry);
             DetectResult result;
-            result.outcome =
-                RunInFolder(out, std::move(inputs), overwrite, CallText("detect", dataset, given),
-                            python_progress, [&](const fs::path& staging) {
-                                app::DetectRequest staged = request;
-                                staged.out = staging;
-                                return app::RunDetect(data, staged);
-                            });
+            result.outcome = RunInFolder(out, std::move(inputs), overwrite, "detect",
+                                         CallText("detect", dataset, given), python_progress,
+                                         [&](const fs::path& staging) {
+                                             app::DetectRequest staged = request;
+                                             staged.out = staging;
+                                             return app::RunDetect(data, staged);
+                                         });
             result.out = out;
             result.method = core::ToString(request.config.descriptor.method);
             return result;
@@ -416,7 +420,7 @@ void BindEvaluate(py::module_& m) {
             if (train_data) inputs.push_back(train_data->root());
             if (odometry) inputs.push_back(*odometry);
             result.outcome = RunInFolder(
-                out, std::move(inputs), overwrite, CallText("evaluate", dataset, given),
+                out, std::move(inputs), overwrite, "evaluate", CallText("evaluate", dataset, given),
                 python_progress, [&](const fs::path& staging) {
                     app::EvaluationRequest staged = request;
                     staged.out = staging;
@@ -528,8 +532,8 @@ void BindOptimise(py::module_& m) {
             OptimiseResult result;
             result.outcome =
                 RunInFolder(out, InputsOf(data, poses, calib, {odometry, request.loops_file}),
-                            overwrite, CallText("optimise", dataset, given), python_progress,
-                            [&](const fs::path& staging) {
+                            overwrite, "optimise", CallText("optimise", dataset, given),
+                            python_progress, [&](const fs::path& staging) {
                                 app::OptimiseRequest staged = request;
                                 staged.out = staging;
                                 return app::RunOptimisation(data, staged);

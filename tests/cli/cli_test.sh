@@ -724,6 +724,18 @@ section_results_folders() {
         fail "a failed rerun changed the earlier run.json"
     fi
     cp "$samples/corner_a.bin" "$seq/scan3.bin"
+    # Another command into detect's folder would remove the map: refused without --overwrite.
+    expect_error "evaluate into detect's results" "holds the results of \`lidarloop detect\`" \
+        "$cli" evaluate "$seq" --poses "$work/odometry.txt" --method range --quiet --out "$res"
+    expect_intact "another command's run" "${detected[@]}"
+    # --overwrite replaces files of the same names, never a folder of the user's as a whole.
+    mkdir -p "$work/mine/velodyne"
+    echo "my notes" >"$work/mine/velodyne/notes.txt"
+    expect_error "simulate over a folder of mine" "would be replaced as a whole" "$cli" simulate \
+        --scans 2 --overwrite --out "$work/mine"
+    if grep -q "my notes" "$work/mine/velodyne/notes.txt"; then pass; else
+        fail "simulate --overwrite removed a folder of the user's"
+    fi
     # bench --json: never into the dataset, never over a file that lidarloop did not write.
     cp "$seq/scan0.bin" "$work/scan0.copy"
     expect_error "bench --json onto a scan" "lies inside the input" "$cli" bench "$seq" \

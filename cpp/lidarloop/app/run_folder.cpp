@@ -117,6 +117,12 @@ void RefuseForeignFolder(const fs::path& folder, const std::optional<io::RunReco
                 "; choose another folder, or give --overwrite to "
                 "replace it");
     }
+    if (holds_files && !earlier->command.empty() && !info.command.empty() &&
+        earlier->command != info.command) {
+        throw io::WriteError(folder, "holds the results of `lidarloop " + earlier->command +
+                                         "`; choose another folder, or give --overwrite to "
+                                         "replace them");
+    }
     if (!earlier && !HoldsOnlyLeftovers(folder)) {
         throw io::WriteError(folder,
                              "is not empty and holds no lidarloop run.json; choose an empty or new "
@@ -215,10 +221,17 @@ std::vector<std::string> FilesToReplace(const fs::path& folder,
     std::error_code ec;
     for (const std::string& name : staged) {
         if (!fs::exists(folder / name, ec)) continue;
-        if (!overwrite && !Contains(listed, name)) {
+        const bool unlisted = !Contains(listed, name);
+        if (unlisted && !overwrite) {
             throw io::WriteError(folder / name,
                                  "exists, and no lidarloop run.json lists it; move it away, or "
                                  "give --overwrite to replace it");
+        }
+        // A folder is replaced as a whole: --overwrite names files, not folders of the user's.
+        if (unlisted && fs::is_directory(folder / name, ec) && !fs::is_empty(folder / name, ec)) {
+            throw io::WriteError(folder / name,
+                                 "is a folder that no lidarloop run.json lists; it would be "
+                                 "replaced as a whole: move it away, or choose another folder");
         }
         replaced.push_back(name);
     }
@@ -331,6 +344,7 @@ void RunFolder::WriteManifest(RunStatus status, const std::vector<std::string>& 
     json["version"] = LIDARLOOP_VERSION;
     json["command_line"] = info_.command_line;
     json["kind"] = io::ToString(info_.kind);
+    if (!info_.command.empty()) json["command"] = info_.command;
     json["status"] = ToString(status);
     json["started"] = started_;
     json["ended"] = UtcNow();

@@ -29,19 +29,24 @@ struct RunInfo {
     /// replacing the files of the same names (its other files stay).
     bool overwrite = false;
     io::RunKind kind = io::RunKind::kResults;  ///< what run.json says the folder holds
+    /// The command's name (detect, evaluate, ...), for run.json: the results of another command
+    /// are replaced only with `overwrite`. Empty: any (runs written before it was recorded).
+    std::string command = {};
 };
 
 /// The results-folder rule of every command that writes (docs/cli.md, "Results folders"):
 /// - a folder inside an input, or holding an input, is refused before anything is written;
 /// - a non-empty folder without a lidarloop run.json, or with one of the other kind (results
-///   against a simulated dataset), is refused unless RunInfo::overwrite;
+///   against a simulated dataset) or of another command (evaluate into detect's results), is
+///   refused unless RunInfo::overwrite;
 /// - the run writes into staging(), a hidden folder inside it; Complete() moves the earlier
 ///   run's files aside, renames the new ones into place (a file is whole or absent, never
 ///   half-written), writes run.json last (version, command line, kind, status, start and end
 ///   time in UTC, the files) and only then deletes the earlier files;
 /// - a run that fails or is interrupted leaves the earlier run's files and run.json as they
 ///   were; in a folder without an earlier run it leaves only a run.json saying how it ended;
-/// - a file of the folder that no run.json lists is never replaced unless RunInfo::overwrite.
+/// - a file of the folder that no run.json lists is never replaced unless RunInfo::overwrite, and
+///   a non-empty subfolder that none lists never (it is replaced as a whole: the user's files).
 /// Complete and Abandon are thread-safe with each other (Abandon may come from a signal
 /// watcher thread); the first of them decides.
 class RunFolder {

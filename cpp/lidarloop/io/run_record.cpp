@@ -25,16 +25,22 @@ std::vector<std::string> ListedFiles(const nlohmann::json& json) {
     return files;
 }
 
+// A string field, or "" when it is missing or not a string (json::value would throw).
+std::string StringField(const nlohmann::json& json, const char* key) {
+    const auto found = json.find(key);
+    return found != json.end() && found->is_string() ? found->get<std::string>() : std::string();
+}
+
 std::optional<RunRecord> ParseRecord(const fs::path& file) {
     std::ifstream in(file);
     if (!in) return std::nullopt;
     const nlohmann::json json = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-    if (!json.is_object() || json.value("tool", "") != "lidarloop") return std::nullopt;
+    if (!json.is_object() || StringField(json, "tool") != "lidarloop") return std::nullopt;
     RunRecord record;
-    record.kind =
-        json.value("kind", "results") == "dataset" ? RunKind::kDataset : RunKind::kResults;
-    record.status = json.value("status", "");
+    record.kind = StringField(json, "kind") == "dataset" ? RunKind::kDataset : RunKind::kResults;
+    record.status = StringField(json, "status");
     record.files = ListedFiles(json);
+    record.command = StringField(json, "command");
     return record;
 }
 
@@ -49,7 +55,8 @@ std::optional<RunRecord> LegacySimulation(const fs::path& folder) {
     return RunRecord{
         RunKind::kDataset,
         "complete",
-        {"velodyne", "poses.txt", "times.txt", "poses_odometry.txt", "simulation.yaml"}};
+        {"velodyne", "poses.txt", "times.txt", "poses_odometry.txt", "simulation.yaml"},
+        "simulate"};
 }
 
 }  // namespace

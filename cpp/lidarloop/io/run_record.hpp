@@ -21,6 +21,7 @@ struct RunRecord {
     RunKind kind = RunKind::kResults;
     std::string status;              ///< complete, failed, interrupted
     std::vector<std::string> files;  ///< plain names in the folder, files or subfolders
+    std::string command = {};        ///< detect, evaluate, ...; empty when not recorded
 };
 
 /// run.json, the record's name in its folder.

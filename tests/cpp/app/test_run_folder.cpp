@@ -15,6 +15,7 @@
 #include "lidarloop/app/run_folder.hpp"
 #include "lidarloop/io/config_yaml.hpp"
 #include "lidarloop/io/read_error.hpp"
+#include "lidarloop/io/run_record.hpp"
 #include "test_utils.hpp"
 
 namespace lidarloop::app {
@@ -242,6 +243,85 @@ TEST(RunFolder, ASequenceIsReplacedOnlyWhenToldTo) {
     // Results into a results folder need no flag.
     WriteDetectResults(dir / "results");
     EXPECT_NO_THROW(WriteDetectResults(dir / "results"));
+}
+
+RunInfo CommandRun(const std::string& command, bool overwrite = false) {
+    RunInfo info;
+    info.command_line = "lidarloop " + command;
+    info.overwrite = overwrite;
+    info.command = command;
+    return info;
+}
+
+// `evaluate --out X` after `detect --out X` would remove the map detect built: another command's
+// results are replaced only with --overwrite; the same command's, as ever, without it.
+TEST(RunFolder, AnotherCommandsResultsAreReplacedOnlyWhenToldTo) {
+    test::TempDir dir;
+    const fs::path out = dir / "results";
+    const auto write = [&](const RunInfo& info, const std::string& text) {
+        RunInFolder(out, info, [&](const fs::path& staging) {
+            test::WriteFile(staging / (info.command + ".txt"), text);
+            return 0;
+        });
+    };
+    write(CommandRun("detect"), "first");
+    EXPECT_EQ(Manifest(out)["command"], "detect");
+    try {
+        write(CommandRun("evaluate"), "second");
+        ADD_FAILURE() << "evaluate replaced detect's results";
+    } catch (const io::WriteError& e) {
+        EXPECT_NE(std::string(e.what()).find("holds the results of `lidarloop detect`"),
+                  std::string::npos)
+            << e.what();
+    }
+    EXPECT_EQ(test::ReadFile(out / "detect.txt"), "first");
+    EXPECT_NO_THROW(write(CommandRun("detect"), "again"));
+    EXPECT_EQ(test::ReadFile(out / "detect.txt"), "again");
+    EXPECT_NO_THROW(write(CommandRun("evaluate", /*overwrite=*/true), "replaced"));
+    EXPECT_EQ(Entries(out), (std::vector<std::string>{"evaluate.txt", "run.json"}));
+    // A run.json from before the command was recorded names none: any results command follows.
+    nlohmann::json legacy = Manifest(out);
+    legacy.erase("command");
+    test::WriteFile(out / "run.json", legacy.dump());
+    EXPECT_NO_THROW(write(CommandRun("detect"), "after legacy"));
+}
+
+// --overwrite replaces files of the same names; a folder of the user's is replaced as a whole,
+// so one that no run.json lists is refused even then (an empty one is no loss).
+TEST(RunFolder, AnUnlistedFolderOfTheSameNameIsNeverReplaced) {
+    test::TempDir dir;
+    const fs::path out = dir / "mine";
+    fs::create_directories(out / "velodyne");
+    test::WriteFile(out / "velodyne" / "notes.txt", "mine");
+    test::WriteFile(out / "poses.txt", "my poses");
+    fs::create_directories(out / "detection");
+    const auto run = [&] {
+        RunInFolder(out, CommandRun("simulate", /*overwrite=*/true), [](const fs::path& staging) {
+            fs::create_directories(staging / "velodyne");
+            test::WriteFile(staging / "velodyne" / "000000.bin", "scan");
+            fs::create_directories(staging / "detection");
+            test::WriteFile(staging / "poses.txt", "simulated");
+            return 0;
+        });
+    };
+    EXPECT_THROW(run(), io::WriteError);
+    EXPECT_EQ(test::ReadFile(out / "velodyne" / "notes.txt"), "mine");
+    EXPECT_EQ(test::ReadFile(out / "poses.txt"), "my poses");
+    fs::remove(out / "velodyne" / "notes.txt");
+    EXPECT_NO_THROW(run());
+    EXPECT_EQ(test::ReadFile(out / "poses.txt"), "simulated");
+}
+
+// A run.json whose fields have the wrong types is no record, not a crash.
+TEST(RunFolder, ARunJsonOfWrongTypesIsNoRecord) {
+    test::TempDir dir;
+    test::WriteFile(dir / "run.json",
+                    R"({"tool": "lidarloop", "status": 5, "kind": [], "command": 1})");
+    const auto record = io::ReadRunRecord(dir.path());
+    ASSERT_TRUE(record.has_value());
+    EXPECT_EQ(record->status, "");
+    EXPECT_EQ(record->command, "");
+    EXPECT_EQ(record->kind, io::RunKind::kResults);
 }
 
 // What a killed run leaves is removed; what a running one uses is not.
