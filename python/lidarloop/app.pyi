@@ -223,7 +223,6 @@ def optimise(
     min_gap_unit: Optional[str] = None,
     min_path_m: Optional[float] = None,
     top_k: Optional[int] = None,
-    verify: Optional[bool] = None,
     stop_at_first_loop: Optional[bool] = None,
     skip_bad: Optional[bool] = None,
     max_odometry_step_m: Optional[float] = None,

@@ -12,6 +12,7 @@
 #include "lidarloop/app/map_building.hpp"
 #include "lidarloop/app/optimisation_report.hpp"
 #include "lidarloop/app/results_folder.hpp"
+#include "lidarloop/core/error.hpp"
 #include "lidarloop/io/map_files.hpp"
 #include "lidarloop/io/map_image.hpp"
 #include "lidarloop/io/png.hpp"
@@ -32,8 +33,7 @@ bool SeparatedInPath(double a_m, double b_m, const posegraph::PoseGraphConfig& c
 std::vector<posegraph::LoopConstraint> DetectLoops(const io::Dataset& dataset,
                                                    const OptimiseRequest& request) {
     DetectRequest detect;
-    detect.config = request.config;
-    detect.config.detection.verify = true;
+    detect.config = request.config;  // verify: RunOptimisation refuses detection.verify false
     detect.skip_bad = request.skip_bad;
     detect.progress = request.progress;
     detect.out = request.out / "detection";
@@ -242,6 +242,11 @@ MapSummary WriteMaps(const io::Dataset& dataset, const OptimiseRequest& request,
 OptimiseOutcome RunOptimisation(const io::Dataset& dataset, const OptimiseRequest& request) {
     Stopwatch total;
     request.config.Validate();
+    if (request.loops_file.empty() && !request.config.detection.verify) {
+        throw core::ConfigError(
+            "optimise verifies the loops it detects (the pose graph needs their poses): "
+            "detection.verify: false is for detect, evaluate and bench");
+    }
     const std::filesystem::path out = PrepareOutputFolder(request.out);
     io::WriteConfigYaml(out / "config.yaml", request.config);
     const std::vector<core::StampedPose> odometry =

@@ -13,6 +13,8 @@ constexpr auto kOptimise = static_cast<std::uint8_t>(RunCommand::kOptimise);
 constexpr auto kBench = static_cast<std::uint8_t>(RunCommand::kBench);
 constexpr std::uint8_t kDetecting = kDetect | kEvaluate | kOptimise | kBench;
 constexpr std::uint8_t kRunning = kDetect | kEvaluate | kOptimise;  // read a whole dataset
+// optimise always verifies: the pose graph needs the loops' poses.
+constexpr std::uint8_t kMayNotVerify = kDetect | kEvaluate | kBench;
 constexpr RunCommand kCommands[] = {RunCommand::kDetect, RunCommand::kEvaluate,
                                     RunCommand::kOptimise, RunCommand::kBench};
 
@@ -79,7 +81,7 @@ std::vector<RunOption> MakeRunOptions() {
          [] { return std::to_string(io::RunConfig{}.detection.top_k); }},
         {"verify", "--no-verify", "", T::kSwitchOff,
          "descriptor only: accept by the threshold, no geometric verification (keyword: False)",
-         "detection.verify", kDetecting,
+         "detection.verify", kMayNotVerify,
          [](const RunTargets& t, const RunOptionValue& v) {
              t.config->detection.verify = std::get<bool>(v);
          },

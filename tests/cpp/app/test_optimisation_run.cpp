@@ -10,6 +10,7 @@
 
 #include "app_test_utils.hpp"
 #include "lidarloop/app/optimisation.hpp"
+#include "lidarloop/core/error.hpp"
 #include "lidarloop/io/poses.hpp"
 #include "lidarloop/io/read_error.hpp"
 #include "test_utils.hpp"
@@ -145,6 +146,19 @@ TEST_F(OptimisationRun, WithoutLoopsTheOdometryComesBackWithANote) {
     ASSERT_FALSE(outcome.notes.empty());
     EXPECT_TRUE(test::Contains(outcome.notes.front(), "no loop"));
     EXPECT_DOUBLE_EQ(outcome.optimised->ate_rmse_m, outcome.odometry->ate_rmse_m);
+}
+
+// The pose graph needs the loops' poses: detecting without verification is refused, not run
+// with verification behind the user's back (as --no-verify once was); loops from a file need none.
+TEST_F(OptimisationRun, DetectingWithoutVerificationIsRefused) {
+    app::OptimiseRequest request = Request("unverified");
+    request.config.detection.verify = false;
+    EXPECT_THROW(app::RunOptimisation(*dataset_, request), core::ConfigError);
+    EXPECT_FALSE(std::filesystem::exists(dir_ / "unverified" / "detection"));
+    test::WriteFile(dir_ / "loops.csv",
+                    "query,match,distance,second_ratio,accepted,rank,tx,ty,tz,qx,qy,qz,qw\n");
+    request.loops_file = dir_ / "loops.csv";
+    EXPECT_NO_THROW(app::RunOptimisation(*dataset_, request));
 }
 
 // A loop repeated in loops.csv, also with its two scans swapped, enters the graph once, with a
