@@ -66,6 +66,11 @@ std::vector<core::StampedPose> ReadOdometry(const std::filesystem::path& file,
                                       std::to_string(dataset.size()) +
                                       " scans: odometry needs one pose per scan");
     }
+    // A KITTI file has no times (ReadPoses numbers the poses): they are the scans' own, so that
+    // poses written with times (optimise --format tum) carry the dataset's.
+    if (!io::IsTumPosesFile(file) && dataset.HasTimes()) {
+        for (std::size_t i = 0; i < odometry.size(); ++i) odometry[i].time_s = dataset.ScanTime(i);
+    }
     return odometry;
 }
 

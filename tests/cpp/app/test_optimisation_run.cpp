@@ -142,10 +142,17 @@ TEST_F(OptimisationRun, WithoutLoopsTheOdometryComesBackWithANote) {
                     "50,3,0.1,,0,1,0,0,0,0,0,0,1\n");
     app::OptimiseRequest request = Request("none");
     request.loops_file = dir_ / "none.csv";
+    request.format = app::PoseFormat::kTum;
     const app::OptimiseOutcome outcome = app::RunOptimisation(*dataset_, request);
     ASSERT_FALSE(outcome.notes.empty());
     EXPECT_TRUE(test::Contains(outcome.notes.front(), "no loop"));
     EXPECT_DOUBLE_EQ(outcome.optimised->ate_rmse_m, outcome.odometry->ate_rmse_m);
+    // A KITTI odometry file has no times: TUM poses carry the scans' own, not their numbers.
+    const auto poses = io::ReadTumPoses(request.out / "poses_optimised.txt");
+    ASSERT_EQ(poses.size(), dataset_->size());
+    ASSERT_NE(dataset_->ScanTime(5), 5.0);
+    for (const std::size_t i : {std::size_t{0}, std::size_t{5}, dataset_->size() - 1})
+        EXPECT_NEAR(poses[i].time_s, dataset_->ScanTime(i), 1e-6) << i;
 }
 
 // The pose graph needs the loops' poses: detecting without verification is refused, not run
