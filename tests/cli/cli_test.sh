@@ -460,6 +460,14 @@ section_evaluate() {
         --out "$work/demo_train3"
     expect_ok "evaluate fixed thresholds" "report:" "$cli" evaluate "$demo_seq" --no-verify --method range \
         --fixed-thresholds 0.003,0.005,0.007 --quiet --out "$work/demo_fixed"
+    if grep -q "every compared pair" "$work/stderr" "$work/demo_fixed/report.md"; then
+        fail "a one-class note on a sequence of both classes"
+    else
+        pass
+    fi
+    # Every pair the same place: the pair protocol's figures mean nothing, and a note says so.
+    expect_ok "evaluate one class" "every compared pair is the same place" "$cli" evaluate \
+        "$demo_seq" --no-verify --method range --distance 100000 --quiet --out "$work/demo_one"
     if grep -q "L_0.003 | L_0.005 | L_0.007" "$work/demo_fixed/report.md"; then pass; else
         fail "report.md lacks the fixed-threshold table"
     fi
@@ -873,6 +881,15 @@ section_path_gap() {
     local odometry="$work/seq/poses_odometry.txt"
     expect_ok "detect gap in metres" "40 scans" "$cli" detect "$work/seq" --min-gap 20 \
         --min-gap-unit metres --odometry "$odometry" --no-verify --top-k 3 --quiet --out "$work/det"
+    if grep -q "no path rule" "$work/stderr"; then fail "a path rule note with odometry"; else pass; fi
+    # Without poses or odometry the 50 m path rule cannot hold: a note says so.
+    mkdir -p "$work/no_poses"
+    cp "$work/seq/velodyne/"*.bin "$work/no_poses/"
+    expect_ok "detect without a path" "40 scans" "$cli" detect "$work/no_poses" --no-verify \
+        --quiet --out "$work/det_no_path"
+    if grep -q "no path rule (detection.min_path_m)" "$work/stderr"; then pass; else
+        fail "detect without poses gave no note on the path rule: $(cat "$work/stderr")"
+    fi
     # Every candidate lies more than 20 m of path back, and path_m is the path walked anew.
     local wrong
     wrong="$(awk -F, 'NR == FNR { x[FNR - 1] = $4; y[FNR - 1] = $8; z[FNR - 1] = $12; next }

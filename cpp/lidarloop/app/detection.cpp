@@ -54,6 +54,14 @@ std::vector<double> PathOfScans(const DetectRequest& request, const io::Dataset&
     return path_m;
 }
 
+// Without poses or odometry no candidate can be held to detection.min_path_m: a slow platform's
+// recent past passes the gap in scans alone.
+std::string NoPathNote() {
+    return "no path rule (detection.min_path_m): the dataset has no poses and no --odometry was "
+           "given, so a candidate need only lie outside the gap in scans; a slow platform's "
+           "recent past may then count as a loop";
+}
+
 }  // namespace
 
 std::vector<core::StampedPose> ReadOdometry(const std::filesystem::path& file,
@@ -190,6 +198,7 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     pipeline::MethodOf(config.descriptor.method).ValidateThreshold(threshold);
     RequireTimesForSeconds(config, dataset);
     const std::vector<double> path_m = PathOfScans(request, dataset, poses);
+    if (path_m.empty() && config.detection.min_path_m > 0.0) outcome.notes.push_back(NoPathNote());
     const std::filesystem::path out_dir = PrepareOutputFolder(request.out);
     io::WriteConfigYaml(out_dir / "config.yaml", config);
 

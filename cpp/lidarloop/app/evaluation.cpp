@@ -306,6 +306,19 @@ void WriteEvaluationResults(const std::filesystem::path& out_dir, const io::Data
     WriteCurveCsvs(out_dir, outcome.methods);
     std::vector<std::string> notes = WriteFigures(out_dir, truth, outcome.methods);
     outcome.notes.insert(outcome.notes.begin(), notes.begin(), notes.end());
+    // The pair protocol needs both classes: one alone makes every threshold perfect (MCC 0,
+    // F1 1) or empty, figures that read as results.
+    if (!outcome.methods.empty()) {
+        const eval::PairwiseEvaluation& pairs = outcome.methods.front().pairwise;
+        if (pairs.positives == 0 || pairs.negatives == 0) {
+            outcome.notes.push_back(
+                std::string("every compared pair is ") +
+                (pairs.positives == 0 ? "a different place" : "the same place") + " (no " +
+                (pairs.positives == 0 ? "positive" : "negative") +
+                " pair at --distance): the pair protocol's MCC, F1, ROC and recall at zero "
+                "errors say nothing here");
+        }
+    }
     for (const MethodEvaluation& e : outcome.methods) {
         if (e.optimum_exact) continue;
         outcome.notes.push_back(

@@ -35,10 +35,10 @@ struct DetectorConfig {
     /// Where the odometry judges the loops (a LoopCheck with view_distance_m: `detect` and
     /// `evaluate` with --odometry, the online detector with a gate, when they verify): the top_k
     /// are the scans among this many best-ranked ones within the odometry's reach whose view
-    /// centres the odometry puts nearest the query's, nearest first; at most top_k: the top_k
-    /// best-ranked, in rank order. 1..1000. 50: chosen on the seed-3 simulated drives and the
-    /// real HKU_1, validated on the seed-7 drives and HKU_2 (docs/verification.md, "The
-    /// odometry orders the shortlist").
+    /// centres the odometry puts nearest the query's, nearest first (at most top_k: the top_k
+    /// best-ranked within reach, still nearest first). 1..1000. 50: chosen on the seed-3 simulated
+    /// drives and the real HKU_1, validated on the seed-7 drives and HKU_2 (docs/verification.md,
+    /// "The odometry orders the shortlist").
     int odometry_shortlist = 50;
     /// The decision threshold, tau (W <= tau, Röhling eq. 7) or t_d (sigma' < t_d, Magnusson
     /// II-E); empty: the method's default (pipeline::DefaultThreshold).
