@@ -67,10 +67,9 @@ void AddMapCommand(CLI::App& app) {
         ->required();
     command->add_option("--config", flags->config, "YAML file; its map.* keys apply")
         ->check(CLI::ExistingFile);
-    command
-        ->add_option("--voxel", flags->voxel_m,
-                     "M: voxel edge, [0.01, 100]; map.voxel_m, default 0.2")
-        ->check(CLI::PositiveNumber);
+    // No CLI11 check: MapConfig::Validate names the key and range ("map.voxel_m must be in ...").
+    command->add_option("--voxel", flags->voxel_m,
+                        "M: voxel edge, [0.01, 100]; map.voxel_m, default 0.2");
     command->add_option("--max-points", flags->max_points,
                         "N: most points, [1000, 1e8]; a larger map gets coarser voxels; "
                         "map.max_points, default 2000000");

@@ -455,6 +455,8 @@ section_evaluate() {
     expect_error "evaluate --train-on without poses" "has no poses; threshold learning needs" \
         "$cli" evaluate "$demo_seq" --no-verify --method height --train-on "$seq" --quiet \
         --out "$work/demo_train2"
+    expect_exit_1 "evaluate a method twice" "method range is asked for twice" "$cli" evaluate \
+        "$demo_seq" --no-verify --method range --method range --quiet --out "$work/demo_twice"
     expect_error "evaluate --train-poses alone" "--train-poses needs --train-on" "$cli" evaluate \
         "$demo_seq" --method height --train-poses "$demo_seq/poses.txt" --quiet \
         --out "$work/demo_train3"
@@ -586,6 +588,8 @@ section_simulate() {
         "$cli" simulate --scene moon --out "$work/sim_bad"
     expect_error "simulate zero scans" "--scans must be in [1, 1000000]" "$cli" simulate --scans 0 \
         --out "$work/sim_bad"
+    expect_exit_1 "simulate negative threads" "threads must be 0 (all cores) or more, got -1" \
+        "$cli" simulate --scans 2 --threads -1 --out "$work/sim_bad"
     expect_error "simulate bad dropout" "sensor.dropout must be in [0, 1)" "$cli" simulate \
         --dropout 1.5 --out "$work/sim_bad"
     expect_error "simulate bad sensor" \
@@ -671,6 +675,8 @@ section_map() {
         --overwrite
     expect_exit_1 "map into the dataset" "lies inside the input" "$cli" map "$work/seq" \
         --out "$work/seq/map.ply"
+    expect_exit_1 "map zero voxel" "map.voxel_m must be in [0.01, 100] m, got 0" "$cli" map \
+        "$work/seq" --voxel 0 --out "$work/bad.ply"
     head -n 39 "$odometry" >"$work/short.txt"
     expect_exit_1 "map short poses" "short.txt: holds 39 poses but" "$cli" map "$work/seq" \
         --poses "$work/short.txt" --out "$work/bad.ply"

@@ -449,6 +449,13 @@ eval::GroundTruthConfig GroundTruthRule(const EvaluationRequest& request) {
 EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequest& request,
                                 const io::Dataset* train_dataset) {
     request.learning.Validate();
+    for (std::size_t m = 0; m < request.methods.size(); ++m) {
+        if (std::find(request.methods.begin(), request.methods.begin() + static_cast<long>(m),
+                      request.methods[m]) != request.methods.begin() + static_cast<long>(m)) {
+            throw core::ConfigError("method " + core::ToString(request.methods[m]) +
+                                    " is asked for twice; each method is evaluated once");
+        }
+    }
     if (request.config.detection.threshold && request.methods.size() > 1) {
         throw core::ConfigError(
             "detection.threshold (" + std::to_string(*request.config.detection.threshold) +

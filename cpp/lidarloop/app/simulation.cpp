@@ -10,6 +10,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "lidarloop/core/error.hpp"
 #include "lidarloop/core/number_text.hpp"
 #include "lidarloop/io/kitti_sequence.hpp"
 #include "lidarloop/io/read_error.hpp"
@@ -113,6 +114,10 @@ void WritePoses(const sim::Simulator& simulator, io::KittiSequenceWriter& writer
 
 SimulationSummary WriteSimulation(const sim::Simulator& simulator, const std::filesystem::path& out,
                                   RunInfo run, int threads, const Progress& progress) {
+    if (threads < 0) {
+        throw core::ConfigError("threads must be 0 (all cores) or more, got " +
+                                std::to_string(threads));
+    }
     const auto start = std::chrono::steady_clock::now();
     run.kind = io::RunKind::kDataset;
     ScanStats stats;
