@@ -77,12 +77,18 @@ void PrintSummary(const nlohmann::json& figures) {
             (verification.value("odometry", false) ? " (odometry)" : "");
         PrintRow("online step, " + verified, "scan", verification["online_step_ms_per_scan"]);
         online_ms = verification["online_step_ms_per_scan"].value("median", 0.0);
-        std::printf(
-            "\nonline step: %s per scan on one core = %.1f Hz (describe, retrieve, prepare, "
-            "coarse images and the %s, over %d scans with candidates; file reading "
-            "excluded)\n",
-            Duration(online_ms).c_str(), verification.value("online_rate_hz", 0.0),
-            verified.c_str(), verification.value("queries", 0));
+        if (verification["online_rate_hz"].is_number()) {
+            std::printf(
+                "\nonline step: %s per scan on one core = %.1f Hz (describe, retrieve, prepare, "
+                "coarse images and the %s, over %d scans with candidates; file reading "
+                "excluded)\n",
+                Duration(online_ms).c_str(), verification["online_rate_hz"].get<double>(),
+                verified.c_str(), verification.value("queries", 0));
+        } else {
+            std::printf(
+                "\nonline step: not measured: no scan had candidates (a dataset shorter than "
+                "the gap, or --queries 0); the rows above are then no measurement either\n");
+        }
         std::printf("memory: %.0f bytes per prepared scan (median)\n",
                     verification["bytes_per_prepared_scan"].value("median", 0.0));
     } else {

@@ -352,11 +352,16 @@ section_bench() {
         --quiet --json -
     # The table: the online step's stages and its rate, with the figures of the JSON.
     expect_ok "bench table" "per scan on one core =" "$cli" bench "$seq" \
-        --queries 3 --verify-queries 2 --quiet
+        --queries 3 --verify-queries 2 --min-gap 2 --quiet
     expect_ok "bench table without verification" "online step without verification" "$cli" \
         bench "$seq" --queries 3 --verify-queries 0 --quiet
-    expect_ok "bench online step in the JSON" '"online_rate_hz"' "$cli" bench "$seq" --queries 3 \
-        --verify-queries 2 --quiet --json -
+    expect_ok "bench online step in the JSON" '"online_rate_hz": ' "$cli" bench "$seq" --queries 3 \
+        --verify-queries 2 --min-gap 2 --quiet --json -
+    if grep -q '"online_rate_hz": null' <<<"$("$cli" bench "$seq" --queries 3 --verify-queries 2 \
+        --min-gap 2 --quiet --json -)"; then fail "bench measured no online step"; else pass; fi
+    # No timed scan (a gap longer than the sequence): no rate that reads as measured.
+    expect_ok "bench without candidates" "online step: not measured" "$cli" bench "$seq" \
+        --queries 3 --verify-queries 2 --min-gap 1000 --quiet
     # A negative count must not wrap to 2^64 - 1 (a bench that never ends), nor a huge one run
     # out of memory.
     expect_error "bench negative queries" "--queries: must not be negative, got -1" "$cli" \

@@ -158,8 +158,10 @@ nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
     json["coarse_images_ms_per_query"] = ms(times.query_seconds, times.query_cpu_seconds);
     json["verify_ms_per_pair"] = ms(times.pair_seconds, times.pair_cpu_seconds);
     json["online_step_ms_per_scan"] = SummaryJson(online_ms);
+    // No timed scan (none had candidates): no rate, rather than a 0 Hz that reads as measured.
     const double median_ms = Quantile(online_ms, 0.5);
-    json["online_rate_hz"] = median_ms > 0.0 ? 1e3 / median_ms : 0.0;
+    json["online_rate_hz"] =
+        median_ms > 0.0 ? nlohmann::json(1e3 / median_ms) : nlohmann::json(nullptr);
     return json;
 }
 
