@@ -169,11 +169,12 @@ std::string TruthFields(const std::vector<core::StampedPose>& poses, const Candi
     return fields.str();
 }
 
-// The registered sensors' distance, metres; empty for a pair never registered (every coarse
-// peak out of reach), whose pose is no registration's.
+// The registered sensors' distance, metres, formatted as the other fields; empty for a pair
+// never registered (every coarse peak out of reach), whose pose is no registration's.
 std::string RegisteredDistance(const registration::Verification& now) {
-    return now.Registered() ? std::to_string(now.T_match_query.translation().norm())
-                            : std::string();
+    std::ostringstream field;
+    if (now.Registered()) field << now.T_match_query.translation().norm();
+    return field.str();
 }
 
 // A scan's structure points, distinctive ones among them, ground points and roughness.

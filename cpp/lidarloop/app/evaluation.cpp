@@ -449,10 +449,10 @@ eval::GroundTruthConfig GroundTruthRule(const EvaluationRequest& request) {
 EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequest& request,
                                 const io::Dataset* train_dataset) {
     request.learning.Validate();
-    for (std::size_t m = 0; m < request.methods.size(); ++m) {
-        if (std::find(request.methods.begin(), request.methods.begin() + static_cast<long>(m),
-                      request.methods[m]) != request.methods.begin() + static_cast<long>(m)) {
-            throw core::ConfigError("method " + core::ToString(request.methods[m]) +
+    const auto& methods = request.methods;
+    for (auto method = methods.begin(); method != methods.end(); ++method) {
+        if (std::find(methods.begin(), method, *method) != method) {
+            throw core::ConfigError("method " + core::ToString(*method) +
                                     " is asked for twice; each method is evaluated once");
         }
     }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <optional>
 
 #include "lidarloop/io/detail/text_parsing.hpp"
 #include "lidarloop/io/osnabrueck.hpp"
@@ -174,6 +175,14 @@ Dataset OpenBag(const fs::path& bag, const DatasetOptions& options) {
     return {std::move(scans), std::move(poses)};
 }
 
+// The layout of the scans directly in `root` (not in its subfolders but velodyne/), if any.
+std::optional<DatasetFormat> FoundFormat(const fs::path& root) {
+    if (!ListFiles(root / "velodyne", IsKittiBin).empty()) return DatasetFormat::kKitti;
+    if (!ListFiles(root, IsOsnabrueckScan).empty()) return DatasetFormat::kOsnabrueck;
+    if (!ListFolderScans(root).empty()) return DatasetFormat::kFolder;
+    return std::nullopt;
+}
+
 // A folder of sequences (KITTI's 00/, 08/ ...) is not one: name those that are, to pick from.
 // Only a hint: a subfolder that cannot be read is left out, not an error of its own.
 std::string SubfolderDatasetsHint(const fs::path& root) try {
@@ -181,11 +190,10 @@ std::string SubfolderDatasetsHint(const fs::path& root) try {
     for (const auto& entry : fs::directory_iterator(root)) {
         const fs::path& sub = entry.path();
         if (!entry.is_directory() || sub.filename() == "velodyne") continue;
-        const auto scans = ListFolderScans(sub);
+        const std::optional<DatasetFormat> format = FoundFormat(sub);
         // A subfolder of .txt files alone more likely holds poses (KITTI's poses/00.txt).
-        const bool binary_scans = !scans.empty() && scans.front().extension() != ".txt";
-        if (!ListFiles(sub / "velodyne", IsKittiBin).empty() ||
-            !ListFiles(sub, IsOsnabrueckScan).empty() || binary_scans) {
+        if (format && (format != DatasetFormat::kFolder ||
+                       ListFolderScans(sub).front().extension() != ".txt")) {
             names.push_back(sub.filename().string());
         }
     }
@@ -199,9 +207,7 @@ std::string SubfolderDatasetsHint(const fs::path& root) try {
 }
 
 DatasetFormat DetectFormat(const fs::path& root) {
-    if (!ListFiles(root / "velodyne", IsKittiBin).empty()) return DatasetFormat::kKitti;
-    if (!ListFiles(root, IsOsnabrueckScan).empty()) return DatasetFormat::kOsnabrueck;
-    if (!ListFolderScans(root).empty()) return DatasetFormat::kFolder;
+    if (const std::optional<DatasetFormat> format = FoundFormat(root)) return *format;
     throw ReadError(root,
                     "cannot tell the dataset format: found no velodyne/*.bin (KITTI), no "
                     "scanNNN.3d (Osnabrueck) and no .pcd/.ply/.xyz/.txt/.pts/.bin scans "
