@@ -578,7 +578,7 @@ std::vector<core::StampedPose> TrajectoryOf(const io::Dataset& data, const py::o
     const std::vector<core::Transform> transforms = TransformsFromArray(trajectory, "trajectory");
     std::vector<core::StampedPose> poses(transforms.size());
     for (std::size_t i = 0; i < poses.size(); ++i)
-        poses[i] = {static_cast<double>(i), transforms[i]};
+        poses[i] = {static_cast<double>(i), transforms[i], std::nullopt};
     return poses;
 }
 

@@ -68,6 +68,9 @@ std::vector<core::StampedPose> ReadOdometry(const std::filesystem::path& file,
                                             const io::Dataset& dataset, double max_step_m) {
     std::vector<core::StampedPose> odometry =
         io::ReadPoses(file, core::Transform::Identity(), {}, max_step_m);
+    if (dataset.format() == io::DatasetFormat::kKitti) {
+        odometry = io::PosesOfFrames(dataset.ScanPaths(), std::move(odometry), file);
+    }
     if (odometry.size() != dataset.size()) {
         throw io::ReadError(file, "holds " + std::to_string(odometry.size()) + " poses but " +
                                       dataset.root().string() + " has " +

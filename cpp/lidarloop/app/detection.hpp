@@ -57,8 +57,9 @@ struct DetectOutcome {
 DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request);
 
 /// The odometry of `dataset` from `file` (KITTI or TUM, T_world_sensor): io::ReadError naming the
-/// file when it has not one pose per scan, or when a step between consecutive poses exceeds
-/// `max_step_m` (a jump or a reset). Shared by detect (the path of a gap in metres) and optimise.
+/// file when it has not one pose per scan (nor, for a KITTI layout, one per frame:
+/// io::PosesOfFrames), or when a step between consecutive poses of the file exceeds `max_step_m` (a
+/// jump or a reset). Shared by detect (the path of a gap in metres) and optimise.
 std::vector<core::StampedPose> ReadOdometry(
     const std::filesystem::path& file, const io::Dataset& dataset,
     double max_step_m = std::numeric_limits<double>::infinity());

@@ -1,5 +1,6 @@
 #include "lidarloop/core/min_gap.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -33,6 +34,11 @@ MinGap::Unit ParseMinGapUnit(std::string_view name) {
 std::vector<double> CumulativePathM(const std::vector<StampedPose>& poses) {
     std::vector<double> path_m;
     path_m.reserve(poses.size());
+    const auto knows_path = [](const StampedPose& pose) { return pose.path_m.has_value(); };
+    if (!poses.empty() && std::all_of(poses.begin(), poses.end(), knows_path)) {
+        for (const StampedPose& pose : poses) path_m.push_back(*pose.path_m - *poses[0].path_m);
+        return path_m;
+    }
     for (std::size_t i = 0; i < poses.size(); ++i) {
         const Eigen::Vector3d position = poses[i].T_world_sensor.translation();
         if (!position.allFinite()) {

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -23,6 +24,9 @@ using Transform = Eigen::Isometry3d;
 struct StampedPose {
     double time_s = 0.0;
     Transform T_world_sensor = Transform::Identity();
+    /// Metres travelled since the trajectory's first pose, when the poses are some of a longer
+    /// trajectory's (frames of a KITTI sequence); else unset: the steps between them are the path.
+    std::optional<double> path_m;
 };
 
 }  // namespace lidarloop::core

@@ -5,6 +5,7 @@
 #include <cctype>
 #include <optional>
 
+#include "lidarloop/core/min_gap.hpp"
 #include "lidarloop/io/detail/text_parsing.hpp"
 #include "lidarloop/io/osnabrueck.hpp"
 #include "lidarloop/io/poses.hpp"
@@ -102,6 +103,17 @@ std::vector<core::StampedPose> ReadPosesFile(const fs::path& file,
     return ReadPoses(file, T_cam0_velo, times_file);
 }
 
+// The frame number of a KITTI scan file (velodyne/000094.bin is frame 94), if its name is one.
+std::optional<std::size_t> FrameNumber(const fs::path& scan) {
+    const std::string stem = scan.stem().string();
+    if (stem.empty() || stem.size() > 9 || !std::all_of(stem.begin(), stem.end(), [](char c) {
+            return std::isdigit(static_cast<unsigned char>(c)) != 0;
+        })) {
+        return std::nullopt;
+    }
+    return static_cast<std::size_t>(std::stoul(stem));
+}
+
 Dataset OpenKitti(const fs::path& root, const DatasetOptions& options) {
     auto scans = ListFiles(root / "velodyne", IsKittiBin);
     const fs::path poses_file = ExistingOr(options.poses_file, root / "poses.txt");
@@ -111,7 +123,8 @@ Dataset OpenKitti(const fs::path& root, const DatasetOptions& options) {
     if (!poses_file.empty()) {
         const core::Transform T_cam0_velo =
             calib_file.empty() ? core::Transform::Identity() : ReadKittiCalibTr(calib_file);
-        poses = ReadPosesFile(poses_file, T_cam0_velo, times_file);
+        poses =
+            PosesOfFrames(scans, ReadPosesFile(poses_file, T_cam0_velo, times_file), poses_file);
     }
     return {DatasetFormat::kKitti, root, std::move(scans), std::move(poses)};
 }
@@ -216,6 +229,34 @@ DatasetFormat DetectFormat(const fs::path& root) {
 }
 
 }  // namespace
+
+std::vector<core::StampedPose> PosesOfFrames(const std::vector<fs::path>& scans,
+                                             std::vector<core::StampedPose> poses,
+                                             const fs::path& poses_file) {
+    if (poses.size() <= scans.size()) return poses;
+    std::vector<std::size_t> frames;
+    frames.reserve(scans.size());
+    for (const fs::path& scan : scans) {
+        const std::optional<std::size_t> frame = FrameNumber(scan);
+        if (!frame) return poses;
+        if (*frame >= poses.size()) {
+            throw ReadError(poses_file,
+                            "holds " + std::to_string(poses.size()) + " poses (frames 0 to " +
+                                std::to_string(poses.size() - 1) + ") but scan " +
+                                scan.filename().string() + " is frame " + std::to_string(*frame));
+        }
+        frames.push_back(*frame);
+    }
+    // The path between two frames is the trajectory's, not the straight line between them.
+    const std::vector<double> path_m = core::CumulativePathM(poses);
+    std::vector<core::StampedPose> selected;
+    selected.reserve(frames.size());
+    for (const std::size_t frame : frames) {
+        selected.push_back(poses[frame]);
+        selected.back().path_m = path_m[frame];
+    }
+    return selected;
+}
 
 Dataset::Dataset(DatasetFormat format, fs::path root, std::vector<fs::path> scan_files,
                  std::vector<core::StampedPose> poses)

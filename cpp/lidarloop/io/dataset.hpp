@@ -45,6 +45,7 @@ public:
     std::size_t size() const { return scan_files_.size(); }
     /// The scan's file, or for a bag its reference "BAG:TOPIC:INDEX" (io::ReadScan reads both).
     const std::filesystem::path& ScanPath(std::size_t index) const;
+    const std::vector<std::filesystem::path>& ScanPaths() const { return scan_files_; }
     core::PointCloud LoadScan(std::size_t index) const;
     bool HasPoses() const { return !poses_.empty(); }
     /// True when the scans have recording times: poses (with their times) or a bag's stamps.
@@ -71,5 +72,13 @@ private:
 /// no scans, the format cannot be told (the message says what was looked for), the number of
 /// poses differs from the number of scans, or a topic is given for a folder.
 Dataset OpenDataset(const std::filesystem::path& path, const DatasetOptions& options = {});
+
+/// A KITTI sequence's scans may be some of its frames (velodyne/000094.bin is frame 94) with a
+/// file of one pose per frame: when `poses` holds more poses than there are `scans` and every
+/// scan's name is a frame number, the poses of those frames, in the scans' order; otherwise
+/// `poses` as given. ReadError naming `poses_file` when a scan's frame lies beyond its poses.
+std::vector<core::StampedPose> PosesOfFrames(const std::vector<std::filesystem::path>& scans,
+                                             std::vector<core::StampedPose> poses,
+                                             const std::filesystem::path& poses_file);
 
 }  // namespace lidarloop::io

@@ -253,7 +253,7 @@ RoutePoint Simulator::PointAt(std::size_t index) const {
 core::StampedPose Simulator::GroundTruthPose(std::size_t index) const {
     CheckIndex(index);
     return {static_cast<double>(index) * sensor_.scan_period_s,
-            VehiclePose(PointAt(index), world_.ground(), sensor_.mount_height_m)};
+            VehiclePose(PointAt(index), world_.ground(), sensor_.mount_height_m), std::nullopt};
 }
 
 core::StampedPose Simulator::OdometryPose(std::size_t index) const {
@@ -277,7 +277,9 @@ std::vector<core::StampedPose> Simulator::OdometryPoses(std::size_t first,
                        MeasureStep(previous.inverse() * current, config_.odometry, config_.seed, i);
             previous = current;
         }
-        if (i >= first) poses.push_back({static_cast<double>(i) * sensor_.scan_period_s, odometry});
+        if (i >= first)
+            poses.push_back(
+                {static_cast<double>(i) * sensor_.scan_period_s, odometry, std::nullopt});
     }
     return poses;
 }

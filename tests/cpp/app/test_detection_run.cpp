@@ -808,6 +808,32 @@ TEST_F(DetectionRun, AGapInMetresWithoutPosesOrOdometryIsAClearError) {
     }
 }
 
+// Some frames of a KITTI sequence with the whole sequence's odometry: each scan takes its frame's
+// pose and the path travelled between the frames, not the straight line.
+TEST_F(DetectionRun, OdometryOfSomeKittiFramesIsPickedByFrameNumber) {
+    const std::filesystem::path odometry_file = dir_ / "sequence" / "poses_odometry.txt";
+    const std::vector<core::StampedPose> whole = app::ReadOdometry(odometry_file, "", *dataset_);
+    std::filesystem::create_directories(dir_ / "frames" / "velodyne");
+    const std::vector<std::size_t> frames = {3, 50, 51, 140};
+    for (const std::size_t frame : frames) {
+        const std::filesystem::path scan = dataset_->ScanPath(frame);
+        std::filesystem::copy_file(scan, dir_ / "frames" / "velodyne" / scan.filename());
+    }
+    const io::Dataset some = io::OpenDataset(dir_ / "frames");
+    const std::vector<core::StampedPose> odometry = app::ReadOdometry(odometry_file, "", some);
+    ASSERT_EQ(odometry.size(), frames.size());
+    const std::vector<double> whole_path_m = core::CumulativePathM(whole);
+    const std::vector<double> path_m = core::CumulativePathM(odometry);
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+        EXPECT_TRUE(odometry[i].T_world_sensor.isApprox(whole[frames[i]].T_world_sensor));
+        EXPECT_NEAR(path_m[i], whole_path_m[frames[i]] - whole_path_m[frames[0]], 1e-9);
+    }
+    EXPECT_GT(path_m[3] - path_m[2],  // the straight line from frame 51 to 140 is shorter
+              (odometry[3].T_world_sensor.translation() - odometry[2].T_world_sensor.translation())
+                      .norm() +
+                  1.0);
+}
+
 // With poses every stored scan is its submap, placed by them; without, each scan is alone, the
 // run says so, and config.yaml and database.scans record it.
 TEST_F(DetectionRun, SubmapsInOrderReadEachScanOnceAndEqualEachSubmapAlone) {

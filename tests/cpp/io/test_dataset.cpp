@@ -1,7 +1,9 @@
+#include <cmath>
 #include <string>
 
 #include <gtest/gtest.h>
 
+#include "lidarloop/core/min_gap.hpp"
 #include "lidarloop/io/dataset.hpp"
 #include "lidarloop/io/kitti_bin.hpp"
 #include "lidarloop/io/osnabrueck.hpp"
@@ -126,8 +128,55 @@ TEST(Dataset, PoseCountMismatchIsAnError) {
     test::TempDir dir;
     fs::create_directories(dir / "velodyne");
     WriteKittiBin(dir.path() / "velodyne" / "000000.bin", test::RandomCloud(5, 1));
-    WriteKittiPoses(dir / "poses.txt", LinePoses(2));
-    EXPECT_NE(ErrorOf(dir.path()).find("has 1 scans but 2 poses"), std::string::npos);
+    WriteKittiBin(dir.path() / "velodyne" / "000001.bin", test::RandomCloud(5, 2));
+    WriteKittiPoses(dir / "poses.txt", LinePoses(1));
+    EXPECT_NE(ErrorOf(dir.path()).find("has 2 scans but 1 poses"), std::string::npos);
+    // More poses than scans: frames are picked by number in KITTI layout alone.
+    test::TempDir folder;
+    WriteKittiBin(folder / "000000.bin", test::RandomCloud(5, 1));
+    WriteKittiPoses(folder / "poses.txt", LinePoses(2));
+    EXPECT_NE(ErrorOf(folder.path()).find("has 1 scans but 2 poses"), std::string::npos);
+    fs::rename(dir / "velodyne" / "000001.bin", dir / "velodyne" / "last.bin");
+    WriteKittiPoses(dir / "poses.txt", LinePoses(3));
+    EXPECT_NE(ErrorOf(dir.path()).find("has 2 scans but 3 poses"), std::string::npos);
+}
+
+// A zigzag: every step is sqrt(2) m long, so a path differs from the straight line between
+// frames.
+std::vector<core::StampedPose> ZigzagPoses(std::size_t count) {
+    std::vector<core::StampedPose> poses(count);
+    for (std::size_t i = 0; i < count; ++i) {
+        poses[i].T_world_sensor.translation() =
+            Eigen::Vector3d(static_cast<double>(i), static_cast<double>(i % 2), 0.0);
+    }
+    return poses;
+}
+
+TEST(Dataset, KittiFramesTakeTheirPosesAndPathFromTheWholeSequence) {
+    test::TempDir dir;
+    fs::create_directories(dir / "velodyne");
+    for (const char* frame : {"000001", "000004", "000005"}) {
+        WriteKittiBin(dir / "velodyne" / (std::string(frame) + ".bin"), test::RandomCloud(5, 1));
+    }
+    WriteKittiPoses(dir / "poses.txt", ZigzagPoses(8));
+    test::WriteFile(dir / "times.txt", "0\n0.1\n0.2\n0.3\n0.4\n0.5\n0.6\n0.7\n");
+    const Dataset dataset = OpenDataset(dir.path());
+    ASSERT_EQ(dataset.poses().size(), 3U);
+    EXPECT_NEAR(dataset.poses()[1].T_world_sensor.translation().x(), 4.0, 1e-12);
+    EXPECT_NEAR(dataset.poses()[2].T_world_sensor.translation().y(), 1.0, 1e-12);
+    EXPECT_NEAR(dataset.ScanTime(1), 0.4, 1e-12);
+    const std::vector<double> path_m = core::CumulativePathM(dataset.poses());
+    ASSERT_EQ(path_m.size(), 3U);
+    EXPECT_NEAR(path_m[0], 0.0, 1e-12);
+    EXPECT_NEAR(path_m[1], 3.0 * std::sqrt(2.0), 1e-12);  // the straight line is sqrt(10)
+    EXPECT_NEAR(path_m[2], 4.0 * std::sqrt(2.0), 1e-12);
+
+    WriteKittiBin(dir / "velodyne" / "000009.bin", test::RandomCloud(5, 1));
+    EXPECT_NE(ErrorOf(dir.path())
+                  .find("poses.txt: holds 8 poses (frames 0 to 7) but scan "
+                        "000009.bin is frame 9"),
+              std::string::npos)
+        << ErrorOf(dir.path());
 }
 
 TEST(Dataset, UndetectableFolderSaysWhatWasLookedFor) {
@@ -157,6 +206,34 @@ TEST(Dataset, UnknownPoseFormatNamesTheLine) {
     options.poses_file = dir / "traj.csv";
     const std::string message = ErrorOf(dir.path(), options);
     EXPECT_NE(message.find("line 2: cannot tell the pose format"), std::string::npos) << message;
+}
+
+// The real KITTI 08 samples with the official poses and calibration (known answers: the
+// relative poses of the samples' README, from Tr^-1 P_i Tr); skipped when the folder is absent.
+TEST(Dataset, RealKittiFramesTakeTheOfficialPoses) {
+    const fs::path samples = LIDARLOOP_KITTI_SAMPLES_DIR;
+    if (!fs::exists(samples / "08" / "velodyne"))
+        GTEST_SKIP() << "real KITTI samples not found at " << samples;
+    DatasetOptions options;
+    options.poses_file = samples / "poses" / "08.txt";
+    options.calib_file = samples / "calib_08.txt";
+    const Dataset dataset = OpenDataset(samples / "08", options);
+    ASSERT_EQ(dataset.poses().size(), 4U);  // frames 209, 720, 1500, 1684 of 4,071
+    EXPECT_EQ(dataset.ScanTime(3), 1684.0);
+    const auto relative = [&](std::size_t a, std::size_t b) {
+        return dataset.poses()[a].T_world_sensor.inverse() * dataset.poses()[b].T_world_sensor;
+    };
+    const auto yaw_deg = [](const core::Transform& T) {
+        return std::atan2(T.linear()(1, 0), T.linear()(0, 0)) * 180.0 / M_PI;
+    };
+    const core::Transform T_209_1684 = relative(0, 3);
+    EXPECT_TRUE(T_209_1684.translation().isApprox(Eigen::Vector3d(-0.677, -1.617, -2.691), 1e-3))
+        << T_209_1684.translation().transpose();
+    EXPECT_NEAR(yaw_deg(T_209_1684), -175.2, 0.05);
+    const core::Transform T_720_1500 = relative(1, 2);
+    EXPECT_TRUE(T_720_1500.translation().isApprox(Eigen::Vector3d(-2.084, -2.026, -1.057), 1e-3))
+        << T_720_1500.translation().transpose();
+    EXPECT_NEAR(yaw_deg(T_720_1500), -148.5, 0.05);
 }
 
 }  // namespace
