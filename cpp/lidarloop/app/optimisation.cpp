@@ -13,6 +13,7 @@
 #include "lidarloop/app/optimisation_report.hpp"
 #include "lidarloop/app/results_folder.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/core/min_gap.hpp"
 #include "lidarloop/io/map_files.hpp"
 #include "lidarloop/io/map_image.hpp"
 #include "lidarloop/io/png.hpp"
@@ -255,7 +256,8 @@ OptimiseOutcome RunOptimisation(const io::Dataset& dataset, const OptimiseReques
     OptimiseOutcome outcome;
     outcome.loops = LoadLoops(dataset, request, outcome.notes);
     const posegraph::PoseGraph graph =
-        posegraph::BuildPoseGraph(Transforms(odometry), outcome.loops, request.config.posegraph);
+        posegraph::BuildPoseGraph(Transforms(odometry), outcome.loops, request.config.posegraph,
+                                  core::CumulativePathM(odometry));
     outcome.result = posegraph::Optimise(graph, request.config.posegraph);
     if (!outcome.result.note.empty()) outcome.notes.push_back(outcome.result.note);
     const std::string rejections = posegraph::SummariseRejections(graph, outcome.result);

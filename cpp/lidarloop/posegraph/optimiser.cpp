@@ -96,6 +96,8 @@ double WhitenedResidual(const Edge& edge, const State& state) {
 
 void CheckGraph(const PoseGraph& graph) {
     if (graph.poses.empty()) throw core::ConfigError("the pose graph has no pose");
+    if (!graph.path_m.empty() && graph.path_m.size() != graph.poses.size())
+        throw core::ConfigError("the pose graph's path has not one length per pose");
     for (const Edge& edge : graph.edges) {
         if (edge.from >= graph.poses.size() || edge.to >= graph.poses.size()) {
             throw core::ConfigError("an edge joins poses " + std::to_string(edge.from) + " and " +
@@ -105,8 +107,11 @@ void CheckGraph(const PoseGraph& graph) {
     }
 }
 
-// Distance travelled from pose 0 to each pose along the initial estimate (the odometry).
-std::vector<double> PathLengths(const std::vector<core::Transform>& poses) {
+// Distance travelled from pose 0 to each pose: the graph's path, else along the initial estimate
+// (the odometry).
+std::vector<double> PathLengths(const PoseGraph& graph) {
+    if (!graph.path_m.empty()) return graph.path_m;
+    const std::vector<core::Transform>& poses = graph.poses;
     std::vector<double> path(poses.size(), 0.0);
     for (std::size_t i = 1; i < poses.size(); ++i) {
         path[i] = path[i - 1] + (poses[i].translation() - poses[i - 1].translation()).norm();
@@ -395,7 +400,7 @@ OptimisationResult Optimise(const PoseGraph& graph, const PoseGraphConfig& confi
     CheckGraph(graph);
     OptimisationResult result;
     result.poses = graph.poses;
-    const std::vector<double> path = PathLengths(graph.poses);
+    const std::vector<double> path = PathLengths(graph);
     const State initial(graph.poses);
     LoopSet loops;
     for (const Edge& edge : graph.edges) {

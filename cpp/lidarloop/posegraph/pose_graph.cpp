@@ -2,6 +2,7 @@
 #include "lidarloop/posegraph/pose_graph.hpp"
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <string>
 #include "lidarloop/core/angles.hpp"
@@ -29,8 +30,9 @@ Matrix6d DiagonalInformation(double sigma_t_m, double sigma_r_rad) {
     return diagonal.asDiagonal();
 }
 
-Matrix6d OdometryInformation(const core::Transform& T_prev_next, const InformationConfig& config) {
-    const double length_m = T_prev_next.translation().norm();
+Matrix6d OdometryInformation(const core::Transform& T_prev_next, const InformationConfig& config,
+                             double length_m) {
+    if (std::isnan(length_m)) length_m = T_prev_next.translation().norm();
     const double a_t = config.odometry_translation_sigma_m_per_sqrt_m;
     const double a_r = config.odometry_rotation_sigma_deg_per_sqrt_m * core::kRadiansPerDegree;
     const double min_t = config.odometry_min_translation_sigma_m;
@@ -50,17 +52,26 @@ Matrix6d LoopInformation(const LoopConstraint& loop, const InformationConfig& co
 }
 
 PoseGraph BuildPoseGraph(const std::vector<core::Transform>& odometry,
-                         const std::vector<LoopConstraint>& loops, const PoseGraphConfig& config) {
+                         const std::vector<LoopConstraint>& loops, const PoseGraphConfig& config,
+                         std::vector<double> path_m) {
     config.Validate();
+    if (!path_m.empty() && path_m.size() != odometry.size()) {
+        throw core::ConfigError("the pose graph's path has " + std::to_string(path_m.size()) +
+                                " lengths for " + std::to_string(odometry.size()) + " poses");
+    }
     PoseGraph graph;
     graph.poses = odometry;
+    graph.path_m = std::move(path_m);
     graph.edges.reserve(odometry.size() + loops.size());
     for (std::size_t i = 0; i + 1 < odometry.size(); ++i) {
         Edge edge;
         edge.from = i;
         edge.to = i + 1;
         edge.T_from_to = odometry[i].inverse() * odometry[i + 1];
-        edge.information = OdometryInformation(edge.T_from_to, config.information);
+        edge.information =
+            OdometryInformation(edge.T_from_to, config.information,
+                                graph.path_m.empty() ? std::numeric_limits<double>::quiet_NaN()
+                                                     : graph.path_m[i + 1] - graph.path_m[i]);
         graph.edges.push_back(edge);
     }
     for (std::size_t k = 0; k < loops.size(); ++k) {

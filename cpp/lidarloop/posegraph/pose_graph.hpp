@@ -43,6 +43,9 @@ struct Edge {
 struct PoseGraph {
     std::vector<core::Transform> poses;
     std::vector<Edge> edges;
+    /// Per pose, metres travelled from pose 0 (the odometry's path, core::CumulativePathM):
+    /// what the odometry's drift grows with. Empty: the straight steps between the poses.
+    std::vector<double> path_m;
 };
 
 /// g2o's EDGE_SE3:QUAT error: with delta = T_from_to^-1 * T_world_from^-1 * T_world_to, the
@@ -57,17 +60,22 @@ Vector6d EdgeError(const core::Transform& T_from_to, const core::Transform& T_wo
 /// half the rotation angle).
 Matrix6d DiagonalInformation(double sigma_t_m, double sigma_r_rad);
 
-/// The information of an odometry step T_prev_next (InformationConfig).
-Matrix6d OdometryInformation(const core::Transform& T_prev_next, const InformationConfig& config);
+/// The information of an odometry step T_prev_next (InformationConfig) over `length_m` of path;
+/// NaN: the step's straight line.
+Matrix6d OdometryInformation(const core::Transform& T_prev_next, const InformationConfig& config,
+                             double length_m = std::numeric_limits<double>::quiet_NaN());
 
 /// The information of a loop from its verification quality (InformationConfig).
 Matrix6d LoopInformation(const LoopConstraint& loop, const InformationConfig& config);
 
 /// The graph of a trajectory: one pose per scan (`odometry`, T_world_sensor), an odometry edge
 /// from every scan to the next (their relative pose), and an edge from match to query for every
-/// loop. Throws core::ConfigError when a loop names a scan outside the trajectory or the same
-/// scan twice, or `config` is invalid.
+/// loop. `path_m`: per pose, the path travelled (PoseGraph::path_m), longer than the straight
+/// steps when the poses are some frames of a longer trajectory; empty: the straight steps.
+/// Throws core::ConfigError when a loop names a scan outside the trajectory or the same scan
+/// twice, `path_m` has another size than `odometry`, or `config` is invalid.
 PoseGraph BuildPoseGraph(const std::vector<core::Transform>& odometry,
-                         const std::vector<LoopConstraint>& loops, const PoseGraphConfig& config);
+                         const std::vector<LoopConstraint>& loops, const PoseGraphConfig& config,
+                         std::vector<double> path_m = {});
 
 }  // namespace lidarloop::posegraph

@@ -71,6 +71,34 @@ TEST(Information, OdometryGrowsWithTheStepAndLoopsWithQuality) {
     EXPECT_GT(LoopInformation(good, config)(3, 3), LoopInformation(poor, config)(3, 3));
 }
 
+// Some frames of a long drive: three poses 3 m apart in a line, 600 m of path between the last
+// two. The odometry's drift, its information and the gate's tolerance grow with that path, not
+// with the straight step.
+TEST(Optimise, ThePathTravelledBetweenFramesSetsTheOdometrysDrift) {
+    const std::vector<core::Transform> frames = {PlanarPose(0, 0, 0), PlanarPose(3, 0, 0),
+                                                 PlanarPose(6, 0, 0)};
+    const std::vector<double> path_m = {0.0, 3.0, 603.0};
+    const InformationConfig information;
+    EXPECT_NEAR(OdometryInformation(frames[1].inverse() * frames[2], information, 600.0)(0, 0),
+                OdometryInformation(PlanarPose(600, 0, 0), information)(0, 0), 1e-12);
+    const PoseGraph graph = BuildPoseGraph(frames, {}, {}, path_m);
+    ASSERT_EQ(graph.edges.size(), 2u);
+    EXPECT_NEAR(graph.edges[1].information(0, 0),
+                OdometryInformation(PlanarPose(600, 0, 0), information)(0, 0), 1e-12);
+    EXPECT_NEAR(graph.edges[0].information(0, 0),
+                OdometryInformation(PlanarPose(3, 0, 0), information)(0, 0), 1e-12);
+    // A loop 6 m off the odometry between scans 600 m of path apart: within the drift of 600 m
+    // (the gate allows about 5 sigma + 3 m + 3 %), far beyond that of the 3 m line.
+    const LoopConstraint loop{2, 1, PlanarPose(-3, 0, 0)};
+    const OptimisationResult along_path = Optimise(BuildPoseGraph(frames, {loop}, {}, path_m), {});
+    ASSERT_EQ(along_path.loops.size(), 1u);
+    EXPECT_EQ(along_path.loops[0].verdict, LoopVerdict::kUsed);
+    EXPECT_NEAR(along_path.loops[0].path_m, 600.0, 1e-9);
+    const OptimisationResult straight = Optimise(BuildPoseGraph(frames, {loop}, {}), {});
+    EXPECT_EQ(straight.loops[0].verdict, LoopVerdict::kRejectedByOdometry);
+    EXPECT_THROW(BuildPoseGraph(frames, {}, {}, {0.0, 3.0}), core::ConfigError);
+}
+
 TEST(Optimise, NoiseFreeGraphStaysAtTheTruth) {
     const std::vector<core::Transform> truth = EllipseLaps(2);
     const auto result = OptimiseLoops(truth, TrueLoops(truth, 1, 5, 50, 5.0, 0.0, 0.0));
