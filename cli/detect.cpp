@@ -2,6 +2,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,7 @@
 #include "lidarloop/app/detection.hpp"
 #include "lidarloop/core/descriptor.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/io/run_record.hpp"
 #include "odometry_options.hpp"
 #include "progress.hpp"
 #include "run_options.hpp"
@@ -55,6 +57,15 @@ std::string FormatRate(double value) {
     return text;
 }
 
+// The files of the results folder, as its run.json lists them.
+std::string WrittenFiles(const std::filesystem::path& out) {
+    const std::optional<io::RunRecord> record = io::ReadRunRecord(out);
+    std::string text;
+    for (const std::string& file : record ? record->files : std::vector<std::string>{})
+        text += (text.empty() ? "" : ", ") + file;
+    return text;
+}
+
 void PrintOutcome(const io::Dataset& dataset, const app::DetectRequest& request,
                   const app::DetectOutcome& outcome, const std::string& map) {
     std::cout << "lidarloop detect: " << dataset.size() << " scans (" << dataset.FormatName()
@@ -70,16 +81,11 @@ void PrintOutcome(const io::Dataset& dataset, const app::DetectRequest& request,
         std::cout << "; " << FormatRate(static_cast<double>(dataset.size()) / outcome.total_s)
                   << " scans/s (" << FormatRate(outcome.total_s) << " s, files read included)";
     }
-    const bool matrix = request.config.output.KeepsSimilarityMatrix(dataset.size());
-    std::cout << "\n  results in " << request.out.string() << "/ "
-              << (!map.empty() ? "(loops.csv: query scan, map scan; candidates.csv, config.yaml, "
-                                 "timings.json)\n"
-                  : matrix     ? "(loops.csv, candidates.csv, similarity.png, "
-                                 "similarity_distance.png, similarity.bin, database.lldb, "
-                                 "config.yaml, timings.json)\n"
-                               : "(loops.csv, candidates.csv, database.lldb, config.yaml, "
-                                 "timings.json; no similarity matrix: it would exceed "
-                                 "output.similarity_matrix_mib)\n");
+    std::cout << "\n  results in " << request.out.string() << "/ (" << WrittenFiles(request.out);
+    if (!map.empty()) std::cout << "; loops.csv: query scan, map scan";
+    if (map.empty() && !request.config.output.KeepsSimilarityMatrix(dataset.size()))
+        std::cout << "; no similarity matrix: it would exceed output.similarity_matrix_mib";
+    std::cout << ")\n";
     for (const std::string& note : outcome.notes) std::cerr << "lidarloop detect: " << note << '\n';
 }
 

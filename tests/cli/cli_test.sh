@@ -312,6 +312,13 @@ section_detect() {
         --out "$work/det2"
     expect_ok "detect --skip-bad" "1 skipped" "$cli" detect "$seq" --skip-bad --quiet --min-gap 2 \
         --out "$work/det3"
+    # The results line names what the run wrote, as run.json lists it.
+    expect_ok "detect names its files" "database.scans, loops.csv, similarity.bin" "$cli" detect \
+        "$seq" --skip-bad --quiet --min-gap 2 --out "$work/det3" --overwrite
+    if grep -q "skipped.txt, timings.json)" <<<"$("$cli" detect "$seq" --skip-bad --quiet \
+        --min-gap 2 --out "$work/det3" --overwrite)"; then pass; else
+        fail "detect's results line omits skipped.txt"
+    fi
     if grep -q "scan3.bin" "$work/det3/skipped.txt"; then pass; else
         fail "skipped.txt lacks scan3"
     fi
