@@ -40,20 +40,26 @@ std::string Duration(double ms) {
     return text;
 }
 
+// A figure of the table: "-" where nothing was timed (null; ASCII keeps the columns aligned), ""
+// where the summary has no such figure.
+std::string Figure(const nlohmann::json& summary, const char* statistic, double scale) {
+    if (!summary.contains(statistic)) return "";
+    const nlohmann::json& value = summary[statistic];
+    return value.is_number() ? Duration(scale * value.get<double>()) : "-";
+}
+
 void PrintRow(const std::string& stage, const std::string& per, const nlohmann::json& summary,
               double scale = 1.0) {
-    std::printf(
-        "| %-34s | %-14s | %10s | %10s |\n", stage.c_str(), per.c_str(),
-        Duration(scale * summary.value("median", 0.0)).c_str(),
-        summary.contains("p95") ? Duration(scale * summary["p95"].get<double>()).c_str() : "");
+    std::printf("| %-44s | %-14s | %10s | %10s |\n", stage.c_str(), per.c_str(),
+                Figure(summary, "median", scale).c_str(), Figure(summary, "p95", scale).c_str());
 }
 
 // The figures as a table a user reads: the stages of the online step and their sum.
 void PrintSummary(const nlohmann::json& figures) {
     std::printf("lidarloop bench: %d scans, method %s (medians and 95th percentiles)\n\n",
                 figures.value("scans", 0), figures.value("method", std::string()).c_str());
-    std::printf("| %-34s | %-14s | %10s | %10s |\n", "stage", "per", "median", "p95");
-    std::printf("|%s|%s|%s|%s|\n", std::string(36, '-').c_str(), std::string(16, '-').c_str(),
+    std::printf("| %-44s | %-14s | %10s | %10s |\n", "stage", "per", "median", "p95");
+    std::printf("|%s|%s|%s|%s|\n", std::string(46, '-').c_str(), std::string(16, '-').c_str(),
                 std::string(12, '-').c_str(), std::string(12, '-').c_str());
     PrintRow("read the file", "scan", figures["load_ms_per_scan"]);
     PrintRow("describe", "scan", figures["describe_ms_per_scan"]);
@@ -92,12 +98,16 @@ void PrintSummary(const nlohmann::json& figures) {
         std::printf("memory: %.0f bytes per prepared scan (median)\n",
                     verification["bytes_per_prepared_scan"].value("median", 0.0));
     } else {
-        online_ms = figures["describe_ms_per_scan"].value("median", 0.0) +
-                    (queries.contains("index_us") ? queries["index_us"] : queries["brute_force_us"])
-                            .value("median", 0.0) /
-                        1e3;
-        std::printf("\nonline step without verification: %s per scan on one core\n",
-                    Duration(online_ms).c_str());
+        const nlohmann::json& retrieval =
+            queries.contains("index_us") ? queries["index_us"] : queries["brute_force_us"];
+        if (retrieval["median"].is_number()) {
+            online_ms = figures["describe_ms_per_scan"].value("median", 0.0) +
+                        retrieval["median"].get<double>() / 1e3;
+            std::printf("\nonline step without verification: %s per scan on one core\n",
+                        Duration(online_ms).c_str());
+        } else {
+            std::printf("\nonline step without verification: not measured (no query timed)\n");
+        }
     }
     std::printf("similarity matrix: %.1f ns per comparison on one core\n",
                 figures.value("ns_per_comparison_one_core", 0.0));

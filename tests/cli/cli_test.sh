@@ -369,6 +369,13 @@ section_bench() {
     # No timed scan (a gap longer than the sequence): no rate that reads as measured.
     expect_ok "bench without candidates" "online step: not measured" "$cli" bench "$seq" \
         --queries 3 --verify-queries 2 --min-gap 1000 --quiet
+    # No query timed: the retrieval row and the JSON say so, no "0.00 us" that reads as measured.
+    expect_ok "bench without queries" "| retrieval (index)                            | query          |          - |          - |" \
+        "$cli" bench "$seq" --queries 0 --verify-queries 0 --quiet
+    expect_ok "bench without queries, the rate" "online step without verification: not measured" \
+        "$cli" bench "$seq" --queries 0 --verify-queries 0 --quiet
+    expect_ok "bench without queries in the JSON" '"count": 0,' "$cli" bench "$seq" --queries 0 \
+        --verify-queries 0 --quiet --json -
     # A negative count must not wrap to 2^64 - 1 (a bench that never ends), nor a huge one run
     # out of memory.
     expect_error "bench negative queries" "--queries: must not be negative, got -1" "$cli" \

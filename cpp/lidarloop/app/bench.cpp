@@ -26,6 +26,15 @@ double PeakMemoryMiB() {
     return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
 }
 
+// How many were timed, their median and 95th percentile: null when none was, rather than a 0
+// that reads as measured (--queries 0).
+nlohmann::json TimedJson(const std::vector<double>& values) {
+    if (values.empty()) return {{"count", 0}, {"median", nullptr}, {"p95", nullptr}};
+    return {{"count", values.size()},
+            {"median", Quantile(values, 0.5)},
+            {"p95", Quantile(values, 0.95)}};
+}
+
 // Times `queries` top-1 searches of stored scans (as queries) against the whole database,
 // through the index when there is one, and by comparing every scan.
 nlohmann::json TimeQueries(const pipeline::DescriptorDatabase& database, std::size_t queries) {
@@ -57,10 +66,8 @@ nlohmann::json TimeQueries(const pipeline::DescriptorDatabase& database, std::si
         }
         (void)best;
     }
-    json["brute_force_us"] = {{"median", Quantile(brute_us, 0.5)},
-                              {"p95", Quantile(brute_us, 0.95)}};
-    if (index)
-        json["index_us"] = {{"median", Quantile(index_us, 0.5)}, {"p95", Quantile(index_us, 0.95)}};
+    json["brute_force_us"] = TimedJson(brute_us);
+    if (index) json["index_us"] = TimedJson(index_us);
     return json;
 }
 
@@ -170,7 +177,7 @@ nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
 double RetrievalMs(const nlohmann::json& queries) {
     const nlohmann::json& figures =
         queries.contains("index_us") ? queries["index_us"] : queries["brute_force_us"];
-    return figures.value("median", 0.0) / 1e3;
+    return figures["median"].is_number() ? figures["median"].get<double>() / 1e3 : 0.0;
 }
 
 }  // namespace
