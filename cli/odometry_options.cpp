@@ -5,7 +5,9 @@ namespace lidarloop::cli {
 void OdometryOptions::AddTo(CLI::App& command, const std::string& use) {
     auto* file =
         command
-            .add_option("--odometry", file_, "odometry poses, KITTI or TUM, one per scan: " + use)
+            .add_option(
+                "--odometry", file_,
+                "odometry poses, KITTI or TUM, one per scan (KITTI layout: or per frame): " + use)
             ->check(CLI::ExistingFile);
     command
         .add_option("--odometry-topic", topic_,

@@ -72,10 +72,13 @@ std::vector<core::StampedPose> ReadOdometry(const std::filesystem::path& file,
         odometry = io::PosesOfFrames(dataset.ScanPaths(), std::move(odometry), file);
     }
     if (odometry.size() != dataset.size()) {
-        throw io::ReadError(file, "holds " + std::to_string(odometry.size()) + " poses but " +
-                                      dataset.root().string() + " has " +
-                                      std::to_string(dataset.size()) +
-                                      " scans: odometry needs one pose per scan");
+        throw io::ReadError(file,
+                            "holds " + std::to_string(odometry.size()) + " poses but " +
+                                dataset.root().string() + " has " + std::to_string(dataset.size()) +
+                                " scans: odometry needs one pose per scan" +
+                                (dataset.format() == io::DatasetFormat::kKitti
+                                     ? io::PosesOfFramesHint(dataset.ScanPaths(), odometry.size())
+                                     : std::string()));
     }
     // A KITTI file has no times (ReadPoses numbers the poses): they are the scans' own, so that
     // poses written with times (optimise --format tum) carry the dataset's.

@@ -103,15 +103,40 @@ std::vector<core::StampedPose> ReadPosesFile(const fs::path& file,
     return ReadPoses(file, T_cam0_velo, times_file);
 }
 
-// The frame number of a KITTI scan file (velodyne/000094.bin is frame 94), if its name is one.
+// A frame number too large for any drive: the names of longer numbers read as it.
+constexpr std::size_t kFrameBeyondAnyDrive = 999'999'999;
+
+// The frame number of a KITTI scan file (velodyne/000094.bin is frame 94; KITTI-360's
+// 0000000094.bin too), if its name is one.
 std::optional<std::size_t> FrameNumber(const fs::path& scan) {
-    const std::string stem = scan.stem().string();
-    if (stem.empty() || stem.size() > 9 || !std::all_of(stem.begin(), stem.end(), [](char c) {
+    std::string_view digits = scan.stem().native();
+    if (digits.empty() || !std::all_of(digits.begin(), digits.end(), [](char c) {
             return std::isdigit(static_cast<unsigned char>(c)) != 0;
         })) {
         return std::nullopt;
     }
-    return static_cast<std::size_t>(std::stoul(stem));
+    while (digits.size() > 1 && digits.front() == '0') digits.remove_prefix(1);
+    if (digits.size() > 9) return kFrameBeyondAnyDrive;
+    return static_cast<std::size_t>(std::stoul(std::string(digits)));
+}
+
+// The scans' frame numbers when every scan is named by one, in the scans' order.
+std::optional<std::vector<std::size_t>> FrameNumbers(const std::vector<fs::path>& scans) {
+    std::vector<std::size_t> frames;
+    frames.reserve(scans.size());
+    for (const fs::path& scan : scans) {
+        const std::optional<std::size_t> frame = FrameNumber(scan);
+        if (!frame) return std::nullopt;
+        frames.push_back(*frame);
+    }
+    return frames;
+}
+
+// Frames 0 to n - 1: a whole sequence (or its beginning), whose poses file has one pose a scan.
+bool FirstFrames(const std::vector<std::size_t>& frames) {
+    for (std::size_t i = 0; i < frames.size(); ++i)
+        if (frames[i] != i) return false;
+    return true;
 }
 
 Dataset OpenKitti(const fs::path& root, const DatasetOptions& options) {
@@ -233,29 +258,47 @@ DatasetFormat DetectFormat(const fs::path& root) {
 std::vector<core::StampedPose> PosesOfFrames(const std::vector<fs::path>& scans,
                                              std::vector<core::StampedPose> poses,
                                              const fs::path& poses_file) {
-    if (poses.size() <= scans.size()) return poses;
-    std::vector<std::size_t> frames;
-    frames.reserve(scans.size());
-    for (const fs::path& scan : scans) {
-        const std::optional<std::size_t> frame = FrameNumber(scan);
-        if (!frame) return poses;
-        if (*frame >= poses.size()) {
-            throw ReadError(poses_file,
-                            "holds " + std::to_string(poses.size()) + " poses (frames 0 to " +
-                                std::to_string(poses.size() - 1) + ") but scan " +
-                                scan.filename().string() + " is frame " + std::to_string(*frame));
+    if (poses.size() <= scans.size() || IsTumPosesFile(poses_file)) return poses;
+    const std::optional<std::vector<std::size_t>> frames = FrameNumbers(scans);
+    if (!frames || FirstFrames(*frames)) return poses;
+    for (std::size_t i = 0; i < frames->size(); ++i) {
+        const fs::path& scan = scans[i];
+        if ((*frames)[i] >= poses.size()) {
+            throw ReadError(poses_file, "holds " + std::to_string(poses.size()) +
+                                            " poses (frames 0 to " +
+                                            std::to_string(poses.size() - 1) + ") but scan " +
+                                            scan.filename().string() + " is " +
+                                            ((*frames)[i] == kFrameBeyondAnyDrive
+                                                 ? std::string("a later frame")
+                                                 : "frame " + std::to_string((*frames)[i])));
         }
-        frames.push_back(*frame);
+        if (i > 0 && (*frames)[i] == (*frames)[i - 1]) {
+            throw ReadError(scan, "is frame " + std::to_string((*frames)[i]) + ", as is " +
+                                      scans[i - 1].filename().string());
+        }
     }
     // The path between two frames is the trajectory's, not the straight line between them.
     const std::vector<double> path_m = core::CumulativePathM(poses);
     std::vector<core::StampedPose> selected;
-    selected.reserve(frames.size());
-    for (const std::size_t frame : frames) {
+    selected.reserve(frames->size());
+    for (const std::size_t frame : *frames) {
         selected.push_back(poses[frame]);
         selected.back().path_m = path_m[frame];
     }
     return selected;
+}
+
+std::string PosesOfFramesHint(const std::vector<fs::path>& scans, std::size_t poses) {
+    if (poses <= scans.size()) return {};
+    const auto unnamed = std::find_if(scans.begin(), scans.end(), [](const fs::path& scan) {
+        return !FrameNumber(scan).has_value();
+    });
+    if (unnamed != scans.end()) {
+        return " (poses are taken by frame number only when every scan is named by one, and " +
+               unnamed->filename().string() + " is not)";
+    }
+    return " (the scans are frames 0 to " + std::to_string(scans.size() - 1) +
+           ": their poses file holds one pose a scan)";
 }
 
 Dataset::Dataset(DatasetFormat format, fs::path root, std::vector<fs::path> scan_files,
@@ -338,8 +381,12 @@ Dataset OpenDataset(const fs::path& path, const DatasetOptions& options) {
         throw ReadError(path, "holds no scans of the " + dataset.FormatName() + " layout");
     }
     if (dataset.HasPoses() && dataset.poses().size() != dataset.size()) {
-        throw ReadError(path, "has " + std::to_string(dataset.size()) + " scans but " +
-                                  std::to_string(dataset.poses().size()) + " poses");
+        throw ReadError(path,
+                        "has " + std::to_string(dataset.size()) + " scans but " +
+                            std::to_string(dataset.poses().size()) + " poses" +
+                            (format == DatasetFormat::kKitti
+                                 ? PosesOfFramesHint(dataset.ScanPaths(), dataset.poses().size())
+                                 : std::string()));
     }
     return dataset;
 }

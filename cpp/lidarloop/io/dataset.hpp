@@ -74,11 +74,18 @@ private:
 Dataset OpenDataset(const std::filesystem::path& path, const DatasetOptions& options = {});
 
 /// A KITTI sequence's scans may be some of its frames (velodyne/000094.bin is frame 94) with a
-/// file of one pose per frame: when `poses` holds more poses than there are `scans` and every
-/// scan's name is a frame number, the poses of those frames, in the scans' order; otherwise
-/// `poses` as given. ReadError naming `poses_file` when a scan's frame lies beyond its poses.
+/// KITTI file of one pose per frame of the whole drive: when `poses` holds more poses than there
+/// are `scans`, `poses_file` is no TUM file, every scan's name is a frame number and the scans
+/// are not frames 0 to n - 1 (a whole sequence, whose file holds one pose a scan), the poses of
+/// those frames, in the scans' order, each with the drive's path to it
+/// (core::StampedPose::path_m); otherwise `poses` as given. ReadError naming `poses_file` when a
+/// scan's frame lies beyond its poses, or naming a scan whose frame the one before has too.
 std::vector<core::StampedPose> PosesOfFrames(const std::vector<std::filesystem::path>& scans,
                                              std::vector<core::StampedPose> poses,
                                              const std::filesystem::path& poses_file);
+
+/// Why PosesOfFrames kept `poses` poses for `scans`, for a count mismatch's message ("" when
+/// there are no more poses than scans).
+std::string PosesOfFramesHint(const std::vector<std::filesystem::path>& scans, std::size_t poses);
 
 }  // namespace lidarloop::io

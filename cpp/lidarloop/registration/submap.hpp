@@ -20,8 +20,9 @@ struct SubmapWindow {
 };
 
 /// Per scan, the path travelled from the first scan along `poses` (T_world_sensor), metres, as
-/// core::CumulativePathM but tolerant: a scan whose pose is not finite gets NaN (it joins no
-/// submap) and the path continues from the last finite pose.
+/// core::CumulativePathM (the drive's path when every pose knows it: StampedPose::path_m) but
+/// tolerant: a scan whose pose is not finite gets NaN (it joins no submap) and the path
+/// continues from the last finite pose.
 std::vector<double> SubmapPathM(const std::vector<core::StampedPose>& poses);
 
 /// The scans of `centre`'s submap in sequence order, `centre` included: those whose path

@@ -136,9 +136,20 @@ TEST(Dataset, PoseCountMismatchIsAnError) {
     WriteKittiBin(folder / "000000.bin", test::RandomCloud(5, 1));
     WriteKittiPoses(folder / "poses.txt", LinePoses(2));
     EXPECT_NE(ErrorOf(folder.path()).find("has 1 scans but 2 poses"), std::string::npos);
-    fs::rename(dir / "velodyne" / "000001.bin", dir / "velodyne" / "last.bin");
+    // Frames 0 and 1 are a whole sequence's first: a third pose is an error, not ignored.
     WriteKittiPoses(dir / "poses.txt", LinePoses(3));
-    EXPECT_NE(ErrorOf(dir.path()).find("has 2 scans but 3 poses"), std::string::npos);
+    EXPECT_NE(ErrorOf(dir.path())
+                  .find("has 2 scans but 3 poses (the scans are frames 0 to 1: "
+                        "their poses file holds one pose a scan)"),
+              std::string::npos)
+        << ErrorOf(dir.path());
+    fs::rename(dir / "velodyne" / "000001.bin", dir / "velodyne" / "last.bin");
+    EXPECT_NE(ErrorOf(dir.path())
+                  .find("has 2 scans but 3 poses (poses are taken by frame number "
+                        "only when every scan is named by one, and last.bin is "
+                        "not)"),
+              std::string::npos)
+        << ErrorOf(dir.path());
 }
 
 // A zigzag: every step is sqrt(2) m long, so a path differs from the straight line between
@@ -176,6 +187,28 @@ TEST(Dataset, KittiFramesTakeTheirPosesAndPathFromTheWholeSequence) {
                   .find("poses.txt: holds 8 poses (frames 0 to 7) but scan "
                         "000009.bin is frame 9"),
               std::string::npos)
+        << ErrorOf(dir.path());
+    fs::remove(dir / "velodyne" / "000009.bin");
+    WriteKittiBin(dir / "velodyne" / "4.bin", test::RandomCloud(5, 1));
+    EXPECT_NE(ErrorOf(dir.path()).find("000004.bin: is frame 4, as is 4.bin"), std::string::npos)
+        << ErrorOf(dir.path());
+    fs::remove(dir / "velodyne" / "4.bin");
+    // KITTI-360's ten digits, and a number beyond any drive.
+    fs::rename(dir / "velodyne" / "000005.bin", dir / "velodyne" / "0000000005.bin");
+    EXPECT_EQ(OpenDataset(dir.path()).poses().size(), 3U);
+    WriteKittiBin(dir / "velodyne" / "123456789012.bin", test::RandomCloud(5, 1));
+    EXPECT_NE(ErrorOf(dir.path()).find("scan 123456789012.bin is a later frame"), std::string::npos)
+        << ErrorOf(dir.path());
+}
+
+// A TUM file's rows are times, not frames: one with more rows than scans is no list of frames.
+TEST(Dataset, TumPosesAreNotPickedByFrameNumber) {
+    test::TempDir dir;
+    fs::create_directories(dir / "velodyne");
+    for (const char* frame : {"000001", "000004"})
+        WriteKittiBin(dir / "velodyne" / (std::string(frame) + ".bin"), test::RandomCloud(5, 1));
+    WriteTumPoses(dir / "poses.txt", LinePoses(8));
+    EXPECT_NE(ErrorOf(dir.path()).find("has 2 scans but 8 poses"), std::string::npos)
         << ErrorOf(dir.path());
 }
 

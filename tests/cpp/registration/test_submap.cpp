@@ -74,6 +74,21 @@ TEST(Submap, ScansWithoutAFinitePoseJoinNoSubmap) {
     EXPECT_EQ(SubmapMembers(path_m, 4, {2.5, 10, false}), (std::vector<std::size_t>{4}));
 }
 
+// Frames of a longer drive: two visits of one place 3 m apart in a straight line, 600 m of path
+// apart, must not share a submap.
+TEST(Submap, FramesOfALongerDriveAreApartByItsPath) {
+    std::vector<core::StampedPose> poses = {PoseAt(0.0, 0.0), PoseAt(1.0, 0.0), PoseAt(3.0, 0.0)};
+    poses[0].path_m = 100.0;
+    poses[1].path_m = 101.0;
+    poses[2].path_m = 701.0;
+    const std::vector<double> path_m = SubmapPathM(poses);
+    EXPECT_EQ(path_m, (std::vector<double>{0.0, 1.0, 601.0}));
+    EXPECT_EQ(SubmapMembers(path_m, 1, {5.0, 10, false}), (std::vector<std::size_t>{0, 1}));
+    poses[1].path_m.reset();  // not every pose knows it: the straight steps
+    EXPECT_EQ(SubmapMembers(SubmapPathM(poses), 1, {5.0, 10, false}),
+              (std::vector<std::size_t>{0, 1, 2}));
+}
+
 // The merge against a brute-force one: every usable point of every scan, by its own sensor's
 // range, moved by inverse(T_world_centre) * T_world_scan.
 TEST(Submap, MergeIsEveryUsablePointInTheCentreFrame) {
