@@ -72,9 +72,11 @@ def build_ground_truth(
     times_s: FloatArray,
     T_world_sensor: FloatArray,
     config: Optional[GroundTruthConfig] = None,
+    path_m: Optional[Sequence[float]] = None,
     **rule: Any,
 ) -> GroundTruth:
-    """From poses (times_s (N,), T_world_sensor (N, 4, 4)); the rule as config or keywords."""
+    """From poses (times_s (N,), T_world_sensor (N, 4, 4)); the rule as config or keywords;
+    path_m per scan (Dataset.path_m), None: the straight steps."""
 
 def heading_difference_deg(T_world_a: FloatArray, T_world_b: FloatArray) -> float: ...
 

@@ -36,6 +36,9 @@ class Dataset:
     def has_poses(self) -> bool: ...
     @property
     def poses(self) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+    @property
+    def path_m(self) -> Optional[list[float]]:
+        """Metres travelled from the first scan; the drive's for some KITTI frames."""
 
 def open_dataset(
     folder: PathLike,

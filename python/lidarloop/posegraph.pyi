@@ -1,5 +1,5 @@
 import os
-from typing import Any, Mapping, Sequence, Union
+from typing import Any, Mapping, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -114,9 +114,13 @@ class OptimisationResult:
     def note(self) -> str: ...
 
 def build_pose_graph(
-    odometry: Transforms, loops: Sequence[LoopConstraint], config: Config = None
+    odometry: Transforms,
+    loops: Sequence[LoopConstraint],
+    config: Config = None,
+    path_m: Optional[Sequence[float]] = None,
 ) -> PoseGraph:
-    """One pose per scan (T_world_sensor), odometry edges i -> i+1, a loop edge per loop."""
+    """One pose per scan (T_world_sensor), odometry edges i -> i+1, a loop edge per loop;
+    path_m per scan, the path the odometry's drift grows with (None: the straight steps)."""
 
 def optimise_pose_graph(graph: PoseGraph, config: Config = None) -> OptimisationResult:
     """Optimises with Ceres (pose 0 fixed), keeping wrong loops out; releases the GIL."""

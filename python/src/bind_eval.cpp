@@ -154,19 +154,23 @@ void BindGroundTruth(py::module_& m) {
     m.def(
         "build_ground_truth",
         [](const py::handle& times_s, const py::handle& T_world_sensor,
-           std::optional<GroundTruthConfig> config, const py::kwargs& rule) {
+           std::optional<GroundTruthConfig> config,
+           const std::optional<std::vector<double>>& path_m, const py::kwargs& rule) {
             if (config && !rule.empty())
                 throw core::ConfigError("give either config or keyword arguments, not both");
             const GroundTruthConfig gt_config =
                 config ? *config : FromKeywords<GroundTruthConfig>(rule);
-            const std::vector<core::StampedPose> poses = PosesFromArrays(times_s, T_world_sensor);
+            std::vector<core::StampedPose> poses = PosesFromArrays(times_s, T_world_sensor);
+            if (path_m) SetPathM(*path_m, poses);
             py::gil_scoped_release release;
             return BuildGroundTruth(poses, gt_config);
         },
         py::arg("times_s"), py::arg("T_world_sensor"), py::arg("config") = py::none(),
+        py::arg("path_m") = py::none(),
         "Ground truth from poses (times_s (N,), T_world_sensor (N, 4, 4)); the rule as a "
         "GroundTruthConfig or its fields as keywords (distance_m=..., max_heading_deg=..., "
-        "min_gap=..., min_gap_unit=...).");
+        "min_gap=..., min_gap_unit=...). path_m: per scan, the path travelled (Dataset.path_m: "
+        "the drive's for some frames of a KITTI sequence); None: the straight steps.");
     m.def(
         "heading_difference_deg",
         [](const py::handle& a, const py::handle& b) {

@@ -8,6 +8,7 @@
 #include "bindings.hpp"
 #include "conversions.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/core/min_gap.hpp"
 #include "lidarloop/io/dataset.hpp"
 #include "lidarloop/io/poses.hpp"
 #include "lidarloop/io/rosbag.hpp"
@@ -123,6 +124,15 @@ void BindDataset(py::module_& m) {
             "poses", [](const io::Dataset& dataset) { return PosesToArrays(dataset.poses()); },
             "(times_s (N,), T_world_sensor (N, 4, 4)) float64 arrays, one pose per scan (empty "
             "arrays when the dataset has none). Time in seconds, world frame in metres.")
+        .def_property_readonly(
+            "path_m",
+            [](const io::Dataset& dataset) -> std::optional<std::vector<double>> {
+                if (!dataset.HasPoses()) return std::nullopt;
+                return core::CumulativePathM(dataset.poses());
+            },
+            "Per scan, metres travelled from the first scan (None without poses): the straight "
+            "steps between the poses, or for some frames of a KITTI drive the drive's own path. "
+            "Pass it as build_ground_truth's path_m.")
         .def("__repr__", [](const io::Dataset& dataset) {
             return "<lidarloop.Dataset " + dataset.FormatName() + " " + dataset.root().string() +
                    ": " + std::to_string(dataset.size()) + " scans>";

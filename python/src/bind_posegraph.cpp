@@ -85,16 +85,19 @@ void BindGraph(py::module_& m) {
     m.def(
         "build_pose_graph",
         [](const py::handle& odometry, const std::vector<LoopConstraint>& loops,
-           const py::object& config) {
+           const py::object& config, std::optional<std::vector<double>> path_m) {
             const std::vector<core::Transform> poses = TransformsFromArray(odometry, "odometry");
             const posegraph::PoseGraphConfig graph_config = PoseGraphConfigFrom(config);
             py::gil_scoped_release release;
-            return posegraph::BuildPoseGraph(poses, loops, graph_config);
+            return posegraph::BuildPoseGraph(poses, loops, graph_config,
+                                             std::move(path_m).value_or(std::vector<double>{}));
         },
         py::arg("odometry"), py::arg("loops"), py::arg("config") = py::none(),
+        py::arg("path_m") = py::none(),
         "The graph of a trajectory: one pose per scan (odometry, (N, 4, 4) T_world_sensor), an "
         "odometry edge from each scan to the next, a loop edge from match to query per loop "
-        "(informations from the config's posegraph section).");
+        "(informations from the config's posegraph section). path_m: per scan, the path "
+        "travelled, which the odometry's drift grows with (None: the straight steps).");
 }
 
 void BindOptimisation(py::module_& m) {

@@ -230,6 +230,16 @@ inline std::vector<core::StampedPose> PosesFromArrays(const py::handle& times_s,
     return poses;
 }
 
+/// Sets each pose's StampedPose::path_m from `path_m` (one per pose): the drive's path for
+/// frames of a longer one. ValueError on another count.
+inline void SetPathM(const std::vector<double>& path_m, std::vector<core::StampedPose>& poses) {
+    if (path_m.size() != poses.size()) {
+        throw py::value_error("path_m has " + std::to_string(path_m.size()) + " values for " +
+                              std::to_string(poses.size()) + " poses");
+    }
+    for (std::size_t i = 0; i < poses.size(); ++i) poses[i].path_m = path_m[i];
+}
+
 /// The run configuration a Python argument names: None gives the defaults; a dict (nested like
 /// the YAML file, e.g. {"method": "ndt", "ndt": {"cell_size_m": 1.0}}) or a path (str or
 /// os.PathLike) of a YAML file overrides the keys it names. lidarloop.ReadError for unknown keys

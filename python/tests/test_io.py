@@ -70,6 +70,30 @@ def test_open_dataset_with_more_poses_than_scans_raises_read_error(data_dir):
         lidarloop.open_dataset(data_dir / "kitti")
 
 
+def test_some_kitti_frames_take_their_poses_and_the_drives_path(tmp_path):
+    # A zigzag drive of 8 frames, each step sqrt(2) m; the scans are frames 1, 4 and 5.
+    (tmp_path / "velodyne").mkdir()
+    cloud = np.zeros((5, 4), dtype="<f4")
+    for frame in (1, 4, 5):
+        cloud.tofile(tmp_path / "velodyne" / f"{frame:06d}.bin")
+    rows = np.zeros((8, 12))
+    rows[:, [0, 5, 10]] = 1.0
+    rows[:, 3] = np.arange(8)
+    rows[:, 7] = np.arange(8) % 2
+    np.savetxt(tmp_path / "poses.txt", rows)
+    dataset = lidarloop.open_dataset(tmp_path)
+    times, T = dataset.poses
+    np.testing.assert_allclose(T[:, 0, 3], [1, 4, 5])
+    np.testing.assert_allclose(dataset.path_m, [0, 3 * np.sqrt(2), 4 * np.sqrt(2)])
+    # Frames 1 and 4: 4.24 m of path apart, sqrt(10) = 3.16 m in a straight line.
+    truth = lidarloop.build_ground_truth(times, T, path_m=dataset.path_m, min_path_m=4.0)
+    straight = lidarloop.build_ground_truth(times, T, min_path_m=4.0)
+    assert truth.comparable(0, 1) and not straight.comparable(0, 1)
+    with pytest.raises(ValueError, match="2 values for 3 poses"):
+        lidarloop.build_ground_truth(times, T, path_m=[0.0, 1.0])
+    assert lidarloop.open_dataset(tmp_path / "velodyne").path_m is None
+
+
 def test_open_dataset_of_an_empty_folder_raises_read_error(tmp_path):
     with pytest.raises(lidarloop.ReadError):
         lidarloop.open_dataset(tmp_path)
