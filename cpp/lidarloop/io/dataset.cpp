@@ -109,7 +109,8 @@ constexpr std::size_t kFrameBeyondAnyDrive = 999'999'999;
 // The frame number of a KITTI scan file (velodyne/000094.bin is frame 94; KITTI-360's
 // 0000000094.bin too), if its name is one.
 std::optional<std::size_t> FrameNumber(const fs::path& scan) {
-    std::string_view digits = scan.stem().native();
+    const std::string stem = scan.stem().string();
+    std::string_view digits = stem;
     if (digits.empty() || !std::all_of(digits.begin(), digits.end(), [](char c) {
             return std::isdigit(static_cast<unsigned char>(c)) != 0;
         })) {
