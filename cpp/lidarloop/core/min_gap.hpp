@@ -55,9 +55,9 @@ MinGap::Unit ParseMinGapUnit(std::string_view name);
 
 /// Per scan, the length of the path travelled from the first scan, metres: the sum of the
 /// straight-line steps between consecutive sensor positions (T_world_sensor), or, when every
-/// pose knows its path (StampedPose::path_m: frames of a longer trajectory), that path. The path between
-/// scans i and j is |path[i] - path[j]|. Empty for no poses. Throws Error naming the pose when a
-/// position is not finite.
+/// pose knows its path (StampedPose::path_m: frames of a longer trajectory), that path. The path
+/// between scans i and j is |path[i] - path[j]|. Empty for no poses. Throws Error naming the pose
+/// when a position is not finite.
 std::vector<double> CumulativePathM(const std::vector<StampedPose>& poses);
 
 }  // namespace lidarloop::core
