@@ -107,7 +107,7 @@ void BindDataset(py::module_& m) {
                 return py::array_t<double>(static_cast<py::ssize_t>(times.size()), times.data());
             },
             "(N,) float64 seconds: a bag message's header stamp, else the pose's time, else the "
-            "scan index.")
+            "line of times.txt, else the scan index.")
         .def_property_readonly(
             "names",
             [](const io::Dataset& dataset) {

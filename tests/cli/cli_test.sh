@@ -341,8 +341,14 @@ section_detect() {
     expect_error "detect into the dataset" "lies inside the input" "$cli" detect "$seq" \
         --quiet --out "$seq/results"
     if [ -e "$seq/results" ]; then fail "a results folder was made inside the dataset"; else pass; fi
-    expect_error "detect seconds without times" "needs scan times" "$cli" detect "$seq" \
-        --min-gap 1 --min-gap-unit seconds --quiet --out "$work/det4"
+    expect_error "detect seconds without times" "has no poses and no times.txt" "$cli" detect \
+        "$seq" --min-gap 1 --min-gap-unit seconds --quiet --out "$work/det4"
+    # A times.txt alone gives the scans' times (KITTI's sequences without poses).
+    seq_times="$work/seq_times"
+    cp -r "$seq" "$seq_times"
+    find "$seq_times" -name 'scan*' | awk '{ print 0.1 * (NR - 1) }' >"$seq_times/times.txt"
+    expect_ok "detect seconds with times.txt" "scans (folder)" "$cli" detect "$seq_times" \
+        --min-gap 0.15 --min-gap-unit seconds --quiet --out "$work/det4"
     expect_error "detect bad top-k" "detection.top_k must be in" "$cli" detect "$seq" --top-k 0 \
         --quiet --out "$work/det5"
     expect_error "detect missing dataset" "no such dataset folder" "$cli" detect "$work/none" \

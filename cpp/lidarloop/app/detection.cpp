@@ -26,7 +26,7 @@ void RequireTimesForSeconds(const io::RunConfig& config, const io::Dataset& data
     if (config.detection.min_gap.unit == core::MinGap::Unit::kSeconds && !dataset.HasTimes()) {
         throw core::ConfigError("a minimum gap in seconds needs scan times, and " +
                                 dataset.root().string() +
-                                " has no poses; give --poses or a gap in scans");
+                                " has no poses and no times.txt; give --poses or a gap in scans");
     }
 }
 

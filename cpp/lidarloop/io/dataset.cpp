@@ -140,18 +140,66 @@ bool FirstFrames(const std::vector<std::size_t>& frames) {
     return true;
 }
 
+// The frames whose `count` rows of `file` (poses or times, one a frame of the drive) the scans
+// take (PosesOfFrames' rule); nullopt when the rows are one a scan as given. ReadError naming
+// `file` for a frame beyond its rows, naming a scan whose frame the one before has too.
+std::optional<std::vector<std::size_t>> FramesToPick(const std::vector<fs::path>& scans,
+                                                     std::size_t count, const std::string& rows,
+                                                     const fs::path& file) {
+    if (count <= scans.size()) return std::nullopt;
+    std::optional<std::vector<std::size_t>> frames = FrameNumbers(scans);
+    if (!frames || FirstFrames(*frames)) return std::nullopt;
+    for (std::size_t i = 0; i < frames->size(); ++i) {
+        const std::size_t frame = (*frames)[i];
+        if (frame >= count) {
+            throw ReadError(
+                file, "holds " + std::to_string(count) + " " + rows + " (frames 0 to " +
+                          std::to_string(count - 1) + ") but scan " + scans[i].filename().string() +
+                          " is " +
+                          (frame == kFrameBeyondAnyDrive ? std::string("a later frame")
+                                                         : "frame " + std::to_string(frame)));
+        }
+        if (i > 0 && frame == (*frames)[i - 1]) {
+            throw ReadError(scans[i], "is frame " + std::to_string(frame) + ", as is " +
+                                          scans[i - 1].filename().string());
+        }
+    }
+    return frames;
+}
+
+// A folder's times.txt when it has no poses (KITTI gives times for every sequence, poses for
+// some): one time a scan, or for some frames of a KITTI drive one a frame; empty without one.
+std::vector<double> TimesOfScans(const std::vector<fs::path>& scans, const fs::path& times_file,
+                                 bool by_frame) {
+    if (times_file.empty()) return {};
+    std::vector<double> times_s = ReadKittiTimes(times_file);
+    const std::optional<std::vector<std::size_t>> frames =
+        by_frame ? FramesToPick(scans, times_s.size(), "times", times_file) : std::nullopt;
+    if (frames) {
+        std::vector<double> selected;
+        for (const std::size_t frame : *frames) selected.push_back(times_s[frame]);
+        times_s = std::move(selected);
+    }
+    if (times_s.size() != scans.size()) {
+        throw ReadError(times_file, "holds " + std::to_string(times_s.size()) + " times for " +
+                                        std::to_string(scans.size()) + " scans");
+    }
+    return times_s;
+}
+
 Dataset OpenKitti(const fs::path& root, const DatasetOptions& options) {
     auto scans = ListFiles(root / "velodyne", IsKittiBin);
     const fs::path poses_file = ExistingOr(options.poses_file, root / "poses.txt");
     const fs::path calib_file = ExistingOr(options.calib_file, root / "calib.txt");
     const fs::path times_file = ExistingOr({}, root / "times.txt");
-    std::vector<core::StampedPose> poses;
-    if (!poses_file.empty()) {
-        const core::Transform T_cam0_velo =
-            calib_file.empty() ? core::Transform::Identity() : ReadKittiCalibTr(calib_file);
-        poses =
-            PosesOfFrames(scans, ReadPosesFile(poses_file, T_cam0_velo, times_file), poses_file);
+    if (poses_file.empty()) {
+        std::vector<double> times_s = TimesOfScans(scans, times_file, /*by_frame=*/true);
+        return {DatasetFormat::kKitti, root, std::move(scans), {}, std::move(times_s)};
     }
+    const core::Transform T_cam0_velo =
+        calib_file.empty() ? core::Transform::Identity() : ReadKittiCalibTr(calib_file);
+    std::vector<core::StampedPose> poses =
+        PosesOfFrames(scans, ReadPosesFile(poses_file, T_cam0_velo, times_file), poses_file);
     return {DatasetFormat::kKitti, root, std::move(scans), std::move(poses)};
 }
 
@@ -186,14 +234,16 @@ Dataset OpenOsnabrueck(const fs::path& root, const DatasetOptions& options) {
 
 Dataset OpenFolder(const fs::path& root, const DatasetOptions& options) {
     auto scans = ListFolderScans(root);
-    std::vector<core::StampedPose> poses;
     const fs::path poses_file = ExistingOr(options.poses_file, root / "poses.txt");
-    if (!poses_file.empty()) {
-        const fs::path calib_file = ExistingOr(options.calib_file, {});
-        const core::Transform T_cam0_velo =
-            calib_file.empty() ? core::Transform::Identity() : ReadKittiCalibTr(calib_file);
-        poses = ReadPosesFile(poses_file, T_cam0_velo, ExistingOr({}, root / "times.txt"));
+    const fs::path times_file = ExistingOr({}, root / "times.txt");
+    if (poses_file.empty()) {
+        std::vector<double> times_s = TimesOfScans(scans, times_file, /*by_frame=*/false);
+        return {DatasetFormat::kFolder, root, std::move(scans), {}, std::move(times_s)};
     }
+    const fs::path calib_file = ExistingOr(options.calib_file, {});
+    const core::Transform T_cam0_velo =
+        calib_file.empty() ? core::Transform::Identity() : ReadKittiCalibTr(calib_file);
+    std::vector<core::StampedPose> poses = ReadPosesFile(poses_file, T_cam0_velo, times_file);
     return {DatasetFormat::kFolder, root, std::move(scans), std::move(poses)};
 }
 
@@ -259,25 +309,10 @@ DatasetFormat DetectFormat(const fs::path& root) {
 std::vector<core::StampedPose> PosesOfFrames(const std::vector<fs::path>& scans,
                                              std::vector<core::StampedPose> poses,
                                              const fs::path& poses_file) {
-    if (poses.size() <= scans.size() || IsTumPosesFile(poses_file)) return poses;
-    const std::optional<std::vector<std::size_t>> frames = FrameNumbers(scans);
-    if (!frames || FirstFrames(*frames)) return poses;
-    for (std::size_t i = 0; i < frames->size(); ++i) {
-        const fs::path& scan = scans[i];
-        if ((*frames)[i] >= poses.size()) {
-            throw ReadError(poses_file, "holds " + std::to_string(poses.size()) +
-                                            " poses (frames 0 to " +
-                                            std::to_string(poses.size() - 1) + ") but scan " +
-                                            scan.filename().string() + " is " +
-                                            ((*frames)[i] == kFrameBeyondAnyDrive
-                                                 ? std::string("a later frame")
-                                                 : "frame " + std::to_string((*frames)[i])));
-        }
-        if (i > 0 && (*frames)[i] == (*frames)[i - 1]) {
-            throw ReadError(scan, "is frame " + std::to_string((*frames)[i]) + ", as is " +
-                                      scans[i - 1].filename().string());
-        }
-    }
+    if (IsTumPosesFile(poses_file)) return poses;
+    const std::optional<std::vector<std::size_t>> frames =
+        FramesToPick(scans, poses.size(), "poses", poses_file);
+    if (!frames) return poses;
     // The path between two frames is the trajectory's, not the straight line between them.
     const std::vector<double> path_m = core::CumulativePathM(poses);
     std::vector<core::StampedPose> selected;
@@ -303,11 +338,12 @@ std::string PosesOfFramesHint(const std::vector<fs::path>& scans, std::size_t po
 }
 
 Dataset::Dataset(DatasetFormat format, fs::path root, std::vector<fs::path> scan_files,
-                 std::vector<core::StampedPose> poses)
+                 std::vector<core::StampedPose> poses, std::vector<double> times_s)
     : format_(format),
       root_(std::move(root)),
       scan_files_(std::move(scan_files)),
-      poses_(std::move(poses)) {}
+      poses_(std::move(poses)),
+      times_s_(std::move(times_s)) {}
 
 Dataset::Dataset(std::shared_ptr<const BagScans> bag, std::vector<core::StampedPose> poses)
     : format_(DatasetFormat::kRosbag), root_(bag->file()), poses_(std::move(poses)) {
@@ -342,7 +378,8 @@ core::PointCloud Dataset::LoadScan(std::size_t index) const {
 
 double Dataset::ScanTime(std::size_t index) const {
     if (bag_) return bag_->times_s().at(index);
-    return HasPoses() ? poses_.at(index).time_s : static_cast<double>(index);
+    if (HasPoses()) return poses_.at(index).time_s;
+    return times_s_.empty() ? static_cast<double>(index) : times_s_.at(index);
 }
 
 std::string Dataset::Topic() const { return bag_ ? bag_->topic() : std::string(); }

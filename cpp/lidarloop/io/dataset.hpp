@@ -33,8 +33,10 @@ struct DatasetOptions {
 /// LoadScan is thread-safe (it only reads files, or a bag under a lock).
 class Dataset {
 public:
+    /// `times_s`: the scans' times (s) when there are no poses (a times.txt), else empty.
     Dataset(DatasetFormat format, std::filesystem::path root,
-            std::vector<std::filesystem::path> scan_files, std::vector<core::StampedPose> poses);
+            std::vector<std::filesystem::path> scan_files, std::vector<core::StampedPose> poses,
+            std::vector<double> times_s = {});
     /// The scans of a bag's topic; `poses` one per scan or none.
     Dataset(std::shared_ptr<const BagScans> bag, std::vector<core::StampedPose> poses);
 
@@ -48,10 +50,11 @@ public:
     const std::vector<std::filesystem::path>& ScanPaths() const { return scan_files_; }
     core::PointCloud LoadScan(std::size_t index) const;
     bool HasPoses() const { return !poses_.empty(); }
-    /// True when the scans have recording times: poses (with their times) or a bag's stamps.
-    bool HasTimes() const { return HasPoses() || bag_ != nullptr; }
+    /// True when the scans have recording times: poses (with their times), a times.txt or a
+    /// bag's stamps.
+    bool HasTimes() const { return HasPoses() || !times_s_.empty() || bag_ != nullptr; }
     /// Recording time of a scan, seconds: a bag message's header stamp, else its pose's time,
-    /// else its index.
+    /// else its line of times.txt, else its index.
     double ScanTime(std::size_t index) const;
     /// The bag's topic ("" for a folder).
     std::string Topic() const;
@@ -63,6 +66,7 @@ private:
     std::filesystem::path root_;
     std::vector<std::filesystem::path> scan_files_;
     std::vector<core::StampedPose> poses_;
+    std::vector<double> times_s_;          ///< without poses: times.txt's, one a scan
     std::shared_ptr<const BagScans> bag_;  ///< for kRosbag
 };
 

@@ -76,7 +76,9 @@ void CheckTimeIncreases(const detail::LineReader& reader, double time_s, double 
                 " (times must increase)");
 }
 
-std::vector<double> ReadTimes(const std::filesystem::path& times_file) {
+}  // namespace
+
+std::vector<double> ReadKittiTimes(const std::filesystem::path& times_file) {
     detail::LineReader reader(times_file);
     std::vector<double> times;
     std::string line;
@@ -92,8 +94,6 @@ std::vector<double> ReadTimes(const std::filesystem::path& times_file) {
     }
     return times;
 }
-
-}  // namespace
 
 core::Transform ReadKittiCalibTr(const std::filesystem::path& calib_file) {
     detail::LineReader reader(calib_file);
@@ -129,7 +129,7 @@ std::vector<core::StampedPose> ReadKittiPosesBounded(const std::filesystem::path
         poses.push_back(pose);
     }
     if (times_file.empty()) return poses;
-    const std::vector<double> times = ReadTimes(times_file);
+    const std::vector<double> times = ReadKittiTimes(times_file);
     if (times.size() != poses.size()) {
         throw ReadError(times_file, "holds " + std::to_string(times.size()) + " times but " +
                                         poses_file.string() + " holds " +

@@ -29,6 +29,11 @@ std::vector<core::StampedPose> ReadKittiPoses(
     const core::Transform& T_cam0_velo = core::Transform::Identity(),
     const std::filesystem::path& times_file = {});
 
+/// Reads a KITTI `times.txt`: one time a line, seconds. Blank and '#' lines are skipped. Throws
+/// ReadError naming the line with another count of values, a non-number, a non-finite value or
+/// a time that does not increase.
+std::vector<double> ReadKittiTimes(const std::filesystem::path& times_file);
+
 /// Writes poses as KITTI `poses.txt` (T_world_sensor, 3x4 row-major, no calibration applied,
 /// full double precision). Times are not written.
 void WriteKittiPoses(const std::filesystem::path& poses_file,

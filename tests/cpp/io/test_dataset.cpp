@@ -201,6 +201,37 @@ TEST(Dataset, KittiFramesTakeTheirPosesAndPathFromTheWholeSequence) {
         << ErrorOf(dir.path());
 }
 
+// KITTI's test sequences have times but no poses: a gap in seconds needs no poses. Some frames
+// take their frames' times; a folder's times.txt holds one a scan.
+TEST(Dataset, TimesWithoutPosesAreTheScansTimes) {
+    test::TempDir dir;
+    fs::create_directories(dir / "velodyne");
+    for (const char* frame : {"000000", "000001", "000002"})
+        WriteKittiBin(dir / "velodyne" / (std::string(frame) + ".bin"), test::RandomCloud(5, 1));
+    test::WriteFile(dir / "times.txt", "0.5\n0.6\n0.75\n");
+    Dataset dataset = OpenDataset(dir.path());
+    EXPECT_FALSE(dataset.HasPoses());
+    ASSERT_TRUE(dataset.HasTimes());
+    EXPECT_EQ(dataset.ScanTime(2), 0.75);
+    test::WriteFile(dir / "times.txt", "0.5\n0.6\n0.75\n0.9\n1.0\n");
+    EXPECT_NE(ErrorOf(dir.path()).find("times.txt: holds 5 times for 3 scans"), std::string::npos)
+        << ErrorOf(dir.path());
+    fs::rename(dir / "velodyne" / "000002.bin", dir / "velodyne" / "000004.bin");
+    dataset = OpenDataset(dir.path());
+    EXPECT_EQ(dataset.ScanTime(2), 1.0);  // frame 4
+    test::WriteFile(dir / "times.txt", "0.5\n0.6\n0.5\n");
+    EXPECT_NE(ErrorOf(dir.path()).find("times.txt: line 3: time 0.5 goes back"), std::string::npos)
+        << ErrorOf(dir.path());
+
+    test::TempDir folder;
+    WriteKittiBin(folder / "a.bin", test::RandomCloud(5, 1));
+    WriteKittiBin(folder / "b.bin", test::RandomCloud(5, 2));
+    test::WriteFile(folder / "times.txt", "3\n4\n");
+    EXPECT_EQ(OpenDataset(folder.path()).ScanTime(1), 4.0);
+    test::WriteFile(folder / "times.txt", "3\n");
+    EXPECT_NE(ErrorOf(folder.path()).find("holds 1 times for 2 scans"), std::string::npos);
+}
+
 // A TUM file's rows are times, not frames: one with more rows than scans is no list of frames.
 TEST(Dataset, TumPosesAreNotPickedByFrameNumber) {
     test::TempDir dir;
