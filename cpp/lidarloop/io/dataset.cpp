@@ -18,8 +18,6 @@ namespace lidarloop::io {
 namespace fs = std::filesystem;
 namespace {
 
-constexpr std::array<const char*, 3> kSidecarPrefixes = {"poses", "times", "calib"};
-
 // "scan2" < "scan10": runs of digits compare by value, so unpadded numbering sorts as expected.
 bool NaturalLess(const std::string& a, const std::string& b) {
     std::size_t i = 0;
@@ -65,15 +63,6 @@ bool IsKittiBin(const fs::path& file) { return file.extension() == ".bin"; }
 
 bool IsOsnabrueckScan(const fs::path& file) {
     return file.extension() == ".3d" && file.filename().string().rfind("scan", 0) == 0;
-}
-
-// Text files beside the scans that hold poses, times or calibration, not points: KITTI's names
-// and their variants (poses_odometry.txt, calib_00.txt).
-bool IsSidecarFile(const fs::path& file) {
-    if (file.extension() != ".txt") return false;
-    const std::string stem = file.stem().string();
-    return std::any_of(kSidecarPrefixes.begin(), kSidecarPrefixes.end(),
-                       [&](const char* prefix) { return stem.rfind(prefix, 0) == 0; });
 }
 
 bool IsFolderScan(const fs::path& file) {

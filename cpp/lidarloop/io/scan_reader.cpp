@@ -1,8 +1,10 @@
 #include "lidarloop/io/scan_reader.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <filesystem>
+#include <string>
 #include <system_error>
 
 #include "lidarloop/io/kitti_bin.hpp"
@@ -43,9 +45,19 @@ Reader FindReader(const std::filesystem::path& file) {
     return nullptr;
 }
 
+// Names of the text files beside scans that hold no points.
+constexpr std::array<const char*, 3> kSidecarPrefixes = {"poses", "times", "calib"};
+
 }  // namespace
 
 bool IsScanFile(const std::filesystem::path& file) { return FindReader(file) != nullptr; }
+
+bool IsSidecarFile(const std::filesystem::path& file) {
+    if (file.extension() != ".txt") return false;
+    const std::string stem = file.stem().string();
+    return std::any_of(kSidecarPrefixes.begin(), kSidecarPrefixes.end(),
+                       [&](const char* prefix) { return stem.rfind(prefix, 0) == 0; });
+}
 
 core::PointCloud ReadScan(const std::filesystem::path& file) {
     if (const auto reference = ParseBagScanReference(file.string())) return ReadBagScan(*reference);
@@ -57,6 +69,11 @@ core::PointCloud ReadScan(const std::filesystem::path& file) {
                                   file.string() +
                                   ":/points:0; `lidarloop bag-info` lists the "
                                   "topics)");
+    }
+    if (IsSidecarFile(file)) {
+        throw ReadError(file,
+                        "is named as a poses, times or calibration file (poses*, times*, "
+                        "calib*.txt), not a scan");
     }
     const Reader reader = FindReader(file);
     if (reader == nullptr) {

@@ -60,6 +60,27 @@ TEST(ScanReader, MissingFileAndFolderAreErrors) {
     EXPECT_THROW(ReadScan(dir / "folder.pcd"), ReadError);
 }
 
+// A poses file's twelve numbers a line would read as points (its first three): a poses, times
+// or calibration file is no scan, as in a dataset folder.
+TEST(ScanReader, PosesTimesAndCalibrationFilesAreNoScans) {
+    test::TempDir dir;
+    for (const char* name : {"poses.txt", "poses_odometry.txt", "times.txt", "calib_00.txt"}) {
+        test::WriteFile(dir / name, "1 0 0 0 0 1 0 0 0 0 1 0\n");
+        try {
+            ReadScan(dir / name);
+            FAIL() << "read " << name << " as a scan";
+        } catch (const ReadError& e) {
+            EXPECT_NE(std::string(e.what()).find("is named as a poses, times or calibration file"),
+                      std::string::npos)
+                << e.what();
+        }
+        EXPECT_TRUE(IsSidecarFile(dir / name));
+    }
+    WriteXyz(dir / "scan_poses.txt", test::RandomCloud(3, 1));
+    EXPECT_EQ(ReadScan(dir / "scan_poses.txt").size(), 3U);
+    EXPECT_FALSE(IsSidecarFile("poses.xyz"));
+}
+
 TEST(ScanReader, WrongContentForTheExtensionIsAnError) {
     test::TempDir dir;
     WriteXyz(dir / "text.xyz", test::RandomCloud(10, 2));
