@@ -4,6 +4,7 @@
 #include <array>
 #include <cctype>
 #include <optional>
+#include <string_view>
 
 #include "lidarloop/core/min_gap.hpp"
 #include "lidarloop/io/detail/text_parsing.hpp"
@@ -160,7 +161,7 @@ std::optional<std::vector<std::size_t>> FramesToPick(const std::vector<fs::path>
 // some): one time a scan, or for some frames of a KITTI drive one a frame; empty without one.
 std::vector<double> TimesOfScans(const std::vector<fs::path>& scans, const fs::path& times_file,
                                  bool by_frame) {
-    if (times_file.empty()) return {};
+    if (times_file.empty() || scans.empty()) return {};
     std::vector<double> times_s = ReadKittiTimes(times_file);
     const std::optional<std::vector<std::size_t>> frames =
         by_frame ? FramesToPick(scans, times_s.size(), "times", times_file) : std::nullopt;
@@ -314,7 +315,7 @@ std::vector<core::StampedPose> PosesOfFrames(const std::vector<fs::path>& scans,
 }
 
 std::string PosesOfFramesHint(const std::vector<fs::path>& scans, std::size_t poses) {
-    if (poses <= scans.size()) return {};
+    if (scans.empty() || poses <= scans.size()) return {};
     const auto unnamed = std::find_if(scans.begin(), scans.end(), [](const fs::path& scan) {
         return !FrameNumber(scan).has_value();
     });
@@ -322,8 +323,11 @@ std::string PosesOfFramesHint(const std::vector<fs::path>& scans, std::size_t po
         return " (poses are taken by frame number only when every scan is named by one, and " +
                unnamed->filename().string() + " is not)";
     }
-    return " (the scans are frames 0 to " + std::to_string(scans.size() - 1) +
-           ": their poses file holds one pose a scan)";
+    if (FirstFrames(*FrameNumbers(scans))) {
+        return " (the scans are frames 0 to " + std::to_string(scans.size() - 1) +
+               ": their poses file holds one pose a scan)";
+    }
+    return " (a TUM file's rows are times, not frames: give a KITTI file of one pose a frame)";
 }
 
 Dataset::Dataset(DatasetFormat format, fs::path root, std::vector<fs::path> scan_files,

@@ -88,8 +88,9 @@ std::vector<core::StampedPose> PosesOfFrames(const std::vector<std::filesystem::
                                              std::vector<core::StampedPose> poses,
                                              const std::filesystem::path& poses_file);
 
-/// Why PosesOfFrames kept `poses` poses for `scans`, for a count mismatch's message ("" when
-/// there are no more poses than scans).
+/// Why PosesOfFrames kept `poses` poses for `scans` (KITTI layout), for a count mismatch's
+/// message: a scan not named by a frame number, frames 0 to n - 1, or else a TUM file; "" when
+/// there are no more poses than scans.
 std::string PosesOfFramesHint(const std::vector<std::filesystem::path>& scans, std::size_t poses);
 
 }  // namespace lidarloop::io

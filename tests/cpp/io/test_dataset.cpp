@@ -239,7 +239,10 @@ TEST(Dataset, TumPosesAreNotPickedByFrameNumber) {
     for (const char* frame : {"000001", "000004"})
         WriteKittiBin(dir / "velodyne" / (std::string(frame) + ".bin"), test::RandomCloud(5, 1));
     WriteTumPoses(dir / "poses.txt", LinePoses(8));
-    EXPECT_NE(ErrorOf(dir.path()).find("has 2 scans but 8 poses"), std::string::npos)
+    EXPECT_NE(ErrorOf(dir.path())
+                  .find("has 2 scans but 8 poses (a TUM file's rows are times, "
+                        "not frames"),
+              std::string::npos)
         << ErrorOf(dir.path());
 }
 
