@@ -31,11 +31,16 @@ MinGap::Unit ParseMinGapUnit(std::string_view name) {
     return ParseEnum(kUnitNames, name, "gap unit");
 }
 
+bool KnowsDrivePath(const std::vector<StampedPose>& poses) {
+    return !poses.empty() && std::all_of(poses.begin(), poses.end(), [](const StampedPose& pose) {
+        return pose.path_m.has_value();
+    });
+}
+
 std::vector<double> CumulativePathM(const std::vector<StampedPose>& poses) {
     std::vector<double> path_m;
     path_m.reserve(poses.size());
-    const auto knows_path = [](const StampedPose& pose) { return pose.path_m.has_value(); };
-    if (!poses.empty() && std::all_of(poses.begin(), poses.end(), knows_path)) {
+    if (KnowsDrivePath(poses)) {
         for (const StampedPose& pose : poses) path_m.push_back(*pose.path_m - *poses[0].path_m);
         return path_m;
     }

@@ -53,6 +53,10 @@ std::string ToString(MinGap::Unit unit);
 /// Parses "scans" / "seconds" / "metres"; throws ConfigError listing the valid names.
 MinGap::Unit ParseMinGapUnit(std::string_view name);
 
+/// True when every pose knows the path to it along a longer drive (StampedPose::path_m: some
+/// frames of a KITTI sequence); false for none.
+bool KnowsDrivePath(const std::vector<StampedPose>& poses);
+
 /// Per scan, the length of the path travelled from the first scan, metres: the sum of the
 /// straight-line steps between consecutive sensor positions (T_world_sensor), or, when every
 /// pose knows its path (StampedPose::path_m: frames of a longer trajectory), that path. The path

@@ -6,6 +6,8 @@
 #include <optional>
 #include <stdexcept>
 
+#include "lidarloop/core/min_gap.hpp"
+
 namespace lidarloop::registration {
 namespace {
 
@@ -34,15 +36,15 @@ void CollectSide(const std::vector<double>& path_m, std::size_t centre, int step
 }  // namespace
 
 std::vector<double> SubmapPathM(const std::vector<core::StampedPose>& poses) {
-    std::vector<double> path_m(poses.size(), std::numeric_limits<double>::quiet_NaN());
     // Frames of a longer drive: its path, not the straight lines between them.
-    const auto knows_path = [](const core::StampedPose& pose) { return pose.path_m.has_value(); };
-    if (!poses.empty() && std::all_of(poses.begin(), poses.end(), knows_path)) {
+    if (core::KnowsDrivePath(poses)) {
+        std::vector<double> path_m = core::CumulativePathM(poses);
         for (std::size_t i = 0; i < poses.size(); ++i)
-            if (FinitePose(poses[i].T_world_sensor))
-                path_m[i] = *poses[i].path_m - *poses[0].path_m;
+            if (!FinitePose(poses[i].T_world_sensor))
+                path_m[i] = std::numeric_limits<double>::quiet_NaN();
         return path_m;
     }
+    std::vector<double> path_m(poses.size(), std::numeric_limits<double>::quiet_NaN());
     double travelled_m = 0.0;
     std::optional<Eigen::Vector3d> last;
     for (std::size_t i = 0; i < poses.size(); ++i) {

@@ -1,4 +1,5 @@
 #include <cmath>
+#include <initializer_list>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -152,6 +153,13 @@ TEST(Dataset, PoseCountMismatchIsAnError) {
         << ErrorOf(dir.path());
 }
 
+// A KITTI layout of small scans named as the given frames: DIR/velodyne/FRAME.bin.
+void WriteKittiFrames(const fs::path& dir, std::initializer_list<const char*> frames) {
+    fs::create_directories(dir / "velodyne");
+    for (const char* frame : frames)
+        WriteKittiBin(dir / "velodyne" / (std::string(frame) + ".bin"), test::RandomCloud(5, 1));
+}
+
 // A zigzag: every step is sqrt(2) m long, so a path differs from the straight line between
 // frames.
 std::vector<core::StampedPose> ZigzagPoses(std::size_t count) {
@@ -165,10 +173,7 @@ std::vector<core::StampedPose> ZigzagPoses(std::size_t count) {
 
 TEST(Dataset, KittiFramesTakeTheirPosesAndPathFromTheWholeSequence) {
     test::TempDir dir;
-    fs::create_directories(dir / "velodyne");
-    for (const char* frame : {"000001", "000004", "000005"}) {
-        WriteKittiBin(dir / "velodyne" / (std::string(frame) + ".bin"), test::RandomCloud(5, 1));
-    }
+    WriteKittiFrames(dir.path(), {"000001", "000004", "000005"});
     WriteKittiPoses(dir / "poses.txt", ZigzagPoses(8));
     test::WriteFile(dir / "times.txt", "0\n0.1\n0.2\n0.3\n0.4\n0.5\n0.6\n0.7\n");
     const Dataset dataset = OpenDataset(dir.path());
@@ -205,9 +210,7 @@ TEST(Dataset, KittiFramesTakeTheirPosesAndPathFromTheWholeSequence) {
 // take their frames' times; a folder's times.txt holds one a scan.
 TEST(Dataset, TimesWithoutPosesAreTheScansTimes) {
     test::TempDir dir;
-    fs::create_directories(dir / "velodyne");
-    for (const char* frame : {"000000", "000001", "000002"})
-        WriteKittiBin(dir / "velodyne" / (std::string(frame) + ".bin"), test::RandomCloud(5, 1));
+    WriteKittiFrames(dir.path(), {"000000", "000001", "000002"});
     test::WriteFile(dir / "times.txt", "0.5\n0.6\n0.75\n");
     Dataset dataset = OpenDataset(dir.path());
     EXPECT_FALSE(dataset.HasPoses());
@@ -235,9 +238,7 @@ TEST(Dataset, TimesWithoutPosesAreTheScansTimes) {
 // A TUM file's rows are times, not frames: one with more rows than scans is no list of frames.
 TEST(Dataset, TumPosesAreNotPickedByFrameNumber) {
     test::TempDir dir;
-    fs::create_directories(dir / "velodyne");
-    for (const char* frame : {"000001", "000004"})
-        WriteKittiBin(dir / "velodyne" / (std::string(frame) + ".bin"), test::RandomCloud(5, 1));
+    WriteKittiFrames(dir.path(), {"000001", "000004"});
     WriteTumPoses(dir / "poses.txt", LinePoses(8));
     EXPECT_NE(ErrorOf(dir.path())
                   .find("has 2 scans but 8 poses (a TUM file's rows are times, "
