@@ -247,6 +247,10 @@ def test_loop_retrieval_checks_a_gap_in_metres_on_the_detectors_path():
     with pytest.raises(lidarloop.Error, match="detector's path"):
         lidarloop.evaluate_loop_retrieval(ranked, truth, times, T,
                                           detector_path_m=odometry_path[:-1])
+    shrinking = odometry_path.copy()
+    shrinking[5] = -1.0
+    with pytest.raises(lidarloop.Error, match="detector's path: scan 5's path"):
+        lidarloop.evaluate_loop_retrieval(ranked, truth, times, T, detector_path_m=shrinking)
 
 
 def test_em_threshold_lies_between_two_clusters():

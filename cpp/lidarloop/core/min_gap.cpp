@@ -42,6 +42,7 @@ std::vector<double> CumulativePathM(const std::vector<StampedPose>& poses) {
     path_m.reserve(poses.size());
     if (KnowsDrivePath(poses)) {
         for (const StampedPose& pose : poses) path_m.push_back(*pose.path_m - *poses[0].path_m);
+        CheckPathM(path_m, "path length");
         return path_m;
     }
     for (std::size_t i = 0; i < poses.size(); ++i) {
@@ -54,6 +55,20 @@ std::vector<double> CumulativePathM(const std::vector<StampedPose>& poses) {
                    : path_m.back() + (position - poses[i - 1].T_world_sensor.translation()).norm());
     }
     return path_m;
+}
+
+void CheckPathM(std::span<const double> path_m, const std::string& what) {
+    for (std::size_t i = 0; i < path_m.size(); ++i) {
+        if (!std::isfinite(path_m[i])) {
+            throw Error(what + ": scan " + std::to_string(i) + "'s path is not finite");
+        }
+        if (i > 0 && path_m[i] < path_m[i - 1]) {
+            throw Error(what + ": scan " + std::to_string(i) + "'s path (" +
+                        std::to_string(path_m[i]) + " m) lies before scan " +
+                        std::to_string(i - 1) + "'s (" + std::to_string(path_m[i - 1]) +
+                        " m): a path never shrinks");
+        }
+    }
 }
 
 }  // namespace lidarloop::core

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -63,5 +64,10 @@ bool KnowsDrivePath(const std::vector<StampedPose>& poses);
 /// between scans i and j is |path[i] - path[j]|. Empty for no poses. Throws Error naming the pose
 /// when a position is not finite.
 std::vector<double> CumulativePathM(const std::vector<StampedPose>& poses);
+
+/// Throws Error naming `what` and the scan when a path position (metres per scan, as
+/// CumulativePathM gives) is not finite or lies before the one of the scan before it: a path
+/// given from outside (Python's path_m, a pose graph's) must be one a drive can have.
+void CheckPathM(std::span<const double> path_m, const std::string& what);
 
 }  // namespace lidarloop::core

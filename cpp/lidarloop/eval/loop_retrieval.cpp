@@ -6,6 +6,7 @@
 #include <string>
 
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/core/min_gap.hpp"
 
 namespace lidarloop::eval {
 namespace {
@@ -84,6 +85,7 @@ void CheckInput(std::span<const QueryCandidates> queries, const GroundTruth& tru
                           std::to_string(detector_path_m.size()) + " scans, the ground truth " +
                           std::to_string(truth.size()));
     }
+    core::CheckPathM(detector_path_m, "loop retrieval: the detector's path");
     std::vector<bool> seen(truth.size(), false);
     for (const auto& q : queries) CheckQuery(q, truth, detector_path_m, seen);
 }

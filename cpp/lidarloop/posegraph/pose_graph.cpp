@@ -7,6 +7,7 @@
 #include <string>
 #include "lidarloop/core/angles.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/core/min_gap.hpp"
 
 namespace lidarloop::posegraph {
 namespace {}  // namespace
@@ -59,6 +60,7 @@ PoseGraph BuildPoseGraph(const std::vector<core::Transform>& odometry,
         throw core::ConfigError("the pose graph's path has " + std::to_string(path_m.size()) +
                                 " lengths for " + std::to_string(odometry.size()) + " poses");
     }
+    core::CheckPathM(path_m, "the pose graph's path");
     PoseGraph graph;
     graph.poses = odometry;
     graph.path_m = std::move(path_m);

@@ -67,5 +67,28 @@ TEST(MinGap, CumulativePathOfStopsAndBadPoses) {
     EXPECT_THROW(CumulativePathM(poses), Error);
 }
 
+TEST(MinGap, AGivenPathMustBeFiniteAndNeverShrink) {
+    EXPECT_NO_THROW(CheckPathM(std::vector<double>{}, "path"));
+    EXPECT_NO_THROW(CheckPathM(std::vector<double>{0.0, 2.0, 2.0, 7.5}, "path"));
+    try {
+        CheckPathM(std::vector<double>{0.0, 3.0, 1.0}, "given path");
+        ADD_FAILURE() << "a shrinking path passed";
+    } catch (const Error& e) {
+        EXPECT_TRUE(
+            test::Contains(e.what(), "given path: scan 2's path (1.000000 m) lies before scan 1"));
+    }
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const double inf = std::numeric_limits<double>::infinity();
+    EXPECT_THROW(CheckPathM(std::vector<double>{0.0, nan, 5.0}, "path"), Error);
+    EXPECT_THROW(CheckPathM(std::vector<double>{0.0, inf}, "path"), Error);
+    // Frames of a longer drive whose path shrinks: the drive's path is checked, not trusted.
+    std::vector<StampedPose> frames(2);
+    frames[0].path_m = 10.0;
+    frames[1].path_m = 4.0;
+    EXPECT_THROW(CumulativePathM(frames), Error);
+    frames[1].path_m = nan;
+    EXPECT_THROW(CumulativePathM(frames), Error);
+}
+
 }  // namespace
 }  // namespace lidarloop::core
