@@ -64,6 +64,17 @@ std::string NoPathNote() {
 
 }  // namespace
 
+std::vector<std::string> FramesNotes(const io::Dataset& dataset,
+                                     const std::vector<core::StampedPose>& odometry) {
+    std::vector<std::string> notes;
+    for (const auto& [poses, what] :
+         {std::pair{&dataset.poses(), "poses"}, std::pair{&odometry, "odometry"}}) {
+        std::string note = io::FramesNote(dataset.ScanPaths(), *poses, what);
+        if (!note.empty()) notes.push_back(std::move(note));
+    }
+    return notes;
+}
+
 std::vector<core::StampedPose> ReadOdometry(const std::filesystem::path& file,
                                             const io::Dataset& dataset, double max_step_m) {
     std::vector<core::StampedPose> odometry =
@@ -198,6 +209,7 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     request.config.Validate();
     const std::vector<core::StampedPose> poses = OdometryOfScans(request, dataset);
     DetectOutcome outcome;
+    outcome.notes = FramesNotes(dataset, poses);
     const io::RunConfig config =
         WithSubmapsWhereTheyApply(request.config, dataset.size(), poses, outcome.notes);
     const double threshold = config.detection.ThresholdFor(config.descriptor.method);

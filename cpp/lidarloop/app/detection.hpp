@@ -64,6 +64,11 @@ std::vector<core::StampedPose> ReadOdometry(
     const std::filesystem::path& file, const io::Dataset& dataset,
     double max_step_m = std::numeric_limits<double>::infinity());
 
+/// The notes that say which frames of a KITTI drive the dataset's poses and `odometry` were taken
+/// from (io::FramesNote), none for poses one a scan.
+std::vector<std::string> FramesNotes(const io::Dataset& dataset,
+                                     const std::vector<core::StampedPose>& odometry);
+
 /// The odometry of `dataset` from `file`, or, when `topic` is given, from the nav_msgs/Odometry
 /// messages of `topic` in the dataset's bag, interpolated at the scans' stamps
 /// (io::ReadBagOdometry: io::ReadError naming the bag and the topic when their times do not

@@ -477,6 +477,8 @@ EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequ
                 "give the sequence's own odometry");
         }
     }
+    for (std::string& note : FramesNotes(dataset, odometry))
+        outcome.notes.push_back(std::move(note));
     EvaluationRequest effective = request;
     // Submaps only from odometry: placed by the dataset's poses, the ground truth scored against
     // here, they would flatter the verified recall.

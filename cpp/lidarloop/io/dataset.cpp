@@ -314,6 +314,17 @@ std::vector<core::StampedPose> PosesOfFrames(const std::vector<fs::path>& scans,
     return selected;
 }
 
+std::string FramesNote(const std::vector<fs::path>& scans,
+                       const std::vector<core::StampedPose>& poses, const std::string& what) {
+    if (!core::KnowsDrivePath(poses) || poses.size() != scans.size()) return {};
+    const std::optional<std::vector<std::size_t>> frames = FrameNumbers(scans);
+    if (!frames) return {};
+    return "the " + std::to_string(scans.size()) + " scans are frames " +
+           std::to_string(frames->front()) + " to " + std::to_string(frames->back()) +
+           " of a KITTI drive (by their file names): they take those frames' " + what +
+           ", and the path between them is the drive's";
+}
+
 std::string PosesOfFramesHint(const std::vector<fs::path>& scans, std::size_t poses) {
     if (scans.empty() || poses <= scans.size()) return {};
     const auto unnamed = std::find_if(scans.begin(), scans.end(), [](const fs::path& scan) {

@@ -93,4 +93,10 @@ std::vector<core::StampedPose> PosesOfFrames(const std::vector<std::filesystem::
 /// there are no more poses than scans.
 std::string PosesOfFramesHint(const std::vector<std::filesystem::path>& scans, std::size_t poses);
 
+/// What a run tells its user when PosesOfFrames took `poses` (named `what`: "poses", "odometry")
+/// by the scans' frame numbers: which frames, so that another drive's file is seen; empty when
+/// the poses are one a scan as given.
+std::string FramesNote(const std::vector<std::filesystem::path>& scans,
+                       const std::vector<core::StampedPose>& poses, const std::string& what);
+
 }  // namespace lidarloop::io

@@ -38,6 +38,10 @@ TEST(KittiSamplesRun, DetectClosesBothLoopsOfSequence08WithTheOfficialPoses) {
     const app::DetectOutcome outcome = app::RunDetect(dataset, request);
     ASSERT_EQ(outcome.path_m.size(), 4U);
     EXPECT_GT(outcome.path_m[2] - outcome.path_m[1], 400.0);  // the straight line: 3 m
+    ASSERT_FALSE(outcome.notes.empty());
+    EXPECT_EQ(outcome.notes[0],
+              "the 4 scans are frames 209 to 1684 of a KITTI drive (by their file names): they "
+              "take those frames' poses, and the path between them is the drive's");
 
     struct Expected {
         std::size_t query, match;
