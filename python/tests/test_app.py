@@ -147,7 +147,7 @@ def test_evaluate_with_odometry_verifies_submaps_as_the_cli(cli, sequence, tmp_p
     assert without_timings(result.metrics) == without_timings(cli_metrics)
     assert result.methods["range"].retrieval_verified is not None
     # Verified with submaps (config.yaml records the window), not scan by scan.
-    assert "submap_path_m: 5" in (tmp_path / "py" / "config.yaml").read_text()
+    assert "submap_path_m: 10" in (tmp_path / "py" / "config.yaml").read_text()
 
 
 def test_evaluate_learns_on_another_dataset_as_the_cli(cli, sequence, tmp_path):

@@ -177,6 +177,7 @@ std::vector<registration::PreparedScan> MapScansFor(LoadedMap& map,
     registration::ScanReductionConfig reduction = detection.verification.reduction;
     reduction.submap_path_m = map.scans->reduction.submap_path_m;
     reduction.submap_max_scans = map.scans->reduction.submap_max_scans;
+    reduction.submap_max_points = map.scans->reduction.submap_max_points;
     if (map.scans->reduction != reduction) {
         throw core::ConfigError("verification.reduction differs from the one " +
                                 scans_file.string() +

@@ -130,6 +130,8 @@ void VisitFields(registration::ScanReductionConfig& c, Visitor& v) {
     v.Field("submap_path_m", c.submap_path_m,
             "with poses: a scan merged with its neighbours this much path either side (0: off)");
     v.Field("submap_max_scans", c.submap_max_scans, "neighbours merged per side, at most");
+    v.Field("submap_max_points", c.submap_max_points,
+            "points merged at most, nearest neighbours in path first");
 }
 
 template <typename Visitor>

@@ -38,6 +38,7 @@ void ScanReductionConfig::Validate() const {
     RequireIn(max_ground_points, 10, 1'000'000, "reduction.max_ground_points");
     RequireIn(submap_path_m, 0.0, 100.0, "reduction.submap_path_m");
     RequireIn(submap_max_scans, 0, 1000, "reduction.submap_max_scans");
+    RequireIn(submap_max_points, 10'000, 100'000'000, "reduction.submap_max_points");
 }
 
 void CoarseConfig::Validate() const {

@@ -27,9 +27,13 @@ struct ScanReductionConfig {
     /// placed by the poses in its own frame (registration::PrepareSubmap); 0: each scan alone.
     /// One sparse scan holds too little structure to pin a pose; a few neighbours, which the
     /// odometry places with little drift, give it (docs/verification.md, "Submaps"). [0, 100]
-    double submap_path_m = 5.0;
+    double submap_path_m = 10.0;
     /// Neighbours per side at most, 0..1000: bounds the merge on a slow or standing platform.
     int submap_max_scans = 30;
+    /// Points a submap merges at most, 10^4..10^8: its nearest neighbours in path first. The
+    /// reduction caps what a scan keeps, so beyond a few dense scans more points cost time and
+    /// add nothing; sparse scans fill the window (docs/verification.md, "Submaps").
+    int submap_max_points = 600'000;
 
     /// Throws core::ConfigError naming the first invalid field (prefix "verification.").
     void Validate() const;

@@ -139,6 +139,40 @@ TEST(Submap, PrepareSubmapIsPrepareScanOfTheMerge) {
     EXPECT_FALSE(submap.view_centre.isApprox(expected.view_centre, 1e-3));
 }
 
+// Dense scans fill a submap with few neighbours: the point budget keeps the centre and its
+// nearest neighbours in path (the earlier of two equally near), whatever the window holds.
+TEST(Submap, ThePointBudgetKeepsTheNearestNeighbours) {
+    std::mt19937 random(12);
+    const std::vector<core::StampedPose> poses = LinePoses(7);
+    std::vector<core::PointCloud> scans;
+    for (int i = 0; i < 7; ++i) scans.push_back(RandomScan(random, 10'000));
+    const std::size_t scan_points = scans[0].size();  // with the two unusable points
+    ScanReductionConfig config;
+    config.submap_path_m = 10.0;                                   // every scan within the window
+    config.submap_max_points = static_cast<int>(4 * scan_points);  // room for four scans
+    const auto load = [&scans](std::size_t k) { return scans.at(k); };
+    const auto merged_of = [&](std::initializer_list<std::size_t> members) {
+        std::vector<core::PointCloud> chosen;
+        std::vector<core::Transform> T_world_scans;
+        for (const std::size_t k : members) {
+            chosen.push_back(scans[k]);
+            T_world_scans.push_back(poses[k].T_world_sensor);
+        }
+        return PrepareScan(MergeIntoFrame(chosen, T_world_scans, poses[3].T_world_sensor, config),
+                           config);
+    };
+    const PreparedScan submap = PrepareSubmap(3, poses, SubmapPathM(poses), load, config);
+    EXPECT_EQ(submap.structure->points(), merged_of({1, 2, 3, 4}).structure->points());
+    // Less than one scan's points: the centre alone still.
+    config.submap_max_points = 10'000;
+    EXPECT_EQ(PrepareSubmap(3, poses, SubmapPathM(poses), load, config).structure->points(),
+              PrepareScan(scans[3], config).structure->points());
+    // A budget for all of them: the whole window.
+    config.submap_max_points = static_cast<int>(7 * scan_points);
+    EXPECT_EQ(PrepareSubmap(3, poses, SubmapPathM(poses), load, config).structure->points(),
+              merged_of({0, 1, 2, 3, 4, 5, 6}).structure->points());
+}
+
 TEST(Submap, WithoutAPoseTheScanIsPreparedAlone) {
     std::mt19937 random(3);
     std::vector<core::StampedPose> poses = LinePoses(3);
@@ -168,22 +202,27 @@ TEST(Submap, ConfigRangesAreValidated) {
     config = {};
     config.submap_max_scans = -1;
     EXPECT_THROW(config.Validate(), core::ConfigError);
+    config = {};
+    config.submap_max_points = 9'999;
+    EXPECT_THROW(config.Validate(), core::ConfigError);
 }
 
 // Sparse keyframes in open country (`lidarloop simulate --scene rural --route uturn --seed 3
 // --sensor hdl32 --keep-every 10 --scans 300 --spacing-min-m 1 --spacing-max-m 2`, or another
 // sensor and thinning) and one of its revisits: the query and match scans, the true
-// T_match_query, and both scans as submaps (the neighbours within 5 m of path, placed by the
-// drifting odometry).
+// T_match_query, and both scans as submaps (the neighbours within `window_m` of path, placed by
+// the drifting odometry). The pairs below were picked with 5 m windows, the default before 10 m,
+// to show one mechanism each; they keep that window.
 struct SparseRuralRevisit {
     SparseRuralRevisit(std::size_t query_scan, std::size_t match_scan,
                        sim::SensorModel sensor = sim::SensorModel::kHdl32,
-                       std::int64_t keep_every = 10)
+                       std::int64_t keep_every = 10, double window_m = 5.0)
         : simulator(test::SparseUTurnKeyframes(sim::SceneType::kRural, keep_every, sensor)),
           query(query_scan),
           match(match_scan),
           truth(simulator.GroundTruthPose(match).T_world_sensor.inverse() *
-                simulator.GroundTruthPose(query).T_world_sensor) {
+                simulator.GroundTruthPose(query).T_world_sensor),
+          config(WithWindow(window_m)) {
         const std::vector<core::StampedPose> odometry =
             simulator.OdometryPoses(0, simulator.size());
         const std::vector<double> path_m = SubmapPathM(odometry);
@@ -207,6 +246,12 @@ struct SparseRuralRevisit {
         return [truth = truth](const core::Transform& T_match_query) {
             return (T_match_query.translation() - truth.translation()).norm() < 5.0;
         };
+    }
+
+    static VerificationConfig WithWindow(double window_m) {
+        VerificationConfig config;
+        config.reduction.submap_path_m = window_m;
+        return config;
     }
 
     const sim::Simulator simulator;
@@ -314,6 +359,21 @@ TEST(Submap, VegetationFitsLooselyWhereTheOdometryJudgesThePose) {
     old_bar.acceptance.max_rmse_ratio_with_odometry = old_bar.acceptance.max_rmse_ratio;
     EXPECT_EQ(revisit.VerifySubmaps(old_bar, revisit.NearTheTruth()).reason,
               RejectReason::kHighRmse);
+}
+
+// The same pair without the odometry's judgement: with 10 m of neighbours on either side (the
+// default) the submaps hold more of the trees and field edges that fix the pose, and the loop
+// passes the RMSE bar at the true pose; 5 m windows, the default before, leave it over the bar.
+// Chosen on the seed-3 rural drives, validated on seeds 7 and 11 (docs/BENCHMARK.md, "Submaps of
+// 10 m within a point budget").
+TEST(Submap, TenMetresOfNeighboursFitTheVegetationThatFiveLeaveOverTheBar) {
+    const SparseRuralRevisit wide(176, 26, sim::SensorModel::kVlp16, 1,
+                                  ScanReductionConfig{}.submap_path_m);
+    const Verification accepted = wide.VerifySubmaps();
+    EXPECT_TRUE(accepted.accepted) << ToString(accepted.reason);
+    EXPECT_LT(wide.ErrorM(accepted), 0.1);
+    const SparseRuralRevisit narrow(176, 26, sim::SensorModel::kVlp16, 1, 5.0);
+    EXPECT_EQ(narrow.VerifySubmaps().reason, RejectReason::kHighRmse);
 }
 
 // Scan 263 back to scan 44 on a road with trees. ICP from the second coarse peak, 13 m off,
