@@ -17,7 +17,8 @@
 // with --poses (KITTI or TUM, T_world_sensor, one per scan), the true distance, the overlap at the
 // true pose and the registered pose's error against it (metres, degrees).
 // --submap-*: each match is the scan merged with its neighbours within M metres of path (at most
-// N a side), placed by the poses given (odometry: the ground truth is for scoring only) and
+// N a side; of those, the nearest within the configuration's submap_max_points, as detect
+// merges them), placed by the poses given (odometry: the ground truth is for scoring only) and
 // prepared as one scan from the raw scans in DIR; --submap-query merges the query's past alike
 // (past) or both sides as the match (full: offline, all scans exist).
 // The question of issue 24: whether a denser match side closes the sparse revisits.
@@ -252,24 +253,38 @@ public:
         const app::ThreadCpuStopwatch clock;
         registration::SubmapWindow window = window_;
         window.past_only = past_only;
+        const std::vector<std::size_t> members = registration::SubmapMembers(path_m_, i, window);
+        members_.push_back(static_cast<double>(members.size()));
+        const registration::PreparedScan prepared = past_only ? PastOnly(i, members) : BothSides(i);
+        prepare_ms_.push_back(1e3 * clock.Seconds());
+        return cache.emplace(i, prepared).first->second;
+    }
+    // As detect prepares it: the window, then its nearest scans within the point budget.
+    registration::PreparedScan BothSides(std::size_t i) const {
+        registration::ScanReductionConfig reduction = reduction_;
+        reduction.submap_path_m = window_.path_m;
+        reduction.submap_max_scans = window_.max_scans;
+        return registration::PrepareSubmap(
+            i, poses_, path_m_, [this](std::size_t k) { return dataset_.LoadScan(k); }, reduction);
+    }
+    // What an online detector could have: the window's past, without the point budget.
+    registration::PreparedScan PastOnly(std::size_t i,
+                                        const std::vector<std::size_t>& members) const {
         std::vector<core::PointCloud> scans;
         std::vector<core::Transform> T_world_scans;
-        for (const std::size_t k : registration::SubmapMembers(path_m_, i, window)) {
+        for (const std::size_t k : members) {
             scans.push_back(dataset_.LoadScan(k));
             T_world_scans.push_back(poses_[k].T_world_sensor);
         }
-        members_.push_back(static_cast<double>(scans.size()));
-        const registration::PreparedScan prepared = registration::PrepareScan(
+        return registration::PrepareScan(
             scans.size() == 1 ? scans.front()
                               : registration::MergeIntoFrame(scans, T_world_scans,
                                                              poses_[i].T_world_sensor, reduction_),
             reduction_);
-        prepare_ms_.push_back(1e3 * clock.Seconds());
-        return cache.emplace(i, prepared).first->second;
     }
     void Report() const {
         std::printf(
-            "  submaps: %zu prepared, scans per submap median %.0f, prepare median %.1f ms\n",
+            "  submaps: %zu prepared, scans in the window median %.0f, prepare median %.1f ms\n",
             prepare_ms_.size(), app::Quantile(members_, 0.5), app::Quantile(prepare_ms_, 0.5));
     }
 

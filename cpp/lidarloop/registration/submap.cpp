@@ -5,6 +5,7 @@
 #include <limits>
 #include <optional>
 #include <stdexcept>
+#include <utility>
 
 #include "lidarloop/core/min_gap.hpp"
 
@@ -33,31 +34,16 @@ void CollectSide(const std::vector<double>& path_m, std::size_t centre, int step
     }
 }
 
-// The members (sequence order) a submap of at most `max_points` points merges: the centre, then
-// its neighbours nearest in path (the earlier of two equally near) while their points fit.
-std::vector<std::size_t> WithinPointBudget(const std::vector<std::size_t>& members,
-                                           const std::vector<std::size_t>& sizes,
-                                           const std::vector<double>& path_m, std::size_t centre,
-                                           std::size_t max_points) {
-    std::vector<std::size_t> order(members.size());
-    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-    // The centre first (-1), then by path from it.
-    const auto away = [&](std::size_t i) {
-        return members[i] == centre ? -1.0 : std::abs(path_m[members[i]] - path_m[centre]);
+// The members of a submap nearest in path first: the centre, then its neighbours (the earlier
+// of two equally near).
+std::vector<std::size_t> NearestFirst(std::vector<std::size_t> members,
+                                      const std::vector<double>& path_m, std::size_t centre) {
+    const auto away = [&](std::size_t k) {
+        return k == centre ? -1.0 : std::abs(path_m[k] - path_m[centre]);
     };
-    std::stable_sort(order.begin(), order.end(),
+    std::stable_sort(members.begin(), members.end(),
                      [&](std::size_t a, std::size_t b) { return away(a) < away(b); });
-    std::vector<bool> kept(members.size(), false);
-    std::size_t points = 0;
-    for (const std::size_t i : order) {
-        if (members[i] != centre && points + sizes[i] > max_points) break;
-        points += sizes[i];
-        kept[i] = true;
-    }
-    std::vector<std::size_t> result;
-    for (std::size_t i = 0; i < members.size(); ++i)
-        if (kept[i]) result.push_back(members[i]);
-    return result;
+    return members;
 }
 
 }  // namespace
@@ -121,24 +107,27 @@ PreparedScan PrepareSubmap(std::size_t centre, const std::vector<core::StampedPo
     const SubmapWindow window{config.submap_path_m, config.submap_max_scans, false};
     const std::vector<std::size_t> members = SubmapMembers(path_m, centre, window);
     if (members.size() == 1) return PrepareScan(load(centre), config);
-    std::vector<core::PointCloud> loaded;
-    std::vector<std::size_t> sizes;
-    for (const std::size_t k : members) {
-        loaded.push_back(load(k));
-        sizes.push_back(loaded.back().size());
+    // Loaded nearest first until the next scan would pass the point budget (the centre always).
+    std::vector<std::pair<std::size_t, core::PointCloud>> kept;
+    std::size_t points = 0;
+    for (const std::size_t k : NearestFirst(members, path_m, centre)) {
+        core::PointCloud scan = load(k);
+        if (k != centre &&
+            points + scan.size() > static_cast<std::size_t>(config.submap_max_points))
+            break;
+        points += scan.size();
+        kept.emplace_back(k, std::move(scan));
     }
-    const std::vector<std::size_t> kept = WithinPointBudget(
-        members, sizes, path_m, centre, static_cast<std::size_t>(config.submap_max_points));
+    std::sort(kept.begin(), kept.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });  // merge in order
     std::vector<core::PointCloud> scans;
     std::vector<core::Transform> T_world_scans;
     Eigen::Vector3d centre_view =
         Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
-    for (std::size_t i = 0, next = 0; i < members.size(); ++i) {
-        if (next == kept.size() || members[i] != kept[next]) continue;
-        ++next;
-        scans.push_back(std::move(loaded[i]));
-        T_world_scans.push_back(poses.at(members[i]).T_world_sensor);
-        if (members[i] == centre) centre_view = ViewCentre(scans.back(), config);
+    for (auto& [k, scan] : kept) {
+        if (k == centre) centre_view = ViewCentre(scan, config);
+        scans.push_back(std::move(scan));
+        T_world_scans.push_back(poses.at(k).T_world_sensor);
     }
     PreparedScan submap = PrepareScan(
         MergeIntoFrame(scans, T_world_scans, poses.at(centre).T_world_sensor, config), config);

@@ -41,10 +41,12 @@ core::PointCloud MergeIntoFrame(const std::vector<core::PointCloud>& scans,
                                 const ScanReductionConfig& config);
 
 /// Scan `centre` prepared for registration together with its neighbours (PrepareScan of
-/// MergeIntoFrame over SubmapMembers, window from config.submap_path_m and submap_max_scans),
-/// in centre's sensor frame, so that a registration against it is still the pose between the
-/// two scans' frames. `path_m` from SubmapPathM(poses); `load(k)` reads scan k (an empty cloud
-/// for one that cannot be read). Only the scan itself when the window is 0 or it has no pose.
+/// MergeIntoFrame over SubmapMembers, window from config.submap_path_m and submap_max_scans; of
+/// those, the nearest in path first while their raw points fit config.submap_max_points, the
+/// centre always), in centre's sensor frame, so that a registration against it is still the
+/// pose between the two scans' frames. `path_m` from SubmapPathM(poses); `load(k)` reads scan k
+/// (an empty cloud for one that cannot be read), nearest first, and no farther than the budget
+/// needs. Only the scan itself when the window is 0 or it has no pose.
 PreparedScan PrepareSubmap(std::size_t centre, const std::vector<core::StampedPose>& poses,
                            const std::vector<double>& path_m,
                            const std::function<core::PointCloud(std::size_t)>& load,

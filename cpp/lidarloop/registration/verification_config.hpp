@@ -30,7 +30,8 @@ struct ScanReductionConfig {
     double submap_path_m = 10.0;
     /// Neighbours per side at most, 0..1000: bounds the merge on a slow or standing platform.
     int submap_max_scans = 30;
-    /// Points a submap merges at most, 10^4..10^8: its nearest neighbours in path first. The
+    /// Raw points a submap merges at most, 10^4..10^8: the centre always, then its nearest
+    /// neighbours in path while their points fit. The
     /// reduction caps what a scan keeps, so beyond a few dense scans more points cost time and
     /// add nothing; sparse scans fill the window (docs/verification.md, "Submaps").
     int submap_max_points = 600'000;

@@ -430,6 +430,8 @@ TEST_F(DetectionRun, LocalisingTheSequenceAgainstItsOwnMapFindsEveryScanItself) 
     LIDARLOOP_RELEASE_SUITE_ONLY();
     app::DetectRequest detect = Request("detect", core::Method::kRange);
     detect.config.detection.top_k = 1;
+    // How the map's scans were merged is the map's affair: the queries need not say it again.
+    detect.config.detection.verification.reduction.submap_max_points = 500'000;
     app::RunDetect(*dataset_, detect);
     app::DetectRequest localise = Request("localise", core::Method::kRange);
     localise.config.detection.top_k = 1;  // itself, verified at the identity
@@ -932,6 +934,7 @@ TEST_F(DetectionRun, ScansAreSubmapsWhenTheOdometryIsKnown) {
     EXPECT_TRUE(outcome.notes.empty());
     const io::StoredPreparedScans stored = io::LoadPreparedScans(request.out / "database.scans");
     EXPECT_EQ(stored.reduction.submap_path_m, reduction.submap_path_m);
+    EXPECT_EQ(stored.reduction.submap_max_points, reduction.submap_max_points);
     const std::vector<core::StampedPose> poses =
         app::ReadOdometry(request.odometry_file, "", *dataset_);
     const auto load = [this](std::size_t k) { return dataset_->LoadScan(k); };

@@ -139,19 +139,20 @@ TEST(Submap, PrepareSubmapIsPrepareScanOfTheMerge) {
     EXPECT_FALSE(submap.view_centre.isApprox(expected.view_centre, 1e-3));
 }
 
-// Dense scans fill a submap with few neighbours: the point budget keeps the centre and its
-// nearest neighbours in path (the earlier of two equally near), whatever the window holds.
+// Dense scans fill a submap with few neighbours: the point budget keeps the centre, then its
+// nearest neighbours in path (the earlier of two equally near) until one does not fit; no
+// farther scan fills the gap (the submap stays one stretch of road).
 TEST(Submap, ThePointBudgetKeepsTheNearestNeighbours) {
     std::mt19937 random(12);
     const std::vector<core::StampedPose> poses = LinePoses(7);
+    const std::vector<double> path_m = {0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0};  // exact ties
     std::vector<core::PointCloud> scans;
-    for (int i = 0; i < 7; ++i) scans.push_back(RandomScan(random, 10'000));
-    const std::size_t scan_points = scans[0].size();  // with the two unusable points
+    for (int i = 0; i < 7; ++i) scans.push_back(RandomScan(random, i == 1 ? 30'000 : 10'000));
+    const auto scan_points = static_cast<int>(scans[0].size());  // with the unusable two
     ScanReductionConfig config;
-    config.submap_path_m = 10.0;                                   // every scan within the window
-    config.submap_max_points = static_cast<int>(4 * scan_points);  // room for four scans
+    config.submap_path_m = 10.0;  // every scan within the window
     const auto load = [&scans](std::size_t k) { return scans.at(k); };
-    const auto merged_of = [&](std::initializer_list<std::size_t> members) {
+    const auto structure_of = [&](std::initializer_list<std::size_t> members) {
         std::vector<core::PointCloud> chosen;
         std::vector<core::Transform> T_world_scans;
         for (const std::size_t k : members) {
@@ -159,18 +160,22 @@ TEST(Submap, ThePointBudgetKeepsTheNearestNeighbours) {
             T_world_scans.push_back(poses[k].T_world_sensor);
         }
         return PrepareScan(MergeIntoFrame(chosen, T_world_scans, poses[3].T_world_sensor, config),
-                           config);
+                           config)
+            .structure->points();
     };
-    const PreparedScan submap = PrepareSubmap(3, poses, SubmapPathM(poses), load, config);
-    EXPECT_EQ(submap.structure->points(), merged_of({1, 2, 3, 4}).structure->points());
-    // Less than one scan's points: the centre alone still.
-    config.submap_max_points = 10'000;
-    EXPECT_EQ(PrepareSubmap(3, poses, SubmapPathM(poses), load, config).structure->points(),
-              PrepareScan(scans[3], config).structure->points());
-    // A budget for all of them: the whole window.
-    config.submap_max_points = static_cast<int>(7 * scan_points);
-    EXPECT_EQ(PrepareSubmap(3, poses, SubmapPathM(poses), load, config).structure->points(),
-              merged_of({0, 1, 2, 3, 4, 5, 6}).structure->points());
+    const auto submap_structure = [&](int max_points) {
+        config.submap_max_points = max_points;
+        return PrepareSubmap(3, poses, path_m, load, config).structure->points();
+    };
+    // Room for four scans: 3, 2 and 4; then scan 1 (three scans' points) does not fit, and 5,
+    // as near, is not taken in its place.
+    EXPECT_EQ(submap_structure(4 * scan_points), structure_of({2, 3, 4}));
+    // Room for two: of 2 and 4, equally near, the earlier.
+    EXPECT_EQ(submap_structure(2 * scan_points), structure_of({2, 3}));
+    // Less than the centre's own points: the centre alone still.
+    EXPECT_EQ(submap_structure(10'000), PrepareScan(scans[3], config).structure->points());
+    // Room for all: the whole window.
+    EXPECT_EQ(submap_structure(100'000'000), structure_of({0, 1, 2, 3, 4, 5, 6}));
 }
 
 TEST(Submap, WithoutAPoseTheScanIsPreparedAlone) {
