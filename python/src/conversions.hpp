@@ -16,6 +16,7 @@
 #include <pybind11/pybind11.h>
 
 #include "errors.hpp"
+#include "lidarloop/core/min_gap.hpp"
 #include "lidarloop/core/point_cloud.hpp"
 #include "lidarloop/io/config_yaml.hpp"
 
@@ -237,6 +238,7 @@ inline void SetPathM(const std::vector<double>& path_m, std::vector<core::Stampe
         throw py::value_error("path_m has " + std::to_string(path_m.size()) + " values for " +
                               std::to_string(poses.size()) + " poses");
     }
+    core::CheckPathM(path_m, "path_m");
     for (std::size_t i = 0; i < poses.size(); ++i) poses[i].path_m = path_m[i];
 }
 

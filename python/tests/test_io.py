@@ -91,9 +91,9 @@ def test_some_kitti_frames_take_their_poses_and_the_drives_path(tmp_path):
     assert truth.comparable(0, 1) and not straight.comparable(0, 1)
     with pytest.raises(ValueError, match="2 values for 3 poses"):
         lidarloop.build_ground_truth(times, T, path_m=[0.0, 1.0])
-    with pytest.raises(lidarloop.Error, match="scan 1's path is not finite"):
+    with pytest.raises(lidarloop.ConfigError, match="path_m: scan 1's path is not finite"):
         lidarloop.build_ground_truth(times, T, path_m=[0.0, np.nan, 2.0])
-    with pytest.raises(lidarloop.Error, match="never shrinks"):
+    with pytest.raises(lidarloop.ConfigError, match="never shrinks"):
         lidarloop.build_ground_truth(times, T, path_m=[0.0, 3.0, 1.0])
     assert lidarloop.open_dataset(tmp_path / "velodyne").path_m is None
 

@@ -104,9 +104,10 @@ def test_bad_graphs_raise_typed_errors():
         lidarloop.build_pose_graph(odometry, [lidarloop.LoopConstraint(5, 0, np.eye(4))])
     with pytest.raises(lidarloop.ShapeError):
         lidarloop.build_pose_graph(np.zeros((2, 3, 4)), [])
-    with pytest.raises(lidarloop.Error, match="pose graph's path: scan 1's path is not finite"):
+    with pytest.raises(lidarloop.ConfigError,
+                       match="pose graph's path: scan 1's path is not finite"):
         lidarloop.build_pose_graph(odometry, [], path_m=[0.0, np.inf])
-    with pytest.raises(lidarloop.Error, match="never shrinks"):
+    with pytest.raises(lidarloop.ConfigError, match="never shrinks"):
         lidarloop.build_pose_graph(odometry, [], path_m=[2.0, 1.0])
     with pytest.raises(lidarloop.ShapeError):
         lidarloop.LoopConstraint(1, 0, np.zeros((4, 4)))  # last row is not 0 0 0 1

@@ -60,13 +60,13 @@ std::vector<double> CumulativePathM(const std::vector<StampedPose>& poses) {
 void CheckPathM(std::span<const double> path_m, const std::string& what) {
     for (std::size_t i = 0; i < path_m.size(); ++i) {
         if (!std::isfinite(path_m[i])) {
-            throw Error(what + ": scan " + std::to_string(i) + "'s path is not finite");
+            throw ConfigError(what + ": scan " + std::to_string(i) + "'s path is not finite");
         }
         if (i > 0 && path_m[i] < path_m[i - 1]) {
-            throw Error(what + ": scan " + std::to_string(i) + "'s path (" +
-                        std::to_string(path_m[i]) + " m) lies before scan " +
-                        std::to_string(i - 1) + "'s (" + std::to_string(path_m[i - 1]) +
-                        " m): a path never shrinks");
+            throw ConfigError(what + ": scan " + std::to_string(i) + "'s path (" +
+                              std::to_string(path_m[i]) + " m) lies before scan " +
+                              std::to_string(i - 1) + "'s (" + std::to_string(path_m[i - 1]) +
+                              " m): a path never shrinks");
         }
     }
 }

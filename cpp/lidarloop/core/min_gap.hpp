@@ -65,7 +65,7 @@ bool KnowsDrivePath(const std::vector<StampedPose>& poses);
 /// when a position is not finite.
 std::vector<double> CumulativePathM(const std::vector<StampedPose>& poses);
 
-/// Throws Error naming `what` and the scan when a path position (metres per scan, as
+/// Throws ConfigError naming `what` and the scan when a path position (metres per scan, as
 /// CumulativePathM gives) is not finite or lies before the one of the scan before it: a path
 /// given from outside (Python's path_m, a pose graph's) must be one a drive can have.
 void CheckPathM(std::span<const double> path_m, const std::string& what);

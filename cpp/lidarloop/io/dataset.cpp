@@ -319,9 +319,9 @@ std::string FramesNote(const std::vector<fs::path>& scans,
     if (!core::KnowsDrivePath(poses) || poses.size() != scans.size()) return {};
     const std::optional<std::vector<std::size_t>> frames = FrameNumbers(scans);
     if (!frames) return {};
-    return "the " + std::to_string(scans.size()) + " scans are frames " +
+    return "the " + std::to_string(scans.size()) + " scans are frames of a KITTI drive (" +
            std::to_string(frames->front()) + " to " + std::to_string(frames->back()) +
-           " of a KITTI drive (by their file names): they take those frames' " + what +
+           ", by their file names): they take those frames' " + what +
            ", and the path between them is the drive's";
 }
 

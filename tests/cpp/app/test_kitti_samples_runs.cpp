@@ -40,7 +40,7 @@ TEST(KittiSamplesRun, DetectClosesBothLoopsOfSequence08WithTheOfficialPoses) {
     EXPECT_GT(outcome.path_m[2] - outcome.path_m[1], 400.0);  // the straight line: 3 m
     ASSERT_FALSE(outcome.notes.empty());
     EXPECT_EQ(outcome.notes[0],
-              "the 4 scans are frames 209 to 1684 of a KITTI drive (by their file names): they "
+              "the 4 scans are frames of a KITTI drive (209 to 1684, by their file names): they "
               "take those frames' poses, and the path between them is the drive's");
 
     struct Expected {

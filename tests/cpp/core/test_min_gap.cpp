@@ -73,14 +73,14 @@ TEST(MinGap, AGivenPathMustBeFiniteAndNeverShrink) {
     try {
         CheckPathM(std::vector<double>{0.0, 3.0, 1.0}, "given path");
         ADD_FAILURE() << "a shrinking path passed";
-    } catch (const Error& e) {
+    } catch (const ConfigError& e) {
         EXPECT_TRUE(
             test::Contains(e.what(), "given path: scan 2's path (1.000000 m) lies before scan 1"));
     }
     const double nan = std::numeric_limits<double>::quiet_NaN();
     const double inf = std::numeric_limits<double>::infinity();
-    EXPECT_THROW(CheckPathM(std::vector<double>{0.0, nan, 5.0}, "path"), Error);
-    EXPECT_THROW(CheckPathM(std::vector<double>{0.0, inf}, "path"), Error);
+    EXPECT_THROW(CheckPathM(std::vector<double>{0.0, nan, 5.0}, "path"), ConfigError);
+    EXPECT_THROW(CheckPathM(std::vector<double>{0.0, inf}, "path"), ConfigError);
     // Frames of a longer drive whose path shrinks: the drive's path is checked, not trusted.
     std::vector<StampedPose> frames(2);
     frames[0].path_m = 10.0;

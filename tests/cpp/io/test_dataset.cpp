@@ -187,7 +187,7 @@ TEST(Dataset, KittiFramesTakeTheirPosesAndPathFromTheWholeSequence) {
     EXPECT_NEAR(path_m[1], 3.0 * std::sqrt(2.0), 1e-12);  // the straight line is sqrt(10)
     EXPECT_NEAR(path_m[2], 4.0 * std::sqrt(2.0), 1e-12);
     EXPECT_NE(FramesNote(dataset.ScanPaths(), dataset.poses(), "poses")
-                  .find("the 3 scans are frames 1 to 5 of a KITTI drive"),
+                  .find("the 3 scans are frames of a KITTI drive (1 to 5, by their file names)"),
               std::string::npos);
     EXPECT_EQ(FramesNote(dataset.ScanPaths(), ZigzagPoses(3), "odometry"), "");
 

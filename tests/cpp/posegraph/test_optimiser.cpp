@@ -97,8 +97,8 @@ TEST(Optimise, ThePathTravelledBetweenFramesSetsTheOdometrysDrift) {
     const OptimisationResult straight = Optimise(BuildPoseGraph(frames, {loop}, {}), {});
     EXPECT_EQ(straight.loops[0].verdict, LoopVerdict::kRejectedByOdometry);
     EXPECT_THROW(BuildPoseGraph(frames, {}, {}, {0.0, 3.0}), core::ConfigError);
-    EXPECT_THROW(BuildPoseGraph(frames, {}, {}, {0.0, 603.0, 3.0}), core::Error);
-    EXPECT_THROW(BuildPoseGraph(frames, {}, {}, {0.0, std::nan(""), 603.0}), core::Error);
+    EXPECT_THROW(BuildPoseGraph(frames, {}, {}, {0.0, 603.0, 3.0}), core::ConfigError);
+    EXPECT_THROW(BuildPoseGraph(frames, {}, {}, {0.0, std::nan(""), 603.0}), core::ConfigError);
 }
 
 TEST(Optimise, NoiseFreeGraphStaysAtTheTruth) {
