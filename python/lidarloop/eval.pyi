@@ -76,7 +76,8 @@ def build_ground_truth(
     **rule: Any,
 ) -> GroundTruth:
     """From poses (times_s (N,), T_world_sensor (N, 4, 4)); the rule as config or keywords;
-    path_m per scan (Dataset.path_m), None: the straight steps."""
+    path_m per scan (Dataset.path_m), None: the straight steps; ConfigError when a value is not
+    finite or smaller than the one before."""
 
 def heading_difference_deg(T_world_a: FloatArray, T_world_b: FloatArray) -> float: ...
 

@@ -120,7 +120,8 @@ def build_pose_graph(
     path_m: Optional[Sequence[float]] = None,
 ) -> PoseGraph:
     """One pose per scan (T_world_sensor), odometry edges i -> i+1, a loop edge per loop;
-    path_m per scan, the path the odometry's drift grows with (None: the straight steps)."""
+    path_m per scan, the path the odometry's drift grows with (None: the straight steps;
+    ConfigError when a value is not finite or smaller than the one before)."""
 
 def optimise_pose_graph(graph: PoseGraph, config: Config = None) -> OptimisationResult:
     """Optimises with Ceres (pose 0 fixed), keeping wrong loops out; releases the GIL."""
