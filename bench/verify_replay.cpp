@@ -4,6 +4,7 @@
 // (docs/BENCHMARK.md): same decisions and poses, time per pair. Run:
 //   taskset -c 1 ./build/bench/verify_replay RUN [--config FILE] [--compact]
 //                                            [--pairs-csv FILE [--poses FILE]]
+//                                            [--odometry FILE]
 //                                            [--submap-scans DIR --submap-poses FILE
 //                                             --submap-window-m M [--submap-max-scans N]
 //                                             [--submap-query past|full]]
@@ -16,6 +17,10 @@
 // the hypotheses ICP refined, and the rank of the hypothesis the registered pose came from) and,
 // with --poses (KITTI or TUM, T_world_sensor, one per scan), the true distance, the overlap at the
 // true pose and the registered pose's error against it (metres, degrees).
+// --odometry (KITTI or TUM, T_world_sensor, one per scan): the odometry's word as `detect
+// --odometry` applies it (app::OdometryLoopCheck with the run's pose-graph gate): the yaws and
+// poses its gate allows, its looser bars, and odometry_mismatch for an accepted pose it
+// contradicts; without it a replay of such a run judges its pairs as if it had none.
 // --submap-*: each match is the scan merged with its neighbours within M metres of path (at most
 // N a side; of those, the nearest within the configuration's submap_max_points, as detect
 // merges them), placed by the poses given (odometry: the ground truth is for scoring only) and
@@ -36,6 +41,8 @@
 #include <vector>
 
 #include "lidarloop/app/results_folder.hpp"
+#include "lidarloop/app/verification_run.hpp"
+#include "lidarloop/core/min_gap.hpp"
 #include "lidarloop/io/config_yaml.hpp"
 #include "lidarloop/io/dataset.hpp"
 #include "lidarloop/io/poses.hpp"
@@ -312,9 +319,40 @@ struct Sources {
     }
 };
 
+// The yaw windows the check gives the candidates of `candidates[first]`'s query (its run).
+std::vector<registration::YawWindow> QueryYaws(const std::vector<Candidate>& candidates,
+                                               std::size_t first,
+                                               const pipeline::LoopCheck& check) {
+    std::vector<registration::YawWindow> yaws;
+    for (std::size_t c = first;
+         c < candidates.size() && candidates[c].query == candidates[first].query; ++c) {
+        yaws.push_back(check.YawWindow(candidates[c].query, candidates[c].match));
+    }
+    return yaws;
+}
+
+// Verify as detect does under `check`: its yaws and poses, and its rejection of a pose it
+// contradicts.
+registration::Verification VerifyUnder(const registration::PreparedScan& query,
+                                       const registration::CoarseQuery& coarse,
+                                       const registration::PreparedScan& match,
+                                       const registration::VerificationConfig& config,
+                                       const Candidate& candidate,
+                                       const pipeline::LoopCheck& check) {
+    const registration::PoseAllowed allowed = check.AllowedPoses(candidate.query, candidate.match);
+    registration::Verification verdict = registration::Verify(
+        query, coarse, match, config, allowed, check.YawWindow(candidate.query, candidate.match));
+    if (verdict.accepted && allowed && !allowed(verdict.T_match_query)) {
+        verdict.accepted = false;
+        verdict.reason = registration::RejectReason::kOdometryMismatch;
+    }
+    return verdict;
+}
+
 void Replay(const std::filesystem::path& run, const registration::VerificationConfig& config,
             const std::filesystem::path& pairs_csv, const std::vector<core::StampedPose>& poses,
-            bool compact, SubmapSource* submaps, bool query_submap, bool query_past_only) {
+            bool compact, SubmapSource* submaps, bool query_submap, bool query_past_only,
+            const pipeline::LoopCheck& check) {
     std::ofstream pairs;
     if (!pairs_csv.empty()) {
         pairs.open(pairs_csv);
@@ -338,18 +376,21 @@ void Replay(const std::filesystem::path& run, const registration::VerificationCo
     std::optional<registration::CoarseQuery> coarse;
     registration::PreparedScan query;
     std::size_t query_index = static_cast<std::size_t>(-1);
-    for (const Candidate& candidate : candidates) {
+    for (std::size_t c = 0; c < candidates.size(); ++c) {
+        const Candidate& candidate = candidates[c];
         if (query_index != candidate.query) {
             const app::ThreadCpuStopwatch clock;
             query = scans.Query(candidate.query);
-            if (query.structure) coarse.emplace(*query.structure, config.coarse);
+            if (query.structure)
+                coarse.emplace(*query.structure, config.coarse, QueryYaws(candidates, c, check));
             tally.query_ms.push_back(1e3 * clock.Seconds());
             query_index = candidate.query;
         }
         const app::ThreadCpuStopwatch clock;
         const registration::PreparedScan match = scans.Match(candidate.match);
         if (!query.structure || !match.structure) continue;
-        const registration::Verification now = registration::Verify(query, *coarse, match, config);
+        const registration::Verification now =
+            VerifyUnder(query, *coarse, match, config, candidate, check);
         tally.pair_ms.push_back(1e3 * clock.Seconds());
         if (pairs.is_open()) {
             // The coarse search alone, timed again (Verify above includes it).
@@ -392,7 +433,8 @@ void Replay(const std::filesystem::path& run, const registration::VerificationCo
 }  // namespace
 
 int main(int argc, char** argv) {
-    std::filesystem::path run, config_file, pairs_csv, poses_file, submap_scans, submap_poses;
+    std::filesystem::path run, config_file, pairs_csv, poses_file, odometry_file, submap_scans,
+        submap_poses;
     registration::SubmapWindow window{0.0, 1000, false};
     bool compact = false, query_submap = false, query_past_only = true;
     for (int i = 1; i < argc; ++i) {
@@ -405,6 +447,8 @@ int main(int argc, char** argv) {
             pairs_csv = argv[++i];
         } else if (argument == "--poses" && i + 1 < argc) {
             poses_file = argv[++i];
+        } else if (argument == "--odometry" && i + 1 < argc) {
+            odometry_file = argv[++i];
         } else if (argument == "--submap-scans" && i + 1 < argc) {
             submap_scans = argv[++i];
         } else if (argument == "--submap-poses" && i + 1 < argc) {
@@ -428,6 +472,7 @@ int main(int argc, char** argv) {
         std::fprintf(
             stderr,
             "usage: %s RUN_FOLDER [--config FILE] [--compact] [--pairs-csv FILE [--poses FILE]]\n"
+            "       [--odometry FILE]\n"
             "       [--submap-scans DIR --submap-poses FILE --submap-window-m M\n"
             "        [--submap-max-scans N] [--submap-query past|full]]\n",
             argv[0]);
@@ -443,8 +488,14 @@ int main(int argc, char** argv) {
             submaps.emplace(submap_scans, submap_poses, window,
                             config.detection.verification.reduction);
         }
+        const std::vector<core::StampedPose> odometry =
+            odometry_file.empty() ? std::vector<core::StampedPose>{} : io::ReadPoses(odometry_file);
+        const std::vector<double> path_m = core::CumulativePathM(odometry);
+        const pipeline::LoopCheck check =
+            odometry.empty() ? pipeline::LoopCheck{}
+                             : app::OdometryLoopCheck(odometry, path_m, config.posegraph);
         Replay(run, config.detection.verification, pairs_csv, poses, compact,
-               submaps ? &*submaps : nullptr, query_submap, query_past_only);
+               submaps ? &*submaps : nullptr, query_submap, query_past_only, check);
     } catch (const std::exception& error) {
         std::fprintf(stderr, "verify_replay: %s\n", error.what());
         return 1;
