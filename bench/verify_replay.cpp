@@ -395,7 +395,8 @@ void Replay(const std::filesystem::path& run, const registration::VerificationCo
         if (pairs.is_open()) {
             // The coarse search alone, timed again (Verify above includes it).
             const app::ThreadCpuStopwatch coarse_clock;
-            const auto hypotheses = registration::CoarseAlign(*coarse, *match.structure);
+            const auto hypotheses = registration::CoarseAlign(
+                *coarse, *match.structure, check.YawWindow(candidate.query, candidate.match));
             const double coarse_ms = 1e3 * coarse_clock.Seconds();
             WritePair(pairs, candidate, now, query, match, config, tally.pair_ms.back(), poses,
                       hypotheses, coarse_ms);
