@@ -217,7 +217,7 @@ void WritePair(std::ofstream& out, const Candidate& candidate,
         << now.registered_hypotheses << ','
         << (now.overlap.query_overlapping == 0 ? -2
                                                : HypothesisRankOf(hypotheses, now.T_match_query))
-        << '\n';
+        << ',' << now.overlap.query_in_view << ',' << now.overlap.match_in_view << '\n';
 }
 
 // The run's scans as a run keeps them: as loaded, or (--compact) encoded as
@@ -364,7 +364,7 @@ void Replay(const std::filesystem::path& run, const registration::VerificationCo
                  "allowed_rmse_m,"
                  "shifted_ratio,constraining,registered_distance_m,coarse_ms,top_coarse_score,"
                  "hypotheses,second_score_ratio,third_score_ratio,registered_hypotheses,"
-                 "result_hypothesis\n";
+                 "result_hypothesis,q_in_view,m_in_view\n";
     }
     io::StoredPreparedScans stored = io::LoadPreparedScans(run / "database.scans");
     const ScanSource stored_scans(std::move(stored.scans), compact);

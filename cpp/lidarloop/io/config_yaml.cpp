@@ -176,6 +176,8 @@ void VisitFields(registration::AcceptanceConfig& c, Visitor& v) {
     v.Field("min_distinctive_overlap", c.min_distinctive_overlap,
             "the same for the structure points off large planes");
     v.Field("min_overlapping_points", c.min_overlapping_points, "overlapping points, each way");
+    v.Field("overlap_confidence_z", c.overlap_confidence_z,
+            "fewer suffice where the share's lower bound (this many standard errors) passes");
     v.Field("max_rmse_ratio", c.max_rmse_ratio,
             "RMS plane distance of the overlap over the scans' own roughness, at most");
     v.Field("max_rmse_ratio_with_odometry", c.max_rmse_ratio_with_odometry,

@@ -194,6 +194,25 @@ double AllowedRmse(const PreparedScan& query, const PreparedScan& match,
     return std::clamp(ratio * roughness_m, config.min_allowed_rmse_m, config.max_rmse_m);
 }
 
+double OverlapLowerBound(std::size_t overlapping, std::size_t in_view, double z) {
+    if (in_view == 0) return 0.0;
+    // Wilson's score interval of a binomial share, its lower end.
+    const double n = static_cast<double>(in_view);
+    const double share = static_cast<double>(overlapping) / n;
+    const double z2_n = z * z / n;
+    const double centre = share + 0.5 * z2_n;
+    const double half = z * std::sqrt(share * (1.0 - share) / n + 0.25 * z2_n / n);
+    return std::max(0.0, (centre - half) / (1.0 + z2_n));
+}
+
+bool EnoughOverlappingPoints(std::size_t overlapping, std::size_t in_view,
+                             const AcceptanceConfig& config) {
+    if (overlapping >= static_cast<std::size_t>(config.min_overlapping_points)) return true;
+    return config.overlap_confidence_z > 0.0 &&
+           OverlapLowerBound(overlapping, in_view, config.overlap_confidence_z) >=
+               config.min_overlap;
+}
+
 namespace {
 
 // The first acceptance rule the registered pair breaks (kNone: none). `odometry_judges`: the
@@ -201,10 +220,10 @@ namespace {
 RejectReason Judge(const PreparedScan& query, const PreparedScan& match,
                    const Verification& verification, bool converged, const AcceptanceConfig& config,
                    bool odometry_judges) {
-    const auto min_points = static_cast<std::size_t>(config.min_overlapping_points);
     const Overlap& overlap = verification.overlap;
     if (!converged) return RejectReason::kNotConverged;
-    if (overlap.query_overlapping < min_points || overlap.match_overlapping < min_points ||
+    if (!EnoughOverlappingPoints(overlap.query_overlapping, overlap.query_in_view, config) ||
+        !EnoughOverlappingPoints(overlap.match_overlapping, overlap.match_in_view, config) ||
         overlap.Min() < config.min_overlap ||
         overlap.MinDistinctive() < config.min_distinctive_overlap) {
         return RejectReason::kLowOverlap;
@@ -351,6 +370,8 @@ Overlap MeasureOverlap(const PreparedScan& query, const PreparedScan& match,
         Fraction(backward.distinctive_overlapping, backward.distinctive_in_view);
     overlap.query_overlapping = forward.overlapping;
     overlap.match_overlapping = backward.overlapping;
+    overlap.query_in_view = forward.in_view;
+    overlap.match_in_view = backward.in_view;
     const std::size_t both = forward.overlapping + backward.overlapping;
     overlap.rmse_m = both == 0 ? 0.0
                                : std::sqrt((forward.squared_sum_m2 + backward.squared_sum_m2) /

@@ -49,7 +49,9 @@ struct Overlap {
     double match_distinctive_fraction = 0.0;
     std::size_t query_overlapping = 0;
     std::size_t match_overlapping = 0;
-    double rmse_m = 0.0;  ///< RMS plane distance of the overlapping points, both ways
+    std::size_t query_in_view = 0;  ///< query structure points in view of both sensors
+    std::size_t match_in_view = 0;  ///< the same, the other way
+    double rmse_m = 0.0;            ///< RMS plane distance of the overlapping points, both ways
     /// Horizontal direction (match frame) the overlapping structure constrains least.
     Eigen::Vector2d weakest_direction = Eigen::Vector2d::UnitX();
     /// Overlapping query points whose surfaces face the weakest direction (they pin it;
@@ -119,6 +121,17 @@ bool OverlapReaches(const PreparedScan& query, const PreparedScan& match,
 /// [min_allowed_rmse_m, max_rmse_m].
 double AllowedRmse(const PreparedScan& query, const PreparedScan& match,
                    const AcceptanceConfig& config, bool odometry_judges = false);
+
+/// The lower end of the Wilson score interval (`z` standard errors) of the share `overlapping` /
+/// `in_view`: how low the share of a pair's structure points on the other scan's surfaces may
+/// truly be, given how few of them the scans show. 0 when none is in view.
+double OverlapLowerBound(std::size_t overlapping, std::size_t in_view, double z);
+
+/// Whether `overlapping` of the `in_view` structure points are enough evidence, one way: at
+/// least min_overlapping_points, or fewer whose share stays at least min_overlap at its lower
+/// bound (OverlapLowerBound, overlap_confidence_z; never when that is 0).
+bool EnoughOverlappingPoints(std::size_t overlapping, std::size_t in_view,
+                             const AcceptanceConfig& config);
 
 /// Whether another source of the pose, the odometry's gate, allows T_match_query for a loop of
 /// two scans (app::OdometryLoopCheck). Empty where no such source judges the pair.

@@ -75,6 +75,7 @@ void AcceptanceConfig::Validate() const {
     RequireIn(min_overlap, 0.0, 1.0, "acceptance.min_overlap");
     RequireIn(min_distinctive_overlap, 0.0, 1.0, "acceptance.min_distinctive_overlap");
     RequireIn(min_overlapping_points, 1, 1'000'000, "acceptance.min_overlapping_points");
+    RequireIn(overlap_confidence_z, 0.0, 10.0, "acceptance.overlap_confidence_z");
     RequireIn(max_rmse_ratio, 0.0, 1000.0, "acceptance.max_rmse_ratio");
     RequireIn(max_rmse_ratio_with_odometry, 0.0, 1000.0, "acceptance.max_rmse_ratio_with_odometry");
     RequireIn(min_allowed_rmse_m, 0.0, 100.0, "acceptance.min_allowed_rmse_m");

@@ -7,10 +7,10 @@
 namespace lidarloop::test {
 
 /// Sparse keyframes as a LIO front end keeps them: `lidarloop simulate --scene SCENE --route uturn
-/// --seed 3 --sensor SENSOR --keep-every N --scans 300 --spacing-min-m 1 --spacing-max-m 2`.
+/// --seed SEED --sensor SENSOR --keep-every N --scans 300 --spacing-min-m 1 --spacing-max-m 2`.
 inline sim::SimulationConfig SparseUTurnKeyframes(
     sim::SceneType scene, std::int64_t keep_every,
-    sim::SensorModel sensor = sim::SensorModel::kHdl32) {
+    sim::SensorModel sensor = sim::SensorModel::kHdl32, std::uint64_t seed = 3) {
     sim::SimulationConfig config;
     config.scene = scene;
     config.route.type = sim::RouteType::kUTurn;
@@ -19,7 +19,7 @@ inline sim::SimulationConfig SparseUTurnKeyframes(
     config.sensor.model = sensor;
     config.front_end.keep_every = keep_every;
     config.scans = 300;
-    config.seed = 3;
+    config.seed = seed;
     return config;
 }
 

@@ -213,16 +213,16 @@ TEST(Submap, ConfigRangesAreValidated) {
 }
 
 // Sparse keyframes in open country (`lidarloop simulate --scene rural --route uturn --seed 3
-// --sensor hdl32 --keep-every 10 --scans 300 --spacing-min-m 1 --spacing-max-m 2`, or another
-// sensor and thinning) and one of its revisits: the query and match scans, the true
+// (or another) --sensor hdl32 --keep-every 10 --scans 300 --spacing-min-m 1 --spacing-max-m 2`, or
+// another sensor and thinning) and one of its revisits: the query and match scans, the true
 // T_match_query, and both scans as submaps (the neighbours within `window_m` of path, placed by
 // the drifting odometry). The pairs below were picked with 5 m windows, the default before 10 m,
 // to show one mechanism each; they keep that window.
 struct SparseRuralRevisit {
     SparseRuralRevisit(std::size_t query_scan, std::size_t match_scan,
                        sim::SensorModel sensor = sim::SensorModel::kHdl32,
-                       std::int64_t keep_every = 10, double window_m = 5.0)
-        : simulator(test::SparseUTurnKeyframes(sim::SceneType::kRural, keep_every, sensor)),
+                       std::int64_t keep_every = 10, double window_m = 5.0, std::uint64_t seed = 3)
+        : simulator(test::SparseUTurnKeyframes(sim::SceneType::kRural, keep_every, sensor, seed)),
           query(query_scan),
           match(match_scan),
           truth(simulator.GroundTruthPose(match).T_world_sensor.inverse() *
@@ -345,7 +345,28 @@ TEST(Submap, SixtyOverlappingPointsPinASparseRuralLoop) {
         << "pick a pair the old floor rejects";
     VerificationConfig old_floor = revisit.config;
     old_floor.acceptance.min_overlapping_points = 80;
+    old_floor.acceptance.overlap_confidence_z = 0.0;  // the floor alone, as before 2026-11-30
     EXPECT_EQ(VerifyPair(query, match, old_floor).reason, RejectReason::kLowOverlap);
+}
+
+// Another drive (seed 7), scan 118 back to scan 63, 3.6 m apart, as 10 m submaps: the right pose
+// overlaps 0.75 each way, but the two see only about 50 structure points in common, and fewer than
+// 60 overlap. Their share's lower bound at 2.5 standard errors is still over the 0.35 bar, so the
+// loop is accepted at the true pose; the fixed floor of 60 points (overlap_confidence_z 0, before
+// 2026-11-30) rejects it (docs/BENCHMARK.md, "Fewer points where the share is clear").
+TEST(Submap, AClearShareOfFewPointsIsALoop) {
+    const SparseRuralRevisit revisit(118, 63, sim::SensorModel::kHdl32, 10,
+                                     ScanReductionConfig{}.submap_path_m, 7);
+    const Verification judged = revisit.VerifySubmaps(revisit.NearTheTruth());
+    ASSERT_TRUE(judged.accepted) << ToString(judged.reason);
+    EXPECT_LT(revisit.ErrorM(judged), 0.1);
+    const auto fewest = static_cast<std::size_t>(revisit.config.acceptance.min_overlapping_points);
+    EXPECT_LT(std::min(judged.overlap.query_overlapping, judged.overlap.match_overlapping), fewest)
+        << "pick a pair the fixed floor rejects";
+    VerificationConfig fixed_floor = revisit.config;
+    fixed_floor.acceptance.overlap_confidence_z = 0.0;
+    EXPECT_EQ(revisit.VerifySubmaps(fixed_floor, revisit.NearTheTruth()).reason,
+              RejectReason::kLowOverlap);
 }
 
 // Rural VLP-16 (every point), scan 176 back to scan 26, 3.5 m apart, as submaps: the right pose

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -372,6 +373,42 @@ TEST(Verification, InvalidConfigIsAConfigError) {
     expect_error([](auto& c) { c.icp.aligned_step_factor = 0.5; });
     expect_error([](auto& c) { c.icp.aligned_step_factor = std::nan(""); });
     expect_error([](auto& c) { c.icp.rival_step_factor = 4.5; });
+    expect_error([](auto& c) { c.acceptance.overlap_confidence_z = -1.0; });
+    expect_error([](auto& c) { c.acceptance.overlap_confidence_z = std::nan(""); });
+}
+
+// Wilson's lower bound p solves (share - p)^2 = z^2 p (1 - p) / n below the share: checked on
+// that equation, not on the formula, and on the hand-worked value of a pair of the seed-7 rural
+// VLP-16 drive (36 of 77 in view, z 2.5: 0.333).
+TEST(Verification, OverlapLowerBoundIsWilsonsScoreBound) {
+    for (const auto& [k, n, z] : {std::tuple{36, 77, 2.5}, std::tuple{5, 10, 1.0},
+                                  std::tuple{400, 1000, 3.0}, std::tuple{1, 3, 2.0}}) {
+        const double share = static_cast<double>(k) / n;
+        const double p = OverlapLowerBound(k, n, z);
+        EXPECT_LT(p, share);
+        EXPECT_NEAR((share - p) * (share - p), z * z * p * (1.0 - p) / n, 1e-12) << k << "/" << n;
+    }
+    EXPECT_NEAR(OverlapLowerBound(36, 77, 2.5), 0.333, 5e-4);
+    EXPECT_DOUBLE_EQ(OverlapLowerBound(36, 77, 0.0), 36.0 / 77.0);
+    EXPECT_EQ(OverlapLowerBound(0, 0, 2.5), 0.0);
+    EXPECT_EQ(OverlapLowerBound(0, 10, 2.5), 0.0);
+    EXPECT_GT(OverlapLowerBound(360, 770, 2.5), OverlapLowerBound(36, 77, 2.5));
+}
+
+// min_overlapping_points suffice at any share (the share has its own test); fewer only when the
+// share's lower bound reaches min_overlap, and never with overlap_confidence_z 0.
+TEST(Verification, FewerOverlappingPointsSufficeWhereTheShareIsClearlyOverTheBar) {
+    AcceptanceConfig config;
+    config.overlap_confidence_z = 2.5;
+    config.min_overlapping_points = 60;
+    EXPECT_TRUE(EnoughOverlappingPoints(60, 1000, config));
+    EXPECT_TRUE(EnoughOverlappingPoints(37, 49, config));    // 0.76: bound 0.58
+    EXPECT_FALSE(EnoughOverlappingPoints(52, 148, config));  // 0.35: bound 0.26
+    EXPECT_FALSE(EnoughOverlappingPoints(36, 77, config));   // 0.47: bound 0.33
+    EXPECT_FALSE(EnoughOverlappingPoints(3, 3, config));     // all of three: bound 0.32
+    config.overlap_confidence_z = 0.0;
+    EXPECT_FALSE(EnoughOverlappingPoints(37, 49, config));
+    EXPECT_TRUE(EnoughOverlappingPoints(60, 1000, config));
 }
 
 // One place seen from 11.6 m away registers at the right pose, but a loop is a revisit of one
