@@ -121,8 +121,9 @@ void RunBench(BenchFlags& flags) {
     flags.request.progress = progress.Callback();
     flags.request.odometry_file = flags.odometry.file();
     flags.request.odometry_topic = flags.odometry.topic();
+    flags.request.odometry_calib = flags.odometry.calib();
     std::vector<std::filesystem::path> inputs = flags.dataset.Inputs();
-    inputs.push_back(flags.odometry.Input());
+    for (const auto& input : flags.odometry.Inputs()) inputs.push_back(input);
     // The file is checked before the run, so that a refused --json costs no measurement.
     const bool json_to_stdout = flags.json == "-";
     if (!flags.json.empty() && !json_to_stdout)

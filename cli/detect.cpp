@@ -93,7 +93,7 @@ void PrintOutcome(const io::Dataset& dataset, const app::DetectRequest& request,
 std::vector<std::filesystem::path> Inputs(const DetectFlags& flags) {
     std::vector<std::filesystem::path> inputs = flags.dataset.Inputs();
     inputs.emplace_back(flags.map);
-    inputs.push_back(flags.odometry.Input());
+    for (const auto& input : flags.odometry.Inputs()) inputs.push_back(input);
     return inputs;
 }
 
@@ -104,6 +104,7 @@ void RunDetect(const DetectFlags& flags) {
     request.out = flags.out;
     request.odometry_file = flags.odometry.file();
     request.odometry_topic = flags.odometry.topic();
+    request.odometry_calib = flags.odometry.calib();
     if (!flags.map.empty()) {
         app::LoadedMap map = app::LoadMap(flags.map);
         request.config = ResolveAgainstMap(flags, map);

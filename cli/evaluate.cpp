@@ -79,6 +79,7 @@ app::EvaluationRequest RequestOf(const EvaluateFlags& flags) {
     request.results_files = flags.results;
     request.odometry_file = flags.odometry.file();
     request.odometry_topic = flags.odometry.topic();
+    request.odometry_calib = flags.odometry.calib();
     request.out = flags.out;
     return request;
 }
@@ -113,7 +114,7 @@ std::vector<std::filesystem::path> Inputs(const EvaluateFlags& flags) {
     inputs.insert(inputs.end(), flags.results.begin(), flags.results.end());
     inputs.emplace_back(flags.train_on);
     inputs.emplace_back(flags.train_poses);
-    inputs.push_back(flags.odometry.Input());
+    for (const auto& input : flags.odometry.Inputs()) inputs.push_back(input);
     return inputs;
 }
 

@@ -70,7 +70,7 @@ void PrintOutcome(const app::OptimiseRequest& request, const app::OptimiseOutcom
 
 std::vector<std::filesystem::path> Inputs(const OptimiseFlags& flags) {
     std::vector<std::filesystem::path> inputs = flags.dataset.Inputs();
-    inputs.push_back(flags.odometry.Input());
+    for (const auto& input : flags.odometry.Inputs()) inputs.push_back(input);
     inputs.emplace_back(flags.loops);
     return inputs;
 }
@@ -87,6 +87,7 @@ void RunOptimise(const OptimiseFlags& flags) {
     flags.options.ApplyTo({&request.config, &request.skip_bad});
     request.odometry_file = flags.odometry.file();
     request.odometry_topic = flags.odometry.topic();
+    request.odometry_calib = flags.odometry.calib();
     request.loops_file = flags.loops;
     request.format = flags.format == "tum" ? app::PoseFormat::kTum : app::PoseFormat::kKitti;
     request.progress = progress.Callback();

@@ -68,6 +68,7 @@ def detect(
     poses: Optional[PathLike] = None,
     calib: Optional[PathLike] = None,
     odometry: Optional[PathLike] = None,
+    odometry_calib: Optional[PathLike] = None,
     # The run options of detect (lidarloop.run_options("detect"); app/run_options.hpp).
     threshold: Optional[float] = None,
     min_gap: Optional[float] = None,
@@ -82,7 +83,9 @@ def detect(
     by default). `out` is a results folder with run.json (refused inside the dataset, or when it
     holds other files unless overwrite=True; a failed run leaves only run.json).
     min_gap_unit: 'scans', 'seconds' or 'metres' of path, measured on `odometry` (KITTI or TUM,
-    one pose per scan) when given, else on the dataset's poses."""
+    one pose per scan) when given, else on the dataset's poses. odometry_calib: a KITTI
+    calib.txt whose Tr converts `odometry`'s KITTI poses from KITTI's camera frame (as calib does
+    for poses); ConfigError without odometry or with a TUM file."""
 
 class MethodEvaluation:
     """Everything `lidarloop evaluate` computed for one method."""
@@ -154,6 +157,7 @@ def evaluate(
     calib: Optional[PathLike] = None,
     train_on: Union[None, PathLike, Dataset] = None,
     odometry: Optional[PathLike] = None,
+    odometry_calib: Optional[PathLike] = None,
     # The run options of evaluate (lidarloop.run_options("evaluate")).
     threshold: Optional[float] = None,
     min_gap: Optional[float] = None,
@@ -174,7 +178,7 @@ def evaluate(
     must be more than that much path apart too, 0: no path rule); train_on: learn
     each method's threshold on that dataset (with poses) instead of the first part; odometry
     (KITTI or TUM, never the ground truth): verification with submaps and the odometry gate,
-    as detect's."""
+    as detect's (odometry_calib as detect's)."""
 
 class OptimiseResult:
     @property
@@ -217,6 +221,7 @@ def optimise(
     format: str = "auto",
     poses: Optional[PathLike] = None,
     calib: Optional[PathLike] = None,
+    odometry_calib: Optional[PathLike] = None,
     # The run options of optimise (lidarloop.run_options("optimise")).
     threshold: Optional[float] = None,
     min_gap: Optional[float] = None,
@@ -227,7 +232,8 @@ def optimise(
     skip_bad: Optional[bool] = None,
     max_odometry_step_m: Optional[float] = None,
 ) -> OptimiseResult:
-    """`lidarloop optimise DATASET --odometry FILE --out OUT [--loops loops.csv]`."""
+    """`lidarloop optimise DATASET --odometry FILE --out OUT [--loops loops.csv]`
+    (odometry_calib as detect's)."""
 
 def build_map(
     dataset: Union[PathLike, Dataset],

@@ -254,7 +254,7 @@ void BindDetect(py::module_& m) {
            const py::object& config, bool overwrite, const py::object& progress,
            const std::string& format, const std::optional<fs::path>& poses,
            const std::optional<fs::path>& calib, const std::optional<fs::path>& odometry,
-           const py::kwargs& options) {
+           const std::optional<fs::path>& odometry_calib, const py::kwargs& options) {
             py::dict given(py::arg("out") = out.string(), py::arg("method") = method);
             const PythonProgress python_progress(progress);
             app::DetectRequest request;
@@ -265,9 +265,11 @@ void BindDetect(py::module_& m) {
             request.progress = python_progress.Callback();
             request.out = out;
             if (odometry) request.odometry_file = *odometry;
+            if (odometry_calib) request.odometry_calib = *odometry_calib;
             const io::Dataset data = DatasetOf(dataset, format, poses, calib);
             std::vector<fs::path> inputs = InputsOf(data, poses, calib);
             if (odometry) inputs.push_back(*odometry);
+            if (odometry_calib) inputs.push_back(*odometry_calib);
             DetectResult result;
             result.outcome = RunInFolder(out, std::move(inputs), overwrite, "detect",
                                          CallText("detect", dataset, given), python_progress,
@@ -284,6 +286,7 @@ void BindDetect(py::module_& m) {
         py::arg("config") = py::none(), py::arg("overwrite") = false,
         py::arg("progress") = py::none(), py::arg("format") = "auto", py::arg("poses") = py::none(),
         py::arg("calib") = py::none(), py::arg("odometry") = py::none(),
+        py::arg("odometry_calib") = py::none(),
         RunDoc(
             app::RunCommand::kDetect,
             "`lidarloop detect DATASET --out OUT` on a dataset folder (or a Dataset of "
@@ -395,7 +398,8 @@ void BindEvaluate(py::module_& m) {
            const std::vector<fs::path>& results, bool overwrite, const py::object& progress,
            const std::string& format, const std::optional<fs::path>& poses,
            const std::optional<fs::path>& calib, const py::object& train_on,
-           const std::optional<fs::path>& odometry, const py::kwargs& options) {
+           const std::optional<fs::path>& odometry, const std::optional<fs::path>& odometry_calib,
+           const py::kwargs& options) {
             py::dict given(py::arg("out") = out.string(), py::arg("methods") = methods);
             const PythonProgress python_progress(progress);
             app::EvaluationRequest request;
@@ -409,6 +413,7 @@ void BindEvaluate(py::module_& m) {
             request.progress = python_progress.Callback();
             request.out = out;
             if (odometry) request.odometry_file = *odometry;
+            if (odometry_calib) request.odometry_calib = *odometry_calib;
             const io::Dataset data = DatasetOf(dataset, format, poses, calib);
             // --train-on: learn each method's threshold on another dataset (with poses).
             std::optional<io::Dataset> train_data;
@@ -419,6 +424,7 @@ void BindEvaluate(py::module_& m) {
             inputs.insert(inputs.end(), results.begin(), results.end());
             if (train_data) inputs.push_back(train_data->root());
             if (odometry) inputs.push_back(*odometry);
+            if (odometry_calib) inputs.push_back(*odometry_calib);
             result.outcome = RunInFolder(
                 out, std::move(inputs), overwrite, "evaluate", CallText("evaluate", dataset, given),
                 python_progress, [&](const fs::path& staging) {
@@ -436,6 +442,7 @@ void BindEvaluate(py::module_& m) {
         py::arg("overwrite") = false, py::arg("progress") = py::none(), py::arg("format") = "auto",
         py::arg("poses") = py::none(), py::arg("calib") = py::none(),
         py::arg("train_on") = py::none(), py::arg("odometry") = py::none(),
+        py::arg("odometry_calib") = py::none(),
         RunDoc(
             app::RunCommand::kEvaluate,
             "`lidarloop evaluate DATASET --out OUT`: scores every method (default all) and "
@@ -511,7 +518,7 @@ void BindOptimise(py::module_& m) {
            const std::optional<std::string>& method, const py::object& config, bool overwrite,
            const py::object& progress, const std::string& format,
            const std::optional<fs::path>& poses, const std::optional<fs::path>& calib,
-           const py::kwargs& options) {
+           const std::optional<fs::path>& odometry_calib, const py::kwargs& options) {
             py::dict given(py::arg("odometry") = odometry.string(), py::arg("out") = out.string(),
                            py::arg("method") = method);
             if (pose_format != "kitti" && pose_format != "tum")
@@ -524,6 +531,7 @@ void BindOptimise(py::module_& m) {
                              {&request.config, &request.skip_bad}, given);
             given["overwrite"] = overwrite;
             request.odometry_file = odometry;
+            if (odometry_calib) request.odometry_calib = *odometry_calib;
             request.loops_file = loops.value_or(fs::path());
             request.format = pose_format == "tum" ? app::PoseFormat::kTum : app::PoseFormat::kKitti;
             request.progress = python_progress.Callback();
@@ -531,7 +539,9 @@ void BindOptimise(py::module_& m) {
             const io::Dataset data = DatasetOf(dataset, format, poses, calib);
             OptimiseResult result;
             result.outcome =
-                RunInFolder(out, InputsOf(data, poses, calib, {odometry, request.loops_file}),
+                RunInFolder(out,
+                            InputsOf(data, poses, calib,
+                                     {odometry, request.loops_file, request.odometry_calib}),
                             overwrite, "optimise", CallText("optimise", dataset, given),
                             python_progress, [&](const fs::path& staging) {
                                 app::OptimiseRequest staged = request;
@@ -546,6 +556,7 @@ void BindOptimise(py::module_& m) {
         py::arg("method") = py::none(), py::arg("config") = py::none(),
         py::arg("overwrite") = false, py::arg("progress") = py::none(), py::arg("format") = "auto",
         py::arg("poses") = py::none(), py::arg("calib") = py::none(),
+        py::arg("odometry_calib") = py::none(),
         RunDoc(
             app::RunCommand::kOptimise,
             "`lidarloop optimise DATASET --odometry FILE --out OUT`: reads the accepted loops "

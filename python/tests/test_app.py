@@ -347,3 +347,36 @@ def test_a_gap_in_metres_and_min_path_match_the_cli(cli, sequence, tmp_path):
     assert without_timings(evaluated.metrics) == without_timings(cli_metrics)
     assert cli_metrics["ground_truth"]["min_path_m"] == min_path
     assert 0 < evaluated.truth.overlapping_count < 55  # fewer revisits than without the rule
+
+
+def test_odometry_in_kittis_camera_frame_is_converted_as_the_cli(cli, sequence, tmp_path):
+    """The odometry written in KITTI's camera frame (Tr T Tr^-1) and given with its calib: the
+    CLI and Python convert it back, so the path and loops are those of the LiDAR-frame file."""
+    lidar = np.loadtxt(sequence / "poses_odometry.txt").reshape(-1, 3, 4)
+    tr = np.array([[0, -1, 0, 0], [0, 0, -1, 0.1], [1, 0, 0, -0.3], [0, 0, 0, 1]], float)
+    calib = tmp_path / "calib.txt"
+    calib.write_text("Tr: " + " ".join(map(str, tr[:3].ravel())) + "\n")
+    square = np.tile(np.eye(4), (len(lidar), 1, 1))
+    square[:, :3] = lidar
+    camera = tr @ square @ np.linalg.inv(tr)
+    camera_file = tmp_path / "odometry_camera.txt"
+    np.savetxt(camera_file, camera[:, :3].reshape(-1, 12), fmt="%.15g")
+    flags = ("--method", "range", "--no-verify", "--min-gap", "20", "--min-gap-unit", "metres")
+    run_cli(cli, "detect", sequence, *flags, "--odometry", sequence / "poses_odometry.txt",
+            "--out", tmp_path / "lidar")
+    run_cli(cli, "detect", sequence, *flags, "--odometry", camera_file, "--odometry-calib", calib,
+            "--out", tmp_path / "cli")
+    lidarloop.detect(sequence, out=tmp_path / "py", method="range", verify=False, min_gap=20,
+                     min_gap_unit="metres", odometry=camera_file, odometry_calib=calib)
+    expected = read_csv(tmp_path / "lidar" / "loops.csv")
+    assert len(expected) > 10
+    for run in ("cli", "py"):
+        rows = read_csv(tmp_path / run / "loops.csv")
+        assert [r["match"] for r in rows] == [r["match"] for r in expected], run
+        np.testing.assert_allclose([float(r["path_m"]) for r in rows],
+                                   [float(r["path_m"]) for r in expected], rtol=1e-9)
+    with pytest.raises(lidarloop.ConfigError, match="TUM"):
+        tum = tmp_path / "odometry.tum"
+        tum.write_text("".join(f"{i} 0 0 0 0 0 0 1\n" for i in range(len(lidar))))
+        lidarloop.detect(sequence, out=tmp_path / "tum", verify=False, odometry=tum,
+                         odometry_calib=calib)

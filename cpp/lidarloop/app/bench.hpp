@@ -25,6 +25,7 @@ struct BenchRequest {
     /// the odometry gate), as the online detector with a gate does; empty: none.
     std::filesystem::path odometry_file;
     std::string odometry_topic;
+    std::filesystem::path odometry_calib;  ///< as DetectRequest::odometry_calib
     Progress progress;
 
     /// Throws core::ConfigError for counts no machine holds (queries, verify_queries over

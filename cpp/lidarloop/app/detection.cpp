@@ -1,6 +1,7 @@
 #include "lidarloop/app/detection.hpp"
 
 #include <atomic>
+#include <cmath>
 #include <optional>
 
 #include "lidarloop/app/describe_run.hpp"
@@ -36,8 +37,12 @@ void RequireTimesForSeconds(const io::RunConfig& config, const io::Dataset& data
 // then scored against it.
 std::vector<core::StampedPose> OdometryOfScans(const DetectRequest& request,
                                                const io::Dataset& dataset) {
-    if (request.odometry_file.empty() && request.odometry_topic.empty()) return {};
-    return ReadOdometry(request.odometry_file, request.odometry_topic, dataset);
+    if (request.odometry_file.empty() && request.odometry_topic.empty() &&
+        request.odometry_calib.empty()) {
+        return {};
+    }
+    return ReadOdometry(request.odometry_file, request.odometry_topic, dataset,
+                        std::numeric_limits<double>::infinity(), request.odometry_calib);
 }
 
 // Per scan, the path travelled (core::CumulativePathM): on the odometry when given, else on the
@@ -64,6 +69,23 @@ std::string NoPathNote() {
 
 }  // namespace
 
+std::string CameraFrameNote(const std::vector<core::StampedPose>& odometry) {
+    // A ground vehicle turns about its up axis: z in the LiDAR frame, y in KITTI's camera frame
+    // (y down). Each pose's turn from the first, weighted by its angle.
+    double about_y = 0.0, about_any = 0.0;
+    for (std::size_t i = 1; i < odometry.size(); ++i) {
+        const Eigen::AngleAxisd turn(odometry.front().T_world_sensor.linear().transpose() *
+                                     odometry[i].T_world_sensor.linear());
+        if (!turn.axis().allFinite() || turn.angle() < kCameraFrameMinTurnRad) continue;
+        about_y += turn.angle() * std::abs(turn.axis().y());
+        about_any += turn.angle();
+    }
+    if (about_any == 0.0 || about_y < kCameraFrameMinAlignment * about_any) return {};
+    return "the odometry turns about its y axis, as poses of a vehicle in KITTI's camera frame "
+           "(y down) do: give --odometry-calib CALIB to convert them to the LiDAR frame, or the "
+           "odometry gate will reject right loops";
+}
+
 std::vector<std::string> FramesNotes(const io::Dataset& dataset,
                                      const std::vector<core::StampedPose>& odometry) {
     std::vector<std::string> notes;
@@ -72,13 +94,22 @@ std::vector<std::string> FramesNotes(const io::Dataset& dataset,
         std::string note = io::FramesNote(dataset.ScanPaths(), *poses, what);
         if (!note.empty()) notes.push_back(std::move(note));
     }
+    if (std::string note = CameraFrameNote(odometry); !note.empty())
+        notes.push_back(std::move(note));
     return notes;
 }
 
 std::vector<core::StampedPose> ReadOdometry(const std::filesystem::path& file,
-                                            const io::Dataset& dataset, double max_step_m) {
-    std::vector<core::StampedPose> odometry =
-        io::ReadPoses(file, core::Transform::Identity(), {}, max_step_m);
+                                            const io::Dataset& dataset, double max_step_m,
+                                            const std::filesystem::path& calib) {
+    if (!calib.empty() && io::IsTumPosesFile(file)) {
+        throw core::ConfigError("an odometry calibration (" + calib.string() +
+                                ") converts KITTI poses, and " + file.string() +
+                                " is a TUM file: give TUM poses in the LiDAR frame");
+    }
+    const core::Transform T_cam0_velo =
+        calib.empty() ? core::Transform::Identity() : io::ReadKittiCalibTr(calib);
+    std::vector<core::StampedPose> odometry = io::ReadPoses(file, T_cam0_velo, {}, max_step_m);
     if (dataset.format() == io::DatasetFormat::kKitti) {
         odometry = io::PosesOfFrames(dataset.ScanPaths(), std::move(odometry), file);
     }
@@ -101,11 +132,20 @@ std::vector<core::StampedPose> ReadOdometry(const std::filesystem::path& file,
 
 std::vector<core::StampedPose> ReadOdometry(const std::filesystem::path& file,
                                             const std::string& topic, const io::Dataset& dataset,
-                                            double max_step_m) {
-    if (topic.empty()) return ReadOdometry(file, dataset, max_step_m);
+                                            double max_step_m, const std::filesystem::path& calib) {
+    if (file.empty() && topic.empty()) {
+        throw core::ConfigError("an odometry calibration (" + calib.string() +
+                                ") converts an odometry file: give --odometry FILE");
+    }
+    if (topic.empty()) return ReadOdometry(file, dataset, max_step_m, calib);
     if (!file.empty()) {
         throw core::ConfigError("odometry from a file (" + file.string() + ") and from topic " +
                                 core::Quoted(topic) + ": give one");
+    }
+    if (!calib.empty()) {
+        throw core::ConfigError("an odometry calibration (" + calib.string() +
+                                ") converts a file's KITTI poses, not topic " +
+                                core::Quoted(topic) + "'s");
     }
     if (dataset.format() != io::DatasetFormat::kRosbag) {
         throw core::ConfigError("an odometry topic (" + core::Quoted(topic) +

@@ -26,6 +26,10 @@ struct DetectRequest {
     /// Instead of odometry_file, for a bag: its nav_msgs/Odometry topic, matched to the scans by
     /// their stamps (io::ReadBagOdometry).
     std::string odometry_topic;
+    /// A KITTI calib.txt whose Tr converts odometry_file's KITTI poses from KITTI's camera frame
+    /// to the LiDAR's (T_velo0_veloi = Tr^-1 P_i Tr, as --calib does for the poses). Empty: the
+    /// file is in the LiDAR frame.
+    std::filesystem::path odometry_calib;
     /// With detection.stop_at_first_loop, verification goes on after a query's first loop to
     /// the candidates that may give the pose graph a further loop of the scan
     /// (PoseGraphLoopsWanted: posegraph.max_loops_per_scan, min_loop_separation_m): optimise.
@@ -59,23 +63,38 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
 /// The odometry of `dataset` from `file` (KITTI or TUM, T_world_sensor): io::ReadError naming the
 /// file when it has not one pose per scan (nor, for a KITTI layout, one per frame:
 /// io::PosesOfFrames), or when a step between consecutive poses of the file exceeds `max_step_m` (a
-/// jump or a reset). Shared by detect (the path of a gap in metres) and optimise.
+/// jump or a reset). With `calib` (a KITTI calib.txt) a KITTI file is converted from KITTI's camera
+/// frame by its Tr; core::ConfigError for a TUM file with `calib`. Shared by detect (the path of
+/// a gap in metres) and optimise.
 std::vector<core::StampedPose> ReadOdometry(
     const std::filesystem::path& file, const io::Dataset& dataset,
-    double max_step_m = std::numeric_limits<double>::infinity());
+    double max_step_m = std::numeric_limits<double>::infinity(),
+    const std::filesystem::path& calib = {});
 
 /// The notes that say which frames of a KITTI drive the dataset's poses and `odometry` were taken
-/// from (io::FramesNote), none for poses one a scan.
+/// from (io::FramesNote), none for poses one a scan, and CameraFrameNote's of the odometry.
 std::vector<std::string> FramesNotes(const io::Dataset& dataset,
                                      const std::vector<core::StampedPose>& odometry);
+
+/// Turns from the first pose smaller than this are not judged by CameraFrameNote (20 degrees).
+inline constexpr double kCameraFrameMinTurnRad = 0.35;
+/// The share of the turns' angles about the y axis that marks KITTI's camera frame.
+inline constexpr double kCameraFrameMinAlignment = 0.9;
+
+/// A note when `odometry`'s turns from its first pose (those over kCameraFrameMinTurnRad) are
+/// about its y axis, as a vehicle's poses in KITTI's camera frame (y down) are: --odometry-calib
+/// converts them. Empty otherwise (no turn, or about another axis).
+std::string CameraFrameNote(const std::vector<core::StampedPose>& odometry);
 
 /// The odometry of `dataset` from `file`, or, when `topic` is given, from the nav_msgs/Odometry
 /// messages of `topic` in the dataset's bag, interpolated at the scans' stamps
 /// (io::ReadBagOdometry: io::ReadError naming the bag and the topic when their times do not
-/// cover the scans). core::ConfigError for a topic with a dataset that is no bag, or both.
+/// cover the scans). core::ConfigError for a topic with a dataset that is no bag, or both, and for
+/// a topic with `calib` (it converts a file's KITTI poses).
 std::vector<core::StampedPose> ReadOdometry(
     const std::filesystem::path& file, const std::string& topic, const io::Dataset& dataset,
-    double max_step_m = std::numeric_limits<double>::infinity());
+    double max_step_m = std::numeric_limits<double>::infinity(),
+    const std::filesystem::path& calib = {});
 
 /// How odometry was given, for reports: the file, or "BAG topic '/odom'".
 std::string OdometryName(const std::filesystem::path& file, const std::string& topic,

@@ -467,9 +467,11 @@ EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequ
     EvaluationOutcome outcome{
         eval::BuildGroundTruth(dataset.poses(), GroundTruthRule(request)), {}, {}};
     std::vector<core::StampedPose> odometry;
-    if (!request.odometry_file.empty() || !request.odometry_topic.empty()) {
-        odometry = ReadOdometry(request.odometry_file, request.odometry_topic, dataset,
-                                request.config.posegraph.max_odometry_step_m);
+    if (!request.odometry_file.empty() || !request.odometry_topic.empty() ||
+        !request.odometry_calib.empty()) {
+        odometry =
+            ReadOdometry(request.odometry_file, request.odometry_topic, dataset,
+                         request.config.posegraph.max_odometry_step_m, request.odometry_calib);
         if (request.config.detection.verify && IsTheGroundTruth(odometry, dataset.poses())) {
             outcome.notes.push_back(
                 "the odometry is the ground truth the loops are scored against (the same "

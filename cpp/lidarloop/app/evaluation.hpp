@@ -114,6 +114,7 @@ struct EvaluationRequest {
     /// Empty: each scan verified alone.
     std::filesystem::path odometry_file;
     std::string odometry_topic;  ///< instead of odometry_file, for a bag: its Odometry topic
+    std::filesystem::path odometry_calib;  ///< as DetectRequest::odometry_calib
     Progress progress;
     std::filesystem::path out;  ///< the results folder (created)
 };

@@ -40,6 +40,7 @@ std::vector<posegraph::LoopConstraint> DetectLoops(const io::Dataset& dataset,
     detect.out = request.out / "detection";
     detect.odometry_file = request.odometry_file;  // the path a gap in metres is measured on
     detect.odometry_topic = request.odometry_topic;
+    detect.odometry_calib = request.odometry_calib;
     detect.pose_graph_loops = true;
     const DetectOutcome detected = RunDetect(dataset, detect);
     std::vector<posegraph::LoopConstraint> loops;
@@ -252,7 +253,7 @@ OptimiseOutcome RunOptimisation(const io::Dataset& dataset, const OptimiseReques
     io::WriteConfigYaml(out / "config.yaml", request.config);
     const std::vector<core::StampedPose> odometry =
         ReadOdometry(request.odometry_file, request.odometry_topic, dataset,
-                     request.config.posegraph.max_odometry_step_m);
+                     request.config.posegraph.max_odometry_step_m, request.odometry_calib);
     OptimiseOutcome outcome;
     outcome.loops = LoadLoops(dataset, request, outcome.notes);
     const posegraph::PoseGraph graph =

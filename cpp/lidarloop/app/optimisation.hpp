@@ -24,6 +24,7 @@ struct OptimiseRequest {
     /// Instead of odometry_file, for a bag: its nav_msgs/Odometry topic, matched to the scans by
     /// their stamps (ReadOdometry).
     std::string odometry_topic;
+    std::filesystem::path odometry_calib;  ///< as DetectRequest::odometry_calib
     /// Accepted loops with their T_match_query (loops.csv of `detect` with verification). Empty:
     /// RunDetect with verification runs first, into out/detection.
     std::filesystem::path loops_file;

@@ -836,6 +836,66 @@ TEST_F(DetectionRun, OdometryOfSomeKittiFramesIsPickedByFrameNumber) {
                   1.0);
 }
 
+// KITTI calib.txt with Tr = T_cam0_velo: the LiDAR x forward, y left, z up seen from the camera
+// (z forward, x right, y down), 0.3 m behind it.
+std::filesystem::path WriteCalib(const std::filesystem::path& file) {
+    std::ofstream(file) << "P0: 1 0 0 0 0 1 0 0 0 0 1 0\n"
+                           "Tr: 0 -1 0 0 0 0 -1 0.1 1 0 0 -0.3\n";
+    return file;
+}
+
+// The odometry written in KITTI's camera frame (P_i = Tr T_i Tr^-1) and read with its calib is
+// the LiDAR-frame odometry again; read without, it turns about its y axis, which the run notes.
+TEST_F(DetectionRun, OdometryInKittisCameraFrameIsConvertedByItsCalib) {
+    const std::filesystem::path lidar_file = dir_ / "sequence" / "poses_odometry.txt";
+    const std::vector<core::StampedPose> lidar = app::ReadOdometry(lidar_file, "", *dataset_);
+    const std::filesystem::path calib = WriteCalib(dir_ / "calib_odometry.txt");
+    const core::Transform Tr = io::ReadKittiCalibTr(calib);
+    std::vector<core::StampedPose> camera = lidar;
+    for (core::StampedPose& pose : camera)
+        pose.T_world_sensor = Tr * pose.T_world_sensor * Tr.inverse();
+    const std::filesystem::path camera_file = dir_ / "odometry_camera.txt";
+    io::WriteKittiPoses(camera_file, camera);
+
+    const std::vector<core::StampedPose> converted = app::ReadOdometry(
+        camera_file, "", *dataset_, std::numeric_limits<double>::infinity(), calib);
+    ASSERT_EQ(converted.size(), lidar.size());
+    for (std::size_t i = 0; i < lidar.size(); ++i)
+        EXPECT_TRUE(converted[i].T_world_sensor.isApprox(lidar[i].T_world_sensor, 1e-9)) << i;
+    EXPECT_EQ(app::CameraFrameNote(converted), "");
+    EXPECT_EQ(app::CameraFrameNote(lidar), "");
+    EXPECT_NE(app::CameraFrameNote(app::ReadOdometry(camera_file, "", *dataset_)), "")
+        << "the simulated drive turns: the camera frame must show";
+
+    app::DetectRequest request;
+    request.config.detection.verify = false;
+    request.out = dir_ / "camera";
+    request.odometry_file = camera_file;
+    const auto notes = app::RunDetect(*dataset_, request).notes;
+    EXPECT_EQ(std::count_if(notes.begin(), notes.end(),
+                            [](const std::string& note) {
+                                return note.find("--odometry-calib") != std::string::npos;
+                            }),
+              1);
+}
+
+// A calib converts KITTI poses from a file: with a TUM file, a bag's topic or no odometry it is
+// a ConfigError, never ignored.
+TEST_F(DetectionRun, AnOdometryCalibWithoutKittiPosesIsAConfigError) {
+    const std::filesystem::path calib = WriteCalib(dir_ / "calib_odometry.txt");
+    const std::filesystem::path tum = dir_ / "odometry.tum";
+    io::WriteTumPoses(tum,
+                      app::ReadOdometry(dir_ / "sequence" / "poses_odometry.txt", "", *dataset_));
+    const double any_step = std::numeric_limits<double>::infinity();
+    EXPECT_THROW(app::ReadOdometry(tum, "", *dataset_, any_step, calib), core::ConfigError);
+    EXPECT_THROW(app::ReadOdometry("", "/odom", *dataset_, any_step, calib), core::ConfigError);
+    EXPECT_THROW(app::ReadOdometry("", "", *dataset_, any_step, calib), core::ConfigError);
+    app::DetectRequest request;
+    request.out = dir_ / "calib_alone";
+    request.odometry_calib = calib;
+    EXPECT_THROW(app::RunDetect(*dataset_, request), core::ConfigError);
+}
+
 // With poses every stored scan is its submap, placed by them; without, each scan is alone, the
 // run says so, and config.yaml and database.scans record it.
 TEST_F(DetectionRun, SubmapsInOrderReadEachScanOnceAndEqualEachSubmapAlone) {

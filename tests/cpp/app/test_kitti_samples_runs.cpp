@@ -1,9 +1,11 @@
 // detect on real KITTI HDL-64E frames with the official poses (../shared/data/kitti-samples, never
 // copied into the repository; skipped with a message when absent, as in CI). Ground truth and how
 // far to trust it at the 08 loops: the folder's README.md.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <optional>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -20,6 +22,14 @@ double YawDeg(const core::Transform& T) {
     return std::atan2(T.linear()(1, 0), T.linear()(0, 0)) * 180.0 / M_PI;
 }
 
+// The samples' frames of sequence 08 with the drive's official poses, converted by its calib.
+io::Dataset Sequence08() {
+    io::DatasetOptions options;
+    options.poses_file = kSamples / "poses" / "08.txt";
+    options.calib_file = kSamples / "calib_08.txt";
+    return io::OpenDataset(kSamples / "08", options);
+}
+
 // Frames 209, 720, 1500, 1684 of sequence 08 with its 4,071 poses: the path between the frames
 // is the drive's (hundreds of metres), so both reverse revisits pass the 50 m path rule, and
 // verification closes them at the README's yaw (within 2 degrees) and planar translation
@@ -27,10 +37,7 @@ double YawDeg(const core::Transform& T) {
 TEST(KittiSamplesRun, DetectClosesBothLoopsOfSequence08WithTheOfficialPoses) {
     if (!std::filesystem::exists(kSamples / "08" / "velodyne"))
         GTEST_SKIP() << "real KITTI samples not found at " << kSamples;
-    io::DatasetOptions options;
-    options.poses_file = kSamples / "poses" / "08.txt";
-    options.calib_file = kSamples / "calib_08.txt";
-    const io::Dataset dataset = io::OpenDataset(kSamples / "08", options);
+    const io::Dataset dataset = Sequence08();
     test::TempDir dir;
     app::DetectRequest request;
     request.config.detection.min_gap.value = 0;  // four frames: the path rule decides
@@ -60,6 +67,33 @@ TEST(KittiSamplesRun, DetectClosesBothLoopsOfSequence08WithTheOfficialPoses) {
     }
     EXPECT_FALSE(outcome.queries.at(1).loop());  // 720 is 93 m from 209
     EXPECT_EQ(outcome.accepted, 2U);
+}
+
+// KITTI's official poses are in its camera frame. Given as odometry without their calib, the
+// odometry's gate judges LiDAR-frame loops against camera-frame turns and rejects both true
+// loops, and the run says why; with --odometry-calib both are closed.
+TEST(KittiSamplesRun, OfficialPosesAsOdometryNeedTheirCalib) {
+    if (!std::filesystem::exists(kSamples / "08" / "velodyne"))
+        GTEST_SKIP() << "real KITTI samples not found at " << kSamples;
+    const io::Dataset dataset = Sequence08();
+    test::TempDir dir;
+    app::DetectRequest request;
+    request.config.detection.min_gap.value = 0;
+    request.odometry_file = kSamples / "poses" / "08.txt";
+    request.out = dir / "uncalibrated";
+    const app::DetectOutcome uncalibrated = app::RunDetect(dataset, request);
+    EXPECT_EQ(uncalibrated.accepted, 0U);
+    EXPECT_EQ(std::count_if(uncalibrated.notes.begin(), uncalibrated.notes.end(),
+                            [](const std::string& note) {
+                                return note.find("--odometry-calib") != std::string::npos;
+                            }),
+              1);
+    request.odometry_calib = kSamples / "calib_08.txt";
+    request.out = dir / "calibrated";
+    const app::DetectOutcome calibrated = app::RunDetect(dataset, request);
+    EXPECT_EQ(calibrated.accepted, 2U);
+    for (const std::string& note : calibrated.notes)
+        EXPECT_EQ(note.find("--odometry-calib"), std::string::npos) << note;
 }
 
 }  // namespace

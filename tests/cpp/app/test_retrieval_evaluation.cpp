@@ -94,7 +94,7 @@ TEST(RetrievalEvaluation, EvaluateRecountsFromDetectsCandidates) {
     const app::RetrievalComparison& r = *evaluated.methods[0].retrieval;
     ASSERT_TRUE(r.verified.has_value());
 
-    app::DetectRequest detect{config, false, {}, dir / "detection", {}, {}};
+    app::DetectRequest detect{config, false, {}, dir / "detection", {}, {}, {}};
     const app::DetectOutcome detected = app::RunDetect(dataset, detect);
     const Recount verified = RecountFrom(dataset, detected.queries, true);
     ExpectSame(verified, *r.verified, dataset.size());

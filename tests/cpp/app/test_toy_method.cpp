@@ -146,7 +146,7 @@ protected:
 };
 
 TEST_F(ToyMethod, DetectsLoopsExactlyAsComparingEveryEarlierScan) {
-    app::DetectRequest request{RingsConfig(), false, {}, dir_ / "detect", {}, {}};
+    app::DetectRequest request{RingsConfig(), false, {}, dir_ / "detect", {}, {}, {}};
     request.config.detection.verify = false;  // the descriptor's own decision
     const app::DetectOutcome outcome = app::RunDetect(*dataset_, request);
     ASSERT_EQ(outcome.queries.size(), dataset_->size());
@@ -171,7 +171,7 @@ TEST_F(ToyMethod, DetectsLoopsExactlyAsComparingEveryEarlierScan) {
 }
 
 TEST_F(ToyMethod, ASavedMapLoadsAndLocalisesEveryScanAtItself) {
-    app::DetectRequest request{RingsConfig(), false, {}, dir_ / "detect", {}, {}};
+    app::DetectRequest request{RingsConfig(), false, {}, dir_ / "detect", {}, {}, {}};
     app::RunDetect(*dataset_, request);
     request.out = dir_ / "localise";
     const app::DetectOutcome outcome =
@@ -202,7 +202,7 @@ TEST_F(ToyMethod, IsEvaluatedBesideThePapersMethods) {
 }
 
 TEST_F(ToyMethod, AMapOfAMethodThisProcessLacksIsAClearError) {
-    app::DetectRequest request{RingsConfig(), false, {}, dir_ / "detect", {}, {}};
+    app::DetectRequest request{RingsConfig(), false, {}, dir_ / "detect", {}, {}, {}};
     app::RunDetect(*dataset_, request);
     std::string saved = test::ReadFile(dir_ / "detect" / "database.lldb");
     const auto at = saved.find("method: rings");
