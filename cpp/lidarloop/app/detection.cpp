@@ -339,6 +339,7 @@ DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const Detec
     Stopwatch total;
     const std::vector<core::StampedPose> poses = OdometryOfScans(request, dataset);
     DetectOutcome outcome;
+    outcome.notes = FramesNotes(dataset, poses);
     io::RunConfig config =
         WithSubmapsWhereTheyApply(request.config, dataset.size(), poses, outcome.notes);
     if (!config.detection.threshold) config.detection.threshold = map.detection.threshold;

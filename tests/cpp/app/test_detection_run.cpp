@@ -871,12 +871,15 @@ TEST_F(DetectionRun, OdometryInKittisCameraFrameIsConvertedByItsCalib) {
     request.config.detection.verify = false;
     request.out = dir_ / "camera";
     request.odometry_file = camera_file;
-    const auto notes = app::RunDetect(*dataset_, request).notes;
-    EXPECT_EQ(std::count_if(notes.begin(), notes.end(),
-                            [](const std::string& note) {
-                                return note.find("--odometry-calib") != std::string::npos;
-                            }),
-              1);
+    const auto calib_notes = [](const std::vector<std::string>& notes) {
+        return std::count_if(notes.begin(), notes.end(), [](const std::string& note) {
+            return note.find("--odometry-calib") != std::string::npos;
+        });
+    };
+    EXPECT_EQ(calib_notes(app::RunDetect(*dataset_, request).notes), 1);
+    const std::filesystem::path map = request.out / "database.lldb";
+    request.out = dir_ / "camera_localised";  // localising against a map says so too
+    EXPECT_EQ(calib_notes(app::RunLocalise(*dataset_, app::LoadMap(map), request).notes), 1);
 }
 
 // A calib converts KITTI poses from a file: with a TUM file, a bag's topic or no odometry it is
