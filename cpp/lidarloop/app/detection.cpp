@@ -133,7 +133,7 @@ std::vector<core::StampedPose> ReadOdometry(const std::filesystem::path& file,
 std::vector<core::StampedPose> ReadOdometry(const std::filesystem::path& file,
                                             const std::string& topic, const io::Dataset& dataset,
                                             double max_step_m, const std::filesystem::path& calib) {
-    if (file.empty() && topic.empty()) {
+    if (file.empty() && topic.empty() && !calib.empty()) {
         throw core::ConfigError("an odometry calibration (" + calib.string() +
                                 ") converts an odometry file: give --odometry FILE");
     }
