@@ -331,22 +331,24 @@ std::vector<registration::YawWindow> QueryYaws(const std::vector<Candidate>& can
     return yaws;
 }
 
-// Verify as detect does under `check`: its yaws and poses, and its rejection of a pose it
-// contradicts.
+// Verify as detect does under `check`: its yaws and poses, then its judgement of the verdict
+// (the check detect runs on each verified query, here on a query of this one candidate).
 registration::Verification VerifyUnder(const registration::PreparedScan& query,
                                        const registration::CoarseQuery& coarse,
                                        const registration::PreparedScan& match,
                                        const registration::VerificationConfig& config,
                                        const Candidate& candidate,
                                        const pipeline::LoopCheck& check) {
-    const registration::PoseAllowed allowed = check.AllowedPoses(candidate.query, candidate.match);
-    registration::Verification verdict = registration::Verify(
-        query, coarse, match, config, allowed, check.YawWindow(candidate.query, candidate.match));
-    if (verdict.accepted && allowed && !allowed(verdict.T_match_query)) {
-        verdict.accepted = false;
-        verdict.reason = registration::RejectReason::kOdometryMismatch;
-    }
-    return verdict;
+    const registration::Verification verdict = registration::Verify(
+        query, coarse, match, config, check.AllowedPoses(candidate.query, candidate.match),
+        check.YawWindow(candidate.query, candidate.match));
+    if (!check) return verdict;
+    pipeline::LoopQuery judged;
+    judged.query = candidate.query;
+    judged.candidates.push_back({candidate.match, 0.0});
+    judged.verifications.push_back(verdict);
+    check(judged);
+    return judged.verifications.front();
 }
 
 void Replay(const std::filesystem::path& run, const registration::VerificationConfig& config,
