@@ -236,11 +236,8 @@ nlohmann::json RunBench(const io::Dataset& dataset, const BenchRequest& request)
     if (verify) {
         // The path on the odometry when given (as detect takes it), else on the poses.
         const std::vector<core::StampedPose> odometry =
-            request.odometry_file.empty() && request.odometry_topic.empty() &&
-                    request.odometry_calib.empty()
-                ? std::vector<core::StampedPose>{}
-                : ReadOdometry(request.odometry_file, request.odometry_topic, dataset,
-                               std::numeric_limits<double>::infinity(), request.odometry_calib);
+            ReadOdometryIfGiven(request.odometry_file, request.odometry_topic, dataset,
+                                std::numeric_limits<double>::infinity(), request.odometry_calib);
         const std::vector<double> path_m = core::CumulativePathM(
             odometry.empty() && dataset.HasPoses() ? dataset.poses() : odometry);
         pipeline::LoopCheck check;

@@ -37,12 +37,8 @@ void RequireTimesForSeconds(const io::RunConfig& config, const io::Dataset& data
 // then scored against it.
 std::vector<core::StampedPose> OdometryOfScans(const DetectRequest& request,
                                                const io::Dataset& dataset) {
-    if (request.odometry_file.empty() && request.odometry_topic.empty() &&
-        request.odometry_calib.empty()) {
-        return {};
-    }
-    return ReadOdometry(request.odometry_file, request.odometry_topic, dataset,
-                        std::numeric_limits<double>::infinity(), request.odometry_calib);
+    return ReadOdometryIfGiven(request.odometry_file, request.odometry_topic, dataset,
+                               std::numeric_limits<double>::infinity(), request.odometry_calib);
 }
 
 // Per scan, the path travelled (core::CumulativePathM): on the odometry when given, else on the
@@ -155,6 +151,14 @@ std::vector<core::StampedPose> ReadOdometry(const std::filesystem::path& file,
     std::vector<double> times_s(dataset.size());
     for (std::size_t i = 0; i < times_s.size(); ++i) times_s[i] = dataset.ScanTime(i);
     return io::ReadBagOdometry(dataset.root(), topic, times_s, max_step_m);
+}
+
+std::vector<core::StampedPose> ReadOdometryIfGiven(const std::filesystem::path& file,
+                                                   const std::string& topic,
+                                                   const io::Dataset& dataset, double max_step_m,
+                                                   const std::filesystem::path& calib) {
+    if (file.empty() && topic.empty() && calib.empty()) return {};
+    return ReadOdometry(file, topic, dataset, max_step_m, calib);
 }
 
 namespace {

@@ -96,6 +96,13 @@ std::vector<core::StampedPose> ReadOdometry(
     double max_step_m = std::numeric_limits<double>::infinity(),
     const std::filesystem::path& calib = {});
 
+/// ReadOdometry when a file, a topic or a calibration is given (its errors too), else no
+/// odometry (empty): how detect, evaluate and bench take their optional odometry.
+std::vector<core::StampedPose> ReadOdometryIfGiven(const std::filesystem::path& file,
+                                                   const std::string& topic,
+                                                   const io::Dataset& dataset, double max_step_m,
+                                                   const std::filesystem::path& calib);
+
 /// How odometry was given, for reports: the file, or "BAG topic '/odom'".
 std::string OdometryName(const std::filesystem::path& file, const std::string& topic,
                          const io::Dataset& dataset);

@@ -466,18 +466,15 @@ EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequ
         RequirePoses(*train_dataset, "threshold learning", "--train-poses");
     EvaluationOutcome outcome{
         eval::BuildGroundTruth(dataset.poses(), GroundTruthRule(request)), {}, {}};
-    std::vector<core::StampedPose> odometry;
-    if (!request.odometry_file.empty() || !request.odometry_topic.empty() ||
-        !request.odometry_calib.empty()) {
-        odometry =
-            ReadOdometry(request.odometry_file, request.odometry_topic, dataset,
-                         request.config.posegraph.max_odometry_step_m, request.odometry_calib);
-        if (request.config.detection.verify && IsTheGroundTruth(odometry, dataset.poses())) {
-            outcome.notes.push_back(
-                "the odometry is the ground truth the loops are scored against (the same "
-                "positions): submaps placed and loops checked by it flatter the verified figures; "
-                "give the sequence's own odometry");
-        }
+    const std::vector<core::StampedPose> odometry =
+        ReadOdometryIfGiven(request.odometry_file, request.odometry_topic, dataset,
+                            request.config.posegraph.max_odometry_step_m, request.odometry_calib);
+    if (!odometry.empty() && request.config.detection.verify &&
+        IsTheGroundTruth(odometry, dataset.poses())) {
+        outcome.notes.push_back(
+            "the odometry is the ground truth the loops are scored against (the same "
+            "positions): submaps placed and loops checked by it flatter the verified figures; "
+            "give the sequence's own odometry");
     }
     for (std::string& note : FramesNotes(dataset, odometry))
         outcome.notes.push_back(std::move(note));

@@ -893,6 +893,8 @@ TEST_F(DetectionRun, AnOdometryCalibWithoutKittiPosesIsAConfigError) {
     EXPECT_THROW(app::ReadOdometry(tum, "", *dataset_, any_step, calib), core::ConfigError);
     EXPECT_THROW(app::ReadOdometry("", "/odom", *dataset_, any_step, calib), core::ConfigError);
     EXPECT_THROW(app::ReadOdometry("", "", *dataset_, any_step, calib), core::ConfigError);
+    EXPECT_THROW(app::ReadOdometryIfGiven("", "", *dataset_, any_step, calib), core::ConfigError);
+    EXPECT_TRUE(app::ReadOdometryIfGiven("", "", *dataset_, any_step, {}).empty());
     app::DetectRequest request;
     request.out = dir_ / "calib_alone";
     request.odometry_calib = calib;
