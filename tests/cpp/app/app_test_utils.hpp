@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdlib>
 #include <filesystem>
 
 #include "lidarloop/app/simulation.hpp"
@@ -7,13 +8,29 @@
 
 namespace lidarloop::test {
 
-/// A short demo-town sequence (200 VLP-16 scans, thinned) in KITTI layout in `folder`, with
-/// poses: small enough for a run-layer test, with revisits.
-inline io::Dataset SmallSequence(const std::filesystem::path& folder) {
+/// Names a SmallSequence written beforehand: ctest's app_tests.small_sequence fixture
+/// (tests/cpp/app/CMakeLists.txt) sets it for the run-layer tests, which copy that folder instead
+/// of simulating the sequence again (most of such a test's time under the sanitizers).
+inline constexpr const char* kSmallSequenceVariable = "LIDARLOOP_SMALL_SEQUENCE";
+
+/// Simulates SmallSequence's scans and poses into `folder`.
+inline void WriteSmallSequence(const std::filesystem::path& folder) {
     sim::SimulationConfig config = sim::DemoConfig();
     config.scans = 200;
     config.sensor.horizontal_steps = 360;
     app::WriteSimulation(sim::Simulator(config), folder, /*run=*/{}, /*threads=*/0);
+}
+
+/// A short demo-town sequence (200 VLP-16 scans, thinned) in KITTI layout in `folder`, with
+/// poses: small enough for a run-layer test, with revisits. A copy of the folder that
+/// kSmallSequenceVariable names, when set; simulated otherwise.
+inline io::Dataset SmallSequence(const std::filesystem::path& folder) {
+    const char* written = std::getenv(kSmallSequenceVariable);
+    if (written != nullptr && *written != '\0') {
+        std::filesystem::copy(written, folder, std::filesystem::copy_options::recursive);
+    } else {
+        WriteSmallSequence(folder);
+    }
     return io::OpenDataset(folder);
 }
 
