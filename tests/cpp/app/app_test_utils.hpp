@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 
@@ -13,11 +14,13 @@ namespace lidarloop::test {
 /// of simulating the sequence again (most of such a test's time under the sanitizers).
 inline constexpr const char* kSmallSequenceVariable = "LIDARLOOP_SMALL_SEQUENCE";
 
-/// Simulates SmallSequence's scans and poses into `folder`.
-inline void WriteSmallSequence(const std::filesystem::path& folder) {
+/// Simulates SmallSequence's scans and poses into `folder`, with the demo's world and noise
+/// (`seed` 1) or another's.
+inline void WriteSmallSequence(const std::filesystem::path& folder, std::uint64_t seed = 1) {
     sim::SimulationConfig config = sim::DemoConfig();
     config.scans = 200;
     config.sensor.horizontal_steps = 360;
+    config.seed = seed;
     app::WriteSimulation(sim::Simulator(config), folder, /*run=*/{}, /*threads=*/0);
 }
 
@@ -31,6 +34,12 @@ inline io::Dataset SmallSequence(const std::filesystem::path& folder) {
     } else {
         WriteSmallSequence(folder);
     }
+    return io::OpenDataset(folder);
+}
+
+/// SmallSequence's route through another seed's town, with its own noise: always simulated.
+inline io::Dataset OtherSmallSequence(const std::filesystem::path& folder, std::uint64_t seed) {
+    WriteSmallSequence(folder, seed);
     return io::OpenDataset(folder);
 }
 

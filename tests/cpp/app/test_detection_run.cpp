@@ -670,8 +670,8 @@ TEST_F(DetectionRun, ReportsProgressOfEveryScanAndEndsTheStage) {
     app::DetectRequest request = Request("detect", core::Method::kHeight);
     request.config.detection.top_k = 1;
     request.odometry_file = dir_ / "sequence" / "poses_odometry.txt";  // with the submaps stage
-    // A few scans a submap: the stage runs as with the default 10 m, at a third of the cost under
-    // the sanitizers, where this test covers verified detection with submaps.
+    // A few scans a submap: the stage runs as with the default 10 m, at half the cost under the
+    // sanitizers, where this test covers verified detection with submaps.
     request.config.detection.verification.reduction.submap_path_m = 4.0;
     std::mutex mutex;
     std::set<std::size_t> seen;

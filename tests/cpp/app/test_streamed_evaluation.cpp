@@ -96,7 +96,8 @@ TEST(StreamedEvaluation, EqualsEveryPairInMemory) {
 TEST(StreamedEvaluation, ThresholdLearntOnAnotherDatasetEqualsEveryPairInMemory) {
     const test::TempDir dir;
     const io::Dataset dataset = test::SmallSequence(dir / "sequence");
-    const io::Dataset train = test::SmallSequence(dir / "train");  // same town, own noise
+    // Another town: a threshold learnt on the evaluated pairs instead would differ.
+    const io::Dataset train = test::OtherSmallSequence(dir / "train", 2);
     app::EvaluationRequest request = Request(dir / "run");
     request.methods = {core::Method::kRange};
     const app::EvaluationOutcome trained = app::RunEvaluation(dataset, request, &train);
