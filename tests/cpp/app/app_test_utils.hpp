@@ -14,9 +14,10 @@ namespace lidarloop::test {
 /// of simulating the sequence again (most of such a test's time under the sanitizers).
 inline constexpr const char* kSmallSequenceVariable = "LIDARLOOP_SMALL_SEQUENCE";
 
-/// Simulates SmallSequence's scans and poses into `folder`, with the demo's world and noise
-/// (`seed` 1) or another's.
-inline void WriteSmallSequence(const std::filesystem::path& folder, std::uint64_t seed = 1) {
+/// Simulates SmallSequence's scans and poses into `folder`, with the demo's world and noise or
+/// another seed's.
+inline void WriteSmallSequence(const std::filesystem::path& folder,
+                               std::uint64_t seed = sim::DemoConfig().seed) {
     sim::SimulationConfig config = sim::DemoConfig();
     config.scans = 200;
     config.sensor.horizontal_steps = 360;
