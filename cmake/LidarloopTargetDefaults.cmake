@@ -62,3 +62,11 @@ function(lidarloop_unity_build target)
         set_target_properties(${target} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE 8)
     endif()
 endfunction()
+
+# lidarloop_test_optimization(<target>): a test program's own code optimised as
+# LIDARLOOP_TEST_OPTIMIZATION says (given after the build type's flags, so it wins).
+function(lidarloop_test_optimization target)
+    if(LIDARLOOP_TEST_OPTIMIZATION)
+        target_compile_options(${target} PRIVATE ${LIDARLOOP_TEST_OPTIMIZATION})
+    endif()
+endfunction()
