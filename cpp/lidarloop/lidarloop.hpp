@@ -66,6 +66,7 @@
 #include "lidarloop/pipeline/histogram_method.hpp"
 #include "lidarloop/pipeline/loop_detector.hpp"
 #include "lidarloop/pipeline/ndt_method.hpp"
+#include "lidarloop/pipeline/neighbour_overlaps.hpp"
 #include "lidarloop/pipeline/progress_counter.hpp"
 #include "lidarloop/pipeline/scancontext_method.hpp"
 #include "lidarloop/pipeline/sequence.hpp"

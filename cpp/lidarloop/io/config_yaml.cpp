@@ -195,6 +195,9 @@ void VisitFields(registration::AcceptanceConfig& c, Visitor& v) {
             "another pose may reach at most this share of the accepted overlap");
     v.Field("max_loop_distance_m", c.max_loop_distance_m,
             "the registered sensors of a loop are at most this far apart");
+    v.Field("min_neighbour_overlap_ratio", c.min_neighbour_overlap_ratio,
+            "without odometry, a loop's distinctive overlap over its scans' with their neighbours, "
+            "at least (0: off)");
 }
 
 template <typename Visitor>

@@ -9,6 +9,7 @@
 #include "lidarloop/core/stopwatch.hpp"
 #include "lidarloop/pipeline/descriptor_method.hpp"
 #include "lidarloop/pipeline/expanded_scans.hpp"
+#include "lidarloop/pipeline/neighbour_overlaps.hpp"
 
 namespace lidarloop::pipeline {
 namespace {
@@ -219,6 +220,9 @@ VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
                                 const MoreLoopsWanted& more) {
     ExpandedScans expanded;
     const auto scan_of = [&](std::size_t i) { return expanded.Get(scans, i); };
+    NeighbourOverlaps neighbours(
+        scan_of, [&scans] { return scans.size(); }, detector.verification);
+    const LoopCheck judge = JudgeOf(check, neighbours, detector.verification);
     std::vector<VerificationTimes> per_query(queries.size());
     ProgressCounter done(progress, queries.size());
     const auto run = [&](std::size_t i) {
@@ -227,7 +231,7 @@ VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
         const Execution per_query_execution =
             detector.stop_at_first_loop ? Execution::kSerial : execution;
         VerifyQuery(queries[i], scan_of(queries[i].query), scan_of, detector, method, &per_query[i],
-                    cache, per_query_execution, check, more);
+                    cache, per_query_execution, judge, more);
         done.Add();
     };
     if (execution == Execution::kParallel) {

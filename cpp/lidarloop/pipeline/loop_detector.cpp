@@ -12,6 +12,7 @@
 #include "lidarloop/core/angles.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/pipeline/candidate_verification.hpp"
+#include "lidarloop/pipeline/neighbour_overlaps.hpp"
 
 namespace lidarloop::pipeline {
 namespace {
@@ -417,7 +418,10 @@ LoopDetector::LoopDetector(DescriptorDatabase database, const DetectorConfig& de
     : database_(std::move(database)),
       detector_(detector),
       threshold_(detector.ThresholdFor(database_.method())),
-      scans_(scans.begin(), scans.end()) {
+      scans_(scans.begin(), scans.end()),
+      neighbours_(std::make_unique<NeighbourOverlaps>(
+          [this](std::size_t j) { return expanded_.Get(scans_, j); },
+          [this] { return scans_.size(); }, detector.verification)) {
     detector_.Validate();
     if (!scans_.empty() && scans_.size() != database_.size()) {
         throw core::ConfigError("LoopDetector: " + std::to_string(scans_.size()) +
@@ -431,6 +435,8 @@ LoopDetector::LoopDetector(DescriptorDatabase database, const DetectorConfig& de
     // One sort instead of n sorted inserts: a loaded map may hold a million scans.
     if (index_) index_->InsertAll([this](std::size_t i) { return database_.IsValid(i); });
 }
+
+LoopDetector::~LoopDetector() = default;
 
 LoopQuery LoopDetector::Search(const PreparedQuery& query, std::size_t query_index,
                                const std::function<bool(std::size_t)>& eligible,
@@ -451,9 +457,26 @@ void LoopDetector::Verify(LoopQuery& result, const registration::CompactPrepared
                           const LoopCheck& check) const {
     if (!detector_.verify || !scan.prepared()) return;
     // The query as it is stored: online, offline and localisation see the same scans.
+    const registration::PreparedScan query = scan.Expand();
+    // The query is not stored yet: its neighbour's overlap is computed here, once, if asked for.
+    std::optional<double> query_reference;
+    const auto reference_of = [&](std::size_t j) {
+        if (j < scans_.size()) return neighbours_->Of(j);
+        if (!query_reference) {
+            query_reference = j == 0
+                                  ? kNan
+                                  : NeighbourOverlaps::Between(query, expanded_.Get(scans_, j - 1),
+                                                               detector_.verification);
+        }
+        return *query_reference;
+    };
+    const LoopCheck judge =
+        check ? check
+              : CheckAgainstNeighbours(
+                    reference_of, detector_.verification.acceptance.min_neighbour_overlap_ratio);
     VerifyQuery(
-        result, scan.Expand(), [this](std::size_t j) { return expanded_.Get(scans_, j); },
-        detector_, database_.method(), nullptr, nullptr, Execution::kParallel, check);
+        result, query, [this](std::size_t j) { return expanded_.Get(scans_, j); }, detector_,
+        database_.method(), nullptr, nullptr, Execution::kParallel, judge);
 }
 
 std::size_t LoopDetector::prepared_bytes() const {

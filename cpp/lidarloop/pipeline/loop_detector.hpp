@@ -19,6 +19,8 @@
 
 namespace lidarloop::pipeline {
 
+class NeighbourOverlaps;
+
 /// How loop candidates are chosen and decided.
 struct DetectorConfig {
     /// S: a scan's candidates are the scans at least this far back (Magnusson II-E).
@@ -253,6 +255,7 @@ public:
                  std::vector<registration::PreparedScan> scans = {});
     LoopDetector(const LoopDetector&) = delete;
     LoopDetector& operator=(const LoopDetector&) = delete;
+    ~LoopDetector();
 
     /// Describes `scan`, finds its candidates among the stored scans (and verifies them when
     /// verify is on, then applies the odometry gate; with the gate, a scan the odometry puts out
@@ -308,6 +311,8 @@ private:
     // By database index, for verification; compact (about 36 kB a scan instead of 214 kB expanded).
     std::vector<registration::CompactPreparedScan> scans_;
     mutable ExpandedScans expanded_;  // the candidates verified lately (thread-safe)
+    // Without odometry, what each stored scan shows with its neighbour (thread-safe).
+    std::unique_ptr<NeighbourOverlaps> neighbours_;
     // The scans loaded from a map come first; this session's scans start here.
     std::size_t session_start_ = 0;
     // With odometry: per scan of this session, its pose T_odom_sensor and cumulative path (m);

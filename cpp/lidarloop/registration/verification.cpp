@@ -340,6 +340,8 @@ std::string ToString(RejectReason reason) {
             return "odometry_mismatch";
         case RejectReason::kNotNeeded:
             return "not_needed";
+        case RejectReason::kUnlikeNeighbours:
+            return "unlike_neighbours";
     }
     return "unknown";
 }

@@ -32,12 +32,14 @@ enum class RejectReason {
     kOdometryMismatch,
     /// not registered: a candidate ranked higher is the query's loop (detection.stop_at_first_loop)
     kNotNeeded,
+    /// registered, but it overlaps far less than its scans do with their neighbours in the
+    /// sequence (AcceptanceConfig::min_neighbour_overlap_ratio; without odometry)
+    kUnlikeNeighbours,
 };
 
 /// "none", "too_few_points", "no_alignment", "not_converged", "low_overlap", "high_rmse",
-/// "degenerate", "ambiguous", "too_far", "pruned", "odometry_mismatch", "not_needed": the
-/// spelling of loops.csv
-/// and `lidarloop verify`.
+/// "degenerate", "ambiguous", "too_far", "pruned", "odometry_mismatch", "not_needed",
+/// "unlike_neighbours": the spelling of loops.csv and `lidarloop verify`.
 std::string ToString(RejectReason reason);
 
 /// How well a query sits on a match at a pose (registration::MeasureOverlap).

@@ -87,6 +87,7 @@ void AcceptanceConfig::Validate() const {
     RequireIn(max_shifted_overlap_ratio, 0.0, 1.0, "acceptance.max_shifted_overlap_ratio");
     RequireIn(max_rival_overlap_ratio, 0.0, 10.0, "acceptance.max_rival_overlap_ratio");
     RequireIn(max_loop_distance_m, 0.1, 1e4, "acceptance.max_loop_distance_m");
+    RequireIn(min_neighbour_overlap_ratio, 0.0, 10.0, "acceptance.min_neighbour_overlap_ratio");
 }
 
 void VerificationConfig::Validate() const {

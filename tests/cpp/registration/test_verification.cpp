@@ -472,6 +472,7 @@ TEST(Verification, ReasonsHaveStableNames) {
     EXPECT_EQ(ToString(RejectReason::kPruned), "pruned");
     EXPECT_EQ(ToString(RejectReason::kOdometryMismatch), "odometry_mismatch");
     EXPECT_EQ(ToString(RejectReason::kNotNeeded), "not_needed");
+    EXPECT_EQ(ToString(RejectReason::kUnlikeNeighbours), "unlike_neighbours");
 }
 
 // Simulated scans: exact ground truth, real ray casting (occlusion, beam pattern, noise).

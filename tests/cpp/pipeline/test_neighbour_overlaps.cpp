@@ -1,0 +1,228 @@
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "lidarloop/pipeline/candidate_verification.hpp"
+#include "lidarloop/pipeline/loop_detector.hpp"
+#include "lidarloop/pipeline/neighbour_overlaps.hpp"
+#include "lidarloop/pipeline/similarity_matrix.hpp"
+#include "registration/registration_test_utils.hpp"
+
+namespace lidarloop::pipeline {
+namespace {
+
+constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+using registration::RejectReason;
+
+// A place's mirror image (y -> -y): the same kinds of surfaces, in an arrangement no rigid motion
+// of the place gives.
+core::PointCloud Mirrored(core::PointCloud cloud) {
+    for (auto& point : cloud) point.y() = -point.y();
+    return cloud;
+}
+
+// Place 1 seen twice 1 m apart (scans 0, 1), place 2 twice (scans 2, 3), place 1 again turned
+// by 170 degrees (scan 4): scans 0, 1 and 4 register to each other, 3 and 4 do not.
+std::vector<core::PointCloud> TwoPlacesAndARevisit() {
+    const core::PointCloud first = test::SyntheticPlace(1);
+    const core::PointCloud second = Mirrored(test::SyntheticPlace(2));
+    return {first, test::Transformed(first, test::PlanarTransform(-1.0, 0.0, 0.0)), second,
+            test::Transformed(second, test::PlanarTransform(-1.0, 0.0, 0.0)),
+            test::Transformed(first, test::PlanarTransform(1.0, -1.5, 170.0))};
+}
+
+std::vector<registration::CompactPreparedScan> Prepared(const std::vector<core::PointCloud>& scans,
+                                                        const DetectorConfig& detector) {
+    std::vector<registration::CompactPreparedScan> prepared;
+    for (const auto& scan : scans)
+        prepared.emplace_back(registration::PrepareScan(scan, detector.verification.reduction));
+    return prepared;
+}
+
+DetectorConfig Verifying(double min_neighbour_overlap_ratio) {
+    DetectorConfig detector;
+    detector.min_gap = {2.0, core::MinGap::Unit::kScans};
+    detector.min_path_m = 0.0;
+    detector.top_k = 2;
+    detector.verification.acceptance.min_neighbour_overlap_ratio = min_neighbour_overlap_ratio;
+    return detector;
+}
+
+// A query whose candidates were all registered and accepted with these distinctive overlaps.
+LoopQuery AcceptedQuery(std::size_t query, const std::vector<std::size_t>& matches,
+                        const std::vector<double>& distinctive_overlaps) {
+    LoopQuery result;
+    result.query = query;
+    for (std::size_t c = 0; c < matches.size(); ++c) {
+        result.candidates.push_back({matches[c], static_cast<double>(c)});
+        registration::Verification verdict;
+        verdict.accepted = true;
+        verdict.overlap.query_fraction = verdict.overlap.match_fraction = 0.9;
+        verdict.overlap.query_distinctive_fraction = distinctive_overlaps[c];
+        verdict.overlap.match_distinctive_fraction = 0.9;
+        result.verifications.push_back(verdict);
+    }
+    result.accepted = true;
+    return result;
+}
+
+TEST(NeighbourOverlaps, RegistersEachScanToTheOneBeforeOnce) {
+    const DetectorConfig detector = Verifying(0.5);
+    const auto prepared = Prepared(TwoPlacesAndARevisit(), detector);
+    std::atomic<int> expanded{0};
+    NeighbourOverlaps neighbours(
+        [&](std::size_t i) {
+            ++expanded;
+            return prepared[i].Expand();
+        },
+        [&] { return prepared.size(); }, detector.verification);
+    // Scan 1 is scan 0 moved 1 m: nearly every distinctive point overlaps; scan 0 shares its pair.
+    const double first_place = neighbours.Of(1);
+    EXPECT_GT(first_place, 0.8);
+    EXPECT_EQ(neighbours.Of(0), first_place);
+    EXPECT_GT(neighbours.Of(3), 0.8);
+    EXPECT_TRUE(std::isnan(neighbours.Of(2))) << "place 2 is not place 1: no reference";
+    EXPECT_TRUE(std::isnan(neighbours.Of(4)));
+    EXPECT_EQ(neighbours.registered(), 4U);
+    const int expansions = expanded;
+    for (std::size_t i = 0; i < prepared.size(); ++i) neighbours.Of(i);
+    EXPECT_EQ(expanded, expansions) << "each pair is registered once";
+    EXPECT_EQ(neighbours.registered(), 4U);
+}
+
+TEST(NeighbourOverlaps, AScanWithoutItsNeighbourYetHasNoReferenceAndGetsOneLater) {
+    const DetectorConfig detector = Verifying(0.5);
+    const auto prepared = Prepared(TwoPlacesAndARevisit(), detector);
+    std::size_t stored = 1;
+    NeighbourOverlaps neighbours([&](std::size_t i) { return prepared.at(i).Expand(); },
+                                 [&] { return stored; }, detector.verification);
+    EXPECT_TRUE(std::isnan(neighbours.Of(0)));
+    EXPECT_EQ(neighbours.registered(), 0U);
+    stored = 2;
+    EXPECT_GT(neighbours.Of(0), 0.8);
+    // A skipped scan (empty) has none.
+    NeighbourOverlaps with_a_gap(
+        [&](std::size_t i) {
+            return i == 1 ? registration::PreparedScan{} : prepared.at(i).Expand();
+        },
+        [&] { return prepared.size(); }, detector.verification);
+    EXPECT_TRUE(std::isnan(with_a_gap.Of(1)));
+    EXPECT_TRUE(std::isnan(with_a_gap.Of(2)));
+}
+
+TEST(CheckAgainstNeighbours, RejectsLoopsFarBelowTheLowerReference) {
+    const std::vector<double> reference = {0.8, 0.9, kNan, 0.6};
+    std::atomic<std::size_t> rejected{0};
+    const LoopCheck check =
+        CheckAgainstNeighbours([&](std::size_t i) { return reference.at(i); }, 0.5, &rejected);
+    ASSERT_TRUE(check);
+    EXPECT_FALSE(check.may_close || check.view_distance_m || check.allowed_poses);
+    // Query 3 (reference 0.6): the lower reference of 3 and 0 is 0.6, so the bar is 0.3.
+    LoopQuery query = AcceptedQuery(3, {0, 1, 2}, {0.29, 0.31, 0.1});
+    check(query);
+    EXPECT_EQ(query.verifications[0].reason, RejectReason::kUnlikeNeighbours);
+    EXPECT_FALSE(query.verifications[0].accepted);
+    EXPECT_TRUE(query.verifications[1].accepted) << "0.31 >= 0.5 * min(0.6, 0.9)";
+    EXPECT_FALSE(query.verifications[2].accepted) << "scan 2 has none, query 3 judges: 0.1 < 0.3";
+    EXPECT_EQ(rejected, 2U);
+    ASSERT_TRUE(query.loop().has_value());
+    EXPECT_EQ(*query.loop(), 1U);
+    EXPECT_TRUE(query.accepted);
+    // Neither scan with a reference: nothing judges.
+    LoopQuery unknown = AcceptedQuery(2, {2}, {0.01});
+    check(unknown);
+    EXPECT_TRUE(unknown.verifications[0].accepted);
+    // Every loop rejected: the query has none.
+    LoopQuery lost = AcceptedQuery(1, {0}, {0.39});
+    check(lost);
+    EXPECT_FALSE(lost.accepted);
+    EXPECT_FALSE(lost.loop().has_value());
+}
+
+// A reference costs a registration: it is asked for only where it may decide.
+TEST(CheckAgainstNeighbours, AsksForAReferenceOnlyWhereItMayDecide) {
+    std::vector<std::size_t> asked;
+    const std::vector<double> reference = {0.9, 0.2, 0.9, 0.9};
+    const LoopCheck check = CheckAgainstNeighbours(
+        [&](std::size_t i) {
+            asked.push_back(i);
+            return reference.at(i);
+        },
+        0.5);
+    LoopQuery sure = AcceptedQuery(3, {0}, {0.5});
+    check(sure);
+    EXPECT_TRUE(sure.accepted);
+    EXPECT_TRUE(asked.empty()) << "0.5 >= 0.5 * any reference";
+    // Query 3's reference (0.9) alone rejects 0.44; the match's decides: scan 1's 0.2 keeps it.
+    LoopQuery kept = AcceptedQuery(3, {1}, {0.44});
+    check(kept);
+    EXPECT_TRUE(kept.accepted);
+    EXPECT_EQ(asked, (std::vector<std::size_t>{3, 1}));
+    // Query 2's own reference keeps 0.46: scan 0's is not needed.
+    asked.clear();
+    LoopQuery passes = AcceptedQuery(2, {0}, {0.46});
+    check(passes);
+    EXPECT_TRUE(passes.accepted);
+    EXPECT_EQ(asked, (std::vector<std::size_t>{2}));
+}
+
+TEST(CheckAgainstNeighbours, RatioZeroIsNoCheck) {
+    EXPECT_FALSE(CheckAgainstNeighbours([](std::size_t) { return 1.0; }, 0.0));
+    NeighbourOverlaps neighbours([](std::size_t) { return registration::PreparedScan{}; },
+                                 [] { return std::size_t{0}; }, {});
+    registration::VerificationConfig config;
+    config.acceptance.min_neighbour_overlap_ratio = 0.0;
+    EXPECT_FALSE(JudgeOf({}, neighbours, config));
+    config.acceptance.min_neighbour_overlap_ratio = 0.5;
+    EXPECT_TRUE(JudgeOf({}, neighbours, config));
+    // Where the odometry judges, it alone does.
+    LoopCheck odometry;
+    odometry.reject = [](LoopQuery& q) { q.accepted = false; };
+    const LoopCheck judge = JudgeOf(odometry, neighbours, config);
+    LoopQuery query = AcceptedQuery(1, {0}, {0.0});
+    judge(query);
+    EXPECT_TRUE(query.verifications[0].accepted) << "the odometry's check ran, not the neighbours'";
+}
+
+// The revisit of place 1 (scan 4 -> 0 or 1) overlaps about as much as scans 0 and 1 do: kept at
+// the default ratio, rejected where a loop must overlap more than its neighbours, online and
+// offline alike.
+TEST(NeighbourOverlaps, DetectorsJudgeLoopsAgainstTheNeighbours) {
+    const std::vector<core::PointCloud> scans = TwoPlacesAndARevisit();
+    for (const double ratio : {0.5, 1.5}) {
+        const DetectorConfig detector = Verifying(ratio);
+        core::DescriptorConfig config;
+        config.method = core::Method::kRange;
+        LoopDetector online(config, detector);
+        std::vector<LoopQuery> online_results;
+        std::vector<double> times;
+        for (std::size_t i = 0; i < scans.size(); ++i) {
+            times.push_back(static_cast<double>(i));
+            online_results.push_back(online.Process(scans[i], times.back()));
+        }
+        std::vector<LoopQuery> offline = DetectFromMatrix(
+            ComputeSimilarityMatrix(online.database()), times, detector, core::Method::kRange);
+        VerifyQueries(offline, Prepared(scans, detector), detector, core::Method::kRange,
+                      Execution::kSerial);
+        for (const LoopQuery* query : {&online_results[4], &offline[4]}) {
+            // Both candidates are place 1: the first registered is the loop, or both fail.
+            ASSERT_EQ(query->candidates.size(), 2U) << ratio;
+            const registration::Verification& first = query->verifications.front();
+            if (ratio < 1.0) {
+                EXPECT_TRUE(first.accepted) << ratio;
+                EXPECT_TRUE(query->accepted) << ratio;
+            } else {
+                for (const auto& verdict : query->verifications)
+                    EXPECT_EQ(verdict.reason, RejectReason::kUnlikeNeighbours) << ratio;
+                EXPECT_FALSE(query->accepted) << ratio;
+            }
+        }
+        EXPECT_EQ(online_results[4].accepted, offline[4].accepted) << ratio;
+    }
+}
+
+}  // namespace
+}  // namespace lidarloop::pipeline
