@@ -31,12 +31,7 @@ const std::string& CommandName();
 
 /// The RunInfo of this command line.
 inline app::RunInfo CommandRun(std::vector<std::filesystem::path> inputs, bool overwrite) {
-    app::RunInfo info;
-    info.command_line = CommandLine();
-    info.inputs = std::move(inputs);
-    info.overwrite = overwrite;
-    info.command = CommandName();
-    return info;
+    return app::CommandRunInfo(CommandName(), CommandLine(), std::move(inputs), overwrite);
 }
 
 /// app::RunInFolder for a command: `inputs` are the files and folders it reads, which `out` may

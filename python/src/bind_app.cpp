@@ -116,16 +116,14 @@ auto RunInFolder(const fs::path& out, std::vector<fs::path> inputs, bool overwri
                  const PythonProgress& progress, Run&& run) {
     try {
         py::gil_scoped_release release;
-        app::RunInfo info;
-        info.command_line = command_line;
-        info.inputs = std::move(inputs);
-        info.overwrite = overwrite;
-        info.command = command;
-        return app::RunInFolder(out, std::move(info), [&](const fs::path& staging) {
-            auto result = run(staging);
-            if (progress.Failed()) throw core::Error("the progress callback raised an exception");
-            return result;
-        });
+        return app::RunInFolder(
+            out, app::CommandRunInfo(command, command_line, std::move(inputs), overwrite),
+            [&](const fs::path& staging) {
+                auto result = run(staging);
+                if (progress.Failed())
+                    throw core::Error("the progress callback raised an exception");
+                return result;
+            });
     } catch (const core::Error&) {
         progress.Rethrow();  // the callback's own exception, when it raised one
         throw;

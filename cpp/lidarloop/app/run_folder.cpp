@@ -255,6 +255,16 @@ std::string ToString(RunStatus status) {
     return "failed";
 }
 
+RunInfo CommandRunInfo(std::string command, std::string command_line, std::vector<fs::path> inputs,
+                       bool overwrite) {
+    RunInfo info;
+    info.command_line = std::move(command_line);
+    info.inputs = std::move(inputs);
+    info.overwrite = overwrite;
+    info.command = std::move(command);
+    return info;
+}
+
 RunFolder::RunFolder(fs::path folder, RunInfo info)
     : folder_(std::move(folder)), info_(std::move(info)), started_(UtcNow()) {
     RefuseInputOverlap(folder_, info_.inputs);

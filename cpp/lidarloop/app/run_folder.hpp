@@ -34,6 +34,11 @@ struct RunInfo {
     std::string command = {};
 };
 
+/// The RunInfo of command `command` (detect, evaluate, ...) writing results, typed as
+/// `command_line`: what the CLI and the Python package both record.
+RunInfo CommandRunInfo(std::string command, std::string command_line,
+                       std::vector<std::filesystem::path> inputs, bool overwrite);
+
 /// The results-folder rule of every command that writes (docs/cli.md, "Results folders"):
 /// - a folder inside an input, or holding an input, is refused before anything is written;
 /// - a non-empty folder without a lidarloop run.json, or with one of the other kind (results

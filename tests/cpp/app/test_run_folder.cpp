@@ -36,6 +36,16 @@ std::vector<std::string> Entries(const fs::path& folder) {
     return names;
 }
 
+TEST(RunFolder, ACommandsRunInfoRecordsWhatItWasGiven) {
+    const RunInfo info = CommandRunInfo("detect", "lidarloop detect seq", {"seq", "odo.txt"}, true);
+    EXPECT_EQ(info.command, "detect");
+    EXPECT_EQ(info.command_line, "lidarloop detect seq");
+    EXPECT_EQ(info.inputs, (std::vector<fs::path>{"seq", "odo.txt"}));
+    EXPECT_TRUE(info.overwrite);
+    EXPECT_EQ(info.kind, io::RunKind::kResults);
+    EXPECT_FALSE(CommandRunInfo("map", "lidarloop map", {}, false).overwrite);
+}
+
 TEST(RunFolder, FilesAppearOnlyWhenTheRunCompletesAndRunJsonSaysSo) {
     test::TempDir dir;
     const fs::path out = dir / "results";
