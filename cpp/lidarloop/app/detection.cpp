@@ -309,6 +309,15 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
                 " registered candidates rejected: the odometry contradicts their pose beyond its "
                 "drift (reason odometry_mismatch in candidates.csv; the gate of posegraph.robust)");
         }
+        const std::size_t unlike =
+            CountRejected(outcome.queries, registration::RejectReason::kUnlikeNeighbours);
+        if (unlike > 0) {
+            outcome.notes.push_back(
+                std::to_string(unlike) +
+                " registered candidates rejected: they overlap far less than their scans do with "
+                "their neighbours, as a look-alike place does (reason unlike_neighbours in "
+                "candidates.csv; verification.acceptance.min_neighbour_overlap_ratio)");
+        }
     }
     const double verify_s = verify_clock.Seconds();
     outcome.accepted = CountAccepted(outcome.queries);

@@ -150,4 +150,13 @@ std::size_t CountAccepted(const std::vector<pipeline::LoopQuery>& queries) {
     return accepted;
 }
 
+std::size_t CountRejected(const std::vector<pipeline::LoopQuery>& queries,
+                          registration::RejectReason reason) {
+    std::size_t rejected = 0;
+    for (const auto& q : queries) {
+        for (const auto& v : q.verifications) rejected += v.reason == reason ? 1 : 0;
+    }
+    return rejected;
+}
+
 }  // namespace lidarloop::app

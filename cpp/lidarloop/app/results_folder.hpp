@@ -48,4 +48,8 @@ void WriteCandidatesCsv(const std::filesystem::path& file,
 /// Query scans with an accepted loop.
 std::size_t CountAccepted(const std::vector<pipeline::LoopQuery>& queries);
 
+/// Candidates of `queries` rejected for `reason`.
+std::size_t CountRejected(const std::vector<pipeline::LoopQuery>& queries,
+                          registration::RejectReason reason);
+
 }  // namespace lidarloop::app

@@ -46,6 +46,24 @@ TEST(RunFolder, ACommandsRunInfoRecordsWhatItWasGiven) {
     EXPECT_FALSE(CommandRunInfo("map", "lidarloop map", {}, false).overwrite);
 }
 
+TEST(ResultsFolder, CountsTheCandidatesRejectedForAReason) {
+    std::vector<pipeline::LoopQuery> queries(3);
+    const auto verdict = [](registration::RejectReason reason) {
+        registration::Verification v;
+        v.reason = reason;
+        v.accepted = reason == registration::RejectReason::kNone;
+        return v;
+    };
+    using R = registration::RejectReason;
+    queries[0].verifications = {verdict(R::kUnlikeNeighbours), verdict(R::kNone)};
+    queries[2].verifications = {verdict(R::kLowOverlap), verdict(R::kUnlikeNeighbours),
+                                verdict(R::kUnlikeNeighbours)};
+    EXPECT_EQ(CountRejected(queries, R::kUnlikeNeighbours), 3U);
+    EXPECT_EQ(CountRejected(queries, R::kLowOverlap), 1U);
+    EXPECT_EQ(CountRejected(queries, R::kOdometryMismatch), 0U);
+    EXPECT_EQ(CountRejected({}, R::kUnlikeNeighbours), 0U);
+}
+
 TEST(RunFolder, FilesAppearOnlyWhenTheRunCompletesAndRunJsonSaysSo) {
     test::TempDir dir;
     const fs::path out = dir / "results";
