@@ -375,6 +375,9 @@ TEST(Verification, InvalidConfigIsAConfigError) {
     expect_error([](auto& c) { c.icp.rival_step_factor = 4.5; });
     expect_error([](auto& c) { c.acceptance.overlap_confidence_z = -1.0; });
     expect_error([](auto& c) { c.acceptance.overlap_confidence_z = std::nan(""); });
+    expect_error([](auto& c) { c.acceptance.min_neighbour_overlap_ratio = -0.1; });
+    expect_error([](auto& c) { c.acceptance.min_neighbour_overlap_ratio = std::nan(""); });
+    expect_error([](auto& c) { c.acceptance.min_neighbour_overlap_ratio = 11.0; });
 }
 
 // Wilson's lower bound p solves (share - p)^2 = z^2 p (1 - p) / n below the share: checked on
