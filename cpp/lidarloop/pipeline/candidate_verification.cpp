@@ -222,7 +222,9 @@ VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
     const auto scan_of = [&](std::size_t i) { return expanded.Get(scans, i); };
     NeighbourOverlaps neighbours(
         scan_of, [&scans] { return scans.size(); }, detector.verification);
-    const LoopCheck judge = JudgeOf(check, neighbours, detector.verification);
+    const LoopCheck judge = JudgeOf(
+        check, [&neighbours](std::size_t scan) { return neighbours.Of(scan); },
+        detector.verification);
     std::vector<VerificationTimes> per_query(queries.size());
     ProgressCounter done(progress, queries.size());
     const auto run = [&](std::size_t i) {

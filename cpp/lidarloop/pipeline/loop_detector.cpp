@@ -470,10 +470,7 @@ void LoopDetector::Verify(LoopQuery& result, const registration::CompactPrepared
         }
         return *query_reference;
     };
-    const LoopCheck judge =
-        check ? check
-              : CheckAgainstNeighbours(
-                    reference_of, detector_.verification.acceptance.min_neighbour_overlap_ratio);
+    const LoopCheck judge = JudgeOf(check, reference_of, detector_.verification);
     VerifyQuery(
         result, query, [this](std::size_t j) { return expanded_.Get(scans_, j); }, detector_,
         database_.method(), nullptr, nullptr, Execution::kParallel, judge);

@@ -46,14 +46,13 @@ double NeighbourOverlaps::Of(std::size_t scan) {
     if (!computed_[later]) {
         computed_[later] = true;
         known_[later] = overlap;
-        ++registered_;
     }
     return known_[later];
 }
 
 std::size_t NeighbourOverlaps::registered() const {
     const std::lock_guard lock(mutex_);
-    return registered_;
+    return static_cast<std::size_t>(std::count(computed_.begin(), computed_.end(), true));
 }
 
 namespace {
@@ -74,12 +73,11 @@ bool UnlikeNeighbours(double distinctive_overlap, double min_ratio,
 
 }  // namespace
 
-LoopCheck CheckAgainstNeighbours(std::function<double(std::size_t)> reference_of, double min_ratio,
-                                 std::atomic<std::size_t>* rejected) {
+LoopCheck CheckAgainstNeighbours(std::function<double(std::size_t)> reference_of,
+                                 double min_ratio) {
     LoopCheck check;
     if (!(min_ratio > 0.0)) return check;
-    check.reject = [reference_of = std::move(reference_of), min_ratio, rejected](LoopQuery& query) {
-        std::size_t count = 0;
+    check.reject = [reference_of = std::move(reference_of), min_ratio](LoopQuery& query) {
         for (std::size_t c = 0; c < query.verifications.size(); ++c) {
             registration::Verification& verdict = query.verifications[c];
             if (!verdict.accepted) continue;
@@ -90,18 +88,16 @@ LoopCheck CheckAgainstNeighbours(std::function<double(std::size_t)> reference_of
                 continue;
             verdict.accepted = false;
             verdict.reason = registration::RejectReason::kUnlikeNeighbours;
-            ++count;
         }
         query.accepted = query.loop().has_value();
-        if (rejected != nullptr) *rejected += count;
     };
     return check;
 }
 
-LoopCheck JudgeOf(const LoopCheck& odometry, NeighbourOverlaps& neighbours,
+LoopCheck JudgeOf(const LoopCheck& odometry, std::function<double(std::size_t)> reference_of,
                   const registration::VerificationConfig& config) {
     if (odometry) return odometry;
-    return CheckAgainstNeighbours([&neighbours](std::size_t scan) { return neighbours.Of(scan); },
+    return CheckAgainstNeighbours(std::move(reference_of),
                                   config.acceptance.min_neighbour_overlap_ratio);
 }
 

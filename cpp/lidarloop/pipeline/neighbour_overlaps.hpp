@@ -1,6 +1,5 @@
 #pragma once
 
-#include <atomic>
 #include <cstddef>
 #include <functional>
 #include <mutex>
@@ -39,7 +38,7 @@ public:
                           const registration::PreparedScan& earlier,
                           const registration::VerificationConfig& config);
 
-    /// How many registrations Of has run (for timings and tests).
+    /// How many neighbour pairs Of has registered.
     std::size_t registered() const;
 
 private:
@@ -49,7 +48,6 @@ private:
     mutable std::mutex mutex_;
     std::vector<double> known_;  ///< by neighbour pair (its later scan); NaN where not computed
     std::vector<bool> computed_;
-    std::size_t registered_ = 0;
 };
 
 /// Rejects (RejectReason::kUnlikeNeighbours) each accepted verification of a query whose
@@ -57,16 +55,14 @@ private:
 /// their neighbours (`reference_of(scan)`, e.g. NeighbourOverlaps::Of; a scan whose reference is
 /// NaN does not judge), and chooses the query's loop again among the rest. Asks for a reference
 /// only where it may decide (a loop overlapping `min_ratio` or more never: a reference is at most
-/// 1; the match's only when the query's alone would reject). Empty when `min_ratio` is 0. Adds the
-/// rejections to `rejected` when given (thread-safe). The check rejects only: the candidates are
-/// searched, ordered and registered as without it.
-LoopCheck CheckAgainstNeighbours(std::function<double(std::size_t)> reference_of, double min_ratio,
-                                 std::atomic<std::size_t>* rejected = nullptr);
+/// 1; the match's only when the query's alone would reject). Empty when `min_ratio` is 0. The
+/// check rejects only: the candidates are searched, ordered and registered as without it.
+LoopCheck CheckAgainstNeighbours(std::function<double(std::size_t)> reference_of, double min_ratio);
 
 /// What judges a sequence's verified loops: `odometry` where given (non-empty), else, with no
-/// knowledge besides the scans, CheckAgainstNeighbours on `neighbours` at
-/// config.acceptance.min_neighbour_overlap_ratio. `neighbours` must outlive the check.
-LoopCheck JudgeOf(const LoopCheck& odometry, NeighbourOverlaps& neighbours,
+/// knowledge besides the scans, CheckAgainstNeighbours with `reference_of` (e.g.
+/// NeighbourOverlaps::Of) at config.acceptance.min_neighbour_overlap_ratio.
+LoopCheck JudgeOf(const LoopCheck& odometry, std::function<double(std::size_t)> reference_of,
                   const registration::VerificationConfig& config);
 
 }  // namespace lidarloop::pipeline
