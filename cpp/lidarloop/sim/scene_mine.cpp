@@ -60,8 +60,10 @@ void FillMineStreet(const StreetFrame& street, Random& rng, SceneBuilder& builde
                               street.length_m, 0.5, ceiling - 1.2, ceiling - 0.7);
         }
         if (rng.Bernoulli(0.3)) {  // an electrical cabinet
-            builder.RaisedBox(street.At(rng.Uniform(1.0, street.length_m - 1.0), side * 4.8),
-                              street.Yaw(), rng.Uniform(0.5, 1.0), 0.4, 0.9, 1.9);
+            // Drawn in GCC's order of the call's arguments (detail/random.hpp).
+            const double length = rng.Uniform(0.5, 1.0);
+            const double along = rng.Uniform(1.0, street.length_m - 1.0);
+            builder.RaisedBox(street.At(along, side * 4.8), street.Yaw(), length, 0.4, 0.9, 1.9);
         }
     }
     if (rng.Bernoulli(0.5)) {  // a lamp hanging from the roof, high above the vehicle

@@ -27,8 +27,11 @@ void Farm(const Rect& block, Random& rng, SceneBuilder& builder) {
     const Rect yard = RandomPatch(block.Inset(4.0), 45.0, 70.0, rng);
     const double yaw = rng.Uniform(-10.0, 10.0) * core::kRadiansPerDegree;
     const Rect house_area{yard.x0, yard.y0, yard.Center().x() - 4.0, yard.Center().y() - 4.0};
-    builder.StandingBox(house_area.Center(), yaw, rng.Uniform(10.0, 15.0), rng.Uniform(8.0, 11.0),
-                        rng.Uniform(6.0, 9.0));
+    // Drawn in GCC's order of the call's arguments (detail/random.hpp).
+    const double house_height = rng.Uniform(6.0, 9.0);
+    const double house_width = rng.Uniform(8.0, 11.0);
+    const double house_length = rng.Uniform(10.0, 15.0);
+    builder.StandingBox(house_area.Center(), yaw, house_length, house_width, house_height);
     const Rect barn_area{yard.Center().x() + 4.0, yard.y0, yard.x1, yard.Center().y() - 4.0};
     builder.StandingBox(barn_area.Center(), yaw, std::min(barn_area.Width() - 2.0, 24.0),
                         std::min(barn_area.Height() - 2.0, 14.0), rng.Uniform(6.0, 10.0));
@@ -41,11 +44,14 @@ void Farm(const Rect& block, Random& rng, SceneBuilder& builder) {
         builder.Cone(silo, radius + 0.2, height, rng.Uniform(1.5, 3.0));
     }
     for (int k = rng.UniformInt(1, 3); k > 0; --k) {
-        builder.Car(RandomPoint(back.Inset(3.0), rng), rng.Uniform(0.0, 2.0 * std::numbers::pi),
-                    rng);
+        // Drawn in GCC's order of the call's arguments (detail/random.hpp).
+        const double car_yaw = rng.Uniform(0.0, 2.0 * std::numbers::pi);
+        builder.Car(RandomPoint(back.Inset(3.0), rng), car_yaw, rng);
     }
     for (int k = rng.UniformInt(2, 6); k > 0; --k) {
-        builder.Tree(RandomPoint(yard, rng), rng, rng.Bernoulli(0.3), 3.5);
+        // Drawn in GCC's order of the call's arguments (detail/random.hpp).
+        const bool conifer = rng.Bernoulli(0.3);
+        builder.Tree(RandomPoint(yard, rng), rng, conifer, 3.5);
     }
 }
 
@@ -56,8 +62,11 @@ void Forest(const Rect& block, Random& rng, SceneBuilder& builder) {
     for (double y = patch.y0; y < patch.y1; y += spacing) {
         for (double x = patch.x0; x < patch.x1; x += spacing) {
             if (!rng.Bernoulli(0.8)) continue;
-            const Eigen::Vector2d at(std::clamp(x + rng.Uniform(-1.5, 1.5), patch.x0, patch.x1),
-                                     std::clamp(y + rng.Uniform(-1.5, 1.5), patch.y0, patch.y1));
+            // Drawn in GCC's order of the call's arguments (detail/random.hpp).
+            const double y_jitter = rng.Uniform(-1.5, 1.5);
+            const double x_jitter = rng.Uniform(-1.5, 1.5);
+            const Eigen::Vector2d at(std::clamp(x + x_jitter, patch.x0, patch.x1),
+                                     std::clamp(y + y_jitter, patch.y0, patch.y1));
             builder.Tree(at, rng, rng.Bernoulli(conifer_share), 3.0);
         }
     }
@@ -133,8 +142,10 @@ void FillRuralStreet(const StreetFrame& street, Random& rng, SceneBuilder& build
         if (rng.Bernoulli(0.4)) {  // a tree row along this side
             for (double along = rng.Uniform(2.0, 8.0); along < street.length_m;
                  along += rng.Uniform(9.0, 14.0)) {
-                builder.Tree(street.At(along, side * (11.5 + rng.Uniform(-0.5, 0.5))), rng,
-                             rng.Bernoulli(0.2), 3.5);
+                // Drawn in GCC's order of the call's arguments (detail/random.hpp).
+                const bool conifer = rng.Bernoulli(0.2);
+                const double offset = 11.5 + rng.Uniform(-0.5, 0.5);
+                builder.Tree(street.At(along, side * offset), rng, conifer, 3.5);
             }
         }
         if (rng.Bernoulli(0.3)) {

@@ -38,8 +38,8 @@ void LShapedBuilding(const Rect& f, double height, Random& rng, SceneBuilder& bu
 }
 
 void TurnedBuilding(const Rect& f, double height, Random& rng, SceneBuilder& builder) {
-    const double yaw =
-        (rng.Bernoulli(0.5) ? 1.0 : -1.0) * rng.Uniform(5.0, 20.0) * core::kRadiansPerDegree;
+    const double sign = rng.Bernoulli(0.5) ? 1.0 : -1.0;
+    const double yaw = sign * rng.Uniform(5.0, 20.0) * core::kRadiansPerDegree;
     double length = f.Width() * rng.Uniform(0.7, 0.95);
     double width = f.Height() * rng.Uniform(0.7, 0.95);
     const double c = std::cos(yaw);
@@ -82,10 +82,13 @@ void Lot(const Rect& lot, const Rect& block, Random& rng, SceneBuilder& builder)
     if (style < 0.5) {
         builder.StandingBox(f.Center(), 0.0, f.Width(), f.Height(), height);
         if (rng.Bernoulli(0.5)) {  // a stair house or air conditioning plant on the roof
-            const Eigen::Vector2d at(rng.Uniform(f.x0 + 3.0, f.x1 - 3.0),
-                                     rng.Uniform(f.y0 + 3.0, f.y1 - 3.0));
-            builder.RaisedBox(at, 0.0, rng.Uniform(2.0, 5.0), rng.Uniform(2.0, 5.0), height - 0.5,
-                              height + rng.Uniform(1.5, 3.5));
+            // Drawn in GCC's order of the call's arguments (detail/random.hpp).
+            const double y = rng.Uniform(f.y0 + 3.0, f.y1 - 3.0);
+            const double x = rng.Uniform(f.x0 + 3.0, f.x1 - 3.0);
+            const double top = height + rng.Uniform(1.5, 3.5);
+            const double width = rng.Uniform(2.0, 5.0);
+            const double length = rng.Uniform(2.0, 5.0);
+            builder.RaisedBox({x, y}, 0.0, length, width, height - 0.5, top);
         }
     } else if (style < 0.85) {
         LShapedBuilding(f, height, rng, builder);
@@ -136,16 +139,21 @@ void FillUrbanStreet(const StreetFrame& street, Random& rng, SceneBuilder& build
         for (double along = rng.Uniform(4.0, 10.0); along < street.length_m - 2.0;
              along += rng.Uniform(8.0, 14.0)) {
             if (!rng.Bernoulli(0.55)) continue;
-            builder.Tree(street.At(along, side * (kTreeOffset_m + rng.Uniform(-0.3, 0.3))), rng,
-                         rng.Bernoulli(0.1), 2.8);
+            // Drawn in GCC's order of the call's arguments (detail/random.hpp).
+            const bool conifer = rng.Bernoulli(0.1);
+            const double offset = kTreeOffset_m + rng.Uniform(-0.3, 0.3);
+            builder.Tree(street.At(along, side * offset), rng, conifer, 2.8);
         }
         if (rng.Bernoulli(0.5)) {
             Sign(street.At(rng.Uniform(1.0, 4.0), side * 9.3), street.Yaw(), rng, builder);
         }
         if (rng.Bernoulli(0.4)) {  // a bench or a rubbish bin
-            builder.StandingCylinder(
-                street.At(rng.Uniform(5.0, street.length_m - 5.0), side * rng.Uniform(10.0, 11.5)),
-                rng.Uniform(0.25, 0.4), rng.Uniform(0.8, 1.1));
+            // Drawn in GCC's order of the call's arguments (detail/random.hpp).
+            const double cylinder_height = rng.Uniform(0.8, 1.1);
+            const double radius = rng.Uniform(0.25, 0.4);
+            const double offset = rng.Uniform(10.0, 11.5);
+            const double along = rng.Uniform(5.0, street.length_m - 5.0);
+            builder.StandingCylinder(street.At(along, side * offset), radius, cylinder_height);
         }
     }
 }

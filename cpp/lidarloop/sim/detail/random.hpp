@@ -46,6 +46,10 @@ constexpr std::uint64_t StreamSeed(std::uint64_t seed, Stream stream,
 
 /// Sequential SplitMix64 generator with the few distributions the simulator needs. Its output
 /// depends only on the seed (no std:: distributions, whose algorithms differ between libraries).
+/// Draw once per statement: the order of a call's arguments is the compiler's (GCC right to left,
+/// clang left to right). Scenes that drew within one call now draw statement by statement in
+/// GCC's order, the one the recorded sequences were made with (test
+/// Simulator.ASeedGivesTheSameScansWhateverTheCompiler).
 class Random {
 public:
     explicit Random(std::uint64_t seed) : state_(seed) {}
