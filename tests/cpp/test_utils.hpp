@@ -35,7 +35,15 @@ inline constexpr double kDeg = std::numbers::pi / 180.0;  // radians per degree
 /// run-scale tests that register hundreds of scan pairs, a minute or more there and seconds in the
 /// release suite, which runs them. Lighter tests cover the same code under the sanitizers.
 /// kSanitizedBuild says which build this is, for a run-scale test that runs smaller there.
+/// GCC says ASan with __SANITIZE_ADDRESS__, clang (the dev preset's compiler) with __has_feature.
 #if defined(__SANITIZE_ADDRESS__)
+#define LIDARLOOP_TEST_ADDRESS_SANITIZER
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define LIDARLOOP_TEST_ADDRESS_SANITIZER
+#endif
+#endif
+#if defined(LIDARLOOP_TEST_ADDRESS_SANITIZER)
 #define LIDARLOOP_RELEASE_SUITE_ONLY() \
     GTEST_SKIP() << "run-scale: the release suite runs it (minutes under the sanitizers)"
 inline constexpr bool kSanitizedBuild = true;

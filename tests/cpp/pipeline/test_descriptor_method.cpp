@@ -77,7 +77,7 @@ TEST(DescriptorMethod, ANameIsRegisteredOnce) {
         ErrorOf([] { RegisterMethod(std::make_shared<HistogramMethod>(core::Method::kRange)); });
     EXPECT_NE(message.find("'range' is already registered"), std::string::npos) << message;
     EXPECT_THROW(RegisterMethod(nullptr), core::ConfigError);
-    EXPECT_THROW(HistogramMethod(core::Method::kNdt), core::ConfigError);
+    EXPECT_THROW(HistogramMethod{core::Method::kNdt}, core::ConfigError);
 }
 
 TEST(DescriptorMethod, DescriptorsOfTwoMethodsAreNotCompared) {

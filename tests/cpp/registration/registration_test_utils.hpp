@@ -51,8 +51,11 @@ inline core::PointCloud SyntheticPlace(std::uint64_t seed = 1, double step_m = 0
     std::normal_distribution<double> noise(0.0, 0.01);
     core::PointCloud cloud;
     const auto add = [&](double x, double y, double z) {
-        cloud.emplace_back(static_cast<float>(x + noise(rng)), static_cast<float>(y + noise(rng)),
-                           static_cast<float>(z + noise(rng)));
+        // One draw per statement, z first: the order of a call's arguments is the compiler's.
+        const double z_noise = noise(rng);
+        const double y_noise = noise(rng);
+        cloud.emplace_back(static_cast<float>(x + noise(rng)), static_cast<float>(y + y_noise),
+                           static_cast<float>(z + z_noise));
     };
     for (double x = -30; x <= 30; x += 2 * step_m)
         for (double y = -12; y <= 12; y += 2 * step_m) add(x, y, -1.7);
