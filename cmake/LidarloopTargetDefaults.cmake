@@ -22,8 +22,8 @@ function(lidarloop_target_defaults target)
 endfunction()
 
 # lidarloop_fuzz_coverage(<target>): libFuzzer's coverage in the target (LIDARLOOP_BUILD_FUZZERS,
-# clang): the readers (lidarloop::io) and the harnesses only. The code they call is checked by the
-# sanitizers but not coverage-guided, so that the tests of the same build keep sanitizer speed.
+# clang): the fuzzers' copy of the readers (lidarloop_io_fuzz) and the harnesses only. The code
+# they call is checked by the sanitizers but not coverage-guided: the tests keep sanitizer speed.
 function(lidarloop_fuzz_coverage target)
     if(LIDARLOOP_BUILD_FUZZERS)
         target_compile_options(${target} PRIVATE -fsanitize=fuzzer-no-link)
