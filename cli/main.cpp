@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "lidarloop/app/heap_reuse.hpp"
 #include "lidarloop/core/error.hpp"
 #include "run_output.hpp"
 
@@ -40,6 +41,7 @@ void RefuseNegativeUnsigned(CLI::App& app) {
 
 int main(int argc, char** argv) {
     lidarloop::cli::InstallInterruptHandler(argc, argv);  // first: before any other thread
+    lidarloop::app::KeepFreedMemoryForReuse();            // before any scan is read
     CLI::App app{"lidarloop: loop closure detection in sequences of 3-D LiDAR scans"};
     app.set_version_flag("--version", std::string("lidarloop ") + LIDARLOOP_VERSION);
     app.require_subcommand(1);

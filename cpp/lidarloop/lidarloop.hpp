@@ -130,6 +130,7 @@
 #include "lidarloop/app/detection.hpp"
 #include "lidarloop/app/evaluation.hpp"
 #include "lidarloop/app/evaluation_report.hpp"
+#include "lidarloop/app/heap_reuse.hpp"
 #include "lidarloop/app/map_building.hpp"
 #include "lidarloop/app/metrics_json.hpp"
 #include "lidarloop/app/optimisation.hpp"
