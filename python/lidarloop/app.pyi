@@ -277,6 +277,11 @@ def write_map(
     Returns out, points, voxel_m, scans, input_points, notes, total_s.
     """
 
+def keep_freed_memory_for_reuse() -> bool:
+    """What the lidarloop tool does first: glibc keeps up to 64 MiB of freed memory for the next
+    scan (a dense scan's pages are not faulted in again). For the whole process; True when the
+    allocator took the settings."""
+
 def run_options(command: str) -> list[dict[str, str]]:
     """The run options of detect, evaluate, optimise or bench as declared once: 'keyword',
     'flag', 'value_name', 'type', 'help', 'sets', 'default'."""
@@ -289,6 +294,7 @@ __all__ = [
     "build_map",
     "detect",
     "evaluate",
+    "keep_freed_memory_for_reuse",
     "optimise",
     "write_map",
     "run_options",

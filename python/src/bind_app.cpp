@@ -17,6 +17,7 @@
 #include "conversions.hpp"
 #include "lidarloop/app/detection.hpp"
 #include "lidarloop/app/evaluation.hpp"
+#include "lidarloop/app/heap_reuse.hpp"
 #include "lidarloop/app/map_building.hpp"
 #include "lidarloop/app/metrics_json.hpp"
 #include "lidarloop/app/optimisation.hpp"
@@ -708,6 +709,11 @@ void BindApp(py::module_& m) {
     BindEvaluate(m);
     BindOptimise(m);
     BindMap(m);
+    m.def("keep_freed_memory_for_reuse", &app::KeepFreedMemoryForReuse,
+          "What the lidarloop tool does first (app::KeepFreedMemoryForReuse): glibc's allocator "
+          "keeps up to 64 MiB of freed memory for the next scan instead of faulting a dense "
+          "scan's megabytes in again (reading a 120k-point scan 0.6 ms instead of 11). For the "
+          "whole process, so not done on import; True when the allocator took the settings.");
 }
 
 }  // namespace lidarloop::python

@@ -380,3 +380,8 @@ def test_odometry_in_kittis_camera_frame_is_converted_as_the_cli(cli, sequence, 
         tum.write_text("".join(f"{i} 0 0 0 0 0 0 1\n" for i in range(len(lidar))))
         lidarloop.detect(sequence, out=tmp_path / "tum", verify=False, odometry=tum,
                          odometry_calib=calib)
+
+
+def test_keep_freed_memory_for_reuse_is_taken_by_glibc():
+    # What the CLI does first; opt-in for a Python process (docs/python.md).
+    assert lidarloop.keep_freed_memory_for_reuse() is True
