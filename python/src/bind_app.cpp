@@ -712,7 +712,7 @@ void BindApp(py::module_& m) {
     m.def("keep_freed_memory_for_reuse", &app::KeepFreedMemoryForReuse,
           "What the lidarloop tool does first (app::KeepFreedMemoryForReuse): glibc's allocator "
           "keeps up to 64 MiB of freed memory for the next scan instead of faulting a dense "
-          "scan's megabytes in again (reading a 120k-point scan 0.6 ms instead of 11). For the "
+          "scan's megabytes in again (reading a 115k-point scan 0.6 ms instead of 11). For the "
           "whole process, so not done on import; True when the allocator took the settings.");
 }
 
