@@ -159,6 +159,10 @@ void VisitFields(registration::IcpConfig& c, Visitor& v) {
     v.Field("convergence_step", c.convergence_step, "a stage ends below this step (m + rad)");
     v.Field("max_structure_points", c.max_structure_points, "query structure points paired");
     v.Field("max_ground_points", c.max_ground_points, "query ground points paired");
+    v.Field("first_stage_structure_points", c.first_stage_structure_points,
+            "query structure points the first stage pairs");
+    v.Field("first_stage_ground_points", c.first_stage_ground_points,
+            "query ground points the first stage pairs");
     v.Field("abandon_below_overlap", c.abandon_below_overlap,
             "a pose overlapping less after the first stage is abandoned");
     v.Field("aligned_step_factor", c.aligned_step_factor,

@@ -66,9 +66,18 @@ core::Transform Increment(const Vector6d& step) {
     return increment;
 }
 
-// Each paired query point's partner in the last iteration, structure and ground.
+// Each paired query point's partner in the last iteration, structure and ground, and the caps
+// of the subsample they belong to: a stage that pairs another subsample starts without hints.
 struct Partners {
     std::vector<std::int64_t> structure, ground;
+    int structure_cap = 0, ground_cap = 0;
+
+    void Follow(int new_structure_cap, int new_ground_cap) {
+        if (new_structure_cap != structure_cap) structure.clear();
+        if (new_ground_cap != ground_cap) ground.clear();
+        structure_cap = new_structure_cap;
+        ground_cap = new_ground_cap;
+    }
 };
 
 // How far to move along `step` when it points within 37 degrees of the previous step (zero at a
@@ -85,22 +94,25 @@ double StepFactor(const Vector6d& step, const Vector6d& previous, const IcpConfi
                        : config.aligned_step_factor;
 }
 
-// One stage at a fixed correspondence distance; returns true when it settled.
+// One stage at a fixed correspondence distance, pairing at most the given query points; returns
+// true when it settled.
 bool RunStage(const PreparedScan& query, const PreparedScan& match, float max_distance_m,
-              const IcpConfig& config, Partners& partners, IcpResult& result) {
+              int structure_cap, int ground_cap, const IcpConfig& config, Partners& partners,
+              IcpResult& result) {
+    partners.Follow(structure_cap, ground_cap);
     Vector6d previous = Vector6d::Zero();
     for (int iteration = 0; iteration < config.max_iterations_per_stage; ++iteration) {
         NormalEquations equations;
         const Eigen::Isometry3f T = result.T_match_query.cast<float>();
         const auto inlier_m = static_cast<float>(config.final_correspondence_m);
-        Accumulate(*query.structure, *match.structure, T, max_distance_m,
-                   config.max_structure_points, inlier_m, partners.structure, equations);
+        Accumulate(*query.structure, *match.structure, T, max_distance_m, structure_cap, inlier_m,
+                   partners.structure, equations);
         result.structure_inliers =
             equations.paired == 0
                 ? 0.0
                 : static_cast<double>(equations.inliers) / static_cast<double>(equations.paired);
-        Accumulate(*query.ground, *match.ground, T, max_distance_m, config.max_ground_points,
-                   inlier_m, partners.ground, equations);
+        Accumulate(*query.ground, *match.ground, T, max_distance_m, ground_cap, inlier_m,
+                   partners.ground, equations);
         ++result.iterations;
         result.correspondences = equations.count;
         if (equations.count < 6) return false;
@@ -124,11 +136,19 @@ IcpResult RefinePointToPlane(const PreparedScan& query, const PreparedScan& matc
     double distance_m = config.initial_correspondence_m;
     Partners partners;
     while (true) {
-        result.converged =
-            RunStage(query, match, static_cast<float>(distance_m), config, partners, result);
+        const bool first = distance_m == config.initial_correspondence_m;
+        // Thinned only when finer stages follow, which pair every point.
+        const bool thinned = first && distance_m > config.final_correspondence_m;
+        const int structure_cap =
+            thinned ? std::min(config.first_stage_structure_points, config.max_structure_points)
+                    : config.max_structure_points;
+        const int ground_cap =
+            thinned ? std::min(config.first_stage_ground_points, config.max_ground_points)
+                    : config.max_ground_points;
+        result.converged = RunStage(query, match, static_cast<float>(distance_m), structure_cap,
+                                    ground_cap, config, partners, result);
         if (distance_m <= config.final_correspondence_m) break;
-        if (distance_m == config.initial_correspondence_m && keep_going &&
-            !keep_going(result.T_match_query)) {
+        if (first && keep_going && !keep_going(result.T_match_query)) {
             result.abandoned = true;
             result.converged = false;
             break;

@@ -297,6 +297,10 @@ bool HasRivalPose(const PreparedScan& query, const PreparedScan& match,
                   const PoseAllowed& allowed) {
     IcpConfig toward_rival = config.icp;
     toward_rival.aligned_step_factor = config.icp.rival_step_factor;
+    // Every point from the start: with the thinner first stage and its longer steps, the other
+    // peaks of four true Livox pairs settled at poses that passed for rivals.
+    toward_rival.first_stage_structure_points = config.icp.max_structure_points;
+    toward_rival.first_stage_ground_points = config.icp.max_ground_points;
     for (std::size_t j = 0; j < hypotheses.size(); ++j) {
         if (j == accepted_index) continue;
         const IcpResult icp = Refine(query, match, PlanarPose(hypotheses[j]), config, toward_rival,

@@ -121,6 +121,31 @@ TEST_F(KittiSamples, DifferentPlacesAreRejected) {
     }
 }
 
+// ICP's thinner first stage (IcpConfig::first_stage_*_points) against the slow path it replaced,
+// every point in every stage: the same decision on every pair, loops and different places, and
+// an accepted pose within a centimetre and 0.05 degrees.
+TEST_F(KittiSamples, TheThinnedFirstStageDecidesAsEveryPointDoes) {
+    VerificationConfig every_point;
+    every_point.icp.first_stage_structure_points = every_point.icp.max_structure_points;
+    every_point.icp.first_stage_ground_points = every_point.icp.max_ground_points;
+    for (const Pair& pair :
+         {Pair{"08", 209, 1684}, Pair{"08", 720, 1500}, Pair{"00", 94, 95}, Pair{"00", 198, 199},
+          Pair{"00", 94, 198}, Pair{"08", 209, 720}, Pair{"08", 1684, 1500}}) {
+        SCOPED_TRACE(pair.sequence + " " + std::to_string(pair.match) + " <- " +
+                     std::to_string(pair.query));
+        const core::PointCloud query = Scan(pair.sequence, pair.query);
+        const core::PointCloud match = Scan(pair.sequence, pair.match);
+        const Verification fast = VerifyPair(query, match, VerificationConfig{});
+        const Verification slow = VerifyPair(query, match, every_point);
+        EXPECT_EQ(fast.accepted, slow.accepted)
+            << ToString(fast.reason) << " / " << ToString(slow.reason);
+        if (!fast.accepted || !slow.accepted) continue;
+        const core::Transform difference = fast.T_match_query.inverse() * slow.T_match_query;
+        EXPECT_LT(difference.translation().norm(), 0.01);
+        EXPECT_LT(Eigen::AngleAxisd(difference.linear()).angle() * 180.0 / M_PI, 0.05);
+    }
+}
+
 // Every `stride`-th point: a 120k-point HDL-64E scan thinned towards a sparse sensor's density.
 core::PointCloud Thinned(const core::PointCloud& scan, std::size_t stride) {
     core::PointCloud thin;

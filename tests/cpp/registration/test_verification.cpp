@@ -1,5 +1,6 @@
 // Verification against known answers: synthetic places moved by known transforms, a corridor,
 // bad input, and simulated scans with exact ground truth.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -10,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/registration/icp.hpp"
 #include "lidarloop/registration/verification.hpp"
 #include "lidarloop/sim/simulator.hpp"
 #include "registration_test_utils.hpp"
@@ -101,6 +103,38 @@ struct PosesAroundTheTruth {
         }
     }
 };
+
+// ICP's first stage pairs first_stage_*_points of the query's points when finer stages follow
+// (abandoned after it, its last iteration's pairs are the first stage's), every point otherwise,
+// and a pose 2 m and 8 degrees off comes to the truth either way.
+TEST(Verification, OnlyAFirstStageThatFinerStagesFollowIsThinned) {
+    const PosesAroundTheTruth around(3);
+    const core::Transform truth = test::PlanarTransform(3.0, -1.0, 12.0);
+    const std::size_t every_point = std::min<std::size_t>(around.query.structure->size(), 600) +
+                                    std::min<std::size_t>(around.query.ground->size(), 200);
+    ASSERT_GT(every_point, 700u);
+    const auto never = [](const core::Transform&) { return false; };
+    IcpConfig icp = around.config.icp;
+    const IcpResult thinned = RefinePointToPlane(around.query, around.match, truth, icp, never);
+    EXPECT_TRUE(thinned.abandoned);
+    EXPECT_LE(thinned.correspondences, 300u);
+    EXPECT_GT(thinned.correspondences, 250u);
+    icp.first_stage_structure_points = icp.max_structure_points;
+    icp.first_stage_ground_points = icp.max_ground_points;
+    const IcpResult full = RefinePointToPlane(around.query, around.match, truth, icp, never);
+    EXPECT_GT(full.correspondences, 700u);
+    IcpConfig one_stage = around.config.icp;
+    one_stage.final_correspondence_m = one_stage.initial_correspondence_m;
+    EXPECT_GT(RefinePointToPlane(around.query, around.match, truth, one_stage).correspondences,
+              700u);
+    const core::Transform start = test::PlanarTransform(1.5, 1.3, 8.0) * truth;
+    for (const IcpConfig& config : {around.config.icp, icp}) {
+        const IcpResult refined = RefinePointToPlane(around.query, around.match, start, config);
+        EXPECT_TRUE(refined.converged);
+        EXPECT_LT((refined.T_match_query.translation() - truth.translation()).norm(), 0.05);
+        EXPECT_LT(RotationErrorDeg(refined.T_match_query, truth), 0.2);
+    }
+}
 
 // The cheap check that abandons a hypothesis decides as the full measure does, at poses from
 // right to far off and at thresholds around the overlaps they reach.
@@ -373,6 +407,8 @@ TEST(Verification, InvalidConfigIsAConfigError) {
     expect_error([](auto& c) { c.icp.aligned_step_factor = 0.5; });
     expect_error([](auto& c) { c.icp.aligned_step_factor = std::nan(""); });
     expect_error([](auto& c) { c.icp.rival_step_factor = 4.5; });
+    expect_error([](auto& c) { c.icp.first_stage_structure_points = 0; });
+    expect_error([](auto& c) { c.icp.first_stage_ground_points = -5; });
     expect_error([](auto& c) { c.acceptance.overlap_confidence_z = -1.0; });
     expect_error([](auto& c) { c.acceptance.overlap_confidence_z = std::nan(""); });
     expect_error([](auto& c) { c.acceptance.min_neighbour_overlap_ratio = -0.1; });
@@ -481,28 +517,51 @@ TEST(Verification, ReasonsHaveStableNames) {
 // Simulated scans: exact ground truth, real ray casting (occlusion, beam pattern, noise).
 class SimulatedRevisit : public ::testing::TestWithParam<sim::SensorModel> {};
 
-TEST_P(SimulatedRevisit, OppositeDirectionRevisitHasTheTruePose) {
+// An urban U-turn of 200 scans, 900 steps a revolution.
+sim::SimulationConfig UTurn(sim::SensorModel sensor) {
     sim::SimulationConfig config;
     config.scene = sim::SceneType::kUrban;
     config.route.type = sim::RouteType::kUTurn;
-    config.sensor.model = GetParam();
+    config.sensor.model = sensor;
     config.sensor.horizontal_steps = 900;
     config.scans = 200;
-    const sim::Simulator simulator(config);
-    // The first scan revisited in the opposite direction, with its nearest earlier scan.
-    std::size_t query = 0, match = 0;
-    for (std::size_t i = 60; i < simulator.size() && query == 0; ++i) {
+    return config;
+}
+
+// The first scan revisited in the opposite direction and its nearest earlier scan (query, match);
+// (0, 0) when the route has none.
+std::pair<std::size_t, std::size_t> FirstOppositeRevisit(const sim::Simulator& simulator) {
+    for (std::size_t i = 60; i < simulator.size(); ++i) {
         const core::Transform Ti = simulator.GroundTruthPose(i).T_world_sensor;
         for (std::size_t j = 0; j + 30 < i; ++j) {
             const core::Transform Tj = simulator.GroundTruthPose(j).T_world_sensor;
             const bool opposite = Ti.linear().col(0).dot(Tj.linear().col(0)) < -0.9;
-            if (opposite && (Ti.translation() - Tj.translation()).norm() < 5.0) {
-                query = i;
-                match = j;
-                break;
-            }
+            if (opposite && (Ti.translation() - Tj.translation()).norm() < 5.0) return {i, j};
         }
     }
+    return {0, 0};
+}
+
+// The revisit, and its query against the first earlier scan more than 40 m from it.
+std::vector<std::pair<std::size_t, std::size_t>> RevisitAndElsewhere(
+    const sim::Simulator& simulator) {
+    const auto [query, match] = FirstOppositeRevisit(simulator);
+    std::vector<std::pair<std::size_t, std::size_t>> pairs{{query, match}};
+    const Eigen::Vector3d at = simulator.GroundTruthPose(query).T_world_sensor.translation();
+    for (std::size_t j = 0; j + 30 < query; ++j) {
+        const auto distance_m =
+            (simulator.GroundTruthPose(j).T_world_sensor.translation() - at).norm();
+        if (distance_m > 40.0) {
+            pairs.emplace_back(query, j);
+            break;
+        }
+    }
+    return pairs;
+}
+
+TEST_P(SimulatedRevisit, OppositeDirectionRevisitHasTheTruePose) {
+    const sim::Simulator simulator(UTurn(GetParam()));
+    const auto [query, match] = FirstOppositeRevisit(simulator);
     ASSERT_NE(query, 0u) << "no opposite-direction revisit in the simulated route";
     const core::Transform truth = simulator.GroundTruthPose(match).T_world_sensor.inverse() *
                                   simulator.GroundTruthPose(query).T_world_sensor;
@@ -512,6 +571,32 @@ TEST_P(SimulatedRevisit, OppositeDirectionRevisitHasTheTruePose) {
     EXPECT_LT((v.T_match_query.translation() - truth.translation()).norm(), 0.1);
     EXPECT_LT(RotationErrorDeg(v.T_match_query, truth), 0.5);
     EXPECT_LT(YawErrorDeg(v.T_match_query, truth), 0.5);
+}
+
+// ICP's thinner first stage against every point in every stage (the slow path it replaced), on
+// the revisit and on the same query against a scan 40 m along the route: the same decisions, and
+// the accepted pose within a centimetre and 0.05 degrees.
+TEST_P(SimulatedRevisit, TheThinnedFirstStageDecidesAsEveryPointDoes) {
+    const sim::Simulator simulator(UTurn(GetParam()));
+    VerificationConfig every_point;
+    every_point.icp.first_stage_structure_points = every_point.icp.max_structure_points;
+    every_point.icp.first_stage_ground_points = every_point.icp.max_ground_points;
+    int accepted = 0;
+    for (const auto& [query, match] : RevisitAndElsewhere(simulator)) {
+        SCOPED_TRACE(std::to_string(match) + " <- " + std::to_string(query));
+        const Verification fast =
+            VerifyPair(simulator.Scan(query), simulator.Scan(match), VerificationConfig{});
+        const Verification slow =
+            VerifyPair(simulator.Scan(query), simulator.Scan(match), every_point);
+        EXPECT_EQ(fast.accepted, slow.accepted)
+            << ToString(fast.reason) << " / " << ToString(slow.reason);
+        if (!fast.accepted || !slow.accepted) continue;
+        ++accepted;
+        const core::Transform difference = fast.T_match_query.inverse() * slow.T_match_query;
+        EXPECT_LT(difference.translation().norm(), 0.01);
+        EXPECT_LT(RotationErrorDeg(fast.T_match_query, slow.T_match_query), 0.05);
+    }
+    EXPECT_GE(accepted, 1);  // the revisit
 }
 
 INSTANTIATE_TEST_SUITE_P(Sensors, SimulatedRevisit,
