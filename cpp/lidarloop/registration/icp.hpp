@@ -24,8 +24,8 @@ struct IcpResult {
 /// Point-to-plane ICP of the query onto the match, from `T_initial` (T_match_query), with the
 /// correspondence distance shrinking stage by stage (coarse to fine). Structure points pair only
 /// with structure points, ground with ground; residuals are distances to the match's planes,
-/// weighted robustly. The first stage pairs IcpConfig::first_stage_*_points of the query's points
-/// when finer stages follow, those all of max_*_points. After the first stage,
+/// weighted robustly. When finer stages follow, the first stage pairs at most IcpConfig::
+/// first_stage_*_points of the query's points and the others max_*_points. After the first stage,
 /// `keep_going(T_match_query)` (when given) decides whether the later stages run; when it says no,
 /// the result is abandoned. Thread-safe.
 IcpResult RefinePointToPlane(const PreparedScan& query, const PreparedScan& match,
