@@ -66,18 +66,9 @@ core::Transform Increment(const Vector6d& step) {
     return increment;
 }
 
-// Each paired query point's partner in the last iteration, structure and ground, and the caps
-// of the subsample they belong to: a stage that pairs another subsample starts without hints.
+// Each paired query point's partner in the last iteration, structure and ground.
 struct Partners {
     std::vector<std::int64_t> structure, ground;
-    int structure_cap = 0, ground_cap = 0;
-
-    void Follow(int new_structure_cap, int new_ground_cap) {
-        if (new_structure_cap != structure_cap) structure.clear();
-        if (new_ground_cap != ground_cap) ground.clear();
-        structure_cap = new_structure_cap;
-        ground_cap = new_ground_cap;
-    }
 };
 
 // How far to move along `step` when it points within 37 degrees of the previous step (zero at a
@@ -99,7 +90,6 @@ double StepFactor(const Vector6d& step, const Vector6d& previous, const IcpConfi
 bool RunStage(const PreparedScan& query, const PreparedScan& match, float max_distance_m,
               int structure_cap, int ground_cap, const IcpConfig& config, Partners& partners,
               IcpResult& result) {
-    partners.Follow(structure_cap, ground_cap);
     Vector6d previous = Vector6d::Zero();
     for (int iteration = 0; iteration < config.max_iterations_per_stage; ++iteration) {
         NormalEquations equations;
@@ -147,6 +137,9 @@ IcpResult RefinePointToPlane(const PreparedScan& query, const PreparedScan& matc
                     : config.max_ground_points;
         result.converged = RunStage(query, match, static_cast<float>(distance_m), structure_cap,
                                     ground_cap, config, partners, result);
+        // The later stages pair every point, another subsample: their hints start afresh.
+        if (structure_cap != config.max_structure_points) partners.structure.clear();
+        if (ground_cap != config.max_ground_points) partners.ground.clear();
         if (distance_m <= config.final_correspondence_m) break;
         if (first && keep_going && !keep_going(result.T_match_query)) {
             result.abandoned = true;

@@ -27,6 +27,15 @@ inline std::vector<Eigen::Vector3f> VoxelCentroids(
     return centroids;
 }
 
+/// The defaults, but ICP's first stage pairs every point as the later ones do: the slow path that
+/// the thinned first stage replaced (IcpConfig::first_stage_structure_points).
+inline registration::VerificationConfig EveryPointInEveryStage() {
+    registration::VerificationConfig config;
+    config.icp.first_stage_structure_points = config.icp.max_structure_points;
+    config.icp.first_stage_ground_points = config.icp.max_ground_points;
+    return config;
+}
+
 /// T_match_query = Translation(x, y, z) * Rz(yaw_deg).
 inline core::Transform PlanarTransform(double x_m, double y_m, double yaw_deg, double z_m = 0.0) {
     core::Transform T = core::Transform::Identity();

@@ -125,9 +125,7 @@ TEST_F(KittiSamples, DifferentPlacesAreRejected) {
 // every point in every stage: the same decision on every pair, loops and different places, and
 // an accepted pose within a centimetre and 0.05 degrees.
 TEST_F(KittiSamples, TheThinnedFirstStageDecidesAsEveryPointDoes) {
-    VerificationConfig every_point;
-    every_point.icp.first_stage_structure_points = every_point.icp.max_structure_points;
-    every_point.icp.first_stage_ground_points = every_point.icp.max_ground_points;
+    const VerificationConfig every_point = test::EveryPointInEveryStage();
     for (const Pair& pair :
          {Pair{"08", 209, 1684}, Pair{"08", 720, 1500}, Pair{"00", 94, 95}, Pair{"00", 198, 199},
           Pair{"00", 94, 198}, Pair{"08", 209, 720}, Pair{"08", 1684, 1500}}) {

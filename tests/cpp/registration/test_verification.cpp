@@ -119,8 +119,7 @@ TEST(Verification, OnlyAFirstStageThatFinerStagesFollowIsThinned) {
     EXPECT_TRUE(thinned.abandoned);
     EXPECT_LE(thinned.correspondences, 300u);
     EXPECT_GT(thinned.correspondences, 250u);
-    icp.first_stage_structure_points = icp.max_structure_points;
-    icp.first_stage_ground_points = icp.max_ground_points;
+    icp = test::EveryPointInEveryStage().icp;
     const IcpResult full = RefinePointToPlane(around.query, around.match, truth, icp, never);
     EXPECT_GT(full.correspondences, 700u);
     IcpConfig one_stage = around.config.icp;
@@ -578,9 +577,7 @@ TEST_P(SimulatedRevisit, OppositeDirectionRevisitHasTheTruePose) {
 // the accepted pose within a centimetre and 0.05 degrees.
 TEST_P(SimulatedRevisit, TheThinnedFirstStageDecidesAsEveryPointDoes) {
     const sim::Simulator simulator(UTurn(GetParam()));
-    VerificationConfig every_point;
-    every_point.icp.first_stage_structure_points = every_point.icp.max_structure_points;
-    every_point.icp.first_stage_ground_points = every_point.icp.max_ground_points;
+    const VerificationConfig every_point = test::EveryPointInEveryStage();
     const auto pairs = RevisitAndElsewhere(simulator);
     ASSERT_NE(pairs.front().first, 0u) << "no opposite-direction revisit in the simulated route";
     ASSERT_EQ(pairs.size(), 2u);
