@@ -54,6 +54,13 @@ double Correlation(const std::vector<float>& plane, std::size_t cell) {
     return static_cast<double>(static_cast<std::int64_t>(2.0F * plane[cell] + 0.5F)) / 2.0;
 }
 
+// A plane value below this cannot round (Correlation) above `score`, a multiple of 0.5: the
+// peak search skips most cells by one float comparison. Rounding gives more than `score` from
+// `score` + 0.25 on; the margin covers the float arithmetic of Correlation and of this bound.
+float SkipBelow(double score) {
+    return static_cast<float>(score + 0.25 - (0.01 + 1e-6 * std::abs(score)));
+}
+
 // The peak at `cell` of one correlation plane, refined to sub-cell precision.
 PlanarHypothesis PeakAt(const std::vector<float>& plane, std::uint32_t cell,
                         const CoarseQuery& query, double yaw_rad) {
@@ -69,6 +76,9 @@ PlanarHypothesis PeakAt(const std::vector<float>& plane, std::uint32_t cell,
             score};
 }
 
+// Peaks of one correlation plane at most this many cells apart are one (detail::PeakCells).
+constexpr int kPeakSeparationCells = 3;
+
 // Cells apart on the wrapped correlation grid (the larger of the two axis distances).
 int CellDistance(std::uint32_t a, std::uint32_t b, int n) {
     const int dx = std::abs(Signed((static_cast<int>(a % n) - static_cast<int>(b % n) + n) % n, n));
@@ -76,30 +86,11 @@ int CellDistance(std::uint32_t a, std::uint32_t b, int n) {
     return std::max(dx, dy);
 }
 
-// The best translations of one correlation grid over the searched cells: the highest cell, then
-// the highest more than kPeakSeparationCells from every one taken, up to `count`. In a place
-// that repeats (a row of identical rooms, a colonnade) one yaw has several peaks; the ambiguity
-// test needs them all.
-constexpr int kPeakSeparationCells = 3;
-
 void AddPeaks(const std::vector<float>& plane, const CoarseQuery& query, double yaw_rad, int count,
               std::vector<PlanarHypothesis>& peaks) {
-    const int n = query.config().grid_cells;
-    std::vector<std::uint32_t> taken;
-    for (int k = 0; k < count; ++k) {
-        double best_score = 0.0;
-        std::optional<std::uint32_t> best;
-        for (const std::uint32_t cell : query.search_cells()) {
-            const double value = Correlation(plane, cell);
-            if (value <= best_score) continue;
-            const bool apart = std::all_of(taken.begin(), taken.end(), [&](std::uint32_t t) {
-                return CellDistance(cell, t, n) > kPeakSeparationCells;
-            });
-            if (apart) best_score = value, best = cell;
-        }
-        if (!best) return;
-        taken.push_back(*best);
-        peaks.push_back(PeakAt(plane, *best, query, yaw_rad));
+    for (const std::uint32_t cell :
+         detail::PeakCells(plane, query.search_cells(), query.config().grid_cells, count)) {
+        peaks.push_back(PeakAt(plane, cell, query, yaw_rad));
     }
 }
 
@@ -263,5 +254,32 @@ std::vector<PlanarHypothesis> CoarseAlign(const CoarseQuery& query,
     }
     return Distinct(std::move(peaks), config);
 }
+
+namespace detail {
+
+std::vector<std::uint32_t> PeakCells(const std::vector<float>& plane,
+                                     const std::vector<std::uint32_t>& search_cells, int n,
+                                     int count) {
+    std::vector<std::uint32_t> taken;
+    for (int k = 0; k < count; ++k) {
+        double best_score = 0.0;
+        float skip_below = SkipBelow(best_score);
+        std::optional<std::uint32_t> best;
+        for (const std::uint32_t cell : search_cells) {
+            if (plane[cell] < skip_below) continue;
+            const double value = Correlation(plane, cell);
+            if (value <= best_score) continue;
+            const bool apart = std::all_of(taken.begin(), taken.end(), [&](std::uint32_t t) {
+                return CellDistance(cell, t, n) > kPeakSeparationCells;
+            });
+            if (apart) best_score = value, skip_below = SkipBelow(value), best = cell;
+        }
+        if (!best) break;
+        taken.push_back(*best);
+    }
+    return taken;
+}
+
+}  // namespace detail
 
 }  // namespace lidarloop::registration

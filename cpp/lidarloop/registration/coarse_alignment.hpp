@@ -77,4 +77,17 @@ std::vector<PlanarHypothesis> CoarseAlign(const CoarseQuery& query,
                                           const SurfacePoints& match_structure,
                                           const YawWindow& allowed = {});
 
+namespace detail {
+
+/// The best translations of one correlation plane (grid_cells `n` squared values) over
+/// `search_cells`, as CoarseAlign takes them: the cell of the highest correlation rounded to a
+/// multiple of 0.5 (the first searched on a tie), then the highest more than 3 cells (wrapped)
+/// from every one taken, up to `count`; only cells above 0. In a place that repeats (a row of
+/// identical rooms, a colonnade) one yaw has several peaks; the ambiguity test needs them all.
+std::vector<std::uint32_t> PeakCells(const std::vector<float>& plane,
+                                     const std::vector<std::uint32_t>& search_cells, int n,
+                                     int count);
+
+}  // namespace detail
+
 }  // namespace lidarloop::registration

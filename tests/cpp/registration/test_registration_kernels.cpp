@@ -401,6 +401,73 @@ TEST(CoarseAlign, ScoresAreExactMultiplesOfAHalf) {
     EXPECT_NEAR(hypotheses.front().yaw_rad, 0.0, 1e-9);
 }
 
+// The peak search's float pre-test against the plain search it shortcuts: every cell's
+// correlation rounded to a multiple of 0.5, the first highest taken, then the highest more than
+// 3 cells (wrapped) from each taken. Planes of multiples of 0.5 with the FFT's small errors and
+// values at the rounding boundaries, one float step either side.
+TEST(CoarseAlign, PeakCellsAreThoseOfTheSearchWithoutAShortcut) {
+    const int n = 16;
+    std::vector<std::uint32_t> search_cells;
+    for (int y = 0; y < n; ++y) {
+        for (int x = 0; x < n; ++x) {
+            const int dx = x < n / 2 ? x : x - n, dy = y < n / 2 ? y : y - n;
+            if (dx * dx + dy * dy <= 36)
+                search_cells.push_back(static_cast<std::uint32_t>(y * n + x));
+        }
+    }
+    const auto rounded = [](float value) { return std::floor(2.0F * value + 0.5F) / 2.0; };
+    const auto apart = [n](std::uint32_t a, std::uint32_t b) {
+        const auto wrapped = [n](int d) { return std::min((d + n) % n, (n - d) % n); };
+        const int dx = wrapped(static_cast<int>(a % n) - static_cast<int>(b % n));
+        const int dy = wrapped(static_cast<int>(a / n) - static_cast<int>(b / n));
+        return std::max(dx, dy) > 3;
+    };
+    const auto plain = [&](const std::vector<float>& plane, int count) {
+        std::vector<std::uint32_t> taken;
+        for (int k = 0; k < count; ++k) {
+            double best = 0.0;
+            std::int64_t at = -1;
+            for (const std::uint32_t cell : search_cells) {
+                const bool free = std::all_of(taken.begin(), taken.end(),
+                                              [&](std::uint32_t t) { return apart(cell, t); });
+                if (free && rounded(plane[cell]) > best) best = rounded(plane[cell]), at = cell;
+            }
+            if (at < 0) break;
+            taken.push_back(static_cast<std::uint32_t>(at));
+        }
+        return taken;
+    };
+    std::mt19937 rng(17);
+    std::uniform_int_distribution<int> halves(-1, 12);
+    std::uniform_int_distribution<int> kind(0, 5);
+    std::uniform_real_distribution<float> fft_error(-1e-3F, 1e-3F);
+    std::size_t boundary_values = 0;
+    for (int trial = 0; trial < 2000; ++trial) {
+        std::vector<float> plane(static_cast<std::size_t>(n * n));
+        for (float& value : plane) {
+            const float half = 0.5F * static_cast<float>(halves(rng));
+            const float edge = half + 0.25F;  // where rounding steps up to half + 0.5
+            switch (kind(rng)) {
+                case 0:
+                    value = std::nextafter(edge, -1e9F), ++boundary_values;
+                    break;
+                case 1:
+                    value = edge, ++boundary_values;
+                    break;
+                case 2:
+                    value = std::nextafter(edge, 1e9F), ++boundary_values;
+                    break;
+                default:
+                    value = half + fft_error(rng);
+            }
+        }
+        for (const int count : {1, 2, 3})
+            ASSERT_EQ(detail::PeakCells(plane, search_cells, n, count), plain(plane, count))
+                << "trial " << trial << " count " << count;
+    }
+    EXPECT_GT(boundary_values, 10000u);
+}
+
 TEST(YawWindow, WrapsAroundAndANanWindowIsWhole) {
     const double deg = std::numbers::pi / 180.0;
     const YawWindow window{179.0 * deg, 5.0 * deg};
