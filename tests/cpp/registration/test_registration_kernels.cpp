@@ -406,7 +406,7 @@ TEST(CoarseAlign, ScoresAreExactMultiplesOfAHalf) {
 // 3 cells (wrapped) from each taken. Planes of multiples of 0.5 with the FFT's small errors and
 // values at the rounding boundaries, one float step either side.
 TEST(CoarseAlign, PeakCellsAreThoseOfTheSearchWithoutAShortcut) {
-    const int n = 16;
+    constexpr int n = 16;
     std::vector<std::uint32_t> search_cells;
     for (int y = 0; y < n; ++y) {
         for (int x = 0; x < n; ++x) {
@@ -416,8 +416,8 @@ TEST(CoarseAlign, PeakCellsAreThoseOfTheSearchWithoutAShortcut) {
         }
     }
     const auto rounded = [](float value) { return std::floor(2.0F * value + 0.5F) / 2.0; };
-    const auto apart = [n](std::uint32_t a, std::uint32_t b) {
-        const auto wrapped = [n](int d) { return std::min((d + n) % n, (n - d) % n); };
+    const auto apart = [](std::uint32_t a, std::uint32_t b) {
+        const auto wrapped = [](int d) { return std::min((d + n) % n, (n - d) % n); };
         const int dx = wrapped(static_cast<int>(a % n) - static_cast<int>(b % n));
         const int dy = wrapped(static_cast<int>(a / n) - static_cast<int>(b / n));
         return std::max(dx, dy) > 3;
