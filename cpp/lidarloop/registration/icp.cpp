@@ -32,13 +32,18 @@ void Accumulate(const SurfacePoints& from, const SurfacePoints& onto, const Eige
     const double scale_m = max_distance_m / 3.0;
     const std::size_t stride = std::max<std::size_t>(1, (from.size() + cap - 1) / cap);
     partners.resize((from.size() + stride - 1) / stride, -1);
+    // A point without a partner of its own takes the last point's as its hint: consecutive
+    // points of a scan lie near each other, and a hint only bounds the search (exact either way).
+    std::int64_t last_partner = -1;
     for (std::size_t i = 0, k = 0; i < from.size(); i += stride, ++k) {
         const Eigen::Vector3f& point = from.points()[i];
         ++equations.paired;
         const Eigen::Vector3f moved = T * point;
-        const auto index = onto.grid().NearestWithin(moved, max_distance_m, partners[k]);
+        const std::int64_t hint = partners[k] >= 0 ? partners[k] : last_partner;
+        const auto index = onto.grid().NearestWithin(moved, max_distance_m, hint);
         partners[k] = index;
         if (index < 0) continue;
+        last_partner = index;
         const Eigen::Vector3d normal =
             onto.normals()[static_cast<std::size_t>(index)].cast<double>();
         const Eigen::Vector3d q = moved.cast<double>();
