@@ -134,12 +134,12 @@ IcpResult RefinePointToPlane(const PreparedScan& query, const PreparedScan& matc
         const bool first = distance_m == config.initial_correspondence_m;
         // Thinned only when finer stages follow, which pair every point.
         const bool thinned = first && distance_m > config.final_correspondence_m;
+        const auto cap = [thinned](int first_stage_points, int points) {
+            return thinned ? std::min(first_stage_points, points) : points;
+        };
         const int structure_cap =
-            thinned ? std::min(config.first_stage_structure_points, config.max_structure_points)
-                    : config.max_structure_points;
-        const int ground_cap =
-            thinned ? std::min(config.first_stage_ground_points, config.max_ground_points)
-                    : config.max_ground_points;
+            cap(config.first_stage_structure_points, config.max_structure_points);
+        const int ground_cap = cap(config.first_stage_ground_points, config.max_ground_points);
         result.converged = RunStage(query, match, static_cast<float>(distance_m), structure_cap,
                                     ground_cap, config, partners, result);
         // The later stages pair every point, another subsample: their hints start afresh.
