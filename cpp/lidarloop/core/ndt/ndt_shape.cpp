@@ -7,16 +7,9 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "lidarloop/core/detail/vector_clones.hpp"
 #include "lidarloop/core/eigen3x3.hpp"
 
-// Function multi-versioning: an AVX2 copy of the batch loop, picked at load time on CPUs that
-// have it (4 doubles per instruction instead of SSE2's 2). AVX2 does not include FMA, so both
-// copies round identically.
-#if defined(__GNUC__) && defined(__x86_64__) && !defined(__SANITIZE_ADDRESS__)
-#define LIDARLOOP_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define LIDARLOOP_VECTOR_CLONES
-#endif
 #if defined(__GNUC__)
 #define LIDARLOOP_ALWAYS_INLINE inline __attribute__((always_inline))
 #else

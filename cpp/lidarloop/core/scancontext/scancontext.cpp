@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "lidarloop/core/detail/vector_clones.hpp"
 #include "lidarloop/core/error.hpp"
 
 namespace lidarloop::core {
@@ -13,14 +14,6 @@ namespace {
 // Bound on the error of PolarCoordinates: 0.00151 rad measured over [0, 1] in float, plus the
 // float rounding of the unfolding (< 1e-6 rad), rounded up.
 constexpr double kAzimuthErrorRad = 0.002;
-
-// Function multi-versioning, as in ndt/ndt_shape.cpp: an AVX2 copy of the batch loop (8 floats per
-// instruction instead of SSE2's 4), picked at load time. AVX2 has no FMA: both round alike.
-#if defined(__GNUC__) && defined(__x86_64__) && !defined(__SANITIZE_ADDRESS__)
-#define LIDARLOOP_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define LIDARLOOP_VECTOR_CLONES
-#endif
 
 constexpr std::size_t kBatch = 256;  // points per pass of PolarCoordinates
 

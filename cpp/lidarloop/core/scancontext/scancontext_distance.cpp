@@ -5,6 +5,7 @@
 #include <numbers>
 #include <string>
 
+#include "lidarloop/core/detail/vector_clones.hpp"
 #include "lidarloop/core/error.hpp"
 
 namespace lidarloop::core {
@@ -14,15 +15,6 @@ constexpr int kMaxSectors = 720;  // ScanContextConfig::Validate
 // The float sums of up to 720 products of unit columns are exact to about 1e-7 each: a smaller
 // distance is rounding of equal columns, and reads 0 (equal descriptors are at 0).
 constexpr double kRoundingDistance = 2e-6;
-
-// Function multi-versioning, as in ndt/ndt_shape.cpp: an AVX2 copy (8 floats per instruction
-// instead of SSE2's 4), picked at load time on CPUs that have it. AVX2 has no FMA, so both
-// copies round identically.
-#if defined(__GNUC__) && defined(__x86_64__) && !defined(__SANITIZE_ADDRESS__)
-#define LIDARLOOP_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define LIDARLOOP_VECTOR_CLONES
-#endif
 
 // Per shift n, the sum over the rings and the columns m of the candidate of its value at (ring,
 // m) times the query's at (ring, m - n): shift n meets query column (m - n) mod S, which is the
