@@ -7,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 #include "lidarloop/core/angles.hpp"
+#include "lidarloop/core/detail/vector_clones.hpp"
 #include "lidarloop/registration/detail/fft2d.hpp"
 
 namespace lidarloop::registration {
@@ -33,6 +34,21 @@ std::vector<float> Spread(const std::vector<float>& image, int n) {
         }
     }
     return spread;
+}
+
+// The spectrum of two yaws' correlations in one: product = qa m + i qb m, where qa and qb are
+// the query's (conjugate) spectra at two yaws and m the match's. Both correlations are real, so
+// yaw b rides in the imaginary part. Written out: std::complex's product checks for NaN and does
+// not vectorise.
+LIDARLOOP_VECTOR_CLONES
+void MultiplyPair(const Spectrum& qa, const Spectrum& qb, const Spectrum& m,
+                  detail::SplitGrid& product) {
+    for (std::size_t i = 0; i < m.size(); ++i) {
+        const float mr = m[i].real(), mi = m[i].imag();
+        const float ar = qa[i].real(), ai = qa[i].imag(), br = qb[i].real(), bi = qb[i].imag();
+        product.re[i] = (ar * mr - ai * mi) - (br * mi + bi * mr);
+        product.im[i] = (ar * mi + ai * mr) + (br * mr - bi * mi);
+    }
 }
 
 // The signed shift of a wrapped correlation index.
@@ -169,18 +185,7 @@ YawWindow SearchedYaws(const YawWindow& allowed, const CoarseConfig& config) {
 
 std::vector<float> OccupancyImage(const std::vector<Eigen::Vector3f>& points, double yaw_rad,
                                   const CoarseConfig& config) {
-    const int n = config.grid_cells;
-    std::vector<float> image(static_cast<std::size_t>(n * n), 0.0F);
-    const Eigen::Rotation2Df rotation(static_cast<float>(yaw_rad));
-    const auto inverse_cell = static_cast<float>(1.0 / config.cell_m);
-    for (const auto& point : points) {
-        const Eigen::Vector2f xy = rotation * point.head<2>();
-        const int x = static_cast<int>(std::floor(xy.x() * inverse_cell)) + n / 2;
-        const int y = static_cast<int>(std::floor(xy.y() * inverse_cell)) + n / 2;
-        if (x < 0 || y < 0 || x >= n || y >= n) continue;
-        image[static_cast<std::size_t>(y * n + x)] = 1.0F;
-    }
-    return image;
+    return detail::OccupancyImage(detail::PlanarPoints(points), yaw_rad, config);
 }
 
 CoarseQuery::CoarseQuery(const SurfacePoints& query_structure, const CoarseConfig& config,
@@ -200,8 +205,9 @@ CoarseQuery::CoarseQuery(const SurfacePoints& query_structure, const CoarseConfi
     }
     const int yaws = static_cast<int>(std::lround(360.0 / config.yaw_step_deg));
     spectra_.resize(static_cast<std::size_t>(yaws));
+    const detail::PlanarPoints planar(query_structure.points());  // read once per yaw
     const auto image_at = [&](int i) {
-        return OccupancyImage(query_structure.points(), YawAt(i, yaws), config);
+        return detail::OccupancyImage(planar, YawAt(i, yaws), config);
     };
     const std::vector<bool> wanted = YawsWithin(windows, config, yaws);
     // Two yaws per transform: the images are real (detail::Fft2dForwardRealPair). The pairs are
@@ -229,9 +235,7 @@ std::vector<PlanarHypothesis> CoarseAlign(const CoarseQuery& query,
     std::vector<PlanarHypothesis> peaks;
     detail::SplitGrid product{std::vector<float>(match.size()), std::vector<float>(match.size())};
     const auto rows = RowsWithNeighbors(query.search_rows(), n);
-    // Two yaws per inverse FFT: both correlations are real, so yaw b rides in the imaginary part:
-    // product = qa m + i qb m (written out: std::complex's product checks for NaN and does not
-    // vectorise).
+    // Two yaws per inverse FFT: both correlations are real, so yaw b rides in the imaginary part.
     const YawWindow searched = SearchedYaws(allowed, config);
     for (int a = 0; a < query.yaw_count(); a += 2) {
         const int b = std::min(a + 1, query.yaw_count() - 1);
@@ -240,14 +244,7 @@ std::vector<PlanarHypothesis> CoarseAlign(const CoarseQuery& query,
         if (!want_a && !want_b) continue;
         if (!query.Has(a) || !query.Has(b))
             throw std::invalid_argument("CoarseAlign: the query's images lack a searched yaw");
-        const Spectrum& qa = query.spectrum(a);
-        const Spectrum& qb = query.spectrum(b);
-        for (std::size_t i = 0; i < match.size(); ++i) {
-            const float mr = match[i].real(), mi = match[i].imag();
-            const float ar = qa[i].real(), ai = qa[i].imag(), br = qb[i].real(), bi = qb[i].imag();
-            product.re[i] = (ar * mr - ai * mi) - (br * mi + bi * mr);
-            product.im[i] = (ar * mi + ai * mr) + (br * mr - bi * mi);
-        }
+        MultiplyPair(query.spectrum(a), query.spectrum(b), match, product);
         detail::Fft2dInverseRows(product, n, rows);
         if (want_a) AddPeaks(product.re, query, query.YawOf(a), config.peaks_per_yaw, peaks);
         if (want_b) AddPeaks(product.im, query, query.YawOf(b), config.peaks_per_yaw, peaks);
@@ -256,6 +253,53 @@ std::vector<PlanarHypothesis> CoarseAlign(const CoarseQuery& query,
 }
 
 namespace detail {
+
+PlanarPoints::PlanarPoints(const std::vector<Eigen::Vector3f>& points) {
+    x.reserve(points.size());
+    y.reserve(points.size());
+    for (const auto& point : points) x.push_back(point.x()), y.push_back(point.y());
+}
+
+namespace {
+
+// Per point, its image cell after the rotation (c -s; s c), or n^2 (a spare cell) outside the
+// image. One branch-free pass over columns, so that it vectorises; the products and sums are
+// those of Eigen's Rotation2Df, so the cells are the same as rotating each point with it.
+LIDARLOOP_VECTOR_CLONES
+void CellsOf(const PlanarPoints& points, float c, float s, float inverse_cell, int n,
+             std::vector<std::int32_t>& cells) {
+    const std::size_t count = points.x.size();
+    cells.resize(count);
+    const float* __restrict xs = points.x.data();
+    const float* __restrict ys = points.y.data();
+    std::int32_t* __restrict out = cells.data();
+    for (std::size_t i = 0; i < count; ++i) {
+        const float rotated_x = c * xs[i] + (-s) * ys[i];
+        const float rotated_y = s * xs[i] + c * ys[i];
+        const auto cx = static_cast<std::int32_t>(std::floor(rotated_x * inverse_cell)) + n / 2;
+        const auto cy = static_cast<std::int32_t>(std::floor(rotated_y * inverse_cell)) + n / 2;
+        // Negative cells wrap to large unsigned ones; & instead of && keeps the loop branch-free.
+        const bool inside = (static_cast<std::uint32_t>(cx) < static_cast<std::uint32_t>(n)) &
+                            (static_cast<std::uint32_t>(cy) < static_cast<std::uint32_t>(n));
+        out[i] = inside ? cy * n + cx : n * n;
+    }
+}
+
+}  // namespace
+
+std::vector<float> OccupancyImage(const PlanarPoints& points, double yaw_rad,
+                                  const CoarseConfig& config) {
+    const int n = config.grid_cells;
+    const Eigen::Matrix2f rotation =
+        Eigen::Rotation2Df(static_cast<float>(yaw_rad)).toRotationMatrix();
+    thread_local std::vector<std::int32_t> cells;
+    CellsOf(points, rotation(0, 0), rotation(1, 0), static_cast<float>(1.0 / config.cell_m), n,
+            cells);
+    std::vector<float> image(static_cast<std::size_t>(n * n) + 1, 0.0F);
+    for (const std::int32_t cell : cells) image[static_cast<std::size_t>(cell)] = 1.0F;
+    image.pop_back();  // the spare cell
+    return image;
+}
 
 std::vector<std::uint32_t> PeakCells(const std::vector<float>& plane,
                                      const std::vector<std::uint32_t>& search_cells, int n,

@@ -79,6 +79,17 @@ std::vector<PlanarHypothesis> CoarseAlign(const CoarseQuery& query,
 
 namespace detail {
 
+/// Points' x and y as two columns: the layout in which the query's images at every yaw are
+/// computed (one pass over the columns per yaw).
+struct PlanarPoints {
+    explicit PlanarPoints(const std::vector<Eigen::Vector3f>& points);
+    std::vector<float> x, y;
+};
+
+/// OccupancyImage of the points, from the columns.
+std::vector<float> OccupancyImage(const PlanarPoints& points, double yaw_rad,
+                                  const CoarseConfig& config);
+
 /// The best translations of one correlation plane (grid_cells `n` squared values) over
 /// `search_cells`, as CoarseAlign takes them: the cell of the highest correlation rounded to a
 /// multiple of 0.5 (the first searched on a tie), then the highest more than 3 cells (wrapped)

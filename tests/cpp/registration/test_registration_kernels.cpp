@@ -368,6 +368,34 @@ TEST(Fft2d, ARealPairSplitsIntoTheSpectraOfEachImage) {
     }
 }
 
+// The images are computed from columns in one vectorised pass per yaw; they must be those of
+// rotating each point with Eigen and flooring its cell, to the last cell: points beyond the
+// image's edge (it spans +-48 m), and points on the cell edges, where a rounding decides.
+TEST(OccupancyImage, EqualsRotatingEachPointWithEigen) {
+    auto points = RandomPoints(4000, 9, 70.0F);
+    for (int i = -40; i <= 40; ++i) {
+        const float edge_m = 1.5F * static_cast<float>(i);
+        points.emplace_back(edge_m, 0.5F * edge_m, 0.0F);
+        points.emplace_back(-0.25F * edge_m, edge_m, 0.0F);
+    }
+    const CoarseConfig config;
+    const int n = config.grid_cells;
+    for (int step = 0; step < 72; ++step) {
+        const double yaw_rad = step * 5.0 * std::numbers::pi / 180.0;
+        std::vector<float> expected(static_cast<std::size_t>(n * n), 0.0F);
+        const Eigen::Rotation2Df rotation(static_cast<float>(yaw_rad));
+        const auto inverse_cell = static_cast<float>(1.0 / config.cell_m);
+        for (const auto& point : points) {
+            const Eigen::Vector2f xy = rotation * point.head<2>();
+            const int x = static_cast<int>(std::floor(xy.x() * inverse_cell)) + n / 2;
+            const int y = static_cast<int>(std::floor(xy.y() * inverse_cell)) + n / 2;
+            if (x >= 0 && y >= 0 && x < n && y < n)
+                expected[static_cast<std::size_t>(y * n + x)] = 1;
+        }
+        ASSERT_EQ(OccupancyImage(points, yaw_rad, config), expected) << "yaw step " << step;
+    }
+}
+
 TEST(CoarseQuery, HoldsTheConjugateSpectrumOfTheRotatedImageAtEveryYaw) {
     ScanReductionConfig reduction;
     const PreparedScan scan = PrepareScan(test::SyntheticPlace(), reduction);

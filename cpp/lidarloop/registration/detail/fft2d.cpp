@@ -6,6 +6,8 @@
 #include <numbers>
 #include <utility>
 
+#include "lidarloop/core/detail/vector_clones.hpp"
+
 namespace lidarloop::registration::detail {
 namespace {
 
@@ -52,6 +54,7 @@ void Butterflies(const float* __restrict ar, const float* __restrict ai, const f
 // of sequence b is at [e * count + b]. Radix-2 Stockham, which sorts itself (no bit reversal):
 // every butterfly combines two runs of contiguous values under one twiddle factor, so the inner
 // loop runs over whole rows and vectorises. Eigen's FFT transforms one sequence at a time.
+LIDARLOOP_VECTOR_CLONES
 void TransformBatch(std::vector<float>& re, std::vector<float>& im, int n, std::size_t count,
                     bool inverse) {
     const Twiddles& twiddles = TwiddlesFor(n);
@@ -128,6 +131,27 @@ void Transform2d(std::vector<std::complex<float>>& grid, int n, bool inverse) {
     Join(split, grid);
 }
 
+// Row `row` of the spectra of the two real images packed in `z` (a in the real part, b in the
+// imaginary part), from z's row and its mirror (the row at -row, the columns reversed):
+// A = (z + conj(z~)) / 2, B = (z - conj(z~)) / 2i. Written out, as std::complex's product checks
+// for NaN and does not vectorise.
+LIDARLOOP_VECTOR_CLONES
+void SeparateRow(const SplitGrid& z, std::size_t row, std::size_t mirrored_row, std::size_t size,
+                 std::vector<std::complex<float>>& spectrum_a,
+                 std::vector<std::complex<float>>& spectrum_b) {
+    const float* __restrict zr = z.re.data() + row * size;
+    const float* __restrict zi = z.im.data() + row * size;
+    const float* __restrict mr = z.re.data() + mirrored_row * size;
+    const float* __restrict mi = z.im.data() + mirrored_row * size;
+    std::complex<float>* __restrict out_a = spectrum_a.data() + row * size;
+    std::complex<float>* __restrict out_b = spectrum_b.data() + row * size;
+    for (std::size_t col = 0; col < size; ++col) {
+        const std::size_t mirrored = (size - col) % size;
+        out_a[col] = {0.5F * (zr[col] + mr[mirrored]), 0.5F * (zi[col] - mi[mirrored])};
+        out_b[col] = {0.5F * (zi[col] + mi[mirrored]), -0.5F * (zr[col] - mr[mirrored])};
+    }
+}
+
 }  // namespace
 
 void Fft2dInverseRows(SplitGrid& grid, int n, const std::vector<int>& rows) {
@@ -160,20 +184,14 @@ void Fft2dForwardRealPair(const std::vector<float>& a, const std::vector<float>&
                           std::vector<std::complex<float>>& spectrum_a,
                           std::vector<std::complex<float>>& spectrum_b) {
     const auto size = static_cast<std::size_t>(n);
-    SplitGrid packed{a, b};
+    thread_local SplitGrid packed;
+    packed.re = a;
+    packed.im = b;
     Transform2d(packed, n, false);
     spectrum_a.resize(size * size);
     spectrum_b.resize(size * size);
     for (std::size_t row = 0; row < size; ++row) {
-        const std::size_t mirrored_row = (size - row) % size;
-        for (std::size_t col = 0; col < size; ++col) {
-            const std::size_t at = row * size + col;
-            const std::size_t mirrored = mirrored_row * size + (size - col) % size;
-            const std::complex<float> z(packed.re[at], packed.im[at]);
-            const std::complex<float> w(packed.re[mirrored], -packed.im[mirrored]);
-            spectrum_a[at] = 0.5F * (z + w);
-            spectrum_b[at] = std::complex<float>(0.0F, -0.5F) * (z - w);
-        }
+        SeparateRow(packed, row, (size - row) % size, size, spectrum_a, spectrum_b);
     }
 }
 
