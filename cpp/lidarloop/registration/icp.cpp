@@ -23,6 +23,15 @@ struct NormalEquations {
     std::size_t inliers = 0;  // of those, within the inlier distance of a plane
 };
 
+// hessian += weighted * jacobian^T in the lower triangle only: the LDLT that solves the normal
+// equations reads no other (Eigen's default), and each entry is the product Eigen's outer
+// product forms, so the step is the same to the bit for 21 of the 36 products.
+void AddLowerOuterProduct(const Vector6d& weighted, const Vector6d& jacobian, Matrix6d& hessian) {
+    for (int j = 0; j < 6; ++j) {
+        for (int i = j; i < 6; ++i) hessian(i, j) += weighted(i) * jacobian(j);
+    }
+}
+
 // Pairs every stride-th point of `from` (an even subsample of at most `cap` points).
 // `partners` holds each paired point's partner of the previous iteration (-1: none), the hint
 // that makes the nearest-neighbour search cheap once the pose moves little; updated here.
@@ -55,7 +64,7 @@ void Accumulate(const SurfacePoints& from, const SurfacePoints& onto, const Eige
         const double weight = 1.0 / ((1.0 + ratio * ratio) * (1.0 + ratio * ratio));
         Vector6d jacobian;
         jacobian << q.cross(normal), normal;
-        equations.hessian.noalias() += weight * jacobian * jacobian.transpose();
+        AddLowerOuterProduct(weight * jacobian, jacobian, equations.hessian);
         equations.gradient.noalias() += weight * residual * jacobian;
         ++equations.count;
     }
