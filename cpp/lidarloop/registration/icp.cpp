@@ -16,7 +16,7 @@ using Vector6d = Eigen::Matrix<double, 6, 1>;
 // The normal equations of one Gauss-Newton step, for increments (rotation, translation) applied
 // on the left of the pose.
 struct NormalEquations {
-    Matrix6d hessian = Matrix6d::Zero();
+    Matrix6d hessian = Matrix6d::Zero();  // lower triangle only (AddLowerOuterProduct)
     Vector6d gradient = Vector6d::Zero();
     std::size_t count = 0;
     std::size_t paired = 0;   // query points given (within the cap)
