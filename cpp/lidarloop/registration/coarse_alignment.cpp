@@ -6,6 +6,7 @@
 #include <numbers>
 #include <optional>
 #include <stdexcept>
+#include <string>
 #include "lidarloop/core/angles.hpp"
 #include "lidarloop/core/detail/vector_clones.hpp"
 #include "lidarloop/registration/detail/fft2d.hpp"
@@ -66,8 +67,8 @@ double ParabolicOffset(double before, double at, double after) {
 // wins), so the hypotheses do not depend on how the FFT computed them. Non-negative images
 // correlate above -0.25 even with that error, where truncating x + 0.5 rounds as std::round
 // does, without a call into libm in the peak search's loop.
-double Correlation(const std::vector<float>& plane, std::size_t cell) {
-    return static_cast<double>(static_cast<std::int64_t>(2.0F * plane[cell] + 0.5F)) / 2.0;
+double Correlation(float value) {
+    return static_cast<double>(static_cast<std::int64_t>(2.0F * value + 0.5F)) / 2.0;
 }
 
 // A plane value below this cannot round (Correlation) above `score`, a multiple of 0.5: the
@@ -77,13 +78,14 @@ float SkipBelow(double score) {
     return static_cast<float>(score + 0.25 - (0.01 + 1e-6 * std::abs(score)));
 }
 
-// The peak at `cell` of one correlation plane, refined to sub-cell precision.
+// The peak at `cell` of one correlation plane (the query's computed rows, column by column),
+// refined to sub-cell precision.
 PlanarHypothesis PeakAt(const std::vector<float>& plane, std::uint32_t cell,
                         const CoarseQuery& query, double yaw_rad) {
     const int n = query.config().grid_cells;
     const int x = static_cast<int>(cell) % n, y = static_cast<int>(cell) / n;
     auto at = [&](int cx, int cy) {
-        return Correlation(plane, static_cast<std::size_t>(((cy + n) % n) * n + (cx + n) % n));
+        return Correlation(plane[query.PositionOf((cx + n) % n, (cy + n) % n)]);
     };
     const double score = at(x, y);
     const double fx = ParabolicOffset(at(x - 1, y), score, at(x + 1, y));
@@ -105,7 +107,8 @@ int CellDistance(std::uint32_t a, std::uint32_t b, int n) {
 void AddPeaks(const std::vector<float>& plane, const CoarseQuery& query, double yaw_rad, int count,
               std::vector<PlanarHypothesis>& peaks) {
     for (const std::uint32_t cell :
-         detail::PeakCells(plane, query.search_cells(), query.config().grid_cells, count)) {
+         detail::PeakCells(plane, query.search_cells(), query.search_positions(),
+                           query.config().grid_cells, count)) {
         peaks.push_back(PeakAt(plane, cell, query, yaw_rad));
     }
 }
@@ -193,6 +196,7 @@ CoarseQuery::CoarseQuery(const SurfacePoints& query_structure, const CoarseConfi
     : config_(config) {
     const int n = config.grid_cells;
     const double max_cells = config.max_translation_m / config.cell_m;
+    std::vector<int> searched_rows;
     for (int y = 0; y < n; ++y) {
         bool row_searched = false;
         for (int x = 0; x < n; ++x) {
@@ -200,8 +204,16 @@ CoarseQuery::CoarseQuery(const SurfacePoints& query_structure, const CoarseConfi
             search_cells_.push_back(static_cast<std::uint32_t>(y * n + x));
             row_searched = true;
         }
-        // The parabolic refinement reads the rows beside a peak too.
-        if (row_searched) search_rows_.push_back(y);
+        if (row_searched) searched_rows.push_back(y);
+    }
+    // The parabolic refinement reads the rows beside a peak too.
+    computed_rows_ = RowsWithNeighbors(searched_rows, n);
+    slot_of_row_.assign(static_cast<std::size_t>(n), -1);
+    for (std::size_t j = 0; j < computed_rows_.size(); ++j)
+        slot_of_row_[static_cast<std::size_t>(computed_rows_[j])] = static_cast<int>(j);
+    for (const std::uint32_t cell : search_cells_) {
+        const int x = static_cast<int>(cell) % n, y = static_cast<int>(cell) / n;
+        search_positions_.push_back(static_cast<std::uint32_t>(PositionOf(x, y)));
     }
     const int yaws = static_cast<int>(std::lround(360.0 / config.yaw_step_deg));
     spectra_.resize(static_cast<std::size_t>(yaws));
@@ -224,6 +236,12 @@ CoarseQuery::CoarseQuery(const SurfacePoints& query_structure, const CoarseConfi
 
 double CoarseQuery::YawOf(int index) const { return YawAt(index, yaw_count()); }
 
+std::size_t CoarseQuery::PositionOf(int x, int y) const {
+    const int slot = slot_of_row_[static_cast<std::size_t>(y)];
+    if (slot < 0) throw std::logic_error("CoarseQuery: row " + std::to_string(y) + " not computed");
+    return static_cast<std::size_t>(x) * computed_rows_.size() + static_cast<std::size_t>(slot);
+}
+
 std::vector<PlanarHypothesis> CoarseAlign(const CoarseQuery& query,
                                           const SurfacePoints& match_structure,
                                           const YawWindow& allowed) {
@@ -234,7 +252,7 @@ std::vector<PlanarHypothesis> CoarseAlign(const CoarseQuery& query,
         ToSpectrum(Spread(OccupancyImage(match_structure.points(), 0.0, config), n), n);
     std::vector<PlanarHypothesis> peaks;
     detail::SplitGrid product{std::vector<float>(match.size()), std::vector<float>(match.size())};
-    const auto rows = RowsWithNeighbors(query.search_rows(), n);
+    detail::SplitGrid correlations;  // the computed rows, column by column
     // Two yaws per inverse FFT: both correlations are real, so yaw b rides in the imaginary part.
     const YawWindow searched = SearchedYaws(allowed, config);
     for (int a = 0; a < query.yaw_count(); a += 2) {
@@ -245,9 +263,9 @@ std::vector<PlanarHypothesis> CoarseAlign(const CoarseQuery& query,
         if (!query.Has(a) || !query.Has(b))
             throw std::invalid_argument("CoarseAlign: the query's images lack a searched yaw");
         MultiplyPair(query.spectrum(a), query.spectrum(b), match, product);
-        detail::Fft2dInverseRows(product, n, rows);
-        if (want_a) AddPeaks(product.re, query, query.YawOf(a), config.peaks_per_yaw, peaks);
-        if (want_b) AddPeaks(product.im, query, query.YawOf(b), config.peaks_per_yaw, peaks);
+        detail::Fft2dInverseRows(product, n, query.computed_rows(), correlations);
+        if (want_a) AddPeaks(correlations.re, query, query.YawOf(a), config.peaks_per_yaw, peaks);
+        if (want_b) AddPeaks(correlations.im, query, query.YawOf(b), config.peaks_per_yaw, peaks);
     }
     return Distinct(std::move(peaks), config);
 }
@@ -301,17 +319,20 @@ std::vector<float> OccupancyImage(const PlanarPoints& points, double yaw_rad,
     return image;
 }
 
-std::vector<std::uint32_t> PeakCells(const std::vector<float>& plane,
-                                     const std::vector<std::uint32_t>& search_cells, int n,
+std::vector<std::uint32_t> PeakCells(const std::vector<float>& values,
+                                     const std::vector<std::uint32_t>& search_cells,
+                                     const std::vector<std::uint32_t>& positions, int n,
                                      int count) {
     std::vector<std::uint32_t> taken;
     for (int k = 0; k < count; ++k) {
         double best_score = 0.0;
         float skip_below = SkipBelow(best_score);
         std::optional<std::uint32_t> best;
-        for (const std::uint32_t cell : search_cells) {
-            if (plane[cell] < skip_below) continue;
-            const double value = Correlation(plane, cell);
+        for (std::size_t i = 0; i < search_cells.size(); ++i) {
+            const float correlation = values[positions[i]];
+            if (correlation < skip_below) continue;
+            const std::uint32_t cell = search_cells[i];
+            const double value = Correlation(correlation);
             if (value <= best_score) continue;
             const bool apart = std::all_of(taken.begin(), taken.end(), [&](std::uint32_t t) {
                 return CellDistance(cell, t, n) > kPeakSeparationCells;

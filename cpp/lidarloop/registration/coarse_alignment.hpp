@@ -50,14 +50,24 @@ public:
     /// Whether the spectrum of yaw `index` was computed.
     bool Has(int index) const { return !spectra_[index].empty(); }
     const std::vector<std::complex<float>>& spectrum(int index) const { return spectra_[index]; }
-    /// Cells of the correlation grid within max_translation_m (wrapped indices), and their rows.
+    /// Cells of the correlation grid within max_translation_m (wrapped indices, row-major).
     const std::vector<std::uint32_t>& search_cells() const { return search_cells_; }
-    const std::vector<int>& search_rows() const { return search_rows_; }
+    /// The rows of the correlation grid the inverse transforms compute: those of the searched
+    /// cells and the rows beside them (the peaks' refinement reads them), ascending. A plane of
+    /// them is stored column by column (detail::Fft2dInverseRows).
+    const std::vector<int>& computed_rows() const { return computed_rows_; }
+    /// Where cell (x, y) of a computed row lies in such a plane; throws std::logic_error for a
+    /// row not computed.
+    std::size_t PositionOf(int x, int y) const;
+    /// PositionOf of each of search_cells().
+    const std::vector<std::uint32_t>& search_positions() const { return search_positions_; }
 
 private:
     CoarseConfig config_;
     std::vector<std::uint32_t> search_cells_;
-    std::vector<int> search_rows_;
+    std::vector<int> computed_rows_;
+    std::vector<int> slot_of_row_;  // per grid row, its index in computed_rows_, or -1
+    std::vector<std::uint32_t> search_positions_;
     std::vector<std::vector<std::complex<float>>> spectra_;  // one grid_cells^2 spectrum per yaw
 };
 
@@ -90,14 +100,15 @@ struct PlanarPoints {
 std::vector<float> OccupancyImage(const PlanarPoints& points, double yaw_rad,
                                   const CoarseConfig& config);
 
-/// The best translations of one correlation plane (grid_cells `n` squared values) over
-/// `search_cells`, as CoarseAlign takes them: the cell of the highest correlation rounded to a
+/// The best translations of one correlation plane over `search_cells` (row-major cells of the
+/// n x n grid; cell search_cells[i] has the value values[positions[i]]), as CoarseAlign takes
+/// them: the cell of the highest correlation rounded to a
 /// multiple of 0.5 (the first searched on a tie), then the highest more than 3 cells (wrapped)
 /// from every one taken, up to `count`; only cells above 0. In a place that repeats (a row of
 /// identical rooms, a colonnade) one yaw has several peaks; the ambiguity test needs them all.
-std::vector<std::uint32_t> PeakCells(const std::vector<float>& plane,
-                                     const std::vector<std::uint32_t>& search_cells, int n,
-                                     int count);
+std::vector<std::uint32_t> PeakCells(const std::vector<float>& values,
+                                     const std::vector<std::uint32_t>& search_cells,
+                                     const std::vector<std::uint32_t>& positions, int n, int count);
 
 }  // namespace detail
 

@@ -306,14 +306,18 @@ TEST(Fft2d, MatchesTheDefinitionAndInverts) {
     auto back = spectrum;
     detail::Fft2dInverse(back, n);
     for (int i = 0; i < n * n; ++i) EXPECT_NEAR(std::abs(back[i] - grid[i]), 0.0, 1e-5);
-    // Only the listed rows are final in the partial inverse; they equal the full one.
-    detail::SplitGrid rows;
-    for (const auto& v : spectrum) rows.re.push_back(v.real()), rows.im.push_back(v.imag());
-    detail::Fft2dInverseRows(rows, n, {1, 5});
-    for (const int row : {1, 5}) {
+    // The partial inverse computes the listed rows only, column by column; they equal the full
+    // one's.
+    detail::SplitGrid partial, narrow;
+    for (const auto& v : spectrum) partial.re.push_back(v.real()), partial.im.push_back(v.imag());
+    const std::vector<int> rows = {1, 5};
+    detail::Fft2dInverseRows(partial, n, rows, narrow);
+    ASSERT_EQ(narrow.re.size(), rows.size() * n);
+    for (std::size_t j = 0; j < rows.size(); ++j) {
         for (int x = 0; x < n; ++x) {
-            EXPECT_NEAR(rows.re[row * n + x], grid[row * n + x].real(), 1e-5);
-            EXPECT_NEAR(rows.im[row * n + x], grid[row * n + x].imag(), 1e-5);
+            const std::size_t at = x * rows.size() + j;
+            EXPECT_NEAR(narrow.re[at], grid[rows[j] * n + x].real(), 1e-5);
+            EXPECT_NEAR(narrow.im[at], grid[rows[j] * n + x].imag(), 1e-5);
         }
     }
 }
@@ -490,7 +494,8 @@ TEST(CoarseAlign, PeakCellsAreThoseOfTheSearchWithoutAShortcut) {
             }
         }
         for (const int count : {1, 2, 3})
-            ASSERT_EQ(detail::PeakCells(plane, search_cells, n, count), plain(plane, count))
+            ASSERT_EQ(detail::PeakCells(plane, search_cells, search_cells, n, count),
+                      plain(plane, count))
                 << "trial " << trial << " count " << count;
     }
     EXPECT_GT(boundary_values, 10000u);

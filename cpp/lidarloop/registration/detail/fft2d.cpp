@@ -154,30 +154,22 @@ void SeparateRow(const SplitGrid& z, std::size_t row, std::size_t mirrored_row, 
 
 }  // namespace
 
-void Fft2dInverseRows(SplitGrid& grid, int n, const std::vector<int>& rows) {
+void Fft2dInverseRows(SplitGrid& grid, int n, const std::vector<int>& rows, SplitGrid& narrow) {
     const auto size = static_cast<std::size_t>(n);
     TransformBatch(grid.re, grid.im, n, size, true);
-    // The listed rows only: gathered as columns of a narrow grid, transformed, put back.
+    // The listed rows only: gathered as columns of a narrow grid and transformed there.
     const std::size_t count = rows.size();
-    thread_local SplitGrid narrow;
     narrow.re.resize(size * count);
     narrow.im.resize(size * count);
-    for (std::size_t j = 0; j < count; ++j) {
-        const std::size_t offset = static_cast<std::size_t>(rows[j]) * size;
-        for (std::size_t col = 0; col < size; ++col) {
-            narrow.re[col * count + j] = grid.re[offset + col];
-            narrow.im[col * count + j] = grid.im[offset + col];
-        }
-    }
-    TransformBatch(narrow.re, narrow.im, n, count, true);
     const float scale = 1.0F / static_cast<float>(n * n);
     for (std::size_t j = 0; j < count; ++j) {
         const std::size_t offset = static_cast<std::size_t>(rows[j]) * size;
         for (std::size_t col = 0; col < size; ++col) {
-            grid.re[offset + col] = scale * narrow.re[col * count + j];
-            grid.im[offset + col] = scale * narrow.im[col * count + j];
+            narrow.re[col * count + j] = scale * grid.re[offset + col];
+            narrow.im[col * count + j] = scale * grid.im[offset + col];
         }
     }
+    TransformBatch(narrow.re, narrow.im, n, count, true);
 }
 
 void Fft2dForwardRealPair(const std::vector<float>& a, const std::vector<float>& b, int n,

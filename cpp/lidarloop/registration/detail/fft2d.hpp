@@ -22,7 +22,8 @@ void Fft2dForwardRealPair(const std::vector<float>& a, const std::vector<float>&
                           std::vector<std::complex<float>>& spectrum_a,
                           std::vector<std::complex<float>>& spectrum_b);
 /// The inverse transform computed only for the rows listed in `rows` (columns first, then those
-/// rows); the other rows hold partial results. For correlations read in a band of rows.
-void Fft2dInverseRows(SplitGrid& grid, int n, const std::vector<int>& rows);
+/// rows), into `narrow` column by column: the value at (x, rows[j]) is at [x * rows.size() + j].
+/// `grid` is left with partial results. For correlations read in a band of rows.
+void Fft2dInverseRows(SplitGrid& grid, int n, const std::vector<int>& rows, SplitGrid& narrow);
 
 }  // namespace lidarloop::registration::detail
