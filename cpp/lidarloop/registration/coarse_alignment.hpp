@@ -102,10 +102,10 @@ std::vector<float> OccupancyImage(const PlanarPoints& points, double yaw_rad,
 
 /// The best translations of one correlation plane over `search_cells` (row-major cells of the
 /// n x n grid; cell search_cells[i] has the value values[positions[i]]), as CoarseAlign takes
-/// them: the cell of the highest correlation rounded to a
-/// multiple of 0.5 (the first searched on a tie), then the highest more than 3 cells (wrapped)
-/// from every one taken, up to `count`; only cells above 0. In a place that repeats (a row of
-/// identical rooms, a colonnade) one yaw has several peaks; the ambiguity test needs them all.
+/// them: the cell of the highest correlation rounded to a multiple of 0.5 (the first searched on
+/// a tie), then the highest more than 3 cells (wrapped) from every one taken, up to `count`; only
+/// cells above 0. In a place that repeats (a row of identical rooms, a colonnade) one yaw has
+/// several peaks; the ambiguity test needs them all.
 std::vector<std::uint32_t> PeakCells(const std::vector<float>& values,
                                      const std::vector<std::uint32_t>& search_cells,
                                      const std::vector<std::uint32_t>& positions, int n, int count);
