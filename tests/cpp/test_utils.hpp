@@ -111,7 +111,7 @@ inline core::PointCloud RandomCloud(std::size_t count, unsigned seed, float half
 /// depend on which tests ran before it.
 inline Eigen::Matrix3d RandomRotation(std::mt19937& rng) {
     std::normal_distribution<double> normal(0.0, 1.0);
-    return Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng))
+    return Eigen::Quaterniond{normal(rng), normal(rng), normal(rng), normal(rng)}
         .normalized()
         .toRotationMatrix();
 }

@@ -44,7 +44,7 @@ PointCloud SampleScene(const std::vector<Box>& boxes, const Eigen::Vector3f& sen
         } else {
             const Box& box = boxes[surface];
             p = box.min +
-                (box.max - box.min).cwiseProduct(Eigen::Vector3f(unit(rng), unit(rng), unit(rng)));
+                (box.max - box.min).cwiseProduct(Eigen::Vector3f{unit(rng), unit(rng), unit(rng)});
             const int axis = static_cast<int>(rng() % 2);  // a vertical face
             p[axis] = (rng() % 2 == 0) ? box.min[axis] : box.max[axis];
         }

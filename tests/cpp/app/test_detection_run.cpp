@@ -128,17 +128,17 @@ TEST(OdometryAllowsALoop, EqualsTryingLoopPosesWithinReach) {
     std::mt19937 random(5);
     std::uniform_real_distribution<double> unit(-1.0, 1.0);
     const auto random_turn = [&](double max_rad) {
-        return Eigen::AngleAxisd(max_rad * unit(random),
-                                 Eigen::Vector3d(unit(random), unit(random), 1.0).normalized())
+        return Eigen::AngleAxisd{max_rad * unit(random),
+                                 Eigen::Vector3d{unit(random), unit(random), 1.0}.normalized()}
             .toRotationMatrix();
     };
     std::size_t ruled_out = 0;
     std::size_t allowed = 0;
     for (int pair = 0; pair < 200; ++pair) {
         std::vector<core::Transform> T_odom_sensor(2, core::Transform::Identity());
+        const double length_m = 40.0 * (1.0 + unit(random));
         T_odom_sensor[1].translation() =
-            40.0 * (1.0 + unit(random)) *
-            Eigen::Vector3d(unit(random), unit(random), 0.1).normalized();
+            length_m * Eigen::Vector3d{unit(random), unit(random), 0.1}.normalized();
         T_odom_sensor[1].linear() = random_turn(M_PI);
         const std::vector<double> path_m{0.0, 200.0 * (1.0 + unit(random))};
         const auto pose_of = [&](std::size_t i) { return T_odom_sensor[i]; };
@@ -157,9 +157,10 @@ TEST(OdometryAllowsALoop, EqualsTryingLoopPosesWithinReach) {
         ++ruled_out;
         for (int attempt = 0; attempt < 500; ++attempt) {
             core::Transform loop = core::Transform::Identity();
+            const double loop_length_m = kMaxLoopM * std::abs(unit(random));
             loop.translation() =
-                kMaxLoopM * std::abs(unit(random)) *
-                Eigen::Vector3d(unit(random), unit(random), unit(random)).normalized();
+                loop_length_m *
+                Eigen::Vector3d{unit(random), unit(random), unit(random)}.normalized();
             loop.linear() = T_0_1.linear() * random_turn(0.3 * std::abs(unit(random)));
             ASSERT_TRUE(gate(loop, T_0_1, path_m[1])) << pair << " " << attempt;
         }
@@ -185,8 +186,8 @@ TEST(OdometryYawWindow, HoldsTheYawOfEveryLoopTheGatePasses) {
     std::mt19937 random(9);
     std::uniform_real_distribution<double> unit(-1.0, 1.0);
     const auto turn = [&](double max_rad, double axis_z) {
-        return Eigen::AngleAxisd(max_rad * unit(random),
-                                 Eigen::Vector3d(unit(random), unit(random), axis_z).normalized())
+        return Eigen::AngleAxisd{max_rad * unit(random),
+                                 Eigen::Vector3d{unit(random), unit(random), axis_z}.normalized()}
             .toRotationMatrix();
     };
     const auto yaw_of = [](const core::Transform& T) {
@@ -195,7 +196,7 @@ TEST(OdometryYawWindow, HoldsTheYawOfEveryLoopTheGatePasses) {
     std::size_t passed = 0;
     for (int pair = 0; pair < 300; ++pair) {
         std::vector<core::Transform> T_odom_sensor(2, core::Transform::Identity());
-        T_odom_sensor[1].translation() = 30.0 * Eigen::Vector3d(unit(random), unit(random), 0.0);
+        T_odom_sensor[1].translation() = 30.0 * Eigen::Vector3d{unit(random), unit(random), 0.0};
         // Any heading, tilted by up to 10 degrees.
         T_odom_sensor[1].linear() =
             Eigen::AngleAxisd(M_PI * unit(random), Eigen::Vector3d::UnitZ()).toRotationMatrix() *
@@ -265,8 +266,8 @@ TEST(OdometryAllowsALoop, TheSearchsBoundSaysTheSame) {
     ASSERT_TRUE(check.in_reach_bound);
     std::size_t in_reach = 0;
     const auto random_turn = [&] {
-        return Eigen::AngleAxisd(M_PI * unit(random),
-                                 Eigen::Vector3d(unit(random), unit(random), 1.0).normalized())
+        return Eigen::AngleAxisd{M_PI * unit(random),
+                                 Eigen::Vector3d{unit(random), unit(random), 1.0}.normalized()}
             .toRotationMatrix();
     };
     for (int pair = 0; pair < 2000; ++pair) {
@@ -279,11 +280,11 @@ TEST(OdometryAllowsALoop, TheSearchsBoundSaysTheSame) {
             pair % 4 == 0 ? reach_m + 1e-3 * unit(random) : reach_m * (1.0 + unit(random));
         T_odom_sensor[0].linear() = random_turn();
         T_odom_sensor[0].translation() =
-            3000.0 * Eigen::Vector3d(unit(random), unit(random), 0.01 * unit(random));
+            3000.0 * Eigen::Vector3d{unit(random), unit(random), 0.01 * unit(random)};
         T_odom_sensor[1].linear() = random_turn();
         T_odom_sensor[1].translation() =
             T_odom_sensor[0].translation() +
-            distance_m * Eigen::Vector3d(unit(random), unit(random), 0.2).normalized();
+            distance_m * Eigen::Vector3d{unit(random), unit(random), 0.2}.normalized();
         const bool may_close = pipeline::OdometryAllowsALoop(
             1, 0, kMaxLoopM, [&](std::size_t i) { return T_odom_sensor[i]; },
             [&](std::size_t i) { return path_m[i]; }, gate);

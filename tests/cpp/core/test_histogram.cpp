@@ -110,7 +110,7 @@ TEST(Histogram, RangesOfEveryPointLandInTheirBucketsWithNonFiniteOnesSkipped) {
         } else {
             const int bucket = bucket_of(rng);
             const Eigen::Vector3f unit =
-                Eigen::Vector3f(direction(rng), direction(rng), direction(rng)).normalized();
+                Eigen::Vector3f{direction(rng), direction(rng), direction(rng)}.normalized();
             cloud.push_back(unit * (static_cast<float>(bucket) + offset_in_bucket(rng)));
             expected[static_cast<std::size_t>(bucket)] += 1.0;
         }

@@ -22,13 +22,13 @@ std::vector<Eigen::Vector3d> TestPoints(unsigned seed, std::size_t count) {
     for (std::size_t i = 0; i < count; ++i) {
         switch (i % 4) {
             case 0:
-                points.emplace_back(wide(rng), wide(rng), wide(rng));
+                points.push_back({wide(rng), wide(rng), wide(rng)});
                 break;
             case 1:
-                points.emplace_back(cluster(rng), cluster(rng), 0.1 * cluster(rng));
+                points.push_back({cluster(rng), cluster(rng), 0.1 * cluster(rng)});
                 break;
             case 2:
-                points.emplace_back(grid(rng), grid(rng), grid(rng));
+                points.push_back(Eigen::Vector3i{grid(rng), grid(rng), grid(rng)}.cast<double>());
                 break;
             default: {
                 const Eigen::Vector3d duplicate =
@@ -91,7 +91,7 @@ TEST(KdTree3, NearestEqualsBruteForceWithTiesToSmallerIndex) {
     for (int k = 0; k < 300; ++k) {
         const Eigen::Vector3d q =
             k % 3 == 0 ? points[static_cast<std::size_t>(k)]
-                       : Eigen::Vector3d(coordinate(rng), coordinate(rng), coordinate(rng));
+                       : Eigen::Vector3d{coordinate(rng), coordinate(rng), coordinate(rng)};
         const auto expected = BruteNearest(points, q, [](std::size_t) { return true; });
         const auto actual = tree.Nearest(q);
         ASSERT_TRUE(actual.has_value());

@@ -21,7 +21,7 @@ std::vector<StampedPose> Wander(unsigned seed, std::size_t count) {
     std::vector<StampedPose> poses(count);
     Eigen::Vector3d position = Eigen::Vector3d::Zero();
     for (std::size_t i = 0; i < count; ++i) {
-        if (unit(rng) > 0.1) position += Eigen::Vector3d(step(rng), step(rng), 0.2 * step(rng));
+        if (unit(rng) > 0.1) position += Eigen::Vector3d{step(rng), step(rng), 0.2 * step(rng)};
         poses[i].time_s = 0.1 * static_cast<double>(i);
         poses[i].T_world_sensor.translation() = position;
     }

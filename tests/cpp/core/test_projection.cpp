@@ -19,11 +19,13 @@ PointCloud TiltedGroundScan(const Eigen::Vector3f& normal, unsigned seed) {
     const Eigen::Vector3f origin(0.0f, 0.0f, -1.7f);
     PointCloud cloud;
     for (int i = 0; i < 30000; ++i) {
-        cloud.push_back(origin + uniform(rng) * u + uniform(rng) * v + noise(rng) * normal);
+        const float along_u = uniform(rng);
+        const float along_v = uniform(rng);
+        cloud.push_back(origin + along_u * u + along_v * v + noise(rng) * normal);
     }
     for (int i = 0; i < 1500; ++i) {
-        cloud.push_back(origin + 8.0f * u + uniform(rng) * v +
-                        (std::abs(uniform(rng)) / 8) * normal);
+        const float along_v = uniform(rng);
+        cloud.push_back(origin + 8.0f * u + along_v * v + (std::abs(uniform(rng)) / 8) * normal);
         cloud.push_back(origin - 5.0f * v + (std::abs(uniform(rng)) / 5) * normal);
     }
     return cloud;

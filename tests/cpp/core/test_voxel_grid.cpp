@@ -59,11 +59,11 @@ std::vector<Eigen::Vector3d> TestPoints(unsigned seed, std::size_t count) {
     std::vector<Eigen::Vector3d> points;
     for (std::size_t i = 0; i < count; ++i) {
         if (i % 3 == 0) {
-            points.emplace_back(wide(rng), wide(rng), wide(rng));
+            points.push_back({wide(rng), wide(rng), wide(rng)});
         } else if (i % 3 == 1) {
-            points.emplace_back(cluster(rng), cluster(rng), cluster(rng));
+            points.push_back({cluster(rng), cluster(rng), cluster(rng)});
         } else {
-            points.emplace_back(0.25 * border(rng), 0.25 * border(rng), 0.25 * border(rng));
+            points.push_back({0.25 * border(rng), 0.25 * border(rng), 0.25 * border(rng)});
         }
     }
     return points;

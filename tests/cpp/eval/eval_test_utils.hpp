@@ -45,8 +45,9 @@ inline std::vector<core::StampedPose> RandomTrajectory(unsigned seed, std::size_
         const double x = radius * std::cos(angle) + 0.5 * noise(rng);
         const double y = radius * std::sin(angle) + 0.5 * noise(rng);
         const double yaw = angle + direction * std::numbers::pi / 2 + 0.3 * noise(rng);
-        poses.push_back(
-            MakePose(t, x, y, yaw, 0.05 * noise(rng), 0.05 * noise(rng), 0.3 * noise(rng)));
+        const double pitch_rad = 0.05 * noise(rng);
+        const double roll_rad = 0.05 * noise(rng);
+        poses.push_back(MakePose(t, x, y, yaw, pitch_rad, roll_rad, 0.3 * noise(rng)));
         t += unit(rng) < 0.05 ? 0.0 : 0.1 + 0.02 * noise(rng) * 0.5;
     }
     return poses;

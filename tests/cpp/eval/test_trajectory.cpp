@@ -70,7 +70,7 @@ TEST(AbsoluteTrajectoryRmse, MatchesABruteForceYawSearch) {
     std::vector<core::Transform> estimate;
     for (const auto& pose : Moved(truth, Pose(5, 5, 0, 0.7))) {
         core::Transform p = pose;
-        p.translation() += Eigen::Vector3d(noise(rng), noise(rng), 0.0);
+        p.translation() += Eigen::Vector3d{noise(rng), noise(rng), 0.0};
         estimate.push_back(p);
     }
     // RMSE at one yaw, with the translation that matches the centroids.

@@ -177,15 +177,15 @@ TEST(Osnabrueck, ConvertedPoseCommutesWithTheCoordinateMapForRandomPoses) {
     std::uniform_real_distribution<double> angle_deg(-180.0, 180.0);
     std::uniform_real_distribution<double> cm(-5000.0, 5000.0);
     for (int trial = 0; trial < 200; ++trial) {
-        const Eigen::Vector3d angles(angle_deg(rng), angle_deg(rng), angle_deg(rng));
-        const Eigen::Vector3d t_cm(cm(rng), cm(rng), cm(rng));
+        const Eigen::Vector3d angles{angle_deg(rng), angle_deg(rng), angle_deg(rng)};
+        const Eigen::Vector3d t_cm{cm(rng), cm(rng), cm(rng)};
         test::WriteFile(dir / "scan.pose", PoseText(t_cm, angles));
         const core::Transform T = ReadOsnabrueckPose(dir / "scan.pose");
         EXPECT_NEAR(T.linear().determinant(), 1.0, 1e-12);
         EXPECT_TRUE((T.linear().transpose() * T.linear()).isIdentity(1e-12));
         const Eigen::Matrix3d R =
             Rotation3dtk(angles.x() * kDeg, angles.y() * kDeg, angles.z() * kDeg);
-        const Eigen::Vector3d p_cm(cm(rng), cm(rng), cm(rng));
+        const Eigen::Vector3d p_cm{cm(rng), cm(rng), cm(rng)};
         const Eigen::Vector3d expected = FromOsnabrueckCoordinates(R * p_cm + t_cm);
         const Eigen::Vector3d actual = T * FromOsnabrueckCoordinates(p_cm);
         ASSERT_LT((expected - actual).norm(), 1e-9) << "trial " << trial;
@@ -199,10 +199,10 @@ TEST(Osnabrueck, PoseRoundTripForRandomAndGimbalLockPoses) {
     std::vector<core::Transform> poses;
     for (int i = 0; i < 100; ++i) {
         core::Transform T = core::Transform::Identity();
-        T.linear() = Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng))
+        T.linear() = Eigen::Quaterniond{normal(rng), normal(rng), normal(rng), normal(rng)}
                          .normalized()
                          .toRotationMatrix();
-        T.translation() = 30.0 * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+        T.translation() = 30.0 * Eigen::Vector3d{normal(rng), normal(rng), normal(rng)};
         poses.push_back(T);
     }
     // 3DTK ry is the yaw about the up axis: +-90 degrees is its gimbal lock.
@@ -255,8 +255,8 @@ TEST(Osnabrueck, FramesAgreeWithPoseFilesForRandomPoses) {
     std::uniform_real_distribution<double> angle_deg(-180.0, 180.0);
     std::uniform_real_distribution<double> cm(-3000.0, 3000.0);
     for (int trial = 0; trial < 50; ++trial) {
-        const Eigen::Vector3d angles(angle_deg(rng), angle_deg(rng), angle_deg(rng));
-        const Eigen::Vector3d t_cm(cm(rng), cm(rng), cm(rng));
+        const Eigen::Vector3d angles{angle_deg(rng), angle_deg(rng), angle_deg(rng)};
+        const Eigen::Vector3d t_cm{cm(rng), cm(rng), cm(rng)};
         const Eigen::Matrix3d R =
             Rotation3dtk(angles.x() * kDeg, angles.y() * kDeg, angles.z() * kDeg);
         test::WriteFile(dir / "scan.frames", FramesLine(Eigen::Matrix3d::Identity(), {1, 2, 3}, 0) +

@@ -33,11 +33,11 @@ std::vector<core::StampedPose> RandomPoses(std::size_t count, unsigned seed) {
     std::normal_distribution<double> normal;
     std::vector<core::StampedPose> poses(count);
     for (std::size_t i = 0; i < count; ++i) {
-        const Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
+        const Eigen::Quaterniond q{normal(rng), normal(rng), normal(rng), normal(rng)};
         poses[i].time_s = static_cast<double>(i);
         poses[i].T_world_sensor =
             MakeTransform(q.normalized().toRotationMatrix(),
-                          100.0 * Eigen::Vector3d(normal(rng), normal(rng), normal(rng)));
+                          100.0 * Eigen::Vector3d{normal(rng), normal(rng), normal(rng)});
     }
     return poses;
 }

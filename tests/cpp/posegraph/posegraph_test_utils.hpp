@@ -64,9 +64,9 @@ inline std::vector<core::Transform> DriftingOdometry(const std::vector<core::Tra
     for (std::size_t i = 1; i < truth.size(); ++i) {
         core::Transform step = truth[i - 1].inverse() * truth[i];
         const double length = step.translation().norm();
-        const Eigen::Vector3d t_noise(normal(rng), normal(rng), normal(rng));
+        const Eigen::Vector3d t_noise{normal(rng), normal(rng), normal(rng)};
         step.translation() += translation_noise * length * t_noise;
-        const Eigen::Vector3d r_noise(normal(rng), normal(rng), normal(rng));
+        const Eigen::Vector3d r_noise{normal(rng), normal(rng), normal(rng)};
         const double deg = std::numbers::pi / 180.0;
         const Eigen::Vector3d rotation = rotation_noise_deg * deg * r_noise +
                                          Eigen::Vector3d(0, 0, yaw_bias_deg_per_m * deg * length);
@@ -98,9 +98,9 @@ inline std::vector<posegraph::LoopConstraint> TrueLoops(const std::vector<core::
             loop.match = m;
             loop.T_match_query = truth[m].inverse() * truth[q];
             loop.T_match_query.translation() +=
-                noise_m * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+                noise_m * Eigen::Vector3d{normal(rng), normal(rng), normal(rng)};
             const Eigen::Vector3d r = noise_deg * std::numbers::pi / 180.0 *
-                                      Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+                                      Eigen::Vector3d{normal(rng), normal(rng), normal(rng)};
             loop.T_match_query.linear() =
                 loop.T_match_query.linear() *
                 Eigen::AngleAxisd(r.norm(), r.normalized()).toRotationMatrix();
@@ -128,8 +128,9 @@ inline std::vector<posegraph::LoopConstraint> WrongLoops(std::size_t scans, std:
         loop.query = scan(rng);
         loop.match = scan(rng);
         if (loop.query < loop.match + min_gap) continue;
-        loop.T_match_query =
-            PlanarPose(10.0 * unit(rng), 10.0 * unit(rng), std::numbers::pi * unit(rng));
+        const double x_m = 10.0 * unit(rng);
+        const double y_m = 10.0 * unit(rng);
+        loop.T_match_query = PlanarPose(x_m, y_m, std::numbers::pi * unit(rng));
         loop.overlap = 0.5;
         loop.rmse_m = 0.1;
         loops.push_back(loop);

@@ -19,7 +19,7 @@ TEST(CompactPreparedScan, NormalsSurviveTheOctahedralEncodingInEveryOctant) {
     double worst_rad = 0.0;
     for (int i = 0; i < 20000; ++i) {
         const Eigen::Vector3f normal =
-            Eigen::Vector3f(gauss(rng), gauss(rng), gauss(rng)).normalized();
+            Eigen::Vector3f{gauss(rng), gauss(rng), gauss(rng)}.normalized();
         std::int16_t u = 0, v = 0;
         EncodeNormal(normal, u, v);
         const Eigen::Vector3f decoded = DecodeNormal(u, v);

@@ -26,7 +26,7 @@ std::vector<Eigen::Vector3f> RandomPoints(std::size_t n, std::uint64_t seed, flo
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<float> u(-extent_m, extent_m);
     std::vector<Eigen::Vector3f> points(n);
-    for (auto& p : points) p = Eigen::Vector3f(u(rng), u(rng), u(rng));
+    for (auto& p : points) p = Eigen::Vector3f{u(rng), u(rng), u(rng)};
     return points;
 }
 
@@ -255,7 +255,7 @@ TEST(NeighborGrid, NearestWithinIsExactOnAScan) {
     std::mt19937_64 rng(18);
     std::normal_distribution<float> jitter(0.0F, 0.2F);
     for (std::size_t i = 0; i < points.size(); i += 37)
-        queries.push_back(points[i] + Eigen::Vector3f(jitter(rng), jitter(rng), jitter(rng)));
+        queries.push_back(points[i] + Eigen::Vector3f{jitter(rng), jitter(rng), jitter(rng)});
     for (const float bound_m : {0.6F, 1.5F, 3.0F}) {
         ExpectGridNearestIsExact(points, 1.0F, queries, bound_m);
         ExpectGridNearestIsExact(points, 0.3F, queries, bound_m);

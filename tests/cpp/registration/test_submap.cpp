@@ -39,7 +39,7 @@ core::PointCloud RandomScan(std::mt19937& random, std::size_t count) {
     std::uniform_real_distribution<float> coordinate(-30.0F, 30.0F);
     core::PointCloud scan;
     for (std::size_t i = 0; i < count; ++i)
-        scan.emplace_back(coordinate(random), coordinate(random), 0.1F * coordinate(random));
+        scan.push_back({coordinate(random), coordinate(random), 0.1F * coordinate(random)});
     scan.emplace_back(1.0F, 0.0F, 0.0F);  // inside min_range: the scan's own vehicle
     scan.emplace_back(kNaN, 0.0F, 0.0F);
     return scan;

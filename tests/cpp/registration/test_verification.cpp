@@ -95,10 +95,10 @@ struct PosesAroundTheTruth {
         std::uniform_real_distribution<double> offset_m(-4.0, 4.0), yaw_deg(-30.0, 30.0);
         for (int trial = 0; trial < 40; ++trial) {
             const double scale = trial / 40.0;
-            const core::Transform pose =
-                test::PlanarTransform(scale * offset_m(rng), scale * offset_m(rng),
-                                      scale * yaw_deg(rng)) *
-                truth;
+            const double x_m = scale * offset_m(rng);
+            const double y_m = scale * offset_m(rng);
+            const double yaw_offset_deg = scale * yaw_deg(rng);
+            const core::Transform pose = test::PlanarTransform(x_m, y_m, yaw_offset_deg) * truth;
             poses.emplace_back(pose, MeasureOverlap(query, match, pose, config.acceptance).Min());
         }
     }

@@ -61,8 +61,8 @@ TEST_P(GridParity, GridMatchesBruteForce) {
     int hits = 0;
     for (int k = 0; k < 800; ++k) {
         // Sensors on the streets (x or y on a street line), rays in every direction.
-        Eigen::Vector3d origin = k % 2 == 0 ? Eigen::Vector3d(along(rng), lane(rng), 0.0)
-                                            : Eigen::Vector3d(lane(rng), along(rng), 0.0);
+        Eigen::Vector3d origin = k % 2 == 0 ? Eigen::Vector3d{along(rng), lane(rng), 0.0}
+                                            : Eigen::Vector3d{lane(rng), along(rng), 0.0};
         origin.z() = world.ground().Height(origin.x(), origin.y()) + 1.5;
         const Ray ray = MakeRay(origin, {unit(rng), unit(rng), 0.4 * unit(rng)});
         const double grid = world.CastRay(ray, 120.0);

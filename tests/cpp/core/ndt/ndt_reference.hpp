@@ -81,7 +81,7 @@ private:
     void Add(const Eigen::Vector3d& p) {
         std::normal_distribution<double> noise(0.0, 0.01);
         cloud_.push_back(
-            (p + Eigen::Vector3d(noise(rng_), noise(rng_), noise(rng_))).cast<float>());
+            (p + Eigen::Vector3d{noise(rng_), noise(rng_), noise(rng_)}).cast<float>());
     }
     // A vertical wall through `centre`, 20 m long and 6 m high, turned by `yaw_rad` about z.
     void Wall(const Eigen::Vector3d& centre, double yaw_rad, int points) {
@@ -101,7 +101,7 @@ private:
     void Bush(const Eigen::Vector3d& centre, int points) {
         std::normal_distribution<double> spread(0.0, 0.4);
         for (int i = 0; i < points; ++i) {
-            Add(centre + Eigen::Vector3d(spread(rng_), spread(rng_), spread(rng_)));
+            Add(centre + Eigen::Vector3d{spread(rng_), spread(rng_), spread(rng_)});
         }
     }
 

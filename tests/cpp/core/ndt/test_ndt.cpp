@@ -115,7 +115,8 @@ PointCloud PlanePoints(const Eigen::Vector3d& normal, int count, unsigned seed) 
     const Eigen::Vector3d b = normal.cross(a);
     PointCloud cloud;
     for (int i = 0; i < count; ++i) {
-        cloud.push_back((Eigen::Vector3d(4, 2, 1) + u(rng) * a + u(rng) * b).cast<float>());
+        const double along_a = u(rng);
+        cloud.push_back((Eigen::Vector3d(4, 2, 1) + along_a * a + u(rng) * b).cast<float>());
     }
     return cloud;
 }
@@ -184,8 +185,8 @@ TEST(NdtClassify, BatchOverColumnsEqualsOneByOne) {
     std::vector<Eigen::Matrix3d> covariances;
     for (int i = 0; i < 3000; ++i) {
         const Eigen::Matrix3d R = RandomRotation(rng);
-        const Eigen::Vector3d lambda(std::pow(10.0, log_scale(rng)), std::pow(10.0, log_scale(rng)),
-                                     std::pow(10.0, log_scale(rng)));
+        const Eigen::Vector3d lambda{std::pow(10.0, log_scale(rng)), std::pow(10.0, log_scale(rng)),
+                                     std::pow(10.0, log_scale(rng))};
         covariances.push_back(R * lambda.asDiagonal() * R.transpose());
     }
     covariances.push_back(Eigen::Matrix3d::Zero());
@@ -466,7 +467,7 @@ TEST(NdtCells, CoincidingPointsAreDegenerateAtAnyDistance) {
     int cells = 0;
     for (int copies : {5, 100, 1000, 3000}) {
         for (int trial = 0; trial < 40; ++trial) {
-            const Eigen::Vector3f p(coordinate(rng), coordinate(rng), coordinate(rng) / 10.0f);
+            const Eigen::Vector3f p{coordinate(rng), coordinate(rng), coordinate(rng) / 10.0f};
             for (const NdtCell& cell : ComputeNdtCells(PointCloud(copies, p), 0.5, 5)) {
                 ++cells;
                 EXPECT_EQ(ClassifyCovariance(cell.covariance_m2, 0.1).shape, CellShape::kDegenerate)
@@ -579,8 +580,8 @@ TEST(Eigen3x3, MatchesEigensIterativeSolverOnRandomCovariances) {
     for (int trial = 0; trial < 2000; ++trial) {
         // Random orientation, eigenvalues spread over 5 decades: planes, lines, blobs.
         const Eigen::Matrix3d R = RandomRotation(rng);
-        const Eigen::Vector3d lambda(std::pow(10.0, log_scale(rng)), std::pow(10.0, log_scale(rng)),
-                                     std::pow(10.0, log_scale(rng)));
+        const Eigen::Vector3d lambda{std::pow(10.0, log_scale(rng)), std::pow(10.0, log_scale(rng)),
+                                     std::pow(10.0, log_scale(rng))};
         const Eigen::Matrix3d a = R * lambda.asDiagonal() * R.transpose();
         Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> reference(a);
         const Eigen::Vector3d expected = reference.eigenvalues().reverse();

@@ -51,7 +51,8 @@ void AddCluster(const Eigen::Vector3d& centre, int count, double spread_deg, std
     const Eigen::Vector3d a = centre.unitOrthogonal();
     const Eigen::Vector3d b = centre.cross(a);
     for (int i = 0; i < count; ++i) {
-        const Eigen::Vector3d v = (centre + angle(rng) * a + angle(rng) * b).normalized();
+        const double along_a = angle(rng);
+        const Eigen::Vector3d v = (centre + along_a * a + angle(rng) * b).normalized();
         lines.Add(flip(rng) ? Eigen::Vector3d(-v) : v);
     }
 }
@@ -59,7 +60,7 @@ void AddCluster(const Eigen::Vector3d& centre, int count, double spread_deg, std
 void AddUniform(int count, std::mt19937& rng, Lines& lines) {
     std::normal_distribution<double> normal(0.0, 1.0);
     for (int i = 0; i < count; ++i) {
-        lines.Add(Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized());
+        lines.Add(Eigen::Vector3d{normal(rng), normal(rng), normal(rng)}.normalized());
     }
 }
 

@@ -44,8 +44,9 @@ void AddPatch(const Patch& patch, double per_m2, unsigned seed, PointCloud& clou
     const Eigen::Vector3d b = n.cross(a);
     const int count = static_cast<int>(per_m2 * 4.0 * patch.half_u * patch.half_v);
     for (int i = 0; i < count; ++i) {
-        const Eigen::Vector3d p =
-            patch.centre + u(rng) * patch.half_u * a + u(rng) * patch.half_v * b + noise(rng) * n;
+        const double along_a = u(rng) * patch.half_u;
+        const double along_b = u(rng) * patch.half_v;
+        const Eigen::Vector3d p = patch.centre + along_a * a + along_b * b + noise(rng) * n;
         cloud.push_back(p.cast<float>());
     }
 }
@@ -312,7 +313,7 @@ TEST(NdtLayout, SphericalSubClassesFollowTheirBand) {
         const double b = a * std::sqrt(ratios[k]);
         for (int i = 0; i < 3000; ++i) {
             cloud.push_back(
-                Eigen::Vector3d(centres_x[k] + a * u(rng), 0.25 + b * u(rng), 0.25 + b * u(rng))
+                Eigen::Vector3d{centres_x[k] + a * u(rng), 0.25 + b * u(rng), 0.25 + b * u(rng)}
                     .cast<float>());
         }
     }

@@ -217,7 +217,8 @@ TEST(HalfSpherePartition, NearestLineMatchesBruteForceDistance) {
     for (int n : {1, 2, 3, 9, 16, 50, 64}) {
         const HalfSpherePartition partition(n);
         for (int s = 0; s < 20000; ++s) {
-            const Eigen::Vector3d d = length(rng) * RandomDirection(rng);
+            const double length_m = length(rng);
+            const Eigen::Vector3d d = length_m * RandomDirection(rng);
             double min_distance = 0.0;
             double gap = 0.0;
             const int expected = BruteForceNearestLine(d, partition.centres(), min_distance, gap);

@@ -85,7 +85,7 @@ PointCloud RandomScan(unsigned seed, std::size_t points) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<float> xy(-100.0f, 100.0f), z(-3.0f, 6.0f);
     PointCloud cloud;
-    for (std::size_t i = 0; i < points; ++i) cloud.emplace_back(xy(rng), xy(rng), z(rng));
+    for (std::size_t i = 0; i < points; ++i) cloud.push_back({xy(rng), xy(rng), z(rng)});
     cloud.emplace_back(0.0f, 0.0f, 1.0f);
     cloud.emplace_back(5.0f, 0.0f, 1.0f);  // on the border of sectors 59 and 0
     return cloud;
@@ -99,7 +99,8 @@ PointCloud PolarScene(unsigned seed, int sectors) {
     std::uniform_int_distribution<int> sector(0, sectors - 1);
     PointCloud cloud;
     for (int i = 0; i < 3000; ++i) {
-        const double azimuth_rad = (sector(rng) + inside(rng)) * 2.0 * std::numbers::pi / sectors;
+        const int whole_sectors = sector(rng);
+        const double azimuth_rad = (whole_sectors + inside(rng)) * 2.0 * std::numbers::pi / sectors;
         const double r = range(rng);
         cloud.emplace_back(static_cast<float>(r * std::cos(azimuth_rad)),
                            static_cast<float>(r * std::sin(azimuth_rad)),
