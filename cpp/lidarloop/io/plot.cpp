@@ -1,8 +1,11 @@
 #include "lidarloop/io/plot.hpp"
 
+#include <spawn.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
@@ -97,22 +100,70 @@ std::string GnuplotScript(const std::filesystem::path& png, const Plot& plot) {
     return script.str();
 }
 
+namespace {
+
+struct GnuplotRun {
+    bool not_installed = false;
+    int status = 0;      // as waitpid gives it
+    std::string output;  // stdout and stderr
+};
+
+// Runs `gnuplot SCRIPT` without a shell: the path is an argument, never shell text, so no
+// character in a user's folder name (a quote, a semicolon) can run a command.
+GnuplotRun RunGnuplot(const std::filesystem::path& png, const std::filesystem::path& script_file) {
+    int fds[2];
+    if (pipe(fds) != 0) throw WriteError(png, "cannot run gnuplot (no pipe)");
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addclose(&actions, fds[0]);
+    posix_spawn_file_actions_adddup2(&actions, fds[1], STDOUT_FILENO);
+    posix_spawn_file_actions_adddup2(&actions, fds[1], STDERR_FILENO);
+    posix_spawn_file_actions_addclose(&actions, fds[1]);
+    // Absolute, so that a path starting with '-' is not read as an option.
+    std::string program = "gnuplot";
+    std::string script = std::filesystem::absolute(script_file).string();
+    char* const argv[] = {program.data(), script.data(), nullptr};
+    pid_t pid = 0;
+    const int spawned = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
+    posix_spawn_file_actions_destroy(&actions);
+    close(fds[1]);
+    GnuplotRun run;
+    if (spawned != 0) {
+        close(fds[0]);
+        if (spawned == ENOENT) {
+            run.not_installed = true;
+            return run;
+        }
+        throw WriteError(png, "cannot run gnuplot");
+    }
+    char buffer[256];
+    for (ssize_t n; (n = read(fds[0], buffer, sizeof(buffer))) != 0;) {
+        if (n > 0) {
+            run.output.append(buffer, static_cast<std::size_t>(n));
+        } else if (errno != EINTR) {
+            break;
+        }
+    }
+    close(fds[0]);
+    while (waitpid(pid, &run.status, 0) < 0) {
+        if (errno != EINTR) throw WriteError(png, "cannot wait for gnuplot");
+    }
+    return run;
+}
+
+}  // namespace
+
 void RenderPlot(const std::filesystem::path& png, const Plot& plot) {
     const std::string script = GnuplotScript(png, plot);
     std::filesystem::path script_file = png;
     script_file.replace_extension(".gp");
     detail::WriteWholeFile(script_file, script);
-    const std::string command = "gnuplot " + std::string("'") + script_file.string() + "' 2>&1";
-    FILE* pipe = popen(command.c_str(), "r");
-    if (pipe == nullptr) throw WriteError(png, "cannot run gnuplot");
-    std::string output;
-    char buffer[256];
-    while (std::fgets(buffer, sizeof(buffer), pipe) != nullptr) output += buffer;
-    const int status = pclose(pipe);
-    if (status != 0) {
-        const bool missing = WIFEXITED(status) && WEXITSTATUS(status) == 127;
-        throw WriteError(png, missing ? "gnuplot is not installed (apt-get install gnuplot-nox)"
-                                      : "gnuplot failed: " + output);
+    const GnuplotRun run = RunGnuplot(png, script_file);
+    if (run.not_installed) {
+        throw WriteError(png, "gnuplot is not installed (apt-get install gnuplot-nox)");
+    }
+    if (!WIFEXITED(run.status) || WEXITSTATUS(run.status) != 0) {
+        throw WriteError(png, "gnuplot failed: " + run.output);
     }
 }
 

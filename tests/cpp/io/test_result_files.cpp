@@ -355,5 +355,23 @@ TEST(Plot, RendersAPngWithGnuplot) {
     EXPECT_THROW(RenderPlot(dir / "no" / "such" / "plot.png", plot), WriteError);
 }
 
+TEST(Plot, AFolderNameIsNeverShellText) {
+    if (!GnuplotAvailable()) GTEST_SKIP() << "gnuplot is not installed (scripts/setup installs it)";
+    test::TempDir dir;
+    // Quotes, a semicolon and $(...): each would end or run shell text were the path in a command.
+    const std::filesystem::path folder = dir / "it's; touch INJECTED; $(touch INJECTED2) '";
+    std::filesystem::create_directories(folder);
+    Plot plot;
+    plot.title = "test";
+    plot.series.push_back({"a", {1, 2, 3}, {3, 1, 2}, PlotSeries::Style::kLines});
+    const std::filesystem::path here = std::filesystem::current_path();
+    std::filesystem::current_path(dir.path());
+    EXPECT_NO_THROW(RenderPlot(folder / "plot.png", plot));
+    std::filesystem::current_path(here);
+    EXPECT_FALSE(std::filesystem::exists(dir / "INJECTED"));
+    EXPECT_FALSE(std::filesystem::exists(dir / "INJECTED2"));
+    EXPECT_EQ(test::ReadFile(folder / "plot.png").substr(0, 4), "\x89PNG");
+}
+
 }  // namespace
 }  // namespace lidarloop::io
