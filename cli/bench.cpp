@@ -25,6 +25,7 @@ struct BenchFlags {
     OdometryOptions odometry;  // the reach, order and gate of the timed verification
     app::BenchRequest request;
     std::string json;
+    const CLI::Option* json_option = nullptr;  // given, even as --json '' (refused)
     bool overwrite = false;
     bool quiet = false;
 };
@@ -124,10 +125,11 @@ void RunBench(BenchFlags& flags) {
     flags.request.odometry_calib = flags.odometry.calib();
     std::vector<std::filesystem::path> inputs = flags.dataset.Inputs();
     for (const auto& input : flags.odometry.Inputs()) inputs.push_back(input);
+    inputs.emplace_back(flags.descriptor.config_file());
     // The file is checked before the run, so that a refused --json costs no measurement.
     const bool json_to_stdout = flags.json == "-";
-    if (!flags.json.empty() && !json_to_stdout)
-        app::CheckOutputFile(flags.json, inputs, flags.overwrite);
+    const bool json_given = flags.json_option->count() > 0;
+    if (json_given && !json_to_stdout) app::CheckOutputFile(flags.json, inputs, flags.overwrite);
     const nlohmann::json figures = app::RunBench(flags.dataset.Open(), flags.request);
     if (json_to_stdout) {
         std::cout << figures.dump(2) << "\n";
@@ -135,7 +137,7 @@ void RunBench(BenchFlags& flags) {
     }
     std::cout.flush();
     PrintSummary(figures);
-    if (!flags.json.empty()) app::WriteOutputJson(flags.json, figures, inputs, flags.overwrite);
+    if (json_given) app::WriteOutputJson(flags.json, figures, inputs, flags.overwrite);
 }
 
 }  // namespace
@@ -157,12 +159,14 @@ void AddBenchCommand(CLI::App& app) {
                           "the timed queries then keep only the scans within its reach, register "
                           "the nearest views first and gate the loops, as the online detector "
                           "with a gate");
-    command->add_option("--json", flags->json,
-                        "also write the figures as JSON to this file (replaced only when "
-                        "lidarloop wrote it, or with --overwrite); '-': JSON to stdout instead of "
-                        "the table");
-    command->add_flag("--overwrite", flags->overwrite,
-                      "let --json replace a file that lidarloop did not write");
+    flags->json_option = command->add_option(
+        "--json", flags->json,
+        "also write the figures as JSON to this file (replaced only when lidarloop wrote it "
+        "and no run folder lists it, or with --overwrite); '-': JSON to stdout instead of the "
+        "table");
+    command->add_flag(
+        "--overwrite", flags->overwrite,
+        "let --json replace a file that lidarloop did not write, or one of a run's results");
     command->add_flag("--quiet", flags->quiet, "no progress bar");
     command->callback([flags] { RunBench(*flags); });
 }

@@ -26,6 +26,8 @@ public:
     io::RunConfig Resolve(io::RunConfig base = {}) const;
     /// The first descriptor flag given on the command line ("--bins", ...), or "" when none.
     std::string FirstGiven() const;
+    /// The --config file ("" when none): an input, never to be replaced by a run's output.
+    const std::string& config_file() const { return config_file_; }
     /// Whether --min or --max was given: they set the value range of one projection.
     bool GivesValueRange() const { return *min_option_ || *max_option_; }
 

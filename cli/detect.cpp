@@ -93,6 +93,7 @@ void PrintOutcome(const io::Dataset& dataset, const app::DetectRequest& request,
 std::vector<std::filesystem::path> Inputs(const DetectFlags& flags) {
     std::vector<std::filesystem::path> inputs = flags.dataset.Inputs();
     inputs.emplace_back(flags.map);
+    inputs.emplace_back(flags.descriptor.config_file());
     for (const auto& input : flags.odometry.Inputs()) inputs.push_back(input);
     return inputs;
 }

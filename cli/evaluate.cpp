@@ -114,6 +114,7 @@ std::vector<std::filesystem::path> Inputs(const EvaluateFlags& flags) {
     inputs.insert(inputs.end(), flags.results.begin(), flags.results.end());
     inputs.emplace_back(flags.train_on);
     inputs.emplace_back(flags.train_poses);
+    inputs.emplace_back(flags.descriptor.config_file());
     for (const auto& input : flags.odometry.Inputs()) inputs.push_back(input);
     return inputs;
 }

@@ -72,6 +72,7 @@ std::vector<std::filesystem::path> Inputs(const OptimiseFlags& flags) {
     std::vector<std::filesystem::path> inputs = flags.dataset.Inputs();
     for (const auto& input : flags.odometry.Inputs()) inputs.push_back(input);
     inputs.emplace_back(flags.loops);
+    inputs.emplace_back(flags.descriptor.config_file());
     return inputs;
 }
 

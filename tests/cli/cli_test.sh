@@ -759,6 +759,14 @@ section_results_folders() {
         --out "$res"
     expect_error "detect into its map's folder" "holds the input $res/database.lldb" "$cli" \
         detect "$seq" --map "$res/database.lldb" --quiet --out "$res"
+    # The config a run wrote, edited and given back, is an input: never replaced by the rerun.
+    echo "# my edits" >>"$res/config.yaml"
+    expect_error "detect with its --config inside --out" "holds the input $res/config.yaml" \
+        "$cli" detect "$seq" --config "$res/config.yaml" --quiet --out "$res"
+    expect_error "bench --json onto its --config" "is an input of this run" "$cli" bench "$seq" \
+        --config "$res/config.yaml" --queries 2 --verify-queries 0 --quiet \
+        --json "$res/config.yaml"
+    if grep -q "# my edits" "$res/config.yaml"; then pass; else fail "detect replaced --config"; fi
     expect_intact "inputs inside --out" "${detected[@]}"
     # A rerun that fails on a truncated scan leaves the earlier results.
     head -c 100 "$samples/corner_a.bin" >"$seq/scan3.bin"
@@ -790,6 +798,12 @@ section_results_folders() {
     expect_error "bench --json onto a foreign file" "give --overwrite" "$cli" bench "$seq" \
         --queries 2 --verify-queries 0 --quiet --json "$work/mine.json"
     if grep -q "my figures" "$work/mine.json"; then pass; else fail "bench replaced mine.json"; fi
+    cp "$res/run.json" "$work/run.json.copy"
+    expect_error "bench --json onto a run's record" "belongs to the results of \`lidarloop detect\`" \
+        "$cli" bench "$seq" --queries 2 --verify-queries 0 --quiet --json "$res/run.json"
+    if cmp -s "$res/run.json" "$work/run.json.copy"; then pass; else fail "bench replaced run.json"; fi
+    expect_error "bench --json ''" "empty file name" "$cli" bench "$seq" --queries 2 \
+        --verify-queries 0 --quiet --json ""
     expect_ok "bench --json" "online step" "$cli" bench "$seq" --queries 2 \
         --verify-queries 0 --quiet --json "$work/bench.json"
     if grep -q '"ns_per_comparison_one_core"' "$work/bench.json"; then pass; else

@@ -162,6 +162,20 @@ bool IsLidarloopJson(const fs::path& file) {
     return json.is_object() && json.value("tool", "") == "lidarloop";
 }
 
+// A file of a lidarloop run folder (one its run.json lists, or run.json itself) is part of that
+// run's record: replaced alone, the folder would describe results it no longer holds.
+void RefuseRunFolderFile(const fs::path& file) {
+    const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
+    const std::optional<io::RunRecord> record = io::ReadRunRecord(folder);
+    const std::string name = file.filename().string();
+    if (!record || (name != io::kRunRecordName && !Contains(record->files, name))) return;
+    const std::string owner = record->command.empty()
+                                  ? "a lidarloop " + io::ToString(record->kind)
+                                  : "the results of `lidarloop " + record->command + "`";
+    throw io::WriteError(file, "belongs to " + owner + " in " + folder.string() +
+                                   "; choose another file, or give --overwrite to replace it");
+}
+
 std::mutex active_mutex;
 RunFolder* active_folder = nullptr;  // guarded by active_mutex
 
@@ -315,11 +329,14 @@ void RunFolder::Abandon(RunStatus status, const std::string& message) noexcept {
 }
 
 // An earlier run's results stay as they were, run.json included; only a folder without results
-// gets a run.json that says how this run ended.
+// gets a run.json that says how this run ended: one that lidarloop's failed runs alone wrote
+// into, or one that is empty. A folder of the user's (--overwrite) keeps its own run.json, and a
+// dataset without a run.json is not marked unfinished by a run that never wrote into it.
 void RunFolder::RecordFailure(RunStatus status, const std::string& message) noexcept {
     try {
         const std::optional<io::RunRecord> earlier = io::ReadRunRecord(folder_);
         if (earlier && !earlier->files.empty()) return;
+        if (!earlier && !HoldsOnlyLeftovers(folder_)) return;
         WriteManifest(status, {}, message);
     } catch (const std::exception&) {  // the first error is the one to report
     }
@@ -391,9 +408,11 @@ void WriteFileAtomically(const fs::path& file, const std::string& text) {
 }
 
 void CheckOutputFile(const fs::path& file, const std::vector<fs::path>& inputs, bool overwrite) {
+    if (file.empty()) throw io::WriteError(file, "is an empty file name");
     RefuseInputOverlap(file, inputs);
     std::error_code ec;
     if (fs::is_directory(file, ec)) throw io::WriteError(file, "is a folder, not a file");
+    if (!overwrite) RefuseRunFolderFile(file);
     if (fs::exists(file, ec) && !overwrite && !IsLidarloopJson(file) && !io::IsLidarloopPly(file)) {
         throw io::WriteError(file,
                              "exists and is not a JSON or PLY file that lidarloop wrote; choose "

@@ -335,9 +335,25 @@ TEST(RunFolder, AnUnlistedFolderOfTheSameNameIsNeverReplaced) {
     EXPECT_THROW(run(), io::WriteError);
     EXPECT_EQ(test::ReadFile(out / "velodyne" / "notes.txt"), "mine");
     EXPECT_EQ(test::ReadFile(out / "poses.txt"), "my poses");
+    // No failure record either: a run.json saying "failed" would make every reader refuse the
+    // user's sequence as unfinished.
+    EXPECT_FALSE(fs::exists(out / "run.json"));
     fs::remove(out / "velodyne" / "notes.txt");
     EXPECT_NO_THROW(run());
     EXPECT_EQ(test::ReadFile(out / "poses.txt"), "simulated");
+}
+
+// A failed run into a folder of the user's (--overwrite) keeps the user's own run.json.
+TEST(RunFolder, AFailedRunKeepsTheUsersOwnRunJson) {
+    test::TempDir dir;
+    const fs::path out = dir / "mine";
+    fs::create_directories(out);
+    test::WriteFile(out / "run.json", R"({"my": "experiment"})");
+    EXPECT_THROW(RunInFolder(out, CommandRun("detect", /*overwrite=*/true),
+                             [](const fs::path&) -> int { throw io::WriteError("x", "failed"); }),
+                 io::WriteError);
+    EXPECT_EQ(test::ReadFile(out / "run.json"), R"({"my": "experiment"})");
+    EXPECT_EQ(Entries(out), std::vector<std::string>{"run.json"});
 }
 
 // A run.json whose fields have the wrong types is no record, not a crash.
@@ -393,6 +409,28 @@ TEST(WriteOutputJson, ReplacesOnlyWhatLidarloopWroteAndNothingInsideAnInput) {
     EXPECT_EQ(test::ReadFile(notes), R"({"mine": true})");
     WriteOutputJson(notes, {{"a", 1}}, {}, /*overwrite=*/true);
     EXPECT_EQ(nlohmann::json::parse(test::ReadFile(notes))["a"], 1);
+}
+
+// A file of a run folder belongs to that run: bench --json over its run.json (or map --out over
+// an optimise folder's map) would leave the folder describing results it no longer holds.
+TEST(WriteOutputJson, AFileOfARunFolderIsReplacedOnlyWhenToldTo) {
+    test::TempDir dir;
+    const fs::path out = dir / "results";
+    RunInFolder(out, CommandRun("detect"), [](const fs::path& staging) {
+        test::WriteFile(staging / "figures.json", R"({"tool": "lidarloop"})");
+        return 0;
+    });
+    const std::string record = test::ReadFile(out / "run.json");
+    for (const fs::path& file : {out / "run.json", out / "figures.json"}) {
+        EXPECT_THROW(WriteOutputJson(file, {{"a", 1}}, {}, false), io::WriteError) << file;
+    }
+    EXPECT_EQ(test::ReadFile(out / "run.json"), record);
+    EXPECT_EQ(test::ReadFile(out / "figures.json"), R"({"tool": "lidarloop"})");
+    WriteOutputJson(out / "bench.json", {{"a", 1}}, {}, false);  // not the run's: a new file
+    WriteOutputJson(out / "bench.json", {{"a", 2}}, {}, false);  // and its own to replace
+    WriteOutputJson(out / "figures.json", {{"a", 1}}, {}, /*overwrite=*/true);
+    EXPECT_EQ(nlohmann::json::parse(test::ReadFile(out / "figures.json"))["a"], 1);
+    EXPECT_THROW(WriteOutputJson("", {{"a", 1}}, {}, true), io::WriteError);
 }
 
 TEST(RunInFolder, ReturnsWhatTheRunReturnsAndLeavesOnlyRunJsonWhenItThrows) {
