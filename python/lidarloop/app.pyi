@@ -140,6 +140,9 @@ class EvaluateResult:
     @property
     def notes(self) -> list[str]: ...
     @property
+    def skipped(self) -> list[str]:
+        """'scan 17: <reason>' per scan that could not be read (skip_bad=True)."""
+    @property
     def metrics(self) -> dict[str, Any]:
         """The whole metrics.json."""
 

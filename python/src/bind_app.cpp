@@ -385,6 +385,9 @@ void BindEvaluate(py::module_& m) {
             "name -> MethodEvaluation, in the order evaluated")
         .def_property_readonly("notes", [](const EvaluateResult& r) { return r.outcome.notes; })
         .def_property_readonly(
+            "skipped", [](const EvaluateResult& r) { return r.outcome.skipped; },
+            "'scan 17: <reason>' per scan that could not be read (skip_bad=True)")
+        .def_property_readonly(
             "metrics",
             [](const EvaluateResult& r) {
                 return JsonToPython(app::EvaluationMetricsJson(r.dataset, r.scans, r.outcome));

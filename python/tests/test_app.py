@@ -3,6 +3,7 @@
 a results folder."""
 
 import json
+import shutil
 import subprocess
 
 import numpy as np
@@ -135,6 +136,19 @@ def test_evaluate_matches_the_cli(cli, sequence, tmp_path):
     assert result.truth.overlapping_count == 53  # as printed, with the default 50 m path rule
     for name in ("metrics.json", "roc.csv", "pr.csv", "report.md", "config.yaml"):
         assert (tmp_path / "py" / name).is_file(), name
+
+
+def test_evaluate_reports_the_scans_it_could_not_read(sequence, tmp_path):
+    copy = tmp_path / "copy"
+    shutil.copytree(sequence, copy)
+    scan = copy / "velodyne" / "000005.bin"
+    scan.write_bytes(scan.read_bytes()[:1000])
+    result = lidarloop.evaluate(copy, out=tmp_path / "eval", methods=["height"], verify=False,
+                                skip_bad=True)
+    assert len(result.skipped) == 1 and result.skipped[0].startswith("scan 5: ")
+    assert result.metrics["skipped_scans"] == 1
+    assert "000005.bin" in (tmp_path / "eval" / "skipped.txt").read_text()
+    assert any("1 scan could not be read" in note for note in result.notes)
 
 
 def test_evaluate_with_odometry_verifies_submaps_as_the_cli(cli, sequence, tmp_path):

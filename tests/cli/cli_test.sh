@@ -525,6 +525,18 @@ section_evaluate() {
     printf 'query,match,distance\n1,999,0.1\n' >"$work/far.csv"
     expect_error "evaluate results beyond" "names a scan beyond the 320" "$cli" evaluate \
         "$demo_seq" --no-verify --method height --results "$work/far.csv" --quiet --out "$work/e4"
+    # A scan evaluate cannot read is reported, as detect reports it: never a silent gap.
+    local small="$work/small"
+    "$cli" simulate --scans 40 --sensor vlp16 --horizontal-steps 200 --quiet --out "$small" \
+        >/dev/null
+    head -c 1000 "$small/velodyne/000005.bin" >"$work/short.bin"
+    mv "$work/short.bin" "$small/velodyne/000005.bin"
+    expect_ok "evaluate --skip-bad" "1 scan could not be read (skipped.txt)" "$cli" evaluate \
+        "$small" --skip-bad --no-verify --method height --quiet --out "$work/e_skip"
+    if grep -q "000005.bin" "$work/e_skip/skipped.txt" &&
+        grep -q '"skipped_scans": 1' "$work/e_skip/metrics.json"; then pass; else
+        fail "evaluate --skip-bad wrote no skipped.txt or skipped_scans"
+    fi
 }
 
 # --- dump-config and --config ----------------------------------------------------------------

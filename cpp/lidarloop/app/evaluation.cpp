@@ -265,6 +265,7 @@ MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method m
     const double comparisons_s = keep_matrix ? matrix_s : streamed_clock.Seconds() / 2.0;
     const double pairs = static_cast<double>(eval::CondensedSize(database.size()));
     e.describe_ms_per_scan_median = 1e3 * Quantile(described.describe_seconds, 0.5);
+    e.skipped = described.skipped;
     e.ns_per_comparison = pairs > 0 ? 1e9 * comparisons_s / pairs : 0.0;
     e.matrix = std::move(matrix);
     const PreparedScans* prepared = verification.prepared ? &*verification.prepared : nullptr;
@@ -296,6 +297,17 @@ MethodEvaluation EvaluateResults(const EvaluationRequest& request, const std::st
                          request.fixed_thresholds, std::nullopt, request.progress);
     e.matrix = std::move(matrix);
     return e;
+}
+
+// Every method reads the same files, so the first one's skipped scans are all of them.
+void NoteSkippedScans(const std::filesystem::path& out_dir, EvaluationOutcome& outcome) {
+    if (outcome.methods.empty() || outcome.methods.front().skipped.empty()) return;
+    outcome.skipped = outcome.methods.front().skipped;
+    WriteSkipped(out_dir, outcome.skipped);
+    const std::size_t count = outcome.skipped.size();
+    outcome.notes.push_back(std::to_string(count) + (count == 1 ? " scan" : " scans") +
+                            " could not be read (skipped.txt): each stands in as a scan that "
+                            "matches nothing, so its revisits count as missed");
 }
 
 void WriteEvaluationResults(const std::filesystem::path& out_dir, const io::Dataset& dataset,
@@ -465,7 +477,7 @@ EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequ
     if (train_dataset != nullptr)
         RequirePoses(*train_dataset, "threshold learning", "--train-poses");
     EvaluationOutcome outcome{
-        eval::BuildGroundTruth(dataset.poses(), GroundTruthRule(request)), {}, {}};
+        eval::BuildGroundTruth(dataset.poses(), GroundTruthRule(request)), {}, {}, {}};
     const std::vector<core::StampedPose> odometry =
         ReadOdometryIfGiven(request.odometry_file, request.odometry_topic, dataset,
                             request.config.posegraph.max_odometry_step_m, request.odometry_calib);
@@ -500,6 +512,7 @@ EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequ
     for (const std::string& file : request.results_files) {
         outcome.methods.push_back(EvaluateResults(request, file, dataset.size(), outcome.truth));
     }
+    NoteSkippedScans(out_dir, outcome);
     WriteEvaluationResults(out_dir, dataset, outcome);
     return outcome;
 }

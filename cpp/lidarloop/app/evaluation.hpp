@@ -47,6 +47,9 @@ struct MethodEvaluation {
     std::optional<RetrievalComparison> retrieval;
     double describe_ms_per_scan_median = 0.0;
     double ns_per_comparison = 0.0;
+    /// "scan 17: <reason>" per scan that could not be read (EvaluationRequest::skip_bad): it
+    /// stands in as a scan that matches nothing.
+    std::vector<std::string> skipped;
 };
 
 /// Scored pairs of another dataset to learn the threshold on (Röhling table I: learnt on one
@@ -122,7 +125,8 @@ struct EvaluationRequest {
 struct EvaluationOutcome {
     eval::GroundTruth truth;
     std::vector<MethodEvaluation> methods;
-    std::vector<std::string> notes;  ///< figures that could not be drawn
+    std::vector<std::string> notes;    ///< figures that could not be drawn
+    std::vector<std::string> skipped;  ///< the scans no method could read (skipped.txt)
 };
 
 /// The ground-truth rule of `request`: its distance, heading, minimum path and the config's

@@ -148,6 +148,7 @@ nlohmann::json EvaluationMetricsJson(const std::string& dataset, std::size_t sca
     nlohmann::json metrics;
     metrics["dataset"] = dataset;
     metrics["scans"] = scans;
+    metrics["skipped_scans"] = outcome.skipped.size();
     metrics["ground_truth"] = {{"rule", truth.Describe()},
                                {"distance_m", truth.config.distance_m},
                                {"max_heading_deg", truth.config.max_heading_deg},

@@ -95,7 +95,7 @@ std::vector<RunOption> MakeRunOptions() {
          },
          [] { return std::string(io::RunConfig{}.detection.stop_at_first_loop ? "stop" : "all"); }},
         {"skip_bad", "--skip-bad", "", T::kSwitch,
-         "skip unreadable scans instead of stopping (detect lists them in skipped.txt)",
+         "skip unreadable scans instead of stopping (listed in skipped.txt)",
          "the request's skip_bad", kRunning,
          [](const RunTargets& t, const RunOptionValue& v) {
              if (t.skip_bad != nullptr) *t.skip_bad = std::get<bool>(v);
