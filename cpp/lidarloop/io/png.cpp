@@ -67,7 +67,8 @@ void WritePng(const std::filesystem::path& file, const Image& image) {
     const bool written = info != nullptr && WriteRows(png, info, out.get(), image);
     png_destroy_write_struct(&png, &info);
     if (!written) throw WriteError(file, std::string("PNG: ") + error.message);
-    if (std::fflush(out.get()) != 0) throw WriteError(file, "writing the PNG failed");
+    // fclose writes what fflush left and reports a full disk or a lost network file system.
+    if (std::fclose(out.release()) != 0) throw WriteError(file, "writing the PNG failed");
 }
 
 }  // namespace lidarloop::io
