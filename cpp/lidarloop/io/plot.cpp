@@ -1,5 +1,6 @@
 #include "lidarloop/io/plot.hpp"
 
+#include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -111,14 +112,14 @@ struct GnuplotRun {
 // Runs `gnuplot SCRIPT` without a shell: the path is an argument, never shell text, so no
 // character in a user's folder name (a quote, a semicolon) can run a command.
 GnuplotRun RunGnuplot(const std::filesystem::path& png, const std::filesystem::path& script_file) {
+    // Close-on-exec: a gnuplot started by another thread meanwhile must not hold this pipe open
+    // (the read below would wait for it); the child's dup2 copies are not close-on-exec.
     int fds[2];
-    if (pipe(fds) != 0) throw WriteError(png, "cannot run gnuplot (no pipe)");
+    if (pipe2(fds, O_CLOEXEC) != 0) throw WriteError(png, "cannot run gnuplot (no pipe)");
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addclose(&actions, fds[0]);
     posix_spawn_file_actions_adddup2(&actions, fds[1], STDOUT_FILENO);
     posix_spawn_file_actions_adddup2(&actions, fds[1], STDERR_FILENO);
-    posix_spawn_file_actions_addclose(&actions, fds[1]);
     // Absolute, so that a path starting with '-' is not read as an option.
     std::string program = "gnuplot";
     std::string script = std::filesystem::absolute(script_file).string();
