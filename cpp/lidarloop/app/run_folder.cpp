@@ -21,6 +21,10 @@ namespace {
 
 constexpr char kStagingPrefix[] = ".lidarloop-staging-";
 constexpr char kEarlierPrefix[] = ".lidarloop-earlier-";
+// In an earlier-files folder: the names a run moves in, written once the earlier files are aside.
+constexpr char kIncomingName[] = ".lidarloop-incoming";
+// The run.json key naming the earlier-files folder of the run that wrote it.
+constexpr char kEarlierFolderKey[] = "earlier_folder";
 
 std::string UtcNow() {
     const std::time_t now = std::time(nullptr);
@@ -84,13 +88,54 @@ bool BelongsToLiveProcess(const fs::path& entry) {
     return pid > 0 && (::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM);
 }
 
-// Removes what killed runs left: their staging folders (half-written results) and folders of
-// earlier files they had moved aside but not yet deleted.
+std::vector<std::string> ListNames(const fs::path& folder) {
+    std::vector<std::string> names;
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(folder, ec))
+        names.push_back(entry.path().filename().string());
+    if (ec) throw io::WriteError(folder, "cannot list (" + ec.message() + ")");
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+// Whether the folder's run.json was written by the run that moved the earlier files into
+// `aside`: then that run completed, and `aside` holds only what it replaced.
+bool RunJsonNames(const fs::path& folder, const fs::path& aside) {
+    std::ifstream in(folder / io::kRunRecordName);
+    const nlohmann::json json = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+    if (!json.is_object()) return false;
+    const auto named = json.find(kEarlierFolderKey);
+    return named != json.end() && named->is_string() &&
+           named->get<std::string>() == aside.filename().string();
+}
+
+// A run killed after moving the earlier files aside and before writing its run.json leaves the
+// only copy of the earlier results in `aside`: they go back, and the files it had moved in go
+// (each name it moved in either replaced an earlier file, now in `aside`, or was new).
+void RestoreUnlessCompleted(const fs::path& folder, const fs::path& aside) {
+    if (RunJsonNames(folder, aside)) return;
+    std::error_code ec;
+    std::ifstream incoming(aside / kIncomingName);
+    for (std::string name; std::getline(incoming, name);) {
+        if (!name.empty() && !fs::exists(aside / name, ec)) fs::remove_all(folder / name, ec);
+    }
+    for (const std::string& name : ListNames(aside)) {
+        if (name == kIncomingName) continue;
+        fs::remove_all(folder / name, ec);
+        fs::rename(aside / name, folder / name, ec);
+        if (ec) throw io::WriteError(aside / name, "cannot move back (" + ec.message() + ")");
+    }
+}
+
+// Removes what killed runs left: their staging folders (half-written results), and folders of
+// earlier files they had moved aside, put back first unless the run had completed.
 void RemoveLeftovers(const fs::path& folder) {
     std::error_code ec;
-    for (const auto& entry : fs::directory_iterator(folder, ec)) {
-        if (IsWorkFolder(entry.path()) && !BelongsToLiveProcess(entry.path()))
-            fs::remove_all(entry.path(), ec);
+    for (const std::string& name : ListNames(folder)) {
+        const fs::path entry = folder / name;
+        if (!IsWorkFolder(entry) || BelongsToLiveProcess(entry)) continue;
+        if (name.rfind(kEarlierPrefix, 0) == 0) RestoreUnlessCompleted(folder, entry);
+        fs::remove_all(entry, ec);
     }
 }
 
@@ -133,16 +178,6 @@ void RefuseForeignFolder(const fs::path& folder, const std::optional<io::RunReco
 std::string UniqueSuffix() {
     static std::atomic<unsigned> count{0};
     return std::to_string(::getpid()) + "-" + std::to_string(count++);
-}
-
-std::vector<std::string> ListNames(const fs::path& folder) {
-    std::vector<std::string> names;
-    std::error_code ec;
-    for (const auto& entry : fs::directory_iterator(folder, ec))
-        names.push_back(entry.path().filename().string());
-    if (ec) throw io::WriteError(folder, "cannot list the staged files (" + ec.message() + ")");
-    std::sort(names.begin(), names.end());
-    return names;
 }
 
 bool Contains(const std::vector<std::string>& names, const std::string& name) {
@@ -196,7 +231,13 @@ public:
         }
     }
 
+    // The names go into `aside` first: a run killed from here on is undone by the next run into
+    // the folder (RestoreUnlessCompleted).
     void MoveIn(const std::vector<std::string>& names) {
+        std::ofstream incoming(aside_ / kIncomingName);
+        for (const std::string& name : names) incoming << name << '\n';
+        incoming.close();
+        if (!incoming) throw io::WriteError(aside_ / kIncomingName, "writing failed");
         for (const std::string& name : names) {
             Rename(staging_ / name, folder_ / name);
             in_names_.push_back(name);
@@ -302,14 +343,16 @@ std::vector<std::string> RunFolder::Complete() {
     const std::lock_guard<std::mutex> lock(mutex_);
     if (finished_) throw io::WriteError(folder_, "the run was already abandoned");
     finished_ = true;
-    FolderSwap swap(folder_, staging_, folder_ / (kEarlierPrefix + UniqueSuffix()));
+    const fs::path aside = folder_ / (kEarlierPrefix + UniqueSuffix());
+    FolderSwap swap(folder_, staging_, aside);
     std::vector<std::string> files;
     try {
         files = ListNames(staging_);
         swap.MoveAside(FilesToReplace(folder_, files, info_.overwrite));
         swap.MoveIn(files);
         // run.json is renamed into place last: until then the earlier one describes the folder.
-        WriteManifest(RunStatus::kComplete, files, "");
+        // It names `aside`, which tells the next run that this swap completed.
+        WriteManifest(RunStatus::kComplete, files, "", aside.filename().string());
     } catch (const io::WriteError& e) {
         swap.Undo();
         RecordFailure(RunStatus::kFailed, e.what());
@@ -365,7 +408,7 @@ fs::path AbandonActiveRun(RunStatus status, const std::string& message) noexcept
 }
 
 void RunFolder::WriteManifest(RunStatus status, const std::vector<std::string>& files,
-                              const std::string& message) const {
+                              const std::string& message, const std::string& earlier_folder) const {
     nlohmann::json json;
     json["tool"] = "lidarloop";
     json["version"] = LIDARLOOP_VERSION;
@@ -377,6 +420,7 @@ void RunFolder::WriteManifest(RunStatus status, const std::vector<std::string>& 
     json["ended"] = UtcNow();
     json["files"] = files;
     if (!message.empty()) json["message"] = message;
+    if (!earlier_folder.empty()) json[kEarlierFolderKey] = earlier_folder;
     WriteFileAtomically(folder_ / io::kRunRecordName, json.dump(2) + "\n");
 }
 

@@ -78,7 +78,7 @@ public:
 private:
     void SwapIn(const std::vector<std::string>& staged);
     void WriteManifest(RunStatus status, const std::vector<std::string>& files,
-                       const std::string& message) const;
+                       const std::string& message, const std::string& earlier_folder = "") const;
     void RecordFailure(RunStatus status, const std::string& message) noexcept;
 
     std::filesystem::path folder_;

@@ -383,6 +383,62 @@ TEST(RunFolder, LeftoversOfKilledRunsAreRemoved) {
     EXPECT_TRUE(fs::exists(live));
 }
 
+// A run killed in the middle of its swap (SIGKILL, a power cut) left the only copy of the earlier
+// results in its earlier-files folder: the next run into the folder puts them back, and removes
+// what the killed run had moved in, even when that next run is then refused.
+TEST(RunFolder, AKilledSwapIsUndoneByTheNextRun) {
+    test::TempDir dir;
+    const fs::path out = dir / "results";
+    WriteDetectResults(out);  // loops.csv "first", database.lldb "map"
+    const std::string record = test::ReadFile(out / "run.json");
+    const fs::path aside = out / ".lidarloop-earlier-2147483000-0";  // no such process
+    // Killed while moving in: both earlier files aside, one new file in.
+    fs::create_directories(aside);
+    fs::rename(out / "loops.csv", aside / "loops.csv");
+    fs::rename(out / "database.lldb", aside / "database.lldb");
+    test::WriteFile(aside / ".lidarloop-incoming", "loops.csv\nnew.txt\n");
+    test::WriteFile(out / "loops.csv", "second");
+    test::WriteFile(out / "new.txt", "new");
+    RunInfo simulate;  // refused: a sequence over results
+    simulate.kind = io::RunKind::kDataset;
+    EXPECT_THROW(RunFolder(out, simulate), io::WriteError);
+    EXPECT_EQ(test::ReadFile(out / "loops.csv"), "first");
+    EXPECT_EQ(test::ReadFile(out / "database.lldb"), "map");
+    EXPECT_EQ(test::ReadFile(out / "run.json"), record);
+    EXPECT_EQ(Entries(out), (std::vector<std::string>{"database.lldb", "loops.csv", "run.json"}));
+    // Killed while moving aside: nothing moved in yet, no list of incoming names.
+    fs::create_directories(aside);
+    fs::rename(out / "loops.csv", aside / "loops.csv");
+    EXPECT_THROW(RunFolder(out, simulate), io::WriteError);
+    EXPECT_EQ(test::ReadFile(out / "loops.csv"), "first");
+    EXPECT_EQ(Entries(out), (std::vector<std::string>{"database.lldb", "loops.csv", "run.json"}));
+}
+
+// Killed after its run.json was written, a run had completed: what it moved aside is only what
+// it replaced, and is removed, not put back.
+TEST(RunFolder, AKilledCompletedSwapIsNotUndone) {
+    test::TempDir dir;
+    const fs::path out = dir / "results";
+    WriteDetectResults(out);
+    RunInFolder(out, {}, [](const fs::path& staging) {
+        test::WriteFile(staging / "loops.csv", "second");
+        return 0;
+    });
+    const std::string aside_name = Manifest(out)["earlier_folder"].get<std::string>();
+    ASSERT_EQ(aside_name.rfind(".lidarloop-earlier-" + std::to_string(::getpid()), 0), 0u);
+    // The same state as if killed before removing it, under a dead process's name.
+    const fs::path aside = out / ".lidarloop-earlier-2147483000-0";
+    nlohmann::json manifest = Manifest(out);
+    manifest["earlier_folder"] = aside.filename().string();
+    test::WriteFile(out / "run.json", manifest.dump(2));
+    fs::create_directories(aside);
+    test::WriteFile(aside / "loops.csv", "first");
+    test::WriteFile(aside / ".lidarloop-incoming", "loops.csv\n");
+    RunFolder next(out, {});
+    EXPECT_FALSE(fs::exists(aside));
+    EXPECT_EQ(test::ReadFile(out / "loops.csv"), "second");
+}
+
 // Issue 25 (5): bench --json must not replace the ground truth or a scan of the dataset.
 TEST(WriteOutputJson, ReplacesOnlyWhatLidarloopWroteAndNothingInsideAnInput) {
     test::TempDir dir;
