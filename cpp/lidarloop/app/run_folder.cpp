@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <cstring>
 #include <ctime>
 #include <fstream>
 #include <optional>
@@ -445,6 +446,10 @@ void WriteFileAtomically(const fs::path& file,
 void WriteFileAtomically(const fs::path& file, const std::string& text) {
     WriteFileAtomically(file, [&](const fs::path& temporary) {
         std::ofstream out(temporary, std::ios::binary);
+        if (!out) {
+            throw io::WriteError(
+                file, "cannot create a file beside it (" + std::string(std::strerror(errno)) + ")");
+        }
         out << text;
         out.close();
         if (!out) throw io::WriteError(file, "writing failed (disk full?)");
@@ -456,6 +461,12 @@ void CheckOutputFile(const fs::path& file, const std::vector<fs::path>& inputs, 
     RefuseInputOverlap(file, inputs);
     std::error_code ec;
     if (fs::is_directory(file, ec)) throw io::WriteError(file, "is a folder, not a file");
+    // Checked before the run, so that a folder that cannot take the file costs no measurement.
+    const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
+    if (fs::is_directory(folder, ec) && ::access(folder.c_str(), W_OK) != 0) {
+        throw io::WriteError(file, "cannot be written: its folder is not writable (" +
+                                       std::string(std::strerror(errno)) + ")");
+    }
     if (!overwrite) RefuseRunFolderFile(file);
     if (fs::exists(file, ec) && !overwrite && !IsLidarloopJson(file) && !io::IsLidarloopPly(file)) {
         throw io::WriteError(file,

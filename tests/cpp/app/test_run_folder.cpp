@@ -489,6 +489,18 @@ TEST(WriteOutputJson, AFileOfARunFolderIsReplacedOnlyWhenToldTo) {
     EXPECT_THROW(WriteOutputJson("", {{"a", 1}}, {}, true), io::WriteError);
 }
 
+// bench checks its --json file before measuring: a folder it cannot write into is an error then.
+TEST(WriteOutputJson, AReadOnlyFolderIsRefusedBeforeTheRun) {
+    if (::geteuid() == 0) GTEST_SKIP() << "root may write into a read-only folder";
+    test::TempDir dir;
+    const fs::path folder = dir / "read_only";
+    fs::create_directories(folder);
+    fs::permissions(folder, fs::perms::owner_read | fs::perms::owner_exec);
+    EXPECT_THROW(CheckOutputFile(folder / "bench.json", {}, false), io::WriteError);
+    fs::permissions(folder, fs::perms::owner_all);
+    EXPECT_NO_THROW(CheckOutputFile(folder / "bench.json", {}, false));
+}
+
 TEST(RunInFolder, ReturnsWhatTheRunReturnsAndLeavesOnlyRunJsonWhenItThrows) {
     test::TempDir dir;
     const int answer = RunInFolder(dir / "ok", {}, [](const fs::path& staging) {
