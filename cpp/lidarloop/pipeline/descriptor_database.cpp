@@ -1,6 +1,8 @@
 #include "lidarloop/pipeline/descriptor_database.hpp"
 
+#include <cmath>
 #include <limits>
+#include <string>
 
 #include "lidarloop/core/error.hpp"
 
@@ -36,6 +38,14 @@ void DescriptorDatabase::CheckMethod(const core::Descriptor& descriptor) const {
     }
 }
 
+// Before anything is stored: a NaN time would make every gap in seconds false.
+void DescriptorDatabase::CheckTime(double time_s) const {
+    if (!std::isfinite(time_s)) {
+        throw core::ConfigError("scan " + std::to_string(size()) + ": time " +
+                                std::to_string(time_s) + " s is not finite");
+    }
+}
+
 std::size_t DescriptorDatabase::Append(double time_s, bool valid) {
     times_s_.push_back(time_s);
     valid_.push_back(valid ? 1 : 0);
@@ -44,11 +54,13 @@ std::size_t DescriptorDatabase::Append(double time_s, bool valid) {
 
 std::size_t DescriptorDatabase::Add(const core::Descriptor& descriptor, double time_s) {
     CheckMethod(descriptor);
+    CheckTime(time_s);
     store_->Add(descriptor);
     return Append(time_s, true);
 }
 
 std::size_t DescriptorDatabase::AddMissing(double time_s) {
+    CheckTime(time_s);
     store_->AddMissing();
     return Append(time_s, false);
 }
@@ -85,7 +97,10 @@ void DescriptorDatabase::Encode(std::size_t i, core::ByteWriter& out) const {
 
 std::size_t DescriptorDatabase::Decode(core::ByteReader& in) {
     const auto time_s = in.Get<double>("scan time");
-    const bool valid = in.Get<std::uint8_t>("valid flag") != 0;
+    if (!std::isfinite(time_s)) in.Fail("scan time is not finite");
+    const auto flag = in.Get<std::uint8_t>("valid flag");
+    if (flag > 1) in.Fail("valid flag is neither 0 nor 1");
+    const bool valid = flag == 1;
     store_->Decode(in, valid);
     return Append(time_s, valid);
 }

@@ -31,9 +31,10 @@ public:
     const DescriptorMethod& definition() const { return *definition_; }
     std::size_t size() const { return times_s_.size(); }
 
-    /// Appends the descriptor of the next scan; its method must be the database's.
+    /// Appends the descriptor of the next scan; its method must be the database's and its time
+    /// finite (else core::ConfigError, nothing stored).
     std::size_t Add(const core::Descriptor& descriptor, double time_s);
-    /// Appends a placeholder for a scan that could not be described.
+    /// Appends a placeholder for a scan that could not be described (time as for Add).
     std::size_t AddMissing(double time_s);
 
     bool IsValid(std::size_t i) const { return valid_[i] != 0; }
@@ -60,6 +61,7 @@ public:
 
 private:
     void CheckMethod(const core::Descriptor& descriptor) const;
+    void CheckTime(double time_s) const;
     std::size_t Append(double time_s, bool valid);
 
     core::DescriptorConfig config_;

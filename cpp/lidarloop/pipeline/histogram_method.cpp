@@ -1,5 +1,8 @@
 #include "lidarloop/pipeline/histogram_method.hpp"
 
+#include <cmath>
+#include <string>
+
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/core/wasserstein.hpp"
 #include "lidarloop/pipeline/histogram_index.hpp"
@@ -66,13 +69,35 @@ public:
     void Encode(std::size_t i, core::ByteWriter& out) const override {
         out.PutArray(rows_.Row(i), static_cast<std::size_t>(rows_.stride()));
     }
-    void Decode(core::ByteReader& in, bool /*valid*/) override {
+    void Decode(core::ByteReader& in, bool valid) override {
         std::vector<float> row(static_cast<std::size_t>(rows_.stride()));
         in.GetArray(row.data(), row.size(), "cumulative histogram");
+        if (const std::string problem = RowProblem(row, valid); !problem.empty()) in.Fail(problem);
         rows_.AddRow(row);
     }
 
 private:
+    // What makes a stored row something MakeRow cannot have written ("" if nothing): a cumulative
+    // mass rises from 0 to 1 (a placeholder is all 0), and the padding after the bins is 0.
+    std::string RowProblem(const std::vector<float>& row, bool valid) const {
+        const auto bins = static_cast<std::size_t>(rows_.bins());
+        float previous = 0.0f;
+        for (std::size_t k = 0; k < bins; ++k) {
+            if (!(row[k] >= previous && row[k] <= 1.0f + kMassTolerance))
+                return "cumulative histogram is not a rising share in [0, 1] at bucket " +
+                       std::to_string(k);
+            previous = row[k];
+        }
+        if (valid && !(std::abs(previous - 1.0f) <= kMassTolerance))
+            return "cumulative histogram does not end at 1";
+        for (std::size_t k = bins; k < row.size(); ++k) {
+            if (row[k] != 0.0f) return "cumulative histogram has values beyond its buckets";
+        }
+        return {};
+    }
+
+    // A float sum of up to a million shares that add up to 1 in double.
+    static constexpr float kMassTolerance = 1e-3f;
     CumulativeHistograms rows_;
 };
 

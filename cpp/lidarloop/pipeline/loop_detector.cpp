@@ -524,6 +524,18 @@ std::optional<double> LoopDetector::PathOf(
 LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_s,
                                 registration::PreparedScan scan,
                                 const std::optional<core::Transform>& T_odom_sensor) {
+    // The gap in seconds counts back in time: within a session, time may not go back (a loaded
+    // map's scans may be of any time).
+    const std::size_t index = database_.size();
+    if (!std::isfinite(time_s)) {
+        throw core::ConfigError("scan " + std::to_string(index) + ": time " +
+                                std::to_string(time_s) + " s is not finite");
+    }
+    if (index > session_start_ && time_s < database_.times_s().back()) {
+        throw core::ConfigError("scan " + std::to_string(index) + ": time " +
+                                std::to_string(time_s) + " s goes back from the scan before (" +
+                                std::to_string(database_.times_s().back()) + " s)");
+    }
     const std::optional<double> query_path_m = PathOf(T_odom_sensor);
     const std::unique_ptr<PreparedQuery> query = database_.Prepare(descriptor);
     const std::size_t query_index = database_.size();

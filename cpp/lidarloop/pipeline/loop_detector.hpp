@@ -262,7 +262,8 @@ public:
     /// of a loop's reach is then no candidate, and the candidates are the nearest views of the
     /// odometry_shortlist best-ranked ones), then stores it. `T_odom_sensor`: the
     /// scan's pose by the odometry, given for every scan or for none. ConfigError for a gap in
-    /// metres without it, for a pose on some scans only, and for a pose that is not finite.
+    /// metres without it, for a pose on some scans only, for a pose that is not finite, and for
+    /// a time that is not finite or earlier than the scan before's in this session.
     LoopQuery Process(const core::PointCloud& scan, double time_s,
                       const std::optional<core::Transform>& T_odom_sensor = std::nullopt);
     /// The same for a scan described (and, for verification, prepared) by the caller; an empty

@@ -20,6 +20,15 @@ void PutNdtSet(core::ByteWriter& out, const core::NdtDescriptorSet& set) {
     }
 }
 
+// Finite, orthonormal and right-handed, to the precision a stored rotation keeps.
+template <typename Matrix>
+bool IsRotation(const Matrix& R) {
+    constexpr double kTolerance = 1e-4;
+    return R.allFinite() &&
+           (R.transpose() * R - Matrix::Identity()).cwiseAbs().maxCoeff() <= kTolerance &&
+           std::abs(R.determinant() - 1.0) <= kTolerance;
+}
+
 core::NdtDescriptorSet GetNdtSet(core::ByteReader& in) {
     core::NdtDescriptorSet set;
     const auto count = in.Get<std::uint32_t>("NDT descriptor count");
@@ -34,6 +43,7 @@ core::NdtDescriptorSet GetNdtSet(core::ByteReader& in) {
         in.GetArray(counts.data(), counts.size(), "NDT counts");
         core::NdtDescriptor f;
         in.GetArray(f.R_aligned_sensor.data(), 9, "NDT rotation");
+        if (!IsRotation(f.R_aligned_sensor)) in.Fail("NDT rotation is not a rotation matrix");
         try {
             core::SetNdtCounts(f, static_cast<int>(rows), static_cast<int>(cols),
                                std::move(counts));

@@ -1,6 +1,7 @@
 #include "lidarloop/pipeline/scancontext_method.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -82,6 +83,8 @@ public:
     void Decode(core::ByteReader& in, bool valid) override {
         std::vector<float> bins(BinCount());
         in.GetArray(bins.data(), bins.size(), "scan context bins");
+        if (!std::all_of(bins.begin(), bins.end(), [](float v) { return std::isfinite(v); }))
+            in.Fail("scan context bins are not all finite");
         if (valid) {
             AddBins(std::move(bins));
         } else {

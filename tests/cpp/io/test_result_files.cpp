@@ -1,3 +1,4 @@
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
@@ -16,6 +17,7 @@
 #include "lidarloop/io/similarity_image.hpp"
 #include "lidarloop/pipeline/loop_detector.hpp"
 #include "lidarloop/pipeline/ndt_method.hpp"
+#include "lidarloop/pipeline/scancontext_method.hpp"
 #include "test_utils.hpp"
 
 namespace lidarloop::io {
@@ -184,6 +186,72 @@ TEST(DatabaseFile, DamagedNdtCountsAreClearErrors) {
     negative.replace(at + 16, 4, std::string(reinterpret_cast<const char*>(&minus_one), 4));
     test::WriteFile(dir / "negative.bin", negative);
     test::ExpectReadError(LoadDatabase, dir / "negative.bin", "finite and non-negative");
+}
+
+// `bytes` with the raw bytes of `value` written at `at`.
+template <typename T>
+std::string Patched(std::string bytes, std::size_t at, T value) {
+    bytes.replace(at, sizeof(T), std::string(reinterpret_cast<const char*>(&value), sizeof(T)));
+    return bytes;
+}
+
+// Where scan 2 (time 1.0 s, valid) begins in a saved SmallDatabase: its time.
+std::size_t ThirdScanAt(const std::string& file) {
+    const std::string time_and_flag = Patched(std::string(9, '\x01'), 0, 1.0);
+    const auto at = file.find(time_and_flag);
+    EXPECT_NE(at, std::string::npos);
+    return at;
+}
+
+// A stored descriptor no method could have written (NaN, a histogram that does not rise from 0
+// to 1, a rotation that is none) is a damaged file: loaded, it crashed the neighbour index or
+// gave other loops without a word.
+TEST(DatabaseFile, ValuesNoDescriptorHasAreClearErrors) {
+    test::TempDir dir;
+    const auto check = [&](const std::string& bytes, const std::string& phrase) {
+        test::WriteFile(dir / "bad.bin", bytes);
+        test::ExpectReadError(LoadDatabase, dir / "bad.bin", phrase);
+    };
+    // 20 buckets: rows of 24 floats, the last 4 padding.
+    core::DescriptorConfig config;
+    config.method = core::Method::kRange;
+    config.histogram.bins = 20;
+    pipeline::DescriptorDatabase database(config);
+    for (unsigned i = 0; i < 4; ++i)
+        database.Add(pipeline::ComputeDescriptor(test::RandomCloud(3000, i, 5.0f), config),
+                     0.5 * i);
+    SaveDatabase(dir / "range.bin", database);
+    const std::string range = test::ReadFile(dir / "range.bin");
+    const std::size_t scan = ThirdScanAt(range);
+    const std::size_t row = scan + 9;
+    check(Patched(range, scan, std::nan("")), "scan time is not finite");
+    check(Patched(range, scan + 8, std::uint8_t{7}), "valid flag is neither 0 nor 1");
+    check(Patched(range, row + 4 * 5, std::nanf("")), "not a rising share in [0, 1] at bucket 5");
+    check(Patched(range, row + 4 * 5, -0.5f), "not a rising share in [0, 1] at bucket 5");
+    check(Patched(range, row + 4 * 5, 1e30f), "not a rising share in [0, 1] at bucket 5");
+    std::string halved = range;
+    for (std::size_t k = 0; k < 20; ++k) {
+        float value = 0.0f;
+        std::memcpy(&value, range.data() + row + 4 * k, 4);
+        halved = Patched(halved, row + 4 * k, 0.5f * value);
+    }
+    check(halved, "does not end at 1");
+    check(Patched(range, row + 4 * 21, 0.25f), "values beyond its buckets");  // padding
+
+    SaveDatabase(dir / "sc.bin", SmallDatabase(pipeline::ScanContextMethod::kMethod));
+    const std::string sc = test::ReadFile(dir / "sc.bin");
+    check(Patched(sc, ThirdScanAt(sc) + 9, std::numeric_limits<float>::infinity()),
+          "scan context bins are not all finite");
+
+    const auto ndt_database = SmallDatabase(core::Method::kNdt);
+    SaveDatabase(dir / "ndt.bin", ndt_database);
+    const std::string ndt = test::ReadFile(dir / "ndt.bin");
+    const core::NdtDescriptor& first = pipeline::NdtSets(ndt_database)->at(0).descriptors[0];
+    const auto at = ndt.find(DescriptorHeaderBytes(first));
+    ASSERT_NE(at, std::string::npos);
+    const std::size_t rotation = at + 16 + 4 * first.counts.size();
+    check(Patched(ndt, rotation, 2.0), "NDT rotation is not a rotation matrix");
+    check(Patched(ndt, rotation + 8, std::nan("")), "NDT rotation is not a rotation matrix");
 }
 
 TEST(Png, WritesAValidFileWithTheRightSize) {

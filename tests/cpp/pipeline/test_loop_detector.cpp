@@ -120,6 +120,28 @@ TEST(LoopDetector, QueryOnlyDoesNotInsertAndSeesEveryScan) {
     EXPECT_EQ(q.candidates.front().distance, 0.0);
 }
 
+// The gap in seconds counts back in time: a NaN time, or one before the scan before's, is an
+// error that stores nothing (a map's scans may be of any time).
+TEST(LoopDetector, ATimeThatIsNaNOrGoesBackIsAnError) {
+    const auto histograms = test::ClusteredHistograms(4, 20, 2, 2);
+    DescriptorDatabase map(HeightConfig(20));
+    map.Add(test::HistogramDescriptor(histograms[0]), 100.0);
+    EXPECT_THROW(map.Add(test::HistogramDescriptor(histograms[1]), std::nan("")),
+                 core::ConfigError);
+    EXPECT_THROW(map.AddMissing(std::numeric_limits<double>::infinity()), core::ConfigError);
+    EXPECT_EQ(map.size(), 1U);
+    LoopDetector detector(std::move(map), Deciding(DetectorConfig{}, 0.01));
+    detector.Process(test::HistogramDescriptor(histograms[1]), 5.0);  // before the map: allowed
+    detector.Process(test::HistogramDescriptor(histograms[2]), 5.0);  // the same time: allowed
+    EXPECT_THROW(detector.Process(test::HistogramDescriptor(histograms[3]), 4.9),
+                 core::ConfigError);
+    EXPECT_THROW(detector.Process(test::HistogramDescriptor(histograms[3]), std::nan("")),
+                 core::ConfigError);
+    EXPECT_EQ(detector.database().size(), 3U);
+    detector.Process(test::HistogramDescriptor(histograms[3]), 6.0);
+    EXPECT_EQ(detector.database().size(), 4U);
+}
+
 TEST(LoopDetector, ALoadedDatabaseNeverOffersAMissingScan) {
     DescriptorDatabase database(HeightConfig(20));
     const auto histograms = test::ClusteredHistograms(30, 20, 3, 4);
