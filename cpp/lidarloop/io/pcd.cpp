@@ -364,6 +364,11 @@ core::PointCloud ReadBinaryData(const std::filesystem::path& file, DataStream& d
                                   " bytes, but " + std::to_string(data.remaining) +
                                   " follow the header");
     }
+    if (*need < data.remaining) {
+        throw ReadError(file, std::to_string(data.remaining - *need) + " bytes follow the " +
+                                  std::to_string(header.points) +
+                                  " points of POINTS: the header's count is wrong");
+    }
     return GatherPoints(ReadDataBytes(file, data, *need), header.points, sources);
 }
 

@@ -316,6 +316,16 @@ core::PointCloud ReadAsciiPly(LineReader& reader, const PlyHeader& header) {
         }
         cloud.push_back(ParseAsciiVertex(reader, detail::SplitFields(line), header, cloud.size()));
     }
+    for (std::size_t e = header.vertex + 1; e < header.elements.size(); ++e) {
+        CheckAsciiCount(reader.file(), header.elements[e], file_size);
+        SkipAsciiElement(reader, header.elements[e]);
+    }
+    // Lines beyond what the header declares: a count that is wrong, so the points read may be
+    // the wrong ones too.
+    while (reader.Next(line)) {
+        if (!detail::SplitFields(line).empty())
+            reader.Fail("more data lines than the header's elements declare");
+    }
     return cloud;
 }
 
@@ -355,6 +365,14 @@ public:
             }
         }
         return cloud;
+    }
+
+    // Bytes beyond what the header declares: a count that is wrong, so the points read may be
+    // the wrong ones too.
+    void RequireEnd() const {
+        if (Remaining() == 0) return;
+        throw ReadError(
+            file_, std::to_string(Remaining()) + " bytes follow the elements the header declares");
     }
 
 private:
@@ -458,7 +476,11 @@ core::PointCloud ReadPly(const std::filesystem::path& file) {
                         ByteOrder(header.encoding));
     // Elements after the vertices are never read.
     for (std::size_t e = 0; e < header.vertex; ++e) binary.SkipElement(header.elements[e]);
-    return binary.ReadVertices(header);
+    core::PointCloud cloud = binary.ReadVertices(header);
+    for (std::size_t e = header.vertex + 1; e < header.elements.size(); ++e)
+        binary.SkipElement(header.elements[e]);
+    binary.RequireEnd();
+    return cloud;
 }
 
 void WritePly(const std::filesystem::path& file, const core::PointCloud& cloud,

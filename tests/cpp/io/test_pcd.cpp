@@ -366,6 +366,14 @@ TEST_F(PcdErrors, TruncatedBinary) {
                     "data truncated: POINTS 100 of 12 bytes need 1200 bytes, but 600 follow");
 }
 
+// As the ASCII reader refuses more lines than POINTS: a wrong count, so maybe the wrong points.
+TEST_F(PcdErrors, MoreBinaryDataThanPoints) {
+    std::size_t header_size = 0;
+    const std::string bytes = Valid(100, PcdEncoding::kBinary, &header_size);
+    ExpectReadError(Write(bytes + std::string(12, '\0')),
+                    "12 bytes follow the 100 points of POINTS: the header's count is wrong");
+}
+
 TEST_F(PcdErrors, TruncatedCompressed) {
     std::size_t header_size = 0;
     const std::string bytes = Valid(1000, PcdEncoding::kBinaryCompressed, &header_size);

@@ -384,6 +384,24 @@ TEST_F(PlyErrors, TruncatedBinaryNamesTheVertex) {
                     "24 bytes (2400 bytes), but 1205 remain");
 }
 
+// More data than the header declares means a wrong count: the points read may be the wrong ones.
+TEST_F(PlyErrors, DataBeyondTheDeclaredElementsIsAnError) {
+    for (const PlyEncoding encoding : {PlyEncoding::kAscii, PlyEncoding::kBinaryLittleEndian}) {
+        const std::string rich = RichFile(encoding);
+        const bool ascii = encoding == PlyEncoding::kAscii;
+        ExpectReadError(Write(rich + (ascii ? "1 2 3\n" : "\x01\x02")),
+                        ascii ? "more data lines than the header's elements declare"
+                              : "2 bytes follow the elements the header declares");
+        std::string fewer = rich;  // the last vertices read as faces, the faces left over
+        ReplaceOnce(fewer, "element vertex 3", "element vertex 2");
+        // Binary: vertex 2's bytes read as a face list count run past the end.
+        ExpectReadError(Write(fewer),
+                        ascii ? "more data lines" : "binary data truncated in 'face' 0 of 2");
+    }
+    // Trailing blank lines are no data.
+    ExpectSameCloud(ReadPly(Write(RichFile(PlyEncoding::kAscii) + "\n  \n")), RichExpected());
+}
+
 TEST_F(PlyErrors, TruncatedInsideAVertexList) {
     std::string text = RichFile(PlyEncoding::kBinaryBigEndian);
     const std::size_t sensors = (1 + 1 + 2 * 4 + 8) + (1 + 1 + 8);
