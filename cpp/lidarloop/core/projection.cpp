@@ -38,6 +38,11 @@ UpVectorMode ParseUpVectorMode(std::string_view name) {
     return ParseEnum(kUpVectorModeNames, name, "up vector mode");
 }
 
+namespace {
+// The second eigenvalue's least share of the scatter's trace for the points to span a plane.
+constexpr double kMinPlaneSpread = 1e-12;
+}  // namespace
+
 Eigen::Vector3d EstimateUpVectorPca(PointsView cloud) {
     // Two passes (mean, then centred second moments) keep the covariance accurate for scans far
     // from the origin, which a one-pass sum of squares would not.
@@ -60,6 +65,13 @@ Eigen::Vector3d EstimateUpVectorPca(PointsView cloud) {
         scatter.noalias() += d * d.transpose();
     }
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scatter);
+    // Identical or collinear points span no plane: any direction would be as good an "up".
+    const Eigen::Vector3d spread = solver.eigenvalues();  // ascending
+    if (!(spread(1) > kMinPlaneSpread * spread.sum())) {
+        throw EmptyInputError("PCA up vector: the " + std::to_string(finite_count) +
+                              " finite points span no plane (they are identical or on one "
+                              "line); give the up axis instead");
+    }
     Eigen::Vector3d up = solver.eigenvectors().col(0);  // eigenvalues are sorted ascending
     if (up.z() < 0.0) up = -up;
     return up.normalized();

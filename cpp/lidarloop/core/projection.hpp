@@ -30,7 +30,8 @@ UpVectorMode ParseUpVectorMode(std::string_view name);
 /// Up vector by PCA (Röhling III-B): the eigenvector of the smallest eigenvalue of the covariance
 /// of the finite points, the direction of least spread, which for a ground vehicle's scan is the
 /// normal of the ground. Sign chosen so that z >= 0 ("positive z values point upwards").
-/// Throws EmptyInputError with fewer than 3 finite points.
+/// Throws EmptyInputError with fewer than 3 finite points, or points that span no plane
+/// (identical, or on one line).
 Eigen::Vector3d EstimateUpVectorPca(PointsView cloud);
 /// The same for a PointCloud (or a braced list of points).
 inline Eigen::Vector3d EstimateUpVectorPca(const PointCloud& cloud) {

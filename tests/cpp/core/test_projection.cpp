@@ -53,11 +53,17 @@ TEST(Projection, PcaNeedsThreeFinitePoints) {
     EXPECT_THROW(EstimateUpVectorPca({{1, 2, 3}, {4, 5, 6}, {nan, 0, 0}}), EmptyInputError);
 }
 
-TEST(Projection, PcaOfDegenerateCloudGivesUnitVector) {
+// Points that span no plane have no direction of least spread: any "up" would be a guess that
+// puts the histogram's heights anywhere.
+TEST(Projection, PcaOfPointsSpanningNoPlaneIsAnError) {
     const PointCloud same(10, Eigen::Vector3f(1, 2, 3));  // no spread at all
-    const Eigen::Vector3d up = EstimateUpVectorPca(same);
-    EXPECT_NEAR(up.norm(), 1.0, 1e-12);
-    EXPECT_GE(up.z(), 0.0);
+    EXPECT_THROW(EstimateUpVectorPca(same), EmptyInputError);
+    EXPECT_THROW(EstimateUpVectorPca(PointCloud(10, Eigen::Vector3f::Zero())), EmptyInputError);
+    PointCloud line;
+    for (float t = 0.0f; t < 10.0f; t += 1.0f) line.emplace_back(0.5f * t, 1.0f + 0.25f * t, 2.0f);
+    EXPECT_THROW(EstimateUpVectorPca(line), EmptyInputError);
+    PointCloud triangle{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};  // three points do span a plane
+    EXPECT_NEAR(EstimateUpVectorPca(triangle).z(), 1.0, 1e-12);
 }
 
 TEST(Projection, NamesRoundTripAndUnknownNamesAreErrors) {
