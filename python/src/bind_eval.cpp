@@ -596,8 +596,13 @@ void BindTrajectory(py::module_& m) {
                 if (a.ndim() != 2 || a.shape(1) != 3)
                     throw ShapeError(what + " must have shape (N, 3)");
                 std::vector<Eigen::Vector3d> points;
-                for (py::ssize_t i = 0; i < a.shape(0); ++i)
+                for (py::ssize_t i = 0; i < a.shape(0); ++i) {
                     points.emplace_back(a.at(i, 0), a.at(i, 1), a.at(i, 2));
+                    if (!points.back().allFinite()) {
+                        throw NonFiniteError(what + " row " + std::to_string(i) +
+                                             " is not finite (NaN or infinite)");
+                    }
+                }
                 return points;
             };
             return TransformToArray(

@@ -145,6 +145,15 @@ def test_ate_matches_numpy_on_a_random_trajectory():
     np.testing.assert_allclose(aligned[:3, :3], np.linalg.inv(T_other_world)[:3, :3], atol=0.02)
 
 
+def test_align_rigid_refuses_positions_that_are_not_finite():
+    good = np.zeros((3, 3))
+    for bad in (np.full((3, 3), np.nan), np.array([[0, 0, 0], [1, np.inf, 0], [0, 1, 0]])):
+        with pytest.raises(lidarloop.NonFiniteError, match="row"):
+            lidarloop.align_rigid(bad, good)
+        with pytest.raises(lidarloop.NonFiniteError, match="truth row"):
+            lidarloop.align_rigid(good, bad)
+
+
 def rotation_angle(R):
     return np.arccos(np.clip((np.trace(R) - 1) / 2, -1, 1))
 
