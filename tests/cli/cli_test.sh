@@ -921,7 +921,7 @@ section_loops() {
         optimise "$work/seq" --odometry "$work/jump.txt" --loops "$work/loops.csv" \
         --config "$work/far_steps.yaml" --max-odometry-step 100 --out "$work/bad"
     printf 'posegraph:\n  max_odometry_step_m: 0\n' >"$work/zero_steps.yaml"
-    expect_exit_1 "a zero step bound" "posegraph.max_odometry_step_m must be in (0, 100000000]" \
+    expect_exit_1 "a zero step bound" "posegraph.max_odometry_step_m must be in (0, 1e+08]" \
         "$cli" optimise "$work/seq" --odometry "$odometry" --loops "$work/loops.csv" \
         --config "$work/zero_steps.yaml" --out "$work/bad"
     # Line 3's time before line 2's (the scans' own times, whatever their spacing).

@@ -17,6 +17,7 @@
 #include "lidarloop/app/results_folder.hpp"
 #include "lidarloop/core/descriptor.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/core/number_text.hpp"
 #include "lidarloop/io/read_error.hpp"
 #include "lidarloop/io/results_csv.hpp"
 #include "lidarloop/pipeline/loop_detector.hpp"
@@ -470,7 +471,7 @@ EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequ
     }
     if (request.config.detection.threshold && request.methods.size() > 1) {
         throw core::ConfigError(
-            "detection.threshold (" + std::to_string(*request.config.detection.threshold) +
+            "detection.threshold (" + core::NumberText(*request.config.detection.threshold) +
             ") is the threshold of one method; evaluate one method with it, or leave it default");
     }
     RequirePoses(dataset, "evaluation", "--poses");

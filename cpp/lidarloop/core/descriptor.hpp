@@ -1,6 +1,10 @@
 #pragma once
 
+#include <cxxabi.h>
+
 #include <any>
+#include <cstdlib>
+#include <memory>
 #include <string>
 #include <typeinfo>
 
@@ -15,6 +19,14 @@ namespace lidarloop::core {
 /// handle without knowing which paper it comes from. `value` holds the method's own type:
 /// Histogram for height and range, NdtDescriptorSet for ndt, whatever a registered method
 /// chooses (pipeline/descriptor_method.hpp computes and compares them).
+/// The C++ name of `type` as written in the source ("lidarloop::core::ScanContext"), for messages.
+inline std::string ReadableTypeName(const std::type_info& type) {
+    int status = 0;
+    const std::unique_ptr<char, decltype(&std::free)> name(
+        abi::__cxa_demangle(type.name(), nullptr, nullptr, &status), &std::free);
+    return status == 0 && name ? std::string(name.get()) : std::string(type.name());
+}
+
 struct Descriptor {
     Method method = Method::kHeight;
     std::any value;
@@ -25,7 +37,7 @@ struct Descriptor {
         const T* typed = std::any_cast<T>(&value);
         if (typed == nullptr) {
             throw ConfigError("the " + ToString(method) + " descriptor does not hold a " +
-                              typeid(T).name());
+                              ReadableTypeName(typeid(T)) + " (another method's descriptor)");
         }
         return *typed;
     }

@@ -6,6 +6,7 @@
 
 #include "lidarloop/core/enum_names.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/core/number_text.hpp"
 
 namespace lidarloop::core {
 namespace {
@@ -21,7 +22,7 @@ static_assert(IsOneToOne(kUnitNames));
 
 void MinGap::Validate(const std::string& field) const {
     if (!std::isfinite(value) || value < 0.0) {
-        throw ConfigError(field + " must be a finite number >= 0, got " + std::to_string(value));
+        throw ConfigError(field + " must be a finite number >= 0, got " + NumberText(value));
     }
 }
 

@@ -7,6 +7,7 @@
 
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/core/min_gap.hpp"
+#include "lidarloop/core/number_text.hpp"
 
 namespace lidarloop::eval {
 namespace {
@@ -178,7 +179,7 @@ void LoopRetrievalConfig::Validate() const {
          {std::pair{wrong_pose_m, "wrong_pose_m"}, std::pair{wrong_pose_deg, "wrong_pose_deg"}}) {
         if (!(std::isfinite(value) && value > 0.0)) {
             throw core::ConfigError(std::string("loop retrieval: ") + name +
-                                    " must be a finite number > 0, got " + std::to_string(value));
+                                    " must be a finite number > 0, got " + core::NumberText(value));
         }
     }
 }

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/core/number_text.hpp"
 
 namespace lidarloop::pipeline {
 
@@ -42,7 +43,7 @@ void DescriptorDatabase::CheckMethod(const core::Descriptor& descriptor) const {
 void DescriptorDatabase::CheckTime(double time_s) const {
     if (!std::isfinite(time_s)) {
         throw core::ConfigError("scan " + std::to_string(size()) + ": time " +
-                                std::to_string(time_s) + " s is not finite");
+                                core::NumberText(time_s) + " s is not finite");
     }
 }
 

@@ -5,6 +5,7 @@
 #include <mutex>
 
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/core/number_text.hpp"
 #include "lidarloop/pipeline/histogram_method.hpp"
 #include "lidarloop/pipeline/ndt_method.hpp"
 #include "lidarloop/pipeline/scancontext_method.hpp"
@@ -79,7 +80,7 @@ core::Descriptor DescriptorMethod::DescribeView(core::PointsView points,
 void DescriptorMethod::ValidateThreshold(double threshold) const {
     if (!(std::isfinite(threshold) && threshold >= 0.0)) {
         throw core::ConfigError("detection.threshold must be a finite number >= 0, got " +
-                                std::to_string(threshold));
+                                core::NumberText(threshold));
     }
 }
 

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/core/number_text.hpp"
 #include "lidarloop/core/wasserstein.hpp"
 #include "lidarloop/pipeline/histogram_index.hpp"
 
@@ -134,7 +135,7 @@ bool HistogramMethod::IsMatch(double distance, double threshold) const {
 void HistogramMethod::ValidateThreshold(double threshold) const {
     if (!(threshold >= 0.0 && threshold <= 1.0)) {
         throw core::ConfigError("detection.threshold must be in [0, 1] for " + name() +
-                                " (the range of W), got " + std::to_string(threshold));
+                                " (the range of W), got " + core::NumberText(threshold));
     }
 }
 

@@ -11,6 +11,7 @@
 
 #include "lidarloop/core/angles.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/core/number_text.hpp"
 #include "lidarloop/pipeline/candidate_verification.hpp"
 #include "lidarloop/pipeline/neighbour_overlaps.hpp"
 
@@ -215,7 +216,7 @@ void DetectorConfig::Validate() const {
     }
     if (threshold && !(std::isfinite(*threshold) && *threshold >= 0.0)) {
         throw core::ConfigError("detection.threshold must be a finite number >= 0, got " +
-                                std::to_string(*threshold));
+                                core::NumberText(*threshold));
     }
     if (top_k < 1 || top_k > 1000) {
         throw core::ConfigError("detection.top_k must be in [1, 1000], got " +
@@ -529,12 +530,12 @@ LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_
     const std::size_t index = database_.size();
     if (!std::isfinite(time_s)) {
         throw core::ConfigError("scan " + std::to_string(index) + ": time " +
-                                std::to_string(time_s) + " s is not finite");
+                                core::NumberText(time_s) + " s is not finite");
     }
     if (index > session_start_ && time_s < database_.times_s().back()) {
         throw core::ConfigError("scan " + std::to_string(index) + ": time " +
-                                std::to_string(time_s) + " s goes back from the scan before (" +
-                                std::to_string(database_.times_s().back()) + " s)");
+                                core::NumberText(time_s) + " s goes back from the scan before (" +
+                                core::NumberText(database_.times_s().back()) + " s)");
     }
     const std::optional<double> query_path_m = PathOf(T_odom_sensor);
     const std::unique_ptr<PreparedQuery> query = database_.Prepare(descriptor);

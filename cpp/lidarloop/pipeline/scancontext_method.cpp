@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/core/number_text.hpp"
 #include "lidarloop/pipeline/loop_detector.hpp"
 
 namespace lidarloop::pipeline {
@@ -195,7 +196,7 @@ void ScanContextMethod::ValidateThreshold(double threshold) const {
         throw core::ConfigError(
             "detection.threshold must be in [0, 1] for scancontext (the range of its "
             "distance), got " +
-            std::to_string(threshold));
+            core::NumberText(threshold));
     }
 }
 

@@ -4,16 +4,12 @@
 #include <string>
 
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/core/number_text.hpp"
 
 namespace lidarloop::posegraph {
 namespace {
 
-std::string Text(double value) {
-    std::string text = std::to_string(value);
-    while (text.size() > 1 && text.back() == '0') text.pop_back();
-    if (!text.empty() && text.back() == '.') text.pop_back();
-    return text;
-}
+std::string Text(double value) { return core::NumberText(value); }
 
 // (low, high] when open_low, else [low, high]; NaN fails every comparison.
 void Require(double value, double low, double high, bool open_low, const std::string& field) {

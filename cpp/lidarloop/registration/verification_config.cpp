@@ -5,6 +5,7 @@
 #include <string>
 
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/core/number_text.hpp"
 
 namespace lidarloop::registration {
 namespace {
@@ -12,8 +13,9 @@ namespace {
 // Finite and within [low, high]; NaN fails every comparison, so test it explicitly.
 void RequireIn(double value, double low, double high, const std::string& field) {
     if (!std::isfinite(value) || value < low || value > high) {
-        throw core::ConfigError("verification." + field + " must be in [" + std::to_string(low) +
-                                ", " + std::to_string(high) + "], got " + std::to_string(value));
+        throw core::ConfigError("verification." + field + " must be in [" + core::NumberText(low) +
+                                ", " + core::NumberText(high) + "], got " +
+                                core::NumberText(value));
     }
 }
 

@@ -379,6 +379,19 @@ TEST(Verification, BadScansAreRejectedWithTheReason) {
     }
 }
 
+// The message shows the value given, not six decimals of it ("got 0.000000" for 1e-9).
+TEST(Verification, AnInvalidValueIsNamedAsGiven) {
+    VerificationConfig config;
+    config.coarse.cell_m = 1e-9;
+    try {
+        config.Validate();
+        ADD_FAILURE() << "no ConfigError";
+    } catch (const core::ConfigError& error) {
+        EXPECT_EQ(std::string(error.what()),
+                  "verification.coarse.cell_m must be in [0.1, 10], got 1e-09");
+    }
+}
+
 TEST(Verification, InvalidConfigIsAConfigError) {
     const core::PointCloud place = test::SyntheticPlace();
     const auto expect_error = [&](auto change) {
