@@ -26,9 +26,10 @@ StoredDatabase LoadStoredDatabase(const std::filesystem::path& file) {
     core::ByteReader in = detail::FileReader(file, detail::ReadWholeFile(file));
     in.ExpectMagic(kDatabaseMagic, "lidarloop database");
     RunConfig config;
+    // Read before the try: its own error names the file already.
+    const std::string yaml = in.GetString("configuration");
     try {
-        ApplyConfigYaml(in.GetString("configuration"), "embedded config", config,
-                        LegacyKeys::kMigrate);
+        ApplyConfigYaml(yaml, "embedded config", config, LegacyKeys::kMigrate);
     } catch (const ReadError& e) {
         in.Fail(e.what());
     }

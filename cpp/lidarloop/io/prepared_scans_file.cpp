@@ -134,8 +134,10 @@ StoredPreparedScans LoadPreparedScans(const std::filesystem::path& file) {
     }
     in.ExpectMagic(kPreparedScansMagic, "lidarloop prepared scans");
     RunConfig config;
+    // Read before the try: its own error names the file already.
+    const std::string yaml = in.GetString("configuration");
     try {
-        ApplyConfigYaml(in.GetString("configuration"), "embedded config", config);
+        ApplyConfigYaml(yaml, "embedded config", config);
     } catch (const ReadError& e) {
         in.Fail(e.what());
     }

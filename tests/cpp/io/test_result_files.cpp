@@ -106,6 +106,17 @@ TEST(DatabaseFile, BadFilesAreClearErrors) {
     const std::string good = test::ReadFile(dir / "db.bin");
     test::WriteFile(dir / "cut.bin", good.substr(0, good.size() / 2));
     test::ExpectReadError(LoadDatabase, dir / "cut.bin", "truncated");
+    // Cut inside the configuration: the file named once.
+    const std::filesystem::path short_file = dir / "short.bin";
+    test::WriteFile(short_file, good.substr(0, 20));
+    const std::string named = short_file.string() + ": ";
+    try {
+        LoadDatabase(short_file);
+        ADD_FAILURE() << "no ReadError";
+    } catch (const ReadError& error) {
+        const std::string message = error.what();
+        EXPECT_EQ(message.rfind(named + "truncated: configuration needs", 0), 0u) << message;
+    }
     test::WriteFile(dir / "magic.bin", "LLSIM001" + good.substr(8));
     test::ExpectReadError(LoadDatabase, dir / "magic.bin", "not a lidarloop database");
     std::string config = good;
