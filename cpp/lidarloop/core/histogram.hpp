@@ -50,8 +50,8 @@ struct HistogramConfig {
     static void Declare(Self& c, Visit&& visit) {
         visit(c.bins, {"bins", "b, number of buckets", "", 1, 1'000'000});
         visit(c.up_vector, {"up_vector", "height projection up vector: fixed (0,0,1) | pca", ""});
-        visit(c.sensor_height_m,
-              {"sensor_height_m", "added to heights so that 0 is the ground", "m"});
+        visit(c.sensor_height_m, {"sensor_height_m", "added to heights so that 0 is the ground",
+                                  "m", -1'000.0, 1'000.0});
         visit(c.height_min_m, {"height_min_m", "v_min of the height histogram", "m"});
         visit(c.height_max_m, {"height_max_m", "v_max of the height histogram", "m"});
         visit(c.range_min_m, {"range_min_m", "v_min of the range histogram", "m", 0.0});

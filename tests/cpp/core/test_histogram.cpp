@@ -237,6 +237,7 @@ TEST(HistogramConfig, RejectsAbsurdValues) {
     expect_invalid([](HistogramConfig& c) { c.range_min_m = -1; }, "range_min_m");
     expect_invalid([](HistogramConfig& c) { c.height_max_m = NAN; }, "height_max_m");
     expect_invalid([](HistogramConfig& c) { c.sensor_height_m = INFINITY; }, "sensor_height_m");
+    expect_invalid([](HistogramConfig& c) { c.sensor_height_m = 1e300; }, "sensor_height_m");
 }
 
 TEST(HistogramConfig, InvalidConfigIsRejectedByCompute) {
