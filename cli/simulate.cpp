@@ -12,6 +12,7 @@
 #include "lidarloop/app/simulation.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/io/poses.hpp"
+#include "lidarloop/io/read_error.hpp"
 #include "lidarloop/sim/odometry_drift.hpp"
 #include "progress.hpp"
 #include "run_output.hpp"
@@ -58,6 +59,8 @@ sim::SimulationConfig ToConfig(const SimulateFlags& flags) {
         for (const core::StampedPose& pose : io::ReadPoses(flags.trajectory)) {
             config.trajectory.push_back(pose.T_world_sensor.translation());
         }
+        if (config.trajectory.empty())
+            throw io::ReadError(flags.trajectory, "holds no poses: nothing to drive");
         config.scans = config.trajectory.size();
     }
     config.seed = flags.seed;

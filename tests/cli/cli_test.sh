@@ -631,6 +631,9 @@ section_simulate() {
         "$cli" simulate --scene moon --out "$work/sim_bad"
     expect_error "simulate zero scans" "--scans must be in [1, 1000000]" "$cli" simulate --scans 0 \
         --out "$work/sim_bad"
+    : >"$work/no_poses.txt"
+    expect_error "simulate an empty trajectory" "$work/no_poses.txt: holds no poses" "$cli" simulate \
+        --trajectory "$work/no_poses.txt" --out "$work/sim_bad"
     expect_exit_1 "simulate negative threads" "threads must be 0 (all cores) or more, got -1" \
         "$cli" simulate --scans 2 --threads -1 --out "$work/sim_bad"
     expect_error "simulate bad dropout" "sensor.dropout must be in [0, 1)" "$cli" simulate \
