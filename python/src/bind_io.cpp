@@ -32,12 +32,12 @@ io::DatasetFormat ParseDatasetFormat(const std::string& name) {
 // Python's index rules: -1 is the last scan; IndexError (which ends a for loop) past the end.
 std::size_t ScanIndex(const io::Dataset& dataset, py::ssize_t index) {
     const auto size = static_cast<py::ssize_t>(dataset.size());
-    if (index < 0) index += size;
-    if (index < 0 || index >= size) {
+    const py::ssize_t from_start = index < 0 ? index + size : index;
+    if (from_start < 0 || from_start >= size) {
         throw py::index_error("scan index " + std::to_string(index) + " out of range for " +
                               std::to_string(size) + " scans");
     }
-    return static_cast<std::size_t>(index);
+    return static_cast<std::size_t>(from_start);
 }
 
 py::array_t<float> ReadScanArray(const path& file) {

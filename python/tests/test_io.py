@@ -61,6 +61,8 @@ def test_open_dataset_reads_a_folder_of_scans_in_name_order(data_dir, tmp_path):
     assert len(list(dataset)) == 3  # iteration stops at the IndexError
     with pytest.raises(IndexError):
         dataset[3]
+    with pytest.raises(IndexError, match="scan index -4 out of range for 3 scans"):
+        dataset[-4]  # named as given, not as -4 + 3
     times, T = dataset.poses
     assert times.shape == (0,) and T.shape == (0, 4, 4)
 
