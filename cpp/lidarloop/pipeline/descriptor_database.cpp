@@ -39,7 +39,7 @@ void DescriptorDatabase::CheckMethod(const core::Descriptor& descriptor) const {
     }
 }
 
-// Before anything is stored: a NaN time would make every gap in seconds false.
+// A NaN time would make every gap in seconds false.
 void DescriptorDatabase::CheckTime(double time_s) const {
     if (!std::isfinite(time_s)) {
         throw core::ConfigError("scan " + std::to_string(size()) + ": time " +

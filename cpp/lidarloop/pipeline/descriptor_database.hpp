@@ -36,6 +36,9 @@ public:
     std::size_t Add(const core::Descriptor& descriptor, double time_s);
     /// Appends a placeholder for a scan that could not be described (time as for Add).
     std::size_t AddMissing(double time_s);
+    /// core::ConfigError naming the next scan unless `time_s` is finite: what Add and AddMissing
+    /// check before storing anything.
+    void CheckTime(double time_s) const;
 
     bool IsValid(std::size_t i) const { return valid_[i] != 0; }
     double TimeS(std::size_t i) const { return times_s_[i]; }
@@ -61,7 +64,6 @@ public:
 
 private:
     void CheckMethod(const core::Descriptor& descriptor) const;
-    void CheckTime(double time_s) const;
     std::size_t Append(double time_s, bool valid);
 
     core::DescriptorConfig config_;

@@ -527,11 +527,8 @@ LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_
                                 const std::optional<core::Transform>& T_odom_sensor) {
     // The gap in seconds counts back in time: within a session, time may not go back (a loaded
     // map's scans may be of any time).
+    database_.CheckTime(time_s);  // before the search, which measures gaps in time
     const std::size_t index = database_.size();
-    if (!std::isfinite(time_s)) {
-        throw core::ConfigError("scan " + std::to_string(index) + ": time " +
-                                core::NumberText(time_s) + " s is not finite");
-    }
     if (index > session_start_ && time_s < database_.times_s().back()) {
         throw core::ConfigError("scan " + std::to_string(index) + ": time " +
                                 core::NumberText(time_s) + " s goes back from the scan before (" +

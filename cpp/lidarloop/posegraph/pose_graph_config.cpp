@@ -9,14 +9,13 @@
 namespace lidarloop::posegraph {
 namespace {
 
-std::string Text(double value) { return core::NumberText(value); }
-
 // (low, high] when open_low, else [low, high]; NaN fails every comparison.
 void Require(double value, double low, double high, bool open_low, const std::string& field) {
     const bool above = open_low ? value > low : value >= low;
     if (!std::isfinite(value) || !above || value > high) {
         throw core::ConfigError("posegraph." + field + " must be in " + (open_low ? "(" : "[") +
-                                Text(low) + ", " + Text(high) + "], got " + Text(value));
+                                core::NumberText(low) + ", " + core::NumberText(high) + "], got " +
+                                core::NumberText(value));
     }
 }
 
