@@ -286,6 +286,17 @@ bool MayBeInReach(std::size_t query, std::size_t match, double max_loop_distance
     return !((query_m - match_m).norm() > reach_m + slack_m);
 }
 
+// How much a registration of the query tells where the query is: a fit that passed every test
+// of the fit itself (accepted, or rejected only for the sensors' distance) 1, one rejected for a
+// rival pose half (either of its two poses may be the place), any other 0.
+double FitVote(const registration::Verification& verdict) {
+    if (verdict.accepted) return 1.0;
+    if (!verdict.Registered()) return 0.0;
+    if (verdict.reason == registration::RejectReason::kTooFar) return 1.0;
+    if (verdict.reason == registration::RejectReason::kAmbiguous) return 0.5;
+    return 0.0;
+}
+
 }  // namespace
 
 registration::PoseAllowed OdometryAllowedPoses(
@@ -322,6 +333,42 @@ bool OdometryAllowsALoop(std::size_t query, std::size_t match, double max_loop_d
     return !gate(nearest, odometry->T_match_query, odometry->path_m);
 }
 
+void RejectLoopsUnlikeEarlierFits(
+    LoopQuery& query, const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
+    const std::function<double(std::size_t)>& path_m_of, const OdometryGate& gate) {
+    // A witness: an earlier fit with a vote whose pose the odometry's gate allows.
+    const auto vote_of = [&](std::size_t c) {
+        const registration::Verification& verdict = query.verifications[c];
+        const double vote = FitVote(verdict);
+        if (vote == 0.0) return 0.0;
+        const registration::PoseAllowed allowed = OdometryAllowedPoses(
+            query.query, query.candidates[c].index, T_odom_sensor_of, path_m_of, gate);
+        return allowed && allowed(verdict.T_match_query) ? vote : 0.0;
+    };
+    for (std::size_t c = 0; c < query.verifications.size(); ++c) {
+        registration::Verification& verdict = query.verifications[c];
+        if (!verdict.accepted) continue;
+        double agree = 1.0;  // the loop's own
+        double disagree = 0.0;
+        for (std::size_t earlier = 0; earlier < c; ++earlier) {
+            const double vote = vote_of(earlier);
+            if (vote == 0.0) continue;
+            // The two fits put the two matches relative to each other; the odometry between
+            // them must allow that as it allows a loop.
+            const registration::PoseAllowed between =
+                OdometryAllowedPoses(query.candidates[earlier].index, query.candidates[c].index,
+                                     T_odom_sensor_of, path_m_of, gate);
+            if (!between) continue;
+            const core::Transform T_match_earlier =
+                verdict.T_match_query * query.verifications[earlier].T_match_query.inverse();
+            (between(T_match_earlier) ? agree : disagree) += vote;
+        }
+        if (agree > disagree) continue;
+        verdict.accepted = false;
+        verdict.reason = registration::RejectReason::kAmbiguous;
+    }
+}
+
 std::size_t RejectLoopsAgainstOdometry(
     LoopQuery& query, const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
     const std::function<double(std::size_t)>& path_m_of, const OdometryGate& gate) {
@@ -336,6 +383,7 @@ std::size_t RejectLoopsAgainstOdometry(
         verdict.reason = registration::RejectReason::kOdometryMismatch;
         ++rejected;
     }
+    RejectLoopsUnlikeEarlierFits(query, T_odom_sensor_of, path_m_of, gate);
     query.accepted = query.loop().has_value();
     return rejected;
 }

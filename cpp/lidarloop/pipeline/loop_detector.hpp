@@ -184,6 +184,15 @@ std::size_t RejectLoopsAgainstOdometry(
     LoopQuery& query, const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
     const std::function<double(std::size_t)>& path_m_of, const OdometryGate& gate);
 
+/// Rejects (RejectReason::kAmbiguous) each accepted verification of `query` whose pose
+/// contradicts the fit of a candidate ranked before it (accepted, or rejected only as ambiguous
+/// or too far, and allowed by `gate`): the two poses put the two matches relative to each other,
+/// and `gate` judges that against the odometry between the matches. Does not choose the loop
+/// again.
+void RejectLoopsUnlikeEarlierFits(
+    LoopQuery& query, const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
+    const std::function<double(std::size_t)>& path_m_of, const OdometryGate& gate);
+
 /// Whether `gate` lets some loop pose from scan `query` to scan `match` pass, its sensors at most
 /// `max_loop_distance_m` apart: it tries the one nearest to the odometry's relative pose (its
 /// rotation, its translation shortened to that distance), which a gate that judges the size of

@@ -21,7 +21,10 @@ enum class RejectReason {
     kLowOverlap,    ///< too few structure points of one scan lie on the other's surfaces
     kHighRmse,      ///< the overlapping points sit too far from the other scan's planes
     kDegenerate,    ///< sliding along the weakest direction fits as well (street, corridor)
-    kAmbiguous,     ///< another, distinct pose fits about as well (periodic structure)
+    /// another, distinct pose fits about as well (periodic structure); or, with the odometry,
+    /// the query's fits on the candidates ranked before contradict the pose (more votes against
+    /// than for it: pipeline::RejectLoopsUnlikeEarlierFits)
+    kAmbiguous,
     /// the sensors are farther apart than one place: registered so, or (not registered) every
     /// coarse peak that could be refined put them farther than a loop's distance plus
     /// CoarseConfig::max_peak_beyond_loop_m

@@ -119,6 +119,95 @@ TEST(RejectLoopsAgainstOdometry, RejectsThePoseTheOdometryContradictsAndChoosesA
                  core::ConfigError);
 }
 
+// A fit of `query` on `match` that a test other than the fit's own rejected.
+registration::Verification FitRejectedAs(registration::RejectReason reason,
+                                         const core::Transform& T_match_query) {
+    registration::Verification verdict = AcceptedAt(T_match_query, 0.6);
+    verdict.accepted = false;
+    verdict.reason = reason;
+    verdict.registered_hypotheses = 1;
+    return verdict;
+}
+
+// A street that looks alike along its length: a query 900 m of path on registers on several
+// scans of the place. A loop that slides along the street passes the gate (its allowance grows
+// with the path), but not the fits of the candidates ranked before it, whose matches the
+// odometry relates over a few metres: the query's fits vote (docs/verification.md).
+TEST(RejectLoopsAgainstOdometry, ALoopMustAgreeWithMostOfTheQuerysEarlierFits) {
+    std::vector<core::StampedPose> odometry(1000);
+    std::vector<double> path_m(1000);
+    for (std::size_t i = 0; i < odometry.size(); ++i) {
+        odometry[i].T_world_sensor.translation().x() = static_cast<double>(i);
+        path_m[i] = static_cast<double>(i);
+    }
+    // The query revisits scan 40's place after a loop; its odometry has drifted 4 m since.
+    odometry[999].T_world_sensor.translation() = Eigen::Vector3d(45.0, 3.0, 0.0);
+    core::Transform T_40_query = core::Transform::Identity();
+    T_40_query.translation() = Eigen::Vector3d(1.0, 3.0, 0.0);
+    const auto at_place = [&](std::size_t match) {
+        return odometry[match].T_world_sensor.inverse() * odometry[40].T_world_sensor * T_40_query;
+    };
+    core::Transform slide = core::Transform::Identity();
+    slide.translation().x() = 9.0;
+    const auto Loop = [&](std::vector<registration::Verification> earlier,
+                          const core::Transform& T_match_query) {
+        pipeline::LoopQuery query;
+        query.query = 999;
+        for (std::size_t c = 0; c < earlier.size(); ++c) query.candidates.push_back({40 + c, 0.1});
+        query.candidates.push_back({46, 0.2});
+        query.verifications = std::move(earlier);
+        query.verifications.push_back(AcceptedAt(T_match_query, 0.5));
+        query.accepted = true;
+        return query;
+    };
+    const auto Kept = [&](pipeline::LoopQuery query) {
+        std::vector<pipeline::LoopQuery> queries{std::move(query)};
+        EXPECT_EQ(app::RejectLoopsAgainstOdometry(queries, odometry, path_m, {}), 0u);
+        const registration::Verification& loop = queries[0].verifications.back();
+        EXPECT_EQ(queries[0].accepted, queries[0].loop().has_value());
+        EXPECT_TRUE(loop.accepted || loop.reason == registration::RejectReason::kAmbiguous);
+        return loop.accepted;
+    };
+    using registration::RejectReason;
+    const auto too_far = [&](std::size_t match, const core::Transform& slid) {
+        return FitRejectedAs(RejectReason::kTooFar, at_place(match) * slid);
+    };
+    const auto ambiguous = [&](std::size_t match, const core::Transform& slid) {
+        return FitRejectedAs(RejectReason::kAmbiguous, at_place(match) * slid);
+    };
+    const core::Transform none = core::Transform::Identity();
+    // The slid loop passes the gate alone; against the query's fits it must win the vote.
+    EXPECT_TRUE(Kept(Loop({}, at_place(46) * slide)));
+    EXPECT_TRUE(Kept(Loop({too_far(40, none)}, at_place(46))));
+    EXPECT_FALSE(Kept(Loop({too_far(40, none)}, at_place(46) * slide)));
+    EXPECT_TRUE(Kept(Loop({too_far(40, none), too_far(41, slide)}, at_place(46) * slide)));
+    EXPECT_FALSE(Kept(Loop({too_far(40, none), ambiguous(41, none)}, at_place(46) * slide)));
+    // A fit with a rival counts half: either pose may be the place.
+    EXPECT_TRUE(Kept(Loop({ambiguous(40, none)}, at_place(46) * slide)));
+    EXPECT_FALSE(Kept(Loop({ambiguous(40, none), ambiguous(41, none)}, at_place(46) * slide)));
+    EXPECT_TRUE(Kept(Loop({ambiguous(40, none), ambiguous(41, none), too_far(42, slide)},
+                          at_place(46) * slide)));
+    // An earlier accepted fit votes fully.
+    EXPECT_FALSE(Kept(Loop({AcceptedAt(at_place(40), 0.4)}, at_place(46) * slide)));
+    // No vote: a fit that failed its own tests, a too-far verdict without a registration, a fit
+    // the odometry contradicts, or a candidate ranked after the loop.
+    EXPECT_TRUE(Kept(Loop({FitRejectedAs(RejectReason::kLowOverlap, at_place(40)),
+                           FitRejectedAs(RejectReason::kDegenerate, at_place(41))},
+                          at_place(46) * slide)));
+    registration::Verification unregistered = too_far(40, none);
+    unregistered.registered_hypotheses = 0;
+    EXPECT_TRUE(Kept(Loop({unregistered}, at_place(46) * slide)));
+    core::Transform far_off = core::Transform::Identity();
+    far_off.translation().y() = 80.0;
+    EXPECT_TRUE(Kept(Loop({too_far(40, far_off)}, at_place(46) * slide)));
+    pipeline::LoopQuery loop_first = Loop({}, at_place(46) * slide);
+    loop_first.candidates.push_back({40, 0.3});
+    loop_first.verifications.push_back(too_far(40, none));
+    std::vector<pipeline::LoopQuery> queries{loop_first};
+    app::RejectLoopsAgainstOdometry(queries, odometry, path_m, {});
+    EXPECT_TRUE(queries[0].verifications.front().accepted);
+}
+
 // OdometryAllowsALoop against brute force with the pose graph's gate: where it says no loop
 // pose within 10 m passes, none of many tried does; where it says one does, the nearest to the
 // odometry's does. Odometry 0-80 m apart over 0-400 m of path, turned anyhow.
