@@ -182,6 +182,13 @@ std::string OdometryName(const std::filesystem::path& file, const std::string& t
 
 namespace {
 
+// A note of how many of the queries' candidates were rejected for `reason`, when any were.
+void NoteRejected(DetectOutcome& outcome, registration::RejectReason reason,
+                  const std::string& what) {
+    const std::size_t count = CountRejected(outcome.queries, reason);
+    if (count > 0) outcome.notes.push_back(std::to_string(count) + what);
+}
+
 // `matrix` is null when the sequence was detected without one (output.similarity_matrix_mib).
 void WriteDetectResults(const std::filesystem::path& out_dir, const io::RunConfig& config,
                         const pipeline::SequenceDescriptors& described,
@@ -309,15 +316,14 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
                 " registered candidates rejected: the odometry contradicts their pose beyond its "
                 "drift (reason odometry_mismatch in candidates.csv; the gate of posegraph.robust)");
         }
-        const std::size_t unlike =
-            CountRejected(outcome.queries, registration::RejectReason::kUnlikeNeighbours);
-        if (unlike > 0) {
-            outcome.notes.push_back(
-                std::to_string(unlike) +
-                " registered candidates rejected: they overlap far less than their scans do with "
-                "their neighbours, as a look-alike place does (reason unlike_neighbours in "
-                "candidates.csv; verification.acceptance.min_neighbour_overlap_ratio)");
-        }
+        NoteRejected(outcome, registration::RejectReason::kUnlikeNeighbours,
+                     " registered candidates rejected: they overlap far less than their scans do "
+                     "with their neighbours, as a look-alike place does (reason unlike_neighbours "
+                     "in candidates.csv; verification.acceptance.min_neighbour_overlap_ratio)");
+        NoteRejected(outcome, registration::RejectReason::kUnlikeRevisit,
+                     " loops rejected: a longer chain of agreeing loops of their revisit places "
+                     "them elsewhere by the odometry (reason unlike_revisit in candidates.csv; "
+                     "verification.acceptance.revisit_path_m)");
     }
     const double verify_s = verify_clock.Seconds();
     outcome.accepted = CountAccepted(outcome.queries);

@@ -202,6 +202,9 @@ void VisitFields(registration::AcceptanceConfig& c, Visitor& v) {
     v.Field("min_neighbour_overlap_ratio", c.min_neighbour_overlap_ratio,
             "without odometry, a loop's distinctive overlap over its scans' with their neighbours, "
             "at least (0: off)");
+    v.Field("revisit_path_m", c.revisit_path_m,
+            "with odometry, loops whose queries and matches lie this close in path must agree; "
+            "of two chains that do not, the shorter is rejected (0: off)");
 }
 
 template <typename Visitor>

@@ -241,6 +241,8 @@ VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
     } else {
         for (std::size_t i = 0; i < queries.size(); ++i) run(i);
     }
+    const double revisit_path_m = detector.verification.acceptance.revisit_path_m;
+    if (check.judge_revisits && revisit_path_m > 0.0) check.judge_revisits(queries, revisit_path_m);
     VerificationTimes times;
     for (const auto& t : per_query) times.Append(t);
     return times;

@@ -69,7 +69,8 @@ void VerifyQuery(LoopQuery& query, const registration::PreparedScan& query_scan,
 /// VerifyQuery for every query that has candidates (in parallel unless told otherwise);
 /// `scans[i]` is scan i prepared, kept compact (each expanded when verified; the pair times
 /// include expanding the candidate). `progress(done, total)` is called from worker threads, one
-/// call at a time with `done` rising.
+/// call at a time with `done` rising. Once every query is verified, `check.judge_revisits` (where
+/// given) judges their loops together within detector.verification.acceptance.revisit_path_m.
 VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
                                 const std::vector<registration::CompactPreparedScan>& scans,
                                 const DetectorConfig& detector, const core::Method& method,

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <optional>
 #include <string>
 
@@ -388,6 +389,108 @@ std::size_t RejectLoopsAgainstOdometry(
     return rejected;
 }
 
+namespace {
+
+// An accepted verification of a sequence, with what the odometry says of its two scans.
+struct AcceptedLoop {
+    std::size_t query_index = 0;  // in the queries
+    std::size_t candidate = 0;    // in the query's candidates
+    std::size_t query = 0;
+    std::size_t match = 0;
+    double query_path_m = 0.0;
+    double match_path_m = 0.0;
+};
+
+std::vector<AcceptedLoop> AcceptedLoopsTheOdometryKnows(
+    const std::vector<LoopQuery>& queries,
+    const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
+    const std::function<double(std::size_t)>& path_m_of) {
+    const auto known = [&](std::size_t scan) {
+        return std::isfinite(path_m_of(scan)) && T_odom_sensor_of(scan).matrix().allFinite();
+    };
+    std::vector<AcceptedLoop> loops;
+    for (std::size_t q = 0; q < queries.size(); ++q) {
+        const LoopQuery& query = queries[q];
+        for (std::size_t c = 0; c < query.verifications.size(); ++c) {
+            const std::size_t match = query.candidates[c].index;
+            if (!query.verifications[c].accepted || !known(query.query) || !known(match)) continue;
+            loops.push_back({q, c, query.query, match, path_m_of(query.query), path_m_of(match)});
+        }
+    }
+    std::sort(loops.begin(), loops.end(), [](const AcceptedLoop& a, const AcceptedLoop& b) {
+        return a.query_path_m < b.query_path_m;
+    });
+    return loops;
+}
+
+}  // namespace
+
+std::size_t RejectLoopsUnlikeTheirRevisit(
+    std::vector<LoopQuery>& queries,
+    const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
+    const std::function<double(std::size_t)>& path_m_of, const OdometryGate& gate,
+    double window_m) {
+    const std::vector<AcceptedLoop> loops =
+        AcceptedLoopsTheOdometryKnows(queries, T_odom_sensor_of, path_m_of);
+    const auto T_of = [&](const AcceptedLoop& loop) {
+        return queries[loop.query_index].verifications[loop.candidate].T_match_query;
+    };
+    // Loops that agree with a neighbour form a chain; a pair that disagrees sets two chains
+    // against each other.
+    std::vector<std::size_t> chain(loops.size());
+    std::iota(chain.begin(), chain.end(), std::size_t{0});
+    const auto root = [&chain](std::size_t i) {
+        while (chain[i] != i) i = chain[i] = chain[chain[i]];
+        return i;
+    };
+    std::vector<std::pair<std::size_t, std::size_t>> disagreeing;
+    for (std::size_t i = 0; i < loops.size(); ++i) {
+        const AcceptedLoop& loop = loops[i];
+        // Sorted by the query's path: the loops within the window after i follow it.
+        for (std::size_t j = i + 1;
+             j < loops.size() && loops[j].query_path_m <= loop.query_path_m + window_m; ++j) {
+            const AcceptedLoop& other = loops[j];
+            if (std::abs(other.match_path_m - loop.match_path_m) > window_m) continue;
+            // Where the other loop and the odometry's links from its scans put this query.
+            const core::Transform T_match_query_carried =
+                T_odom_sensor_of(loop.match).inverse() * T_odom_sensor_of(other.match) *
+                T_of(other) * T_odom_sensor_of(other.query).inverse() *
+                T_odom_sensor_of(loop.query);
+            const double links_m = std::abs(other.query_path_m - loop.query_path_m) +
+                                   std::abs(other.match_path_m - loop.match_path_m);
+            if (gate(T_of(loop), T_match_query_carried, links_m)) {
+                disagreeing.emplace_back(i, j);
+            } else {
+                chain[root(i)] = root(j);
+            }
+        }
+    }
+    std::vector<std::size_t> chain_size(loops.size(), 0);
+    for (std::size_t i = 0; i < loops.size(); ++i) ++chain_size[root(i)];
+    // Of two chains that disagree, the shorter is rejected; of two as long, both.
+    std::vector<bool> rejected_chain(loops.size(), false);
+    for (const auto& [i, j] : disagreeing) {
+        const std::size_t a = root(i);
+        const std::size_t b = root(j);
+        if (a == b) continue;  // a chain that bridges two poses: the pair alone cannot tell
+        if (chain_size[a] <= chain_size[b]) rejected_chain[a] = true;
+        if (chain_size[b] <= chain_size[a]) rejected_chain[b] = true;
+    }
+    std::size_t rejected = 0;
+    for (std::size_t i = 0; i < loops.size(); ++i) {
+        if (!rejected_chain[root(i)]) continue;
+        registration::Verification& verdict =
+            queries[loops[i].query_index].verifications[loops[i].candidate];
+        verdict.accepted = false;
+        verdict.reason = registration::RejectReason::kUnlikeRevisit;
+        ++rejected;
+    }
+    for (LoopQuery& query : queries) {
+        if (query.verified()) query.accepted = query.loop().has_value();
+    }
+    return rejected;
+}
+
 LoopCheck CheckAgainstOdometry(std::function<core::Transform(std::size_t)> T_odom_sensor_of,
                                std::function<double(std::size_t)> path_m_of, OdometryGate gate,
                                std::atomic<std::size_t>* rejected,
@@ -405,6 +508,10 @@ LoopCheck CheckAgainstOdometry(std::function<core::Transform(std::size_t)> T_odo
         const std::size_t count =
             RejectLoopsAgainstOdometry(query, T_odom_sensor_of, path_m_of, gate);
         if (rejected != nullptr) *rejected += count;
+    };
+    check.judge_revisits = [T_odom_sensor_of, path_m_of, gate](std::vector<LoopQuery>& queries,
+                                                               double window_m) {
+        return RejectLoopsUnlikeTheirRevisit(queries, T_odom_sensor_of, path_m_of, gate, window_m);
     };
     check.allowed_poses = [T_odom_sensor_of, path_m_of, gate](std::size_t query,
                                                               std::size_t match) {

@@ -129,6 +129,10 @@ struct LoopCheck {
     /// search looks there only (registration::Verify's `yaws`). The whole circle where it cannot
     /// judge the pair. Empty: every yaw.
     std::function<registration::YawWindow(std::size_t query, std::size_t match)> yaw_window;
+    /// Judges a sequence's verified queries together once all are verified: rejects the loops a
+    /// longer chain of agreeing loops within `window_m` of path contradicts
+    /// (RejectLoopsUnlikeTheirRevisit); returns how many. Empty: none.
+    std::function<std::size_t(std::vector<LoopQuery>& queries, double window_m)> judge_revisits;
 
     explicit operator bool() const { return static_cast<bool>(reject); }
     void operator()(LoopQuery& query) const { reject(query); }
@@ -192,6 +196,22 @@ std::size_t RejectLoopsAgainstOdometry(
 void RejectLoopsUnlikeEarlierFits(
     LoopQuery& query, const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
     const std::function<double(std::size_t)>& path_m_of, const OdometryGate& gate);
+
+/// Rejects (RejectReason::kUnlikeRevisit) the accepted verifications of `queries` that a longer
+/// chain of agreeing loops of their revisit contradicts. Two loops are neighbours when their
+/// queries lie within `window_m` of path of each other and their matches too; the odometry
+/// carries one over to the other (T_match_query ≈ T_match_other · T_other_query' ·
+/// T_query'_query, both links by the odometry) and `gate` judges the two over the path of the
+/// links. Neighbours that agree join one chain; of two chains with a neighbour pair that
+/// disagrees, the one with fewer loops is rejected, both when as many (a pair that disagrees
+/// within one chain decides nothing). Every loop is judged as the loops were before, so the
+/// order does not matter; the loops to or from a scan the odometry does not know are neither
+/// judged nor judge. Then each query's loop is chosen again among the rest. Returns how many it
+/// rejected.
+std::size_t RejectLoopsUnlikeTheirRevisit(
+    std::vector<LoopQuery>& queries,
+    const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
+    const std::function<double(std::size_t)>& path_m_of, const OdometryGate& gate, double window_m);
 
 /// Whether `gate` lets some loop pose from scan `query` to scan `match` pass, its sensors at most
 /// `max_loop_distance_m` apart: it tries the one nearest to the odometry's relative pose (its

@@ -346,6 +346,8 @@ std::string ToString(RejectReason reason) {
             return "not_needed";
         case RejectReason::kUnlikeNeighbours:
             return "unlike_neighbours";
+        case RejectReason::kUnlikeRevisit:
+            return "unlike_revisit";
     }
     return "unknown";
 }

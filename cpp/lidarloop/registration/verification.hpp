@@ -38,11 +38,15 @@ enum class RejectReason {
     /// registered, but it overlaps far less than its scans do with their neighbours in the
     /// sequence (AcceptanceConfig::min_neighbour_overlap_ratio; without odometry)
     kUnlikeNeighbours,
+    /// registered, but with the odometry a longer chain of agreeing loops of its revisit (queries
+    /// and matches within AcceptanceConfig::revisit_path_m of path) places it elsewhere (offline:
+    /// detect, evaluate, optimise; pipeline::RejectLoopsUnlikeTheirRevisit)
+    kUnlikeRevisit,
 };
 
 /// "none", "too_few_points", "no_alignment", "not_converged", "low_overlap", "high_rmse",
 /// "degenerate", "ambiguous", "too_far", "pruned", "odometry_mismatch", "not_needed",
-/// "unlike_neighbours": the spelling of loops.csv and `lidarloop verify`.
+/// "unlike_neighbours", "unlike_revisit": the spelling of loops.csv and `lidarloop verify`.
 std::string ToString(RejectReason reason);
 
 /// How well a query sits on a match at a pose (registration::MeasureOverlap).

@@ -92,6 +92,7 @@ void AcceptanceConfig::Validate() const {
     RequireIn(max_rival_overlap_ratio, 0.0, 10.0, "acceptance.max_rival_overlap_ratio");
     RequireIn(max_loop_distance_m, 0.1, 1e4, "acceptance.max_loop_distance_m");
     RequireIn(min_neighbour_overlap_ratio, 0.0, 10.0, "acceptance.min_neighbour_overlap_ratio");
+    RequireIn(revisit_path_m, 0.0, 1e4, "acceptance.revisit_path_m");
 }
 
 void VerificationConfig::Validate() const {

@@ -198,6 +198,12 @@ struct AcceptanceConfig {
     /// drives and HKU, validated on seeds 7 and 11 and two seed-2 drives (docs/verification.md,
     /// "What the neighbours show").
     double min_neighbour_overlap_ratio = 0.5;
+    /// With the odometry, offline (detect, evaluate, optimise): loops whose queries lie within
+    /// this much path of each other, and their matches too, are neighbours, which the odometry
+    /// relates over that short path; neighbours that agree form chains, and of two chains that
+    /// disagree the shorter is rejected (pipeline::RejectLoopsUnlikeTheirRevisit). 0: off. 10 m:
+    /// one place, the submaps' reach (docs/verification.md, "The loops of one revisit agree").
+    double revisit_path_m = 10.0;
 
     void Validate() const;
     bool operator==(const AcceptanceConfig&) const = default;

@@ -208,6 +208,125 @@ TEST(RejectLoopsAgainstOdometry, ALoopMustAgreeWithMostOfTheQuerysEarlierFits) {
     EXPECT_TRUE(queries[0].verifications.front().accepted);
 }
 
+// A revisit along a straight road: queries 150-169 come back to scans 20-39 (1 m apart, 3 m to
+// the side), their odometry 0.5 m and 1 m off. Loops of one revisit that agree form chains: a run
+// of loops slid 12 m along the road, one tree period, is a chain of its own, shorter than the
+// right one.
+class RevisitChains : public ::testing::Test {
+protected:
+    RevisitChains() : odometry(200), path_m(200) {
+        for (std::size_t i = 0; i < odometry.size(); ++i) {
+            path_m[i] = static_cast<double>(i);
+            odometry[i].T_world_sensor.translation().x() = static_cast<double>(i);
+        }
+        for (std::size_t query = 150; query < 170; ++query)
+            odometry[query].T_world_sensor.translation() =
+                TruePlace(query) + Eigen::Vector3d(0.5, 1, 0);
+    }
+    static Eigen::Vector3d TruePlace(std::size_t query) {
+        return {static_cast<double>(query) - 130.0, 3.0, 0.0};
+    }
+    // Query's loop to scan query - 130, slid along the road by `slide_m`.
+    static pipeline::LoopQuery Loop(std::size_t query, double slide_m) {
+        const std::size_t match = query - 130;
+        core::Transform T_match_query = core::Transform::Identity();
+        T_match_query.translation() =
+            TruePlace(query) - Eigen::Vector3d(static_cast<double>(match), 0, 0);
+        T_match_query.translation().x() += slide_m;
+        pipeline::LoopQuery loop;
+        loop.query = query;
+        loop.candidates = {{match, 0.1}};
+        loop.verifications = {AcceptedAt(T_match_query, 0.6)};
+        loop.accepted = true;
+        return loop;
+    }
+    // The queries whose loop stays accepted after the vote within `window_m`.
+    std::vector<std::size_t> Kept(std::vector<pipeline::LoopQuery> queries,
+                                  double window_m = 10.0) {
+        const pipeline::LoopCheck check = app::OdometryLoopCheck(odometry, path_m, {});
+        const std::size_t rejected = check.judge_revisits(queries, window_m);
+        std::vector<std::size_t> kept;
+        std::size_t rejected_counted = 0;
+        for (const pipeline::LoopQuery& query : queries) {
+            EXPECT_EQ(query.accepted, query.loop().has_value());
+            if (query.accepted) kept.push_back(query.query);
+            for (const auto& verdict : query.verifications)
+                rejected_counted += verdict.reason == registration::RejectReason::kUnlikeRevisit;
+        }
+        EXPECT_EQ(rejected, rejected_counted);
+        std::sort(kept.begin(), kept.end());
+        return kept;
+    }
+    static std::vector<std::size_t> Range(std::size_t first, std::size_t end) {
+        std::vector<std::size_t> range;
+        for (std::size_t i = first; i < end; ++i) range.push_back(i);
+        return range;
+    }
+
+    std::vector<core::StampedPose> odometry;
+    std::vector<double> path_m;
+};
+
+TEST_F(RevisitChains, TheShorterOfTwoChainsThatDisagreeIsRejected) {
+    std::vector<pipeline::LoopQuery> queries;
+    for (std::size_t query = 150; query < 164; ++query)
+        queries.push_back(Loop(query, query < 160 ? 0.0 : 12.0));
+    EXPECT_EQ(Kept(queries), Range(150, 160));
+    // The order of the queries does not matter.
+    std::reverse(queries.begin(), queries.end());
+    EXPECT_EQ(Kept(queries), Range(150, 160));
+    EXPECT_EQ(registration::ToString(registration::RejectReason::kUnlikeRevisit), "unlike_revisit");
+    // A slid run as long as the window, then the right loops: the longer chain wins, though
+    // around the first right loops the slid ones are as many as the right ones.
+    queries.clear();
+    for (std::size_t query = 150; query < 170; ++query)
+        queries.push_back(Loop(query, query < 158 ? 12.0 : 0.0));
+    EXPECT_EQ(Kept(queries), Range(158, 170));
+    // Two loops that disagree with nothing else around: neither can be trusted.
+    EXPECT_TRUE(Kept({Loop(150, 0.0), Loop(152, 12.0)}).empty());
+    // Alone, or with agreeing loops only, a loop is kept, slid or not (the gate judges it alone).
+    EXPECT_EQ(Kept({Loop(160, 12.0)}), (std::vector<std::size_t>{160}));
+    EXPECT_EQ(Kept({Loop(160, 12.0), Loop(161, 12.0)}), (std::vector<std::size_t>{160, 161}));
+}
+
+TEST_F(RevisitChains, OnlyTheLoopsOfTheRevisitJudge) {
+    // Queries 12 m of path apart are of another revisit: with a window of 10 m they do not vote.
+    EXPECT_EQ(Kept({Loop(150, 0.0), Loop(162, 12.0)}), (std::vector<std::size_t>{150, 162}));
+    EXPECT_TRUE(Kept({Loop(150, 0.0), Loop(162, 12.0)}, 12.0).empty());
+    // Matches 12 m apart (query 151 to scan 33 instead of 21), queries 1 m apart: no vote either.
+    pipeline::LoopQuery other_match = Loop(151, 0.0);
+    other_match.candidates[0].index = 33;
+    other_match.verifications[0].T_match_query.translation().x() -= 12.0;
+    EXPECT_EQ(Kept({Loop(150, 12.0), other_match}), (std::vector<std::size_t>{150, 151}));
+    // Matches 5 m apart, queries 15 m: no vote.
+    pipeline::LoopQuery later_query = Loop(165, 12.0);
+    later_query.candidates[0].index = 25;
+    later_query.verifications[0].T_match_query.translation().x() += 10.0;
+    EXPECT_EQ(Kept({Loop(150, 0.0), later_query}), (std::vector<std::size_t>{150, 165}));
+    // A scan the odometry lost neither judges nor is judged.
+    odometry[152].T_world_sensor.translation().x() = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_EQ(Kept({Loop(150, 0.0), Loop(152, 12.0)}), (std::vector<std::size_t>{150, 152}));
+}
+
+TEST_F(RevisitChains, AQuerysOtherLoopBecomesItsLoop) {
+    std::vector<pipeline::LoopQuery> queries;
+    for (std::size_t query = 150; query < 160; ++query) queries.push_back(Loop(query, 0.0));
+    // Query 155: the slid loop overlaps best, a second candidate holds the right one.
+    pipeline::LoopQuery& two = queries[5];
+    two.verifications[0].T_match_query.translation().x() += 12.0;
+    two.verifications[0].overlap.query_fraction = 0.9;
+    two.verifications[0].overlap.match_fraction = 0.9;
+    two.candidates.push_back({26, 0.2});
+    two.verifications.push_back(Loop(155, 0.0).verifications[0]);
+    two.verifications[1].T_match_query.translation().x() -= 1.0;  // scan 26 is 1 m on
+    ASSERT_EQ(two.loop(), 0u);
+    const pipeline::LoopCheck check = app::OdometryLoopCheck(odometry, path_m, {});
+    EXPECT_EQ(check.judge_revisits(queries, 10.0), 1u);
+    EXPECT_EQ(queries[5].verifications[0].reason, registration::RejectReason::kUnlikeRevisit);
+    EXPECT_EQ(queries[5].loop(), 1u);
+    EXPECT_TRUE(queries[5].accepted);
+}
+
 // OdometryAllowsALoop against brute force with the pose graph's gate: where it says no loop
 // pose within 10 m passes, none of many tried does; where it says one does, the nearest to the
 // odometry's does. Odometry 0-80 m apart over 0-400 m of path, turned anyhow.
