@@ -91,8 +91,13 @@ std::vector<Candidate> ReadCandidates(const std::filesystem::path& file) {
             fields[reason] == "not_needed") {
             continue;
         }
+        // Rejected by the sequence (the neighbours, the query's other fits, the revisit's other
+        // loops), not by the pair: a replay of the pair alone accepts it.
+        const bool rejected_by_the_sequence = fields[reason] == "unlike_neighbours" ||
+                                              fields[reason] == "unlike_fits" ||
+                                              fields[reason] == "unlike_revisit";
         Candidate candidate{std::stoul(fields[query]), std::stoul(fields[match]),
-                            fields[accepted] == "1", fields[reason]};
+                            fields[accepted] == "1" || rejected_by_the_sequence, fields[reason]};
         for (int i = 0; i < 3; ++i) {
             if (!fields[tx + i].empty()) candidate.translation_m[i] = std::stod(fields[tx + i]);
         }

@@ -151,7 +151,7 @@ void AddDetectCommand(CLI::App& app) {
                           "the path a gap in metres and loops.csv's path_m are measured on "
                           "(default: the dataset's poses), what places each scan's neighbours in "
                           "its submap (without it: no submaps), and what a registered loop must "
-                          "agree with (reason odometry_mismatch)");
+                          "agree with (reasons odometry_mismatch, unlike_fits, unlike_revisit)");
     command->add_flag("--overwrite", flags->overwrite,
                       "write into a non-empty folder that holds no earlier lidarloop run");
     command->add_flag("--quiet", flags->quiet, "no progress bar");

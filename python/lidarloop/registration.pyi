@@ -17,8 +17,9 @@ class Verification:
     def reason(self) -> str:
         """'none' when accepted, else 'too_few_points', 'no_alignment', 'not_converged',
         'low_overlap', 'high_rmse', 'degenerate', 'ambiguous', 'too_far',
-        'pruned', 'odometry_mismatch' (detect with odometry) or 'not_needed' (not registered:
-        a candidate ranked higher is the loop, detection.stop_at_first_loop)."""
+        'pruned', 'odometry_mismatch', 'unlike_fits' or 'unlike_revisit' (detect with odometry),
+        'unlike_neighbours' (without odometry) or 'not_needed' (not registered: a candidate
+        ranked higher is the loop, detection.stop_at_first_loop)."""
     @property
     def T_match_query(self) -> npt.NDArray[np.float64]:
         """(4, 4): maps query-frame points into the match scan's frame, metres."""

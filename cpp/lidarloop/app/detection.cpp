@@ -320,6 +320,10 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
                      " registered candidates rejected: they overlap far less than their scans do "
                      "with their neighbours, as a look-alike place does (reason unlike_neighbours "
                      "in candidates.csv; verification.acceptance.min_neighbour_overlap_ratio)");
+        NoteRejected(outcome, registration::RejectReason::kUnlikeFits,
+                     " registered candidates rejected: more of their query's fits on candidates "
+                     "ranked before them place the query elsewhere by the odometry (reason "
+                     "unlike_fits in candidates.csv)");
         NoteRejected(outcome, registration::RejectReason::kUnlikeRevisit,
                      " loops rejected: a longer chain of agreeing loops of their revisit places "
                      "them elsewhere by the odometry (reason unlike_revisit in candidates.csv; "

@@ -6,6 +6,7 @@
 #include <numeric>
 #include <optional>
 #include <string>
+#include <tuple>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -346,9 +347,20 @@ void RejectLoopsUnlikeEarlierFits(
             query.query, query.candidates[c].index, T_odom_sensor_of, path_m_of, gate);
         return allowed && allowed(verdict.T_match_query) ? vote : 0.0;
     };
+    // Not decided yet: neither accepted nor rejected (rank order, a candidate after a batch).
+    const auto undecided = [&](std::size_t c) {
+        const registration::Verification& verdict = query.verifications[c];
+        return !verdict.accepted && verdict.reason == registration::RejectReason::kNone;
+    };
     for (std::size_t c = 0; c < query.verifications.size(); ++c) {
         registration::Verification& verdict = query.verifications[c];
         if (!verdict.accepted) continue;
+        // A verdict found before those ranked before it were decided (a cached one) is judged
+        // when they are: its votes are theirs.
+        bool earlier_decided = true;
+        for (std::size_t earlier = 0; earlier < c; ++earlier)
+            earlier_decided = earlier_decided && !undecided(earlier);
+        if (!earlier_decided) continue;
         double agree = 1.0;  // the loop's own
         double disagree = 0.0;
         for (std::size_t earlier = 0; earlier < c; ++earlier) {
@@ -366,7 +378,7 @@ void RejectLoopsUnlikeEarlierFits(
         }
         if (agree > disagree) continue;
         verdict.accepted = false;
-        verdict.reason = registration::RejectReason::kAmbiguous;
+        verdict.reason = registration::RejectReason::kUnlikeFits;
     }
 }
 
@@ -418,7 +430,8 @@ std::vector<AcceptedLoop> AcceptedLoopsTheOdometryKnows(
         }
     }
     std::sort(loops.begin(), loops.end(), [](const AcceptedLoop& a, const AcceptedLoop& b) {
-        return a.query_path_m < b.query_path_m;
+        return std::tie(a.query_path_m, a.query, a.match) <
+               std::tie(b.query_path_m, b.query, b.match);
     });
     return loops;
 }
@@ -434,6 +447,11 @@ std::size_t RejectLoopsUnlikeTheirRevisit(
         AcceptedLoopsTheOdometryKnows(queries, T_odom_sensor_of, path_m_of);
     const auto T_of = [&](const AcceptedLoop& loop) {
         return queries[loop.query_index].verifications[loop.candidate].T_match_query;
+    };
+    // Where loop `from` and the odometry's links from its scans put the query of loop `to`.
+    const auto Carried = [&](const AcceptedLoop& from, const AcceptedLoop& to) {
+        return T_odom_sensor_of(to.match).inverse() * T_odom_sensor_of(from.match) * T_of(from) *
+               T_odom_sensor_of(from.query).inverse() * T_odom_sensor_of(to.query);
     };
     // Loops that agree with a neighbour form a chain; a pair that disagrees sets two chains
     // against each other.
@@ -451,22 +469,26 @@ std::size_t RejectLoopsUnlikeTheirRevisit(
              j < loops.size() && loops[j].query_path_m <= loop.query_path_m + window_m; ++j) {
             const AcceptedLoop& other = loops[j];
             if (std::abs(other.match_path_m - loop.match_path_m) > window_m) continue;
-            // Where the other loop and the odometry's links from its scans put this query.
-            const core::Transform T_match_query_carried =
-                T_odom_sensor_of(loop.match).inverse() * T_odom_sensor_of(other.match) *
-                T_of(other) * T_odom_sensor_of(other.query).inverse() *
-                T_odom_sensor_of(loop.query);
             const double links_m = std::abs(other.query_path_m - loop.query_path_m) +
                                    std::abs(other.match_path_m - loop.match_path_m);
-            if (gate(T_of(loop), T_match_query_carried, links_m)) {
+            // The gate measures in the frame of the loop it judges: each way round.
+            if (gate(T_of(loop), Carried(other, loop), links_m) ||
+                gate(T_of(other), Carried(loop, other), links_m)) {
                 disagreeing.emplace_back(i, j);
             } else {
                 chain[root(i)] = root(j);
             }
         }
     }
+    // A chain's length: its queries (a query's further loops for the pose graph count once).
+    std::vector<std::pair<std::size_t, std::size_t>> chain_queries;
+    for (std::size_t i = 0; i < loops.size(); ++i)
+        chain_queries.emplace_back(root(i), loops[i].query_index);
+    std::sort(chain_queries.begin(), chain_queries.end());
+    chain_queries.erase(std::unique(chain_queries.begin(), chain_queries.end()),
+                        chain_queries.end());
     std::vector<std::size_t> chain_size(loops.size(), 0);
-    for (std::size_t i = 0; i < loops.size(); ++i) ++chain_size[root(i)];
+    for (const auto& [chain_root, query_index] : chain_queries) ++chain_size[chain_root];
     // Of two chains that disagree, the shorter is rejected; of two as long, both.
     std::vector<bool> rejected_chain(loops.size(), false);
     for (const auto& [i, j] : disagreeing) {

@@ -188,10 +188,13 @@ std::size_t RejectLoopsAgainstOdometry(
     LoopQuery& query, const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,
     const std::function<double(std::size_t)>& path_m_of, const OdometryGate& gate);
 
-/// Rejects (RejectReason::kAmbiguous) each accepted verification of `query` whose pose
-/// contradicts the fit of a candidate ranked before it (accepted, or rejected only as ambiguous
-/// or too far, and allowed by `gate`): the two poses put the two matches relative to each other,
-/// and `gate` judges that against the odometry between the matches. Does not choose the loop
+/// Rejects (RejectReason::kUnlikeFits) each accepted verification of `query` that more of the
+/// fits of the candidates ranked before it contradict than agree with it (its own counts for it,
+/// a tie rejects). A fit votes when `gate` allows its pose: accepted or rejected only as too far
+/// one vote, rejected only as ambiguous half (either of its poses may be the place). Its pose
+/// and the loop's put the two matches relative to each other, which `gate` judges against the
+/// odometry between the matches. A verification found before the candidates ranked before it
+/// were decided (reason kNone, not accepted) is judged once they are. Does not choose the loop
 /// again.
 void RejectLoopsUnlikeEarlierFits(
     LoopQuery& query, const std::function<core::Transform(std::size_t)>& T_odom_sensor_of,

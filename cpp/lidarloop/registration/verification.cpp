@@ -348,6 +348,8 @@ std::string ToString(RejectReason reason) {
             return "unlike_neighbours";
         case RejectReason::kUnlikeRevisit:
             return "unlike_revisit";
+        case RejectReason::kUnlikeFits:
+            return "unlike_fits";
     }
     return "unknown";
 }

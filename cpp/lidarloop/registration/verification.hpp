@@ -21,10 +21,7 @@ enum class RejectReason {
     kLowOverlap,    ///< too few structure points of one scan lie on the other's surfaces
     kHighRmse,      ///< the overlapping points sit too far from the other scan's planes
     kDegenerate,    ///< sliding along the weakest direction fits as well (street, corridor)
-    /// another, distinct pose fits about as well (periodic structure); or, with the odometry,
-    /// the query's fits on the candidates ranked before contradict the pose (more votes against
-    /// than for it: pipeline::RejectLoopsUnlikeEarlierFits)
-    kAmbiguous,
+    kAmbiguous,     ///< another, distinct pose fits about as well (periodic structure)
     /// the sensors are farther apart than one place: registered so, or (not registered) every
     /// coarse peak that could be refined put them farther than a loop's distance plus
     /// CoarseConfig::max_peak_beyond_loop_m
@@ -42,11 +39,15 @@ enum class RejectReason {
     /// and matches within AcceptanceConfig::revisit_path_m of path) places it elsewhere (offline:
     /// detect, evaluate, optimise; pipeline::RejectLoopsUnlikeTheirRevisit)
     kUnlikeRevisit,
+    /// registered and passing, but with the odometry more of the query's fits on candidates
+    /// ranked before it place the query elsewhere than agree with it
+    /// (pipeline::RejectLoopsUnlikeEarlierFits)
+    kUnlikeFits,
 };
 
 /// "none", "too_few_points", "no_alignment", "not_converged", "low_overlap", "high_rmse",
 /// "degenerate", "ambiguous", "too_far", "pruned", "odometry_mismatch", "not_needed",
-/// "unlike_neighbours", "unlike_revisit": the spelling of loops.csv and `lidarloop verify`.
+/// "unlike_neighbours", "unlike_revisit", "unlike_fits": the spelling of loops.csv and `lidarloop verify`.
 std::string ToString(RejectReason reason);
 
 /// How well a query sits on a match at a pose (registration::MeasureOverlap).

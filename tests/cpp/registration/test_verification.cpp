@@ -426,6 +426,9 @@ TEST(Verification, InvalidConfigIsAConfigError) {
     expect_error([](auto& c) { c.acceptance.min_neighbour_overlap_ratio = -0.1; });
     expect_error([](auto& c) { c.acceptance.min_neighbour_overlap_ratio = std::nan(""); });
     expect_error([](auto& c) { c.acceptance.min_neighbour_overlap_ratio = 11.0; });
+    expect_error([](auto& c) { c.acceptance.revisit_path_m = -1.0; });
+    expect_error([](auto& c) { c.acceptance.revisit_path_m = std::nan(""); });
+    expect_error([](auto& c) { c.acceptance.revisit_path_m = 1e5; });
 }
 
 // Wilson's lower bound p solves (share - p)^2 = z^2 p (1 - p) / n below the share: checked on
@@ -524,6 +527,8 @@ TEST(Verification, ReasonsHaveStableNames) {
     EXPECT_EQ(ToString(RejectReason::kOdometryMismatch), "odometry_mismatch");
     EXPECT_EQ(ToString(RejectReason::kNotNeeded), "not_needed");
     EXPECT_EQ(ToString(RejectReason::kUnlikeNeighbours), "unlike_neighbours");
+    EXPECT_EQ(ToString(RejectReason::kUnlikeRevisit), "unlike_revisit");
+    EXPECT_EQ(ToString(RejectReason::kUnlikeFits), "unlike_fits");
 }
 
 // Simulated scans: exact ground truth, real ray casting (occlusion, beam pattern, noise).
