@@ -43,7 +43,8 @@ void BindVerification(py::module_& m) {
             "reason", [](const Verification& v) { return registration::ToString(v.reason); },
             "why it was not accepted: 'none' (accepted), 'too_few_points', 'no_alignment', "
             "'not_converged', 'low_overlap', 'high_rmse', 'degenerate', 'ambiguous', 'too_far', "
-            "'pruned', 'odometry_mismatch', 'not_needed', 'unlike_neighbours', 'unlike_revisit', 'unlike_fits'")
+            "'pruned', 'odometry_mismatch', 'not_needed', 'unlike_neighbours', 'unlike_revisit', "
+            "'unlike_fits'")
         .def_property_readonly(
             "T_match_query",
             [](const Verification& v) { return TransformToArray(v.T_match_query); },

@@ -47,7 +47,8 @@ enum class RejectReason {
 
 /// "none", "too_few_points", "no_alignment", "not_converged", "low_overlap", "high_rmse",
 /// "degenerate", "ambiguous", "too_far", "pruned", "odometry_mismatch", "not_needed",
-/// "unlike_neighbours", "unlike_revisit", "unlike_fits": the spelling of loops.csv and `lidarloop verify`.
+/// "unlike_neighbours", "unlike_revisit", "unlike_fits": the spelling of loops.csv and
+/// `lidarloop verify`.
 std::string ToString(RejectReason reason);
 
 /// How well a query sits on a match at a pose (registration::MeasureOverlap).
