@@ -11,6 +11,7 @@
 #include "lidarloop/core/descriptor.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/core/min_gap.hpp"
+#include "lidarloop/core/number_text.hpp"
 #include "lidarloop/io/database_file.hpp"
 #include "lidarloop/io/png.hpp"
 #include "lidarloop/io/poses.hpp"
@@ -61,6 +62,22 @@ std::string NoPathNote() {
     return "no path rule (detection.min_path_m): the dataset has no poses and no --odometry was "
            "given, so a candidate need only lie outside the gap in scans; a slow platform's "
            "recent past may then count as a loop";
+}
+
+// When no scan of a sequence of several has a single candidate: nothing was compared, so nothing
+// can be found (e.g. a gap longer than the sequence), which a run must say.
+std::string NoCandidateNote(const std::vector<pipeline::LoopQuery>& queries,
+                            const pipeline::DetectorConfig& detector, bool odometry) {
+    if (queries.size() < 2) return {};
+    for (const pipeline::LoopQuery& query : queries) {
+        if (query.has_match()) return {};
+    }
+    return "no scan had a candidate: every earlier scan lies within the minimum gap "
+           "(detection.min_gap: " +
+           core::NumberText(detector.min_gap.value) + " " + core::ToString(detector.min_gap.unit) +
+           ") or fails the path rule (detection.min_path_m: " +
+           core::NumberText(detector.min_path_m) + " m)" +
+           (odometry ? " or lies out of a loop's reach by the odometry" : "");
 }
 
 }  // namespace
@@ -302,6 +319,10 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
                                       pipeline::Execution::kParallel, path_m, odometry_check);
     }
     const double matrix_s = matrix_clock.Seconds();
+    if (std::string note = NoCandidateNote(outcome.queries, config.detection, !poses.empty());
+        !note.empty()) {
+        outcome.notes.push_back(std::move(note));
+    }
     Stopwatch verify_clock;
     pipeline::VerificationTimes verification_times;
     if (verify) {

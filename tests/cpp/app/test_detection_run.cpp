@@ -932,6 +932,27 @@ TEST_F(DetectionRun, AGapInSecondsWithoutTimesIsAClearError) {
     EXPECT_THROW(app::RunDetect(bare, request), core::ConfigError);
 }
 
+TEST_F(DetectionRun, ARunWithoutAnyCandidateSaysSo) {
+    const auto says_no_candidate = [](const app::DetectOutcome& outcome) {
+        return std::count_if(outcome.notes.begin(), outcome.notes.end(), [](const auto& note) {
+            return test::Contains(note, "no scan had a candidate");
+        });
+    };
+    app::DetectRequest request = Request("detect", core::Method::kHeight);
+    request.config.detection.verify = false;
+    const app::DetectOutcome usual = app::RunDetect(*dataset_, request);
+    EXPECT_EQ(says_no_candidate(usual), 0);
+    request.config.detection.min_gap = {1e30, core::MinGap::Unit::kScans};
+    request.out = dir_ / "no_candidate";
+    const app::DetectOutcome none = app::RunDetect(*dataset_, request);
+    ASSERT_EQ(says_no_candidate(none), 1);
+    EXPECT_EQ(none.accepted, 0u);
+    const auto note = std::find_if(none.notes.begin(), none.notes.end(), [](const auto& text) {
+        return test::Contains(text, "no scan had a candidate");
+    });
+    EXPECT_TRUE(test::Contains(*note, "1e+30 scans")) << *note;
+}
+
 // The rows of a CSV file, split at commas (the header first).
 std::vector<std::vector<std::string>> CsvCells(const std::filesystem::path& file) {
     std::ifstream in(file);
