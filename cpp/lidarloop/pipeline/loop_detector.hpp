@@ -206,7 +206,7 @@ void RejectLoopsUnlikeEarlierFits(
 /// carries one over to the other (T_match_query ≈ T_match_other · T_other_query' ·
 /// T_query'_query, both links by the odometry) and `gate` judges the two over the path of the
 /// links. Neighbours that agree join one chain; of two chains with a neighbour pair that
-/// disagrees, the one with fewer loops is rejected, both when as many (a pair that disagrees
+/// disagrees, the one with fewer queries is rejected, both when as many (a pair that disagrees
 /// within one chain decides nothing). Every loop is judged as the loops were before, so the
 /// order does not matter; the loops to or from a scan the odometry does not know are neither
 /// judged nor judge. Then each query's loop is chosen again among the rest. Returns how many it
