@@ -92,10 +92,10 @@ std::vector<Candidate> ReadCandidates(const std::filesystem::path& file) {
             continue;
         }
         // Rejected by the sequence (the neighbours, the query's other fits, the revisit's other
-        // loops), not by the pair: a replay of the pair alone accepts it.
-        const bool rejected_by_the_sequence = fields[reason] == "unlike_neighbours" ||
-                                              fields[reason] == "unlike_fits" ||
-                                              fields[reason] == "unlike_revisit";
+        // loops, the scans' motion), not by the pair: a replay of the pair alone accepts it.
+        const bool rejected_by_the_sequence =
+            fields[reason] == "unlike_neighbours" || fields[reason] == "unlike_fits" ||
+            fields[reason] == "unlike_revisit" || fields[reason] == "unlike_motion";
         Candidate candidate{std::stoul(fields[query]), std::stoul(fields[match]),
                             fields[accepted] == "1" || rejected_by_the_sequence, fields[reason]};
         for (int i = 0; i < 3; ++i) {

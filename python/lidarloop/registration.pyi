@@ -18,7 +18,7 @@ class Verification:
         """'none' when accepted, else 'too_few_points', 'no_alignment', 'not_converged',
         'low_overlap', 'high_rmse', 'degenerate', 'ambiguous', 'too_far',
         'pruned', 'odometry_mismatch', 'unlike_fits' or 'unlike_revisit' (detect with odometry),
-        'unlike_neighbours' (without odometry) or 'not_needed' (not registered: a candidate
+        'unlike_neighbours' or 'unlike_motion' (without odometry) or 'not_needed' (not registered: a candidate
         ranked higher is the loop, detection.stop_at_first_loop)."""
     @property
     def T_match_query(self) -> npt.NDArray[np.float64]:

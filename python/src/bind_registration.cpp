@@ -44,7 +44,7 @@ void BindVerification(py::module_& m) {
             "why it was not accepted: 'none' (accepted), 'too_few_points', 'no_alignment', "
             "'not_converged', 'low_overlap', 'high_rmse', 'degenerate', 'ambiguous', 'too_far', "
             "'pruned', 'odometry_mismatch', 'not_needed', 'unlike_neighbours', 'unlike_revisit', "
-            "'unlike_fits'")
+            "'unlike_fits', 'unlike_motion'")
         .def_property_readonly(
             "T_match_query",
             [](const Verification& v) { return TransformToArray(v.T_match_query); },

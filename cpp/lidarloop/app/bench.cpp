@@ -135,8 +135,9 @@ nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
     const auto match_of = [&](std::size_t index) { return expanded.Get(prepared.scans, index); };
     pipeline::NeighbourOverlaps neighbours(
         match_of, [&prepared] { return prepared.scans.size(); }, config.detection.verification);
+    // As the online detector judges: without the motion rule (offline only).
     const pipeline::LoopCheck judge = pipeline::JudgeOf(
-        check, [&neighbours](std::size_t scan) { return neighbours.Of(scan); },
+        check, [&neighbours](std::size_t scan) { return neighbours.Of(scan); }, {},
         config.detection.verification);
     std::size_t timed = 0;
     for (std::size_t q = 0; q < all.size() && timed < queries; q += step) {

@@ -341,6 +341,11 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
                      " registered candidates rejected: they overlap far less than their scans do "
                      "with their neighbours, as a look-alike place does (reason unlike_neighbours "
                      "in candidates.csv; verification.acceptance.min_neighbour_overlap_ratio)");
+        NoteRejected(outcome, registration::RejectReason::kUnlikeMotion,
+                     " registered candidates rejected: the scans between match and query, each "
+                     "registered to the one before, went on without turning and put them too far "
+                     "apart for a loop (reason unlike_motion in candidates.csv; "
+                     "verification.acceptance.motion_max_turn_deg)");
         NoteRejected(outcome, registration::RejectReason::kUnlikeFits,
                      " registered candidates rejected: more of their query's fits on candidates "
                      "ranked before them place the query elsewhere by the odometry (reason "

@@ -205,6 +205,11 @@ void VisitFields(registration::AcceptanceConfig& c, Visitor& v) {
     v.Field("revisit_path_m", c.revisit_path_m,
             "with odometry, loops whose queries and matches lie this close in path must agree; "
             "of two chains that do not, the shorter is rejected (0: off)");
+    v.Field("motion_max_turn_deg", c.motion_max_turn_deg,
+            "without odometry, where the scans from match to query never turn more than this, "
+            "their chained motion must allow the loop (0: off)");
+    v.Field("motion_drift_m", c.motion_drift_m, "the chain may be off by this, metres,");
+    v.Field("motion_drift_ratio", c.motion_drift_ratio, "plus this share of its path");
 }
 
 template <typename Visitor>

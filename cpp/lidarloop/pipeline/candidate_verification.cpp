@@ -224,7 +224,7 @@ VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
         scan_of, [&scans] { return scans.size(); }, detector.verification);
     const LoopCheck judge = JudgeOf(
         check, [&neighbours](std::size_t scan) { return neighbours.Of(scan); },
-        detector.verification);
+        [&neighbours](std::size_t scan) { return neighbours.StepOf(scan); }, detector.verification);
     std::vector<VerificationTimes> per_query(queries.size());
     ProgressCounter done(progress, queries.size());
     const auto run = [&](std::size_t i) {

@@ -644,11 +644,15 @@ void LoopDetector::Verify(LoopQuery& result, const registration::CompactPrepared
             query_reference = j == 0
                                   ? kNan
                                   : NeighbourOverlaps::Between(query, expanded_.Get(scans_, j - 1),
-                                                               detector_.verification);
+                                                               detector_.verification)
+                                        .distinctive_overlap;
         }
         return *query_reference;
     };
-    const LoopCheck judge = JudgeOf(check, reference_of, detector_.verification);
+    // No motion rule online: its chain from a match up to the query would register, at the
+    // first loop of a revisit, every scan from the match to the next turn at once (offline it
+    // costs at most a registration per scan; docs/verification.md, "The scans' own motion").
+    const LoopCheck judge = JudgeOf(check, reference_of, {}, detector_.verification);
     VerifyQuery(
         result, query, [this](std::size_t j) { return expanded_.Get(scans_, j); }, detector_,
         database_.method(), nullptr, nullptr, Execution::kParallel, judge);

@@ -5,6 +5,7 @@
 #include <limits>
 #include <utility>
 
+#include "lidarloop/core/angles.hpp"
 #include "lidarloop/registration/coarse_alignment.hpp"
 #include "lidarloop/registration/verification.hpp"
 
@@ -15,13 +16,15 @@ constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 
 }  // namespace
 
-double NeighbourOverlaps::Between(const registration::PreparedScan& later,
-                                  const registration::PreparedScan& earlier,
-                                  const registration::VerificationConfig& config) {
-    if (!later.structure || !earlier.structure) return kNan;
+NeighbourOverlaps::Pair NeighbourOverlaps::Between(const registration::PreparedScan& later,
+                                                   const registration::PreparedScan& earlier,
+                                                   const registration::VerificationConfig& config) {
+    if (!later.structure || !earlier.structure) return {kNan, std::nullopt};
     const registration::CoarseQuery coarse(*later.structure, config.coarse);
     const registration::Verification verdict = registration::Verify(later, coarse, earlier, config);
-    return verdict.accepted ? verdict.overlap.MinDistinctive() : kNan;
+    Pair pair{verdict.accepted ? verdict.overlap.MinDistinctive() : kNan, std::nullopt};
+    if (verdict.Registered()) pair.T_earlier_later = verdict.T_match_query;
+    return pair;
 }
 
 NeighbourOverlaps::NeighbourOverlaps(
@@ -32,20 +35,29 @@ NeighbourOverlaps::NeighbourOverlaps(
 double NeighbourOverlaps::Of(std::size_t scan) {
     const std::size_t later = std::max<std::size_t>(scan, 1);  // scan 0's neighbour pair is 1 -> 0
     if (later >= count_of_()) return kNan;                     // not there yet: nothing cached
+    return PairOf(later).distinctive_overlap;
+}
+
+std::optional<core::Transform> NeighbourOverlaps::StepOf(std::size_t scan) {
+    if (scan == 0 || scan >= count_of_()) return std::nullopt;
+    return PairOf(scan).T_earlier_later;
+}
+
+const NeighbourOverlaps::Pair& NeighbourOverlaps::PairOf(std::size_t later) {
     {
         const std::lock_guard lock(mutex_);
         if (later < computed_.size() && computed_[later]) return known_[later];
     }
     // Registered outside the lock: two threads asking at once compute the same value.
-    const double overlap = Between(prepared_of_(later), prepared_of_(later - 1), config_);
+    Pair pair = Between(prepared_of_(later), prepared_of_(later - 1), config_);
     const std::lock_guard lock(mutex_);
     if (later >= computed_.size()) {
         computed_.resize(later + 1, false);
-        known_.resize(later + 1, kNan);
+        known_.resize(later + 1, Pair{kNan, std::nullopt});
     }
     if (!computed_[later]) {
         computed_[later] = true;
-        known_[later] = overlap;
+        known_[later] = std::move(pair);
     }
     return known_[later];
 }
@@ -94,11 +106,56 @@ LoopCheck CheckAgainstNeighbours(std::function<double(std::size_t)> reference_of
     return check;
 }
 
+bool MotionRulesOutLoop(std::size_t query, std::size_t match, const StepOf& step_of,
+                        const registration::AcceptanceConfig& config) {
+    if (!(config.motion_max_turn_deg > 0.0) || match >= query) return false;
+    const double max_turn_rad = config.motion_max_turn_deg * core::kRadiansPerDegree;
+    core::Transform T_match_scan = core::Transform::Identity();
+    double path_m = 0.0;
+    for (std::size_t scan = match + 1; scan <= query; ++scan) {
+        const std::optional<core::Transform> step = step_of(scan);
+        if (!step) return false;
+        T_match_scan = T_match_scan * *step;
+        path_m += step->translation().norm();
+        const Eigen::Matrix3d& R = T_match_scan.linear();
+        if (std::abs(std::atan2(R(1, 0), R(0, 0))) > max_turn_rad) return false;  // it turned
+    }
+    return T_match_scan.translation().norm() >
+           config.max_loop_distance_m + config.motion_drift_m + config.motion_drift_ratio * path_m;
+}
+
+LoopCheck CheckAgainstMotion(StepOf step_of, const registration::AcceptanceConfig& config) {
+    LoopCheck check;
+    if (!(config.motion_max_turn_deg > 0.0)) return check;
+    check.reject = [step_of = std::move(step_of), config](LoopQuery& query) {
+        for (std::size_t c = 0; c < query.verifications.size(); ++c) {
+            registration::Verification& verdict = query.verifications[c];
+            if (!verdict.accepted ||
+                !MotionRulesOutLoop(query.query, query.candidates[c].index, step_of, config))
+                continue;
+            verdict.accepted = false;
+            verdict.reason = registration::RejectReason::kUnlikeMotion;
+        }
+        query.accepted = query.loop().has_value();
+    };
+    return check;
+}
+
 LoopCheck JudgeOf(const LoopCheck& odometry, std::function<double(std::size_t)> reference_of,
-                  const registration::VerificationConfig& config) {
+                  StepOf step_of, const registration::VerificationConfig& config) {
     if (odometry) return odometry;
-    return CheckAgainstNeighbours(std::move(reference_of),
-                                  config.acceptance.min_neighbour_overlap_ratio);
+    LoopCheck neighbours = CheckAgainstNeighbours(std::move(reference_of),
+                                                  config.acceptance.min_neighbour_overlap_ratio);
+    LoopCheck motion =
+        step_of ? CheckAgainstMotion(std::move(step_of), config.acceptance) : LoopCheck{};
+    if (!motion) return neighbours;
+    if (!neighbours) return motion;
+    LoopCheck both;
+    both.reject = [neighbours = std::move(neighbours), motion = std::move(motion)](LoopQuery& q) {
+        neighbours(q);
+        motion(q);
+    };
+    return both;
 }
 
 }  // namespace lidarloop::pipeline

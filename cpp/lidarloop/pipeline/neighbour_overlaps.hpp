@@ -3,7 +3,10 @@
 #include <cstddef>
 #include <functional>
 #include <mutex>
+#include <optional>
 #include <vector>
+
+#include "lidarloop/core/point_cloud.hpp"
 
 #include "lidarloop/pipeline/loop_detector.hpp"
 #include "lidarloop/registration/prepared_scan.hpp"
@@ -16,9 +19,18 @@ namespace lidarloop::pipeline {
 /// for both), as registration::Verify registers a candidate. It is the overlap a revisit of the
 /// same place can show at this density, field of view and step, the reference of
 /// AcceptanceConfig::min_neighbour_overlap_ratio (docs/verification.md, "What the neighbours
-/// show"). Computed when first asked for, once per scan; thread-safe.
+/// show"). Computed when first asked for, once per scan; thread-safe. The same registration
+/// gives the step between the two scans, which the motion rule chains (MotionRulesOutLoop).
 class NeighbourOverlaps {
 public:
+    /// A scan registered to the one before it.
+    struct Pair {
+        /// registration::Overlap::MinDistinctive when the pair is accepted, else NaN.
+        double distinctive_overlap;
+        /// The later scan in the earlier one's frame when registered (any verdict), else none.
+        std::optional<core::Transform> T_earlier_later;
+    };
+
     /// `prepared_of(i)`: scan i prepared as the candidates are (an empty PreparedScan for a
     /// skipped scan), for i < `count_of()` (the scans so far: a sequence only grows); called for
     /// a scan and its neighbour when Of first needs them, from the asking thread. What they refer
@@ -32,11 +44,15 @@ public:
     /// reference, no rule.
     double Of(std::size_t scan);
 
-    /// What `later` shows with `earlier` (registered as Of registers a scan to its neighbour):
-    /// a scan not stored in the sequence yet, e.g. an online query with the last stored scan.
-    static double Between(const registration::PreparedScan& later,
-                          const registration::PreparedScan& earlier,
-                          const registration::VerificationConfig& config);
+    /// Scan `scan` (>= 1) in the frame of scan `scan` - 1 (T_{scan-1}_{scan}), from the same
+    /// registration as Of; none for scan 0, a pair ICP did not register, or one not there yet.
+    std::optional<core::Transform> StepOf(std::size_t scan);
+
+    /// `later` registered to `earlier` as Of registers a scan to its neighbour: a scan not
+    /// stored in the sequence yet, e.g. an online query with the last stored scan.
+    static Pair Between(const registration::PreparedScan& later,
+                        const registration::PreparedScan& earlier,
+                        const registration::VerificationConfig& config);
 
     /// How many neighbour pairs Of has registered.
     std::size_t registered() const;
@@ -45,10 +61,31 @@ private:
     std::function<registration::PreparedScan(std::size_t)> prepared_of_;
     std::function<std::size_t()> count_of_;
     registration::VerificationConfig config_;
+    // The pair of `later` and the scan before it, registered once.
+    const Pair& PairOf(std::size_t later);
+
     mutable std::mutex mutex_;
-    std::vector<double> known_;  ///< by neighbour pair (its later scan); NaN where not computed
+    std::vector<Pair> known_;  ///< by neighbour pair (its later scan); valid where computed
     std::vector<bool> computed_;
 };
+
+/// Scan i in the frame of scan i - 1 (NeighbourOverlaps::StepOf): none where unknown.
+using StepOf = std::function<std::optional<core::Transform>(std::size_t scan)>;
+
+/// Whether the scans from `match` to `query` (match < query), chained by their steps, rule out a
+/// loop between the two: a sensor that goes on without turning cannot come back. They do when
+/// the chain never turns more than acceptance.motion_max_turn_deg from the match's heading and
+/// puts the query farther from the match than max_loop_distance_m + motion_drift_m +
+/// motion_drift_ratio times the chain's path (docs/verification.md, "The scans' own motion").
+/// False when the rule is off (0 degrees), match >= query, or a step is unknown; the chain is
+/// walked from the match and left at its first turn, so a revisit costs few steps.
+bool MotionRulesOutLoop(std::size_t query, std::size_t match, const StepOf& step_of,
+                        const registration::AcceptanceConfig& config);
+
+/// Rejects (RejectReason::kUnlikeMotion) each accepted verification of a query that
+/// MotionRulesOutLoop rules out, and chooses the query's loop again among the rest. Empty when
+/// the rule is off. The check rejects only, as CheckAgainstNeighbours.
+LoopCheck CheckAgainstMotion(StepOf step_of, const registration::AcceptanceConfig& config);
 
 /// Rejects (RejectReason::kUnlikeNeighbours) each accepted verification of a query whose
 /// distinctive overlap is under `min_ratio` times the lower of what its two scans show with
@@ -61,8 +98,9 @@ LoopCheck CheckAgainstNeighbours(std::function<double(std::size_t)> reference_of
 
 /// What judges a sequence's verified loops: `odometry` where given (non-empty), else, with no
 /// knowledge besides the scans, CheckAgainstNeighbours with `reference_of` (e.g.
-/// NeighbourOverlaps::Of) at config.acceptance.min_neighbour_overlap_ratio.
+/// NeighbourOverlaps::Of) at config.acceptance.min_neighbour_overlap_ratio, then, given
+/// `step_of` (e.g. NeighbourOverlaps::StepOf; offline: VerifyQueries), CheckAgainstMotion.
 LoopCheck JudgeOf(const LoopCheck& odometry, std::function<double(std::size_t)> reference_of,
-                  const registration::VerificationConfig& config);
+                  StepOf step_of, const registration::VerificationConfig& config);
 
 }  // namespace lidarloop::pipeline

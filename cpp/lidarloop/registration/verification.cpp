@@ -350,6 +350,8 @@ std::string ToString(RejectReason reason) {
             return "unlike_revisit";
         case RejectReason::kUnlikeFits:
             return "unlike_fits";
+        case RejectReason::kUnlikeMotion:
+            return "unlike_motion";
     }
     return "unknown";
 }

@@ -43,12 +43,16 @@ enum class RejectReason {
     /// ranked before it place the query elsewhere than agree with it
     /// (pipeline::RejectLoopsUnlikeEarlierFits)
     kUnlikeFits,
+    /// registered, but without odometry the scans between match and query, each registered to
+    /// the one before, went on without turning and put the two too far apart for a loop
+    /// (AcceptanceConfig::motion_max_turn_deg; pipeline::MotionRulesOutLoop)
+    kUnlikeMotion,
 };
 
 /// "none", "too_few_points", "no_alignment", "not_converged", "low_overlap", "high_rmse",
 /// "degenerate", "ambiguous", "too_far", "pruned", "odometry_mismatch", "not_needed",
-/// "unlike_neighbours", "unlike_revisit", "unlike_fits": the spelling of loops.csv and
-/// `lidarloop verify`.
+/// "unlike_neighbours", "unlike_revisit", "unlike_fits", "unlike_motion": the spelling of loops.csv
+/// and `lidarloop verify`.
 std::string ToString(RejectReason reason);
 
 /// How well a query sits on a match at a pose (registration::MeasureOverlap).

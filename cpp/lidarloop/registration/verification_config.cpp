@@ -93,6 +93,9 @@ void AcceptanceConfig::Validate() const {
     RequireIn(max_loop_distance_m, 0.1, 1e4, "acceptance.max_loop_distance_m");
     RequireIn(min_neighbour_overlap_ratio, 0.0, 10.0, "acceptance.min_neighbour_overlap_ratio");
     RequireIn(revisit_path_m, 0.0, 1e4, "acceptance.revisit_path_m");
+    RequireIn(motion_max_turn_deg, 0.0, 180.0, "acceptance.motion_max_turn_deg");
+    RequireIn(motion_drift_m, 0.0, 1e4, "acceptance.motion_drift_m");
+    RequireIn(motion_drift_ratio, 0.0, 10.0, "acceptance.motion_drift_ratio");
 }
 
 void VerificationConfig::Validate() const {

@@ -204,6 +204,19 @@ struct AcceptanceConfig {
     /// disagree the shorter is rejected (pipeline::RejectLoopsUnlikeTheirRevisit). 0: off. 10 m:
     /// one place, the submaps' reach (docs/verification.md, "The loops of one revisit agree").
     double revisit_path_m = 10.0;
+    /// Without odometry, offline (detect, evaluate, optimise; not the online detector), a loop of
+    /// a sequence is also judged by the scans' own motion: the scans
+    /// from its match to its query, each registered to the one before (pipeline::
+    /// NeighbourOverlaps), chained. Where the chain never turns more than this from the match's
+    /// heading, the sensor went on and cannot have come back: the loop is rejected when the
+    /// chain puts the query farther from the match than max_loop_distance_m + motion_drift_m +
+    /// motion_drift_ratio times the chain's path (pipeline::MotionRulesOutLoop). 0: off. On the
+    /// 29 gate sequences no true loop had a chain this straight; the false loops on a straight
+    /// road (periodic trees, look-alike blocks) do (docs/verification.md, "The scans' own
+    /// motion").
+    double motion_max_turn_deg = 30.0;
+    double motion_drift_m = 3.0;      ///< what the chain may be off by besides its share, metres
+    double motion_drift_ratio = 0.2;  ///< and this share of its path
 
     void Validate() const;
     bool operator==(const AcceptanceConfig&) const = default;

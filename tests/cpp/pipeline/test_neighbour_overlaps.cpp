@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -9,6 +10,7 @@
 #include "lidarloop/pipeline/loop_detector.hpp"
 #include "lidarloop/pipeline/neighbour_overlaps.hpp"
 #include "lidarloop/pipeline/similarity_matrix.hpp"
+#include "pipeline/detect_both_ways.hpp"
 #include "registration/registration_test_utils.hpp"
 
 namespace lidarloop::pipeline {
@@ -91,6 +93,17 @@ TEST(NeighbourOverlaps, RegistersEachScanToTheOneBeforeOnce) {
     for (std::size_t i = 0; i < prepared.size(); ++i) neighbours.Of(i);
     EXPECT_EQ(expanded, expansions) << "each pair is registered once";
     EXPECT_EQ(neighbours.registered(), 4U);
+    // The same registrations give the steps: scan 1 sits 1 m ahead of scan 0 (its points lie 1 m
+    // further back), scan 3 1 m ahead of scan 2.
+    for (const std::size_t later : {1U, 3U}) {
+        const std::optional<core::Transform> step = neighbours.StepOf(later);
+        ASSERT_TRUE(step.has_value()) << later;
+        EXPECT_LT((step->translation() - Eigen::Vector3d(1.0, 0.0, 0.0)).norm(), 0.05) << later;
+        EXPECT_LT(Eigen::AngleAxisd(step->linear()).angle(), 0.01) << later;
+    }
+    EXPECT_FALSE(neighbours.StepOf(0).has_value()) << "scan 0 has no scan before it";
+    EXPECT_FALSE(neighbours.StepOf(5).has_value()) << "not there yet";
+    EXPECT_EQ(expanded, expansions) << "StepOf reads the pairs Of registered";
 }
 
 TEST(NeighbourOverlaps, AScanWithoutItsNeighbourYetHasNoReferenceAndGetsOneLater) {
@@ -174,15 +187,21 @@ TEST(CheckAgainstNeighbours, AsksForAReferenceOnlyWhereItMayDecide) {
 TEST(CheckAgainstNeighbours, RatioZeroIsNoCheck) {
     EXPECT_FALSE(CheckAgainstNeighbours([](std::size_t) { return 1.0; }, 0.0));
     const auto reference_of = [](std::size_t) { return 1.0; };
+    const auto step_of = [](std::size_t) { return std::optional<core::Transform>(); };
     registration::VerificationConfig config;
     config.acceptance.min_neighbour_overlap_ratio = 0.0;
-    EXPECT_FALSE(JudgeOf({}, reference_of, config));
+    config.acceptance.motion_max_turn_deg = 0.0;
+    EXPECT_FALSE(JudgeOf({}, reference_of, step_of, config));
     config.acceptance.min_neighbour_overlap_ratio = 0.5;
-    EXPECT_TRUE(JudgeOf({}, reference_of, config));
+    EXPECT_TRUE(JudgeOf({}, reference_of, step_of, config));
+    config.acceptance.min_neighbour_overlap_ratio = 0.0;
+    config.acceptance.motion_max_turn_deg = 30.0;
+    EXPECT_TRUE(JudgeOf({}, reference_of, step_of, config)) << "the motion rule alone";
     // Where the odometry judges, it alone does.
     LoopCheck odometry;
     odometry.reject = [](LoopQuery& q) { q.accepted = false; };
-    const LoopCheck judge = JudgeOf(odometry, reference_of, config);
+    config.acceptance.min_neighbour_overlap_ratio = 0.5;
+    const LoopCheck judge = JudgeOf(odometry, reference_of, step_of, config);
     LoopQuery query = AcceptedQuery(1, {0}, {0.0});
     judge(query);
     EXPECT_TRUE(query.verifications[0].accepted) << "the odometry's check ran, not the neighbours'";
@@ -194,20 +213,9 @@ TEST(CheckAgainstNeighbours, RatioZeroIsNoCheck) {
 TEST(NeighbourOverlaps, DetectorsJudgeLoopsAgainstTheNeighbours) {
     const std::vector<core::PointCloud> scans = TwoPlacesAndARevisit();
     for (const double ratio : {0.5, 1.5}) {
-        const DetectorConfig detector = Verifying(ratio);
-        core::DescriptorConfig config;
-        config.method = core::Method::kRange;
-        LoopDetector online(config, detector);
-        std::vector<LoopQuery> online_results;
-        std::vector<double> times;
-        for (std::size_t i = 0; i < scans.size(); ++i) {
-            times.push_back(static_cast<double>(i));
-            online_results.push_back(online.Process(scans[i], times.back()));
-        }
-        std::vector<LoopQuery> offline = DetectFromMatrix(
-            ComputeSimilarityMatrix(online.database()), times, detector, core::Method::kRange);
-        VerifyQueries(offline, Prepared(scans, detector), detector, core::Method::kRange,
-                      Execution::kSerial);
+        const test::Detections detections = test::DetectBothWays(scans, Verifying(ratio));
+        const std::vector<LoopQuery>& online_results = detections.online;
+        const std::vector<LoopQuery>& offline = detections.offline;
         for (const LoopQuery* query : {&online_results[4], &offline[4]}) {
             // Both candidates are place 1: the first registered is the loop, or both fail.
             ASSERT_EQ(query->candidates.size(), 2U) << ratio;

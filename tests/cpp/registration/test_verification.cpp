@@ -429,6 +429,12 @@ TEST(Verification, InvalidConfigIsAConfigError) {
     expect_error([](auto& c) { c.acceptance.revisit_path_m = -1.0; });
     expect_error([](auto& c) { c.acceptance.revisit_path_m = std::nan(""); });
     expect_error([](auto& c) { c.acceptance.revisit_path_m = 1e5; });
+    expect_error([](auto& c) { c.acceptance.motion_max_turn_deg = -1.0; });
+    expect_error([](auto& c) { c.acceptance.motion_max_turn_deg = 181.0; });
+    expect_error([](auto& c) { c.acceptance.motion_max_turn_deg = std::nan(""); });
+    expect_error([](auto& c) { c.acceptance.motion_drift_m = -0.5; });
+    expect_error([](auto& c) { c.acceptance.motion_drift_ratio = std::nan(""); });
+    expect_error([](auto& c) { c.acceptance.motion_drift_ratio = 11.0; });
 }
 
 // Wilson's lower bound p solves (share - p)^2 = z^2 p (1 - p) / n below the share: checked on
@@ -529,6 +535,7 @@ TEST(Verification, ReasonsHaveStableNames) {
     EXPECT_EQ(ToString(RejectReason::kUnlikeNeighbours), "unlike_neighbours");
     EXPECT_EQ(ToString(RejectReason::kUnlikeRevisit), "unlike_revisit");
     EXPECT_EQ(ToString(RejectReason::kUnlikeFits), "unlike_fits");
+    EXPECT_EQ(ToString(RejectReason::kUnlikeMotion), "unlike_motion");
 }
 
 // Simulated scans: exact ground truth, real ray casting (occlusion, beam pattern, noise).
