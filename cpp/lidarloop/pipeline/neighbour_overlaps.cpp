@@ -43,7 +43,7 @@ std::optional<core::Transform> NeighbourOverlaps::StepOf(std::size_t scan) {
     return PairOf(scan).T_earlier_later;
 }
 
-const NeighbourOverlaps::Pair& NeighbourOverlaps::PairOf(std::size_t later) {
+NeighbourOverlaps::Pair NeighbourOverlaps::PairOf(std::size_t later) {
     {
         const std::lock_guard lock(mutex_);
         if (later < computed_.size() && computed_[later]) return known_[later];

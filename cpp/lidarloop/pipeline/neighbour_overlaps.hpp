@@ -61,8 +61,9 @@ private:
     std::function<registration::PreparedScan(std::size_t)> prepared_of_;
     std::function<std::size_t()> count_of_;
     registration::VerificationConfig config_;
-    // The pair of `later` and the scan before it, registered once.
-    const Pair& PairOf(std::size_t later);
+    // The pair of `later` and the scan before it, registered once; a copy, since another thread
+    // may grow the cache.
+    Pair PairOf(std::size_t later);
 
     mutable std::mutex mutex_;
     std::vector<Pair> known_;  ///< by neighbour pair (its later scan); valid where computed
