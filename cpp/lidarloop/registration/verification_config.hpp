@@ -204,7 +204,7 @@ struct AcceptanceConfig {
     /// disagree the shorter is rejected (pipeline::RejectLoopsUnlikeTheirRevisit). 0: off. 10 m:
     /// one place, the submaps' reach (docs/verification.md, "The loops of one revisit agree").
     double revisit_path_m = 10.0;
-    /// Without odometry, offline (detect, evaluate, optimise; not the online detector), a loop of
+    /// Without odometry, offline (detect, evaluate; not the online detector), a loop of
     /// a sequence is also judged by the scans' own motion: the scans
     /// from its match to its query, each registered to the one before (pipeline::
     /// NeighbourOverlaps), chained. Where the chain never turns more than this from the match's

@@ -106,6 +106,29 @@ TEST(NeighbourOverlaps, RegistersEachScanToTheOneBeforeOnce) {
     EXPECT_EQ(expanded, expansions) << "StepOf reads the pairs Of registered";
 }
 
+// Two walls along a straight corridor: a step along it is not pinned, so the pair is rejected
+// (no reference), but ICP registered it, and its heading and sideways offset are the corridor's.
+TEST(NeighbourOverlaps, ARegisteredPairGivesItsStepWhateverItsVerdict) {
+    core::PointCloud corridor;
+    for (double x = -40.0; x <= 40.0; x += 0.25) {
+        for (double z = -1.7; z <= 3.0; z += 0.25) {
+            corridor.emplace_back(x, 4.0, z);
+            corridor.emplace_back(x, -4.0, z);
+        }
+        for (double y = -4.0; y <= 4.0; y += 0.5) corridor.emplace_back(x, y, -1.7);
+    }
+    const DetectorConfig detector = Verifying(0.5);
+    const auto prepared = Prepared(
+        {corridor, test::Transformed(corridor, test::PlanarTransform(-1.0, 0.3, 0.0))}, detector);
+    NeighbourOverlaps neighbours([&](std::size_t i) { return prepared.at(i).Expand(); },
+                                 [&] { return prepared.size(); }, detector.verification);
+    EXPECT_TRUE(std::isnan(neighbours.Of(1))) << "a corridor does not pin a step along it";
+    const std::optional<core::Transform> step = neighbours.StepOf(1);
+    ASSERT_TRUE(step.has_value());
+    EXPECT_NEAR(step->translation().y(), -0.3, 0.05);
+    EXPECT_LT(Eigen::AngleAxisd(step->linear()).angle(), 0.01);
+}
+
 TEST(NeighbourOverlaps, AScanWithoutItsNeighbourYetHasNoReferenceAndGetsOneLater) {
     const DetectorConfig detector = Verifying(0.5);
     const auto prepared = Prepared(TwoPlacesAndARevisit(), detector);
