@@ -636,16 +636,17 @@ void LoopDetector::Verify(LoopQuery& result, const registration::CompactPrepared
     if (!detector_.verify || !scan.prepared()) return;
     // The query as it is stored: online, offline and localisation see the same scans.
     const registration::PreparedScan query = scan.Expand();
-    // The query is not stored yet: its neighbour's overlap is computed here, once, if asked for.
+    // The query is not stored yet (Process, or a localisation query searched as the scan after
+    // the stored ones): its neighbour is the last stored scan, registered here, once, if asked.
     std::optional<double> query_reference;
     const auto reference_of = [&](std::size_t j) {
         if (j < scans_.size()) return neighbours_->Of(j);
         if (!query_reference) {
-            query_reference = j == 0
-                                  ? kNan
-                                  : NeighbourOverlaps::Between(query, expanded_.Get(scans_, j - 1),
-                                                               detector_.verification)
-                                        .distinctive_overlap;
+            query_reference = scans_.empty() ? kNan
+                                             : NeighbourOverlaps::Between(
+                                                   query, expanded_.Get(scans_, scans_.size() - 1),
+                                                   detector_.verification)
+                                                   .distinctive_overlap;
         }
         return *query_reference;
     };
@@ -771,9 +772,12 @@ LoopQuery LoopDetector::Query(const PreparedQuery& query, std::size_t query_inde
 
 LoopQuery LoopDetector::Query(const PreparedQuery& query, std::size_t query_index,
                               const registration::CompactPreparedScan& scan) const {
+    // Searched and judged as the scan after the stored ones (its neighbour is the last stored
+    // scan); `query_index`, an index of another sequence, only labels the result.
     LoopQuery result =
-        Search(query, query_index, [&](std::size_t j) { return database_.IsValid(j); });
+        Search(query, database_.size(), [&](std::size_t j) { return database_.IsValid(j); });
     Verify(result, scan);
+    result.query = query_index;
     return result;
 }
 

@@ -233,6 +233,32 @@ TEST(CheckAgainstNeighbours, RatioZeroIsNoCheck) {
 // The revisit of place 1 (scan 4 -> 0 or 1) overlaps about as much as scans 0 and 1 do: kept at
 // the default ratio, rejected where a loop must overlap more than its neighbours, online and
 // offline alike.
+// A localisation query labelled with its index in another, longer sequence is judged as the
+// scan after the map's: its neighbour is the map's last scan (it once read the map's scan of
+// that index, or past the map's end: detect --map on a sequence longer than the map crashed).
+TEST(NeighbourOverlaps, ALocalisationQueryTakesTheMapsLastScanAsItsNeighbour) {
+    const std::vector<core::PointCloud> scans = TwoPlacesAndARevisit();
+    const DetectorConfig detector = Verifying(1.5);  // every accepted loop asks for references
+    core::DescriptorConfig config;
+    config.method = core::Method::kRange;
+    LoopDetector online(config, detector);
+    for (std::size_t i = 0; i + 1 < scans.size(); ++i)
+        online.Process(scans[i], static_cast<double>(i));
+    const registration::PreparedScan revisit =
+        registration::PrepareScan(scans.back(), detector.verification.reduction);
+    const core::Descriptor descriptor = ComputeDescriptor(scans.back(), config);
+    const LoopQuery as_next = online.Query(descriptor, revisit);
+    for (const std::size_t label : {std::size_t{1}, std::size_t{4}, std::size_t{40}}) {
+        LoopQuery labelled;
+        ASSERT_NO_THROW(labelled =
+                            online.Query(*online.database().Prepare(descriptor), label, revisit));
+        EXPECT_EQ(labelled.query, label);
+        ASSERT_EQ(labelled.verifications.size(), as_next.verifications.size()) << label;
+        for (std::size_t c = 0; c < labelled.verifications.size(); ++c)
+            EXPECT_EQ(labelled.verifications[c].reason, as_next.verifications[c].reason) << label;
+    }
+}
+
 TEST(NeighbourOverlaps, DetectorsJudgeLoopsAgainstTheNeighbours) {
     const std::vector<core::PointCloud> scans = TwoPlacesAndARevisit();
     for (const double ratio : {0.5, 1.5}) {
