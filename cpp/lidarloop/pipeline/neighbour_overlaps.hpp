@@ -54,7 +54,7 @@ public:
                         const registration::PreparedScan& earlier,
                         const registration::VerificationConfig& config);
 
-    /// How many neighbour pairs Of has registered.
+    /// How many neighbour pairs Of and StepOf have registered.
     std::size_t registered() const;
 
 private:
@@ -79,7 +79,8 @@ using StepOf = std::function<std::optional<core::Transform>(std::size_t scan)>;
 /// puts the query farther from the match than max_loop_distance_m + motion_drift_m +
 /// motion_drift_ratio times the chain's path (docs/verification.md, "The scans' own motion").
 /// False when the rule is off (0 degrees), match >= query, or a step is unknown; the chain is
-/// walked from the match and left at its first turn, so a revisit costs few steps.
+/// walked from the match and left at its first turn, so a revisit registers the steps up to
+/// that turn only, once (they are cached).
 bool MotionRulesOutLoop(std::size_t query, std::size_t match, const StepOf& step_of,
                         const registration::AcceptanceConfig& config);
 
