@@ -1,10 +1,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <optional>
+#include <random>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <tbb/parallel_for.h>
 
 #include "lidarloop/pipeline/candidate_verification.hpp"
 #include "lidarloop/pipeline/loop_detector.hpp"
@@ -127,6 +130,44 @@ TEST(NeighbourOverlaps, ARegisteredPairGivesItsStepWhateverItsVerdict) {
     ASSERT_TRUE(step.has_value());
     EXPECT_NEAR(step->translation().y(), -0.3, 0.05);
     EXPECT_LT(Eigen::AngleAxisd(step->linear()).angle(), 0.01);
+}
+
+// VerifyQueries asks from several threads, in any order, while the cache grows: every thread
+// must read the pairs one thread alone reads, and each pair is kept once.
+TEST(NeighbourOverlaps, ThreadsAskingInAnyOrderReadWhatOneThreadReads) {
+    const core::PointCloud place = test::SyntheticPlace(3);
+    std::vector<core::PointCloud> scans;
+    for (int i = 0; i < 24; ++i)
+        scans.push_back(test::Transformed(place, test::PlanarTransform(-0.7 * i, 0.0, 2.0 * i)));
+    const DetectorConfig detector = Verifying(0.5);
+    const auto prepared = Prepared(scans, detector);
+    const auto make = [&] {
+        return NeighbourOverlaps([&](std::size_t i) { return prepared.at(i).Expand(); },
+                                 [&] { return prepared.size(); }, detector.verification);
+    };
+    NeighbourOverlaps alone = make();
+    std::vector<std::size_t> order(scans.size());
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    std::shuffle(order.begin(), order.end(), std::mt19937(7));
+    std::reverse(order.begin(), order.begin() + 8);  // some high indices first: the cache grows
+    NeighbourOverlaps shared = make();
+    std::vector<std::optional<core::Transform>> steps(scans.size());
+    std::vector<double> overlaps(scans.size());
+    tbb::parallel_for(std::size_t{0}, order.size(), [&](std::size_t k) {
+        steps[order[k]] = shared.StepOf(order[k]);
+        overlaps[order[k]] = shared.Of(order[k]);
+    });
+    for (std::size_t i = 0; i < scans.size(); ++i) {
+        const std::optional<core::Transform> expected = alone.StepOf(i);
+        ASSERT_EQ(steps[i].has_value(), expected.has_value()) << i;
+        if (expected) {
+            EXPECT_TRUE(steps[i]->isApprox(*expected, 1e-12)) << i;
+        }
+        const double overlap = alone.Of(i);
+        EXPECT_TRUE(overlaps[i] == overlap || (std::isnan(overlaps[i]) && std::isnan(overlap)))
+            << i;
+    }
+    EXPECT_EQ(shared.registered(), alone.registered());
 }
 
 TEST(NeighbourOverlaps, AScanWithoutItsNeighbourYetHasNoReferenceAndGetsOneLater) {
