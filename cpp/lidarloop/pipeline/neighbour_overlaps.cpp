@@ -83,6 +83,19 @@ bool UnlikeNeighbours(double distinctive_overlap, double min_ratio,
     return distinctive_overlap < min_ratio * std::fmin(query, match_reference());
 }
 
+// Rejects, for `reason`, each accepted verification of `query` for whose candidate `rejects(c)`
+// holds, then chooses the query's loop again among the rest.
+void RejectAcceptedWhere(LoopQuery& query, registration::RejectReason reason,
+                         const std::function<bool(std::size_t candidate)>& rejects) {
+    for (std::size_t c = 0; c < query.verifications.size(); ++c) {
+        registration::Verification& verdict = query.verifications[c];
+        if (!verdict.accepted || !rejects(c)) continue;
+        verdict.accepted = false;
+        verdict.reason = reason;
+    }
+    query.accepted = query.loop().has_value();
+}
+
 }  // namespace
 
 LoopCheck CheckAgainstNeighbours(std::function<double(std::size_t)> reference_of,
@@ -90,18 +103,13 @@ LoopCheck CheckAgainstNeighbours(std::function<double(std::size_t)> reference_of
     LoopCheck check;
     if (!(min_ratio > 0.0)) return check;
     check.reject = [reference_of = std::move(reference_of), min_ratio](LoopQuery& query) {
-        for (std::size_t c = 0; c < query.verifications.size(); ++c) {
-            registration::Verification& verdict = query.verifications[c];
-            if (!verdict.accepted) continue;
-            const std::size_t match = query.candidates[c].index;
-            if (!UnlikeNeighbours(
-                    verdict.overlap.MinDistinctive(), min_ratio,
-                    [&] { return reference_of(query.query); }, [&] { return reference_of(match); }))
-                continue;
-            verdict.accepted = false;
-            verdict.reason = registration::RejectReason::kUnlikeNeighbours;
-        }
-        query.accepted = query.loop().has_value();
+        RejectAcceptedWhere(
+            query, registration::RejectReason::kUnlikeNeighbours, [&](std::size_t c) {
+                const std::size_t match = query.candidates[c].index;
+                return UnlikeNeighbours(
+                    query.verifications[c].overlap.MinDistinctive(), min_ratio,
+                    [&] { return reference_of(query.query); }, [&] { return reference_of(match); });
+            });
     };
     return check;
 }
@@ -128,15 +136,9 @@ LoopCheck CheckAgainstMotion(StepOf step_of, const registration::AcceptanceConfi
     LoopCheck check;
     if (!(config.motion_max_turn_deg > 0.0)) return check;
     check.reject = [step_of = std::move(step_of), config](LoopQuery& query) {
-        for (std::size_t c = 0; c < query.verifications.size(); ++c) {
-            registration::Verification& verdict = query.verifications[c];
-            if (!verdict.accepted ||
-                !MotionRulesOutLoop(query.query, query.candidates[c].index, step_of, config))
-                continue;
-            verdict.accepted = false;
-            verdict.reason = registration::RejectReason::kUnlikeMotion;
-        }
-        query.accepted = query.loop().has_value();
+        RejectAcceptedWhere(query, registration::RejectReason::kUnlikeMotion, [&](std::size_t c) {
+            return MotionRulesOutLoop(query.query, query.candidates[c].index, step_of, config);
+        });
     };
     return check;
 }
