@@ -181,7 +181,8 @@ def evaluate(
     must be more than that much path apart too, 0: no path rule); train_on: learn
     each method's threshold on that dataset (with poses) instead of the first part; odometry
     (KITTI or TUM, never the ground truth): verification with submaps and the odometry gate,
-    as detect's (odometry_calib as detect's)."""
+    as detect's (odometry_calib as detect's); without it the scans' registrations to their
+    neighbours place the submaps, as detect's."""
 
 class OptimiseResult:
     @property

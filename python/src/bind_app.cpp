@@ -453,7 +453,8 @@ void BindEvaluate(py::module_& m) {
             "images, report.md, config.yaml and run.json into `out` (a results folder, as "
             "detect's). train_on (a folder or Dataset with poses) learns each method's threshold "
             "there instead of on the first part. odometry (a KITTI or TUM file, never the ground "
-            "truth): verification with submaps and the odometry gate, as detect's. None keeps "
+            "truth): verification with submaps and the odometry gate, as detect's; without it "
+            "the scans' registrations to their neighbours place the submaps. None keeps "
             "the default of app::EvaluationRequest or the config."));
 }
 

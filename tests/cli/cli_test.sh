@@ -82,6 +82,11 @@ make_sequence() {
     cp "$samples/courtyard.bin" "$1/scan7.bin"
 }
 
+# alone_yaml FILE: a detect configuration verifying each scan alone, without submaps.
+alone_yaml() {
+    printf 'verification:\n  reduction:\n    submap_path_m: 0\n' >"$1"
+}
+
 # --- describe: every format gives the same histogram for the same scan -----------------------
 section_describe() {
     reference="$("$cli" describe "$samples/corner_a.bin")"
@@ -223,8 +228,9 @@ section_scancontext() {
     expect_ok "dump-config --markdown" '| `scancontext.rings` | 20 |' "$cli" dump-config --markdown
     seq="$work/seq"
     make_sequence "$seq"
+    alone_yaml "$work/alone.yaml"
     expect_ok "detect scancontext" "method scancontext" "$cli" detect "$seq" --method scancontext \
-        --min-gap 2 --quiet --out "$work/det_sc"
+        --min-gap 2 --config "$work/alone.yaml" --quiet --out "$work/det_sc"
     # Scan 3 is a copy of scan 0: at distance 0, verified at the identity pose.
     if grep -q "^3,0,0,,1,1,0,0,0,0,0,0,1," "$work/det_sc/loops.csv"; then pass; else
         fail "scancontext: scan 3 (a copy of scan 0) is not a verified loop: $(cat "$work/det_sc/loops.csv")"
@@ -235,7 +241,23 @@ section_scancontext() {
 section_detect() {
     seq="$work/seq"
     make_sequence "$seq"
-    expect_ok "detect" "8 scans (folder)" "$cli" detect "$seq" --min-gap 2 --quiet --out "$work/det"
+    # Scans 0-5, copies of one scan, are one piece of the chain of each scan registered to the
+    # one before (no odometry): 0 m of path apart, the recent past, so no candidates of each
+    # other. The checks of a verified identity loop below verify each scan alone.
+    expect_ok "detect, submaps from the neighbours" "8 scans (folder)" "$cli" detect "$seq" \
+        --min-gap 2 --out "$work/det_chain"
+    if grep -qF "placed by each scan's registration to the one before" "$work/stderr"; then
+        pass
+    else fail "detect without odometry does not say that the neighbours place submaps"; fi
+    if grep -q "^3,[0-9]*,[0-2]," "$work/det_chain/candidates.csv"; then
+        fail "scan 3 has a copy of its recent past as a candidate: $(cat "$work/det_chain/candidates.csv")"
+    else pass; fi
+    if grep -q "submap_path_m: 10" "$work/det_chain/config.yaml"; then pass; else
+        fail "config.yaml does not record the submaps"
+    fi
+    alone_yaml "$work/alone.yaml"
+    expect_ok "detect" "8 scans (folder)" "$cli" detect "$seq" --min-gap 2 \
+        --config "$work/alone.yaml" --quiet --out "$work/det"
     for file in loops.csv candidates.csv similarity.png similarity_distance.png similarity.bin \
         database.lldb database.scans config.yaml timings.json; do
         if [ -s "$work/det/$file" ]; then pass; else fail "detect did not write $file"; fi

@@ -180,13 +180,18 @@ std::vector<core::StampedPose> ReadOdometryIfGiven(const std::filesystem::path& 
 
 namespace {
 
-// With submaps, replaces each prepared scan by its submap.
+// With submaps, replaces each prepared scan by its submap: placed by `poses`, or without them
+// by the scans' registrations to their neighbours.
 void PrepareSubmapsIfAsked(const io::Dataset& dataset, const io::RunConfig& config,
                            const std::vector<core::StampedPose>& poses,
                            const DetectRequest& request, PreparedScans& prepared) {
-    const auto& reduction = config.detection.verification.reduction;
-    if (!config.detection.verify || reduction.submap_path_m <= 0.0) return;
-    PrepareSubmaps(dataset, poses, reduction, prepared, request.progress);
+    const auto& verification = config.detection.verification;
+    if (!config.detection.verify || verification.reduction.submap_path_m <= 0.0) return;
+    if (poses.empty()) {
+        PrepareSubmapsFromNeighbours(dataset, verification, prepared, request.progress);
+    } else {
+        PrepareSubmaps(dataset, poses, verification.reduction, prepared, request.progress);
+    }
 }
 
 }  // namespace
@@ -241,7 +246,8 @@ std::vector<registration::PreparedScan> MapScansFor(LoadedMap& map,
                                 "--no-verify");
     }
     // Whether the map's scans are submaps is the map's affair: the queries are prepared as
-    // submaps when their own poses allow, and a scan registers to a submap in its frame.
+    // submaps where their odometry or their neighbours place them, and a scan registers to a
+    // submap in its frame.
     registration::ScanReductionConfig reduction = detection.verification.reduction;
     reduction.submap_path_m = map.scans->reduction.submap_path_m;
     reduction.submap_max_scans = map.scans->reduction.submap_max_scans;
@@ -260,15 +266,18 @@ std::vector<registration::PreparedScan> MapScansFor(LoadedMap& map,
 }
 
 // Describes every scan of `dataset`; with verification, also prepares each scan for
-// registration into `prepared` in the same pass (one read per scan).
+// registration into `prepared` in the same pass (one read per scan): alone, or only marked as
+// read where the odometry's submaps replace them (`odometry`).
 pipeline::SequenceDescriptors DescribeAndPrepare(const io::Dataset& dataset,
                                                  const io::RunConfig& config,
                                                  const DetectRequest& request,
-                                                 PreparedScans& prepared) {
+                                                 PreparedScans& prepared, bool odometry) {
     DescribeRun run{
         "describing", request.skip_bad, pipeline::Execution::kParallel, request.progress, {}};
+    const auto& reduction = config.detection.verification.reduction;
     if (config.detection.verify)
-        run.with_cloud = prepared.CollectorFor(config.detection.verification.reduction);
+        run.with_cloud =
+            odometry ? prepared.CollectorFor(reduction) : prepared.Collector(reduction);
     return DescribeDataset(dataset, config.descriptor, run);
 }
 
@@ -280,7 +289,8 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     DetectOutcome outcome;
     outcome.notes = FramesNotes(dataset, poses);
     const io::RunConfig config =
-        WithSubmapsWhereTheyApply(request.config, dataset.size(), poses, outcome.notes);
+        WithSubmapsWhereTheyApply(request.config, dataset.size(), poses, outcome.notes,
+                                  NeighboursPlaceSubmaps(dataset, poses));
     const double threshold = config.detection.ThresholdFor(config.descriptor.method);
     pipeline::MethodOf(config.descriptor.method).ValidateThreshold(threshold);
     RequireTimesForSeconds(config, dataset);
@@ -294,15 +304,15 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     const bool verify = config.detection.verify;
     PreparedScans prepared(verify ? dataset.size() : 0);
     const pipeline::SequenceDescriptors described =
-        DescribeAndPrepare(dataset, config, request, prepared);
+        DescribeAndPrepare(dataset, config, request, prepared, !poses.empty());
     PrepareSubmapsIfAsked(dataset, config, poses, request, prepared);
     const double describe_s = describe_clock.Seconds();
 
     // Where the odometry judges the loops, the scans out of a loop's reach are no candidates.
     std::atomic<std::size_t> rejected{0};
-    pipeline::LoopCheck odometry_check;
+    pipeline::LoopCheck check = prepared.submaps_apart;
     if (verify && !poses.empty())
-        odometry_check = OdometryLoopCheck(poses, path_m, config.posegraph, &rejected, &prepared);
+        check = OdometryLoopCheck(poses, path_m, config.posegraph, &rejected, &prepared);
     // All pairs either way; the matrix only when it fits the budget (same results without).
     Stopwatch matrix_clock;
     std::optional<pipeline::SimilarityMatrix> matrix;
@@ -312,11 +322,10 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
         matrix = pipeline::ComputeSimilarityMatrix(described.database);
         outcome.queries =
             pipeline::DetectFromMatrix(*matrix, described.database.times_s(), config.detection,
-                                       config.descriptor.method, path_m, odometry_check);
+                                       config.descriptor.method, path_m, check);
     } else {
-        outcome.queries =
-            pipeline::DetectStreaming(described.database, config.detection,
-                                      pipeline::Execution::kParallel, path_m, odometry_check);
+        outcome.queries = pipeline::DetectStreaming(described.database, config.detection,
+                                                    pipeline::Execution::kParallel, path_m, check);
     }
     const double matrix_s = matrix_clock.Seconds();
     if (std::string note = NoCandidateNote(outcome.queries, config.detection, !poses.empty());
@@ -330,7 +339,7 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
         if (request.pose_graph_loops) more = PoseGraphLoopsWanted(path_m, config.posegraph);
         verification_times =
             VerifyAll(outcome.queries, prepared, config.detection, config.descriptor.method,
-                      request.progress, nullptr, odometry_check, more);
+                      request.progress, nullptr, check, more);
         if (rejected > 0) {
             outcome.notes.push_back(
                 std::to_string(rejected) +
@@ -389,8 +398,12 @@ DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const Detec
     const std::vector<core::StampedPose> poses = OdometryOfScans(request, dataset);
     DetectOutcome outcome;
     outcome.notes = FramesNotes(dataset, poses);
+    // Without odometry the queries are submaps only against a map of submaps: a submap on one
+    // side only shows much its partner never saw.
+    const bool map_of_submaps = map.scans && map.scans->reduction.submap_path_m > 0.0;
     io::RunConfig config =
-        WithSubmapsWhereTheyApply(request.config, dataset.size(), poses, outcome.notes);
+        WithSubmapsWhereTheyApply(request.config, dataset.size(), poses, outcome.notes,
+                                  map_of_submaps && NeighboursPlaceSubmaps(dataset, poses));
     if (!config.detection.threshold) config.detection.threshold = map.detection.threshold;
     config.Validate();
     if (config.descriptor != map.database.config()) {
@@ -406,7 +419,7 @@ DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const Detec
     const bool verify = config.detection.verify;
     PreparedScans prepared(verify ? dataset.size() : 0);
     const pipeline::SequenceDescriptors described =
-        DescribeAndPrepare(dataset, config, request, prepared);
+        DescribeAndPrepare(dataset, config, request, prepared, !poses.empty());
     PrepareSubmapsIfAsked(dataset, config, poses, request, prepared);
     Stopwatch query_clock;
     outcome.queries = pipeline::LocaliseSequence(detector, described.database,

@@ -217,13 +217,20 @@ struct VerificationState {
     pipeline::VerificationCache cache;
 };
 
-// Scan i's submap replaces it once every scan has been read (skipped scans are then known).
+// Scan i's submap replaces it once every scan has been read (skipped scans are then known),
+// placed by the odometry or, without it, by the scans' registrations to their neighbours.
 void CollectPrepared(const io::Dataset& dataset, const io::RunConfig& config,
                      const OdometryCheck* odometry, const Progress& progress,
                      VerificationState& verification) {
-    const auto& reduction = config.detection.verification.reduction;
-    if (reduction.submap_path_m <= 0.0 || odometry == nullptr) return;
-    PrepareSubmaps(dataset, odometry->odometry, reduction, *verification.prepared, progress);
+    const auto& verification_config = config.detection.verification;
+    if (verification_config.reduction.submap_path_m <= 0.0) return;
+    if (odometry == nullptr) {
+        PrepareSubmapsFromNeighbours(dataset, verification_config, *verification.prepared,
+                                     progress);
+    } else {
+        PrepareSubmaps(dataset, odometry->odometry, verification_config.reduction,
+                       *verification.prepared, progress);
+    }
 }
 
 MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method method,
@@ -242,8 +249,10 @@ MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method m
                     {}};
     const bool collecting = verification.prepared && !verification.collected;
     if (collecting) {
-        run.with_cloud =
-            verification.prepared->CollectorFor(config.detection.verification.reduction);
+        const auto& reduction = config.detection.verification.reduction;
+        // Without odometry each scan is prepared alone first: its neighbours place the submaps.
+        run.with_cloud = odometry != nullptr ? verification.prepared->CollectorFor(reduction)
+                                             : verification.prepared->Collector(reduction);
         verification.collected = true;
     }
     const auto described = DescribeDataset(dataset, config.descriptor, run);
@@ -492,10 +501,11 @@ EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequ
     for (std::string& note : FramesNotes(dataset, odometry))
         outcome.notes.push_back(std::move(note));
     EvaluationRequest effective = request;
-    // Submaps only from odometry: placed by the dataset's poses, the ground truth scored against
-    // here, they would flatter the verified recall.
+    // Submaps from the odometry or the scans themselves: placed by the dataset's poses, the
+    // ground truth scored against here, they would flatter the verified recall.
     effective.config =
-        WithSubmapsWhereTheyApply(request.config, dataset.size(), odometry, outcome.notes);
+        WithSubmapsWhereTheyApply(request.config, dataset.size(), odometry, outcome.notes,
+                                  NeighboursPlaceSubmaps(dataset, odometry));
     const std::filesystem::path out_dir = PrepareOutputFolder(request.out);
     io::WriteConfigYaml(out_dir / "config.yaml", effective.config);
     VerificationState verification;

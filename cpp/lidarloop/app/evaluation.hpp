@@ -114,7 +114,7 @@ struct EvaluationRequest {
     bool skip_bad = false;
     /// Odometry, KITTI or TUM, one pose per scan (never the ground truth): verification then
     /// registers submaps placed by it and rejects loops it contradicts, as `detect --odometry`.
-    /// Empty: each scan verified alone.
+    /// Empty: submaps placed by each scan's registration to the one before, as `detect`.
     std::filesystem::path odometry_file;
     std::string odometry_topic;  ///< instead of odometry_file, for a bag: its Odometry topic
     std::filesystem::path odometry_calib;  ///< as DetectRequest::odometry_calib

@@ -50,7 +50,8 @@ const std::vector<double>& DetectorPathM(const eval::GroundTruth& truth,
 pipeline::LoopCheck VerificationCheckOf(const OdometryCheck* odometry,
                                         const pipeline::DetectorConfig& detector,
                                         const PreparedScans* prepared) {
-    if (odometry == nullptr || !detector.verify || prepared == nullptr) return {};
+    if (!detector.verify || prepared == nullptr) return {};
+    if (odometry == nullptr) return prepared->submaps_apart;
     return OdometryLoopCheck(odometry->odometry, odometry->path_m, odometry->config, nullptr,
                              prepared);
 }

@@ -58,8 +58,9 @@ const std::vector<double>& DetectorPathM(const eval::GroundTruth& truth,
 
 /// The check `odometry` puts on candidates and loops where a run verifies them
 /// (OdometryLoopCheck): detection leaves out the scans it puts out of a loop's reach, and
-/// verification rejects the loops it contradicts. None without odometry, without
-/// detector.verify or without `prepared` scans. It refers to `odometry`, which must outlive it.
+/// verification rejects the loops it contradicts. Without odometry, prepared->submaps_apart
+/// (submaps placed by the scans' neighbours); none without detector.verify or without `prepared`
+/// scans. It refers to `odometry`, which must outlive it.
 pipeline::LoopCheck VerificationCheckOf(const OdometryCheck* odometry,
                                         const pipeline::DetectorConfig& detector,
                                         const PreparedScans* prepared);

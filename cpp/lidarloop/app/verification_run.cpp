@@ -4,11 +4,14 @@
 #include <atomic>
 #include <cmath>
 #include <map>
+#include <utility>
 
 #include <tbb/parallel_for.h>
 
 #include "lidarloop/app/results_folder.hpp"
+#include "lidarloop/core/min_gap.hpp"
 #include "lidarloop/io/scan_reader.hpp"
+#include "lidarloop/pipeline/expanded_scans.hpp"
 #include "lidarloop/posegraph/optimiser.hpp"
 #include "lidarloop/registration/submap.hpp"
 
@@ -125,10 +128,48 @@ void PrepareSubmaps(const io::Dataset& dataset, const std::vector<core::StampedP
                           });
 }
 
+void PrepareSubmapsFromNeighbours(const io::Dataset& dataset,
+                                  const registration::VerificationConfig& verification,
+                                  PreparedScans& prepared, const Progress& progress) {
+    const std::size_t count = prepared.scans.size();
+    // The scans alone serve the registrations only; once each pair is registered the rules
+    // read the cached results, and the scans alone are freed before any submap is made.
+    auto alone = std::make_shared<std::vector<registration::CompactPreparedScan>>(
+        std::exchange(prepared.scans, std::vector<registration::CompactPreparedScan>(count)));
+    auto expanded = std::make_shared<pipeline::ExpandedScans>();
+    prepared.neighbours = std::make_shared<pipeline::NeighbourOverlaps>(
+        [alone, expanded](std::size_t i) { return expanded->Get(*alone, i); },
+        [count] { return count; }, verification);
+    const Stopwatch clock;
+    const std::vector<core::StampedPose> poses = pipeline::PosesFromNeighbours(
+        *prepared.neighbours, count, verification.reduction.submap_path_m,
+        pipeline::Execution::kParallel);
+    if (progress) progress("neighbours", count, count);
+    prepared.submaps_apart = pipeline::SubmapsApart(poses, verification.reduction.submap_path_m);
+    alone->clear();
+    alone->shrink_to_fit();
+    // Each scan's share of the registrations counts in its preparation.
+    for (double& seconds : prepared.prepare_seconds)
+        seconds += clock.Seconds() / static_cast<double>(std::max<std::size_t>(count, 1));
+    PrepareSubmaps(dataset, poses, verification.reduction, prepared, progress);
+}
+
+bool NeighboursPlaceSubmaps(const io::Dataset& dataset,
+                            const std::vector<core::StampedPose>& odometry) {
+    return odometry.empty() && !core::KnowsDrivePath(dataset.poses());
+}
+
 bool SubmapsApply(const registration::ScanReductionConfig& reduction,
-                  const std::vector<core::StampedPose>& poses, std::size_t scans,
-                  std::string& note) {
+                  const std::vector<core::StampedPose>& poses, std::size_t scans, std::string& note,
+                  bool neighbours_place) {
     if (reduction.submap_path_m <= 0.0 || reduction.submap_max_scans == 0) return false;
+    if (poses.empty() && neighbours_place) {
+        note =
+            "submaps (verification.reduction.submap_path_m) placed by each scan's registration "
+            "to the one before, as no odometry is given; a piece ends where that registration "
+            "is not accepted";
+        return true;
+    }
     if (poses.size() != scans) {
         note =
             "no submaps (verification.reduction.submap_path_m): they need the scans' odometry; "
@@ -141,14 +182,14 @@ bool SubmapsApply(const registration::ScanReductionConfig& reduction,
 
 io::RunConfig WithSubmapsWhereTheyApply(const io::RunConfig& config, std::size_t scans,
                                         const std::vector<core::StampedPose>& poses,
-                                        std::vector<std::string>& notes) {
+                                        std::vector<std::string>& notes, bool neighbours_place) {
     io::RunConfig effective = config;
     std::string note;
     auto& reduction = effective.detection.verification.reduction;
-    if (effective.detection.verify && !SubmapsApply(reduction, poses, scans, note)) {
-        if (!note.empty()) notes.push_back(note);
+    if (!effective.detection.verify) return effective;
+    if (!SubmapsApply(reduction, poses, scans, note, neighbours_place))
         reduction.submap_path_m = 0.0;
-    }
+    if (!note.empty()) notes.push_back(note);
     return effective;
 }
 
@@ -159,9 +200,9 @@ pipeline::VerificationTimes VerifyAll(std::vector<pipeline::LoopQuery>& queries,
                                       pipeline::VerificationCache* cache,
                                       const pipeline::LoopCheck& check,
                                       const pipeline::MoreLoopsWanted& more) {
-    return pipeline::VerifyQueries(queries, prepared.scans, detector, method,
-                                   pipeline::Execution::kParallel,
-                                   StageReport(progress, "verifying"), cache, check, more);
+    return pipeline::VerifyQueries(
+        queries, prepared.scans, detector, method, pipeline::Execution::kParallel,
+        StageReport(progress, "verifying"), cache, check, more, prepared.neighbours.get());
 }
 
 pipeline::OdometryGate OdometryGateOf(const posegraph::PoseGraphConfig& config) {

@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,7 @@
 #include "lidarloop/io/config_yaml.hpp"
 #include "lidarloop/io/dataset.hpp"
 #include "lidarloop/pipeline/candidate_verification.hpp"
+#include "lidarloop/pipeline/neighbour_overlaps.hpp"
 #include "lidarloop/posegraph/pose_graph_config.hpp"
 #include "lidarloop/registration/compact_prepared_scan.hpp"
 #include "lidarloop/registration/prepared_scan.hpp"
@@ -28,6 +30,13 @@ struct PreparedScans {
     std::vector<double> prepare_seconds;      ///< per scan, wall time
     std::vector<double> prepare_cpu_seconds;  ///< per scan, thread CPU time
     std::vector<char> readable;               ///< per scan, 1 when it was read
+
+    /// Where each scan alone registered to the one before placed the submaps (no odometry:
+    /// PrepareSubmapsFromNeighbours), those registrations, kept for the neighbour and motion rules.
+    std::shared_ptr<pipeline::NeighbourOverlaps> neighbours;
+    /// Then the pairs whose submaps are apart (pipeline::SubmapsApart): the candidate search's
+    /// check where no odometry judges. Empty otherwise.
+    pipeline::LoopCheck submaps_apart;
 
     explicit PreparedScans(std::size_t count)
         : scans(count),
@@ -73,17 +82,34 @@ void PrepareSubmaps(const io::Dataset& dataset, const std::vector<core::StampedP
                     const registration::ScanReductionConfig& reduction, PreparedScans& prepared,
                     const Progress& progress);
 
+/// Where no odometry is given (offline, every scan read and prepared alone into `prepared`):
+/// registers each scan to the one before (pipeline::PosesFromNeighbours, kept in
+/// prepared.neighbours), then prepares every scan again as its submap placed by those
+/// registrations (PrepareSubmaps), telling `progress` as stages "neighbours" and "submaps".
+void PrepareSubmapsFromNeighbours(const io::Dataset& dataset,
+                                  const registration::VerificationConfig& verification,
+                                  PreparedScans& prepared, const Progress& progress);
+
+/// Whether a run without `odometry` places submaps by the scans' registrations to their
+/// neighbours: none is given and the scans follow one another, not frames picked from a longer
+/// drive (whose poses name their frames: core::KnowsDrivePath of the dataset's poses).
+bool NeighboursPlaceSubmaps(const io::Dataset& dataset,
+                            const std::vector<core::StampedPose>& odometry);
+
 /// Whether scans are prepared as submaps: the config asks for them and `poses` (the odometry,
-/// never a dataset's ground truth) has one per scan. `note` tells why not when asked for.
+/// never a dataset's ground truth) has one per scan, or, with `neighbours_place`, none is given
+/// (PrepareSubmapsFromNeighbours). `note` tells why not when asked for, or that the neighbours
+/// place them.
 bool SubmapsApply(const registration::ScanReductionConfig& reduction,
-                  const std::vector<core::StampedPose>& poses, std::size_t scans,
-                  std::string& note);
+                  const std::vector<core::StampedPose>& poses, std::size_t scans, std::string& note,
+                  bool neighbours_place = false);
 
 /// `config` as a run applies it: submaps only where SubmapsApply (else submap_path_m 0, with
 /// its note in `notes`), so that config.yaml and database.scans say what was done.
 io::RunConfig WithSubmapsWhereTheyApply(const io::RunConfig& config, std::size_t scans,
                                         const std::vector<core::StampedPose>& poses,
-                                        std::vector<std::string>& notes);
+                                        std::vector<std::string>& notes,
+                                        bool neighbours_place = false);
 
 /// pipeline::VerifyQueries over `queries`, telling `progress` as stage "verifying"; `check`
 /// (e.g. OdometryLoopCheck) runs on each verified query.

@@ -217,14 +217,17 @@ VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
                                 const DetectorConfig& detector, const core::Method& method,
                                 Execution execution, const ProgressReport& progress,
                                 VerificationCache* cache, const LoopCheck& check,
-                                const MoreLoopsWanted& more) {
+                                const MoreLoopsWanted& more, NeighbourOverlaps* neighbours) {
     ExpandedScans expanded;
     const auto scan_of = [&](std::size_t i) { return expanded.Get(scans, i); };
-    NeighbourOverlaps neighbours(
-        scan_of, [&scans] { return scans.size(); }, detector.verification);
+    std::optional<NeighbourOverlaps> own_neighbours;
+    if (neighbours == nullptr) {
+        neighbours = &own_neighbours.emplace(
+            scan_of, [&scans] { return scans.size(); }, detector.verification);
+    }
     const LoopCheck judge = JudgeOf(
-        check, [&neighbours](std::size_t scan) { return neighbours.Of(scan); },
-        [&neighbours](std::size_t scan) { return neighbours.StepOf(scan); }, detector.verification);
+        check, [neighbours](std::size_t scan) { return neighbours->Of(scan); },
+        [neighbours](std::size_t scan) { return neighbours->StepOf(scan); }, detector.verification);
     std::vector<VerificationTimes> per_query(queries.size());
     ProgressCounter done(progress, queries.size());
     const auto run = [&](std::size_t i) {

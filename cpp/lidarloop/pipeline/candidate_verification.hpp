@@ -15,6 +15,8 @@
 
 namespace lidarloop::pipeline {
 
+class NeighbourOverlaps;
+
 /// Times of one verification run, seconds.
 struct VerificationTimes {
     std::vector<double> pair_seconds;   ///< per registered candidate pair (coarse search + ICP)
@@ -71,12 +73,15 @@ void VerifyQuery(LoopQuery& query, const registration::PreparedScan& query_scan,
 /// include expanding the candidate). `progress(done, total)` is called from worker threads, one
 /// call at a time with `done` rising. Once every query is verified, `check.judge_revisits` (where
 /// given) judges their loops together within detector.verification.acceptance.revisit_path_m.
+/// `neighbours`: the registrations of each scan alone to the one before, for the neighbour and
+/// motion rules, where `scans` are submaps (PosesFromNeighbours); null: made from `scans`.
 VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
                                 const std::vector<registration::CompactPreparedScan>& scans,
                                 const DetectorConfig& detector, const core::Method& method,
                                 Execution execution = Execution::kParallel,
                                 const ProgressReport& progress = {},
                                 VerificationCache* cache = nullptr, const LoopCheck& check = {},
-                                const MoreLoopsWanted& more = {});
+                                const MoreLoopsWanted& more = {},
+                                NeighbourOverlaps* neighbours = nullptr);
 
 }  // namespace lidarloop::pipeline

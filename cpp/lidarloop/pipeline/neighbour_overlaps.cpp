@@ -5,6 +5,8 @@
 #include <limits>
 #include <utility>
 
+#include <tbb/parallel_for.h>
+
 #include "lidarloop/core/angles.hpp"
 #include "lidarloop/registration/coarse_alignment.hpp"
 #include "lidarloop/registration/verification.hpp"
@@ -65,6 +67,50 @@ NeighbourOverlaps::Pair NeighbourOverlaps::PairOf(std::size_t later) {
 std::size_t NeighbourOverlaps::registered() const {
     const std::lock_guard lock(mutex_);
     return static_cast<std::size_t>(std::count(computed_.begin(), computed_.end(), true));
+}
+
+std::vector<core::StampedPose> PosesFromNeighbours(NeighbourOverlaps& neighbours, std::size_t count,
+                                                   double window_m, Execution execution) {
+    const auto register_pair = [&neighbours](std::size_t later) { neighbours.Of(later); };
+    if (execution == Execution::kParallel) {
+        tbb::parallel_for(std::size_t{1}, std::max<std::size_t>(count, 1), register_pair);
+    } else {
+        for (std::size_t later = 1; later < count; ++later) register_pair(later);
+    }
+    // Twice the window and a metre: no window reaches across a piece's end.
+    const double break_m = 2.0 * window_m + 1.0;
+    std::vector<core::StampedPose> poses(count);
+    core::Transform T_world_scan = core::Transform::Identity();
+    double path_m = 0.0;
+    for (std::size_t i = 0; i < count; ++i) {
+        if (i > 0) {
+            const std::optional<core::Transform> step = neighbours.StepOf(i);
+            if (step && std::isfinite(neighbours.Of(i))) {
+                T_world_scan = T_world_scan * *step;
+                path_m += step->translation().norm();
+            } else {
+                T_world_scan = core::Transform::Identity();
+                path_m += break_m;
+            }
+        }
+        poses[i].T_world_sensor = T_world_scan;
+        poses[i].path_m = path_m;
+    }
+    return poses;
+}
+
+LoopCheck SubmapsApart(const std::vector<core::StampedPose>& chained, double window_m) {
+    std::vector<double> path_m(chained.size());
+    for (std::size_t i = 0; i < chained.size(); ++i) path_m[i] = chained[i].path_m.value_or(kNan);
+    const auto apart = [path_m = std::move(path_m), reach_m = 2.0 * window_m](
+                           std::size_t query, std::size_t match, double /*max_loop_distance_m*/) {
+        if (query >= path_m.size() || match >= path_m.size()) return true;
+        return !(std::abs(path_m[query] - path_m[match]) <= reach_m);
+    };
+    LoopCheck check;
+    check.may_close = apart;
+    check.in_reach_bound = apart;
+    return check;
 }
 
 namespace {

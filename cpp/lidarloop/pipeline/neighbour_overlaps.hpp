@@ -70,6 +70,22 @@ private:
     std::vector<bool> computed_;
 };
 
+/// Every scan's pose from the scans alone, where no odometry places submaps (offline, when every
+/// scan exists): scan i is scan i - 1's pose times their step where `neighbours` accepts the pair
+/// (Of finite: an accepted registration is right to centimetres), else it starts a new piece at
+/// the identity. Each pose's path_m runs along the accepted steps and jumps by more than `window_m`
+/// between pieces, so that a submap window of `window_m` never joins two pieces
+/// (docs/verification.md, "Submaps without odometry"). Registers every pair of the `count` scans
+/// (in parallel with kParallel), which the neighbour and motion rules then find cached.
+std::vector<core::StampedPose> PosesFromNeighbours(NeighbourOverlaps& neighbours, std::size_t count,
+                                                   double window_m, Execution execution);
+
+/// The candidate search's check where PosesFromNeighbours (`chained`) placed the submaps: two
+/// scans at most twice `window_m` apart along the chained steps may not close a loop. Their
+/// submaps could share scans, and a registration would find the shared points; they are the
+/// recent past of one piece, not a revisit. Scans of different pieces are never that close.
+LoopCheck SubmapsApart(const std::vector<core::StampedPose>& chained, double window_m);
+
 /// Scan i in the frame of scan i - 1 (NeighbourOverlaps::StepOf): none where unknown.
 using StepOf = std::function<std::optional<core::Transform>(std::size_t scan)>;
 

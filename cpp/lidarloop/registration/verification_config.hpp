@@ -21,12 +21,13 @@ struct ScanReductionConfig {
     int max_structure_points = 3000;
     /// Other points (mostly ground; they fix z, roll and pitch) kept at most.
     int max_ground_points = 600;
-    /// Submaps, when the scans' odometry is given (never a dataset's own poses, which may be its
-    /// ground truth; offline runs only):
-    /// a scan is prepared merged with its neighbours within this much path on each side, metres,
-    /// placed by the poses in its own frame (registration::PrepareSubmap); 0: each scan alone.
-    /// One sparse scan holds too little structure to pin a pose; a few neighbours, which the
-    /// odometry places with little drift, give it (docs/verification.md, "Submaps"). [0, 100]
+    /// Submaps (offline runs only): a scan is prepared merged with its neighbours within this
+    /// much path on each side, metres, placed in its own frame (registration::PrepareSubmap) by
+    /// the scans' odometry where given (never a dataset's own poses, which may be its ground
+    /// truth), else by each scan's accepted registration to the one before
+    /// (pipeline::PosesFromNeighbours); 0: each scan alone. One sparse scan holds too little
+    /// structure to pin a pose; a few neighbours, placed with little drift, give it
+    /// (docs/verification.md, "Submaps"). [0, 100]
     double submap_path_m = 10.0;
     /// Neighbours per side at most, 0..1000: bounds the merge on a slow or standing platform.
     int submap_max_scans = 30;

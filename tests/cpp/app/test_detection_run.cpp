@@ -1234,15 +1234,17 @@ TEST_F(DetectionRun, EvaluateWithOdometryVerifiesAsDetectWithIt) {
     ASSERT_EQ(flattered.notes.size(), 1u);
     EXPECT_TRUE(test::Contains(flattered.notes.front(), "ground truth")) << flattered.notes[0];
 
-    // Without odometry each scan is verified alone, and a note says so.
+    // Without odometry the scans' registrations to their neighbours place the submaps, as in
+    // detect, and a note says so.
     evaluate.odometry_file.clear();
-    evaluate.out = dir_ / "evaluate_alone";
-    const app::EvaluationOutcome alone = app::RunEvaluation(*dataset_, evaluate);
-    ASSERT_EQ(alone.notes.size(), 1u);
-    EXPECT_TRUE(test::Contains(alone.notes.front(), "--odometry")) << alone.notes.front();
+    evaluate.out = dir_ / "evaluate_neighbours";
+    const app::EvaluationOutcome by_neighbours = app::RunEvaluation(*dataset_, evaluate);
+    ASSERT_EQ(by_neighbours.notes.size(), 1u);
+    EXPECT_TRUE(test::Contains(by_neighbours.notes.front(), "registration to the one before"))
+        << by_neighbours.notes.front();
     EXPECT_EQ(io::LoadConfigYaml(evaluate.out / "config.yaml")
                   .detection.verification.reduction.submap_path_m,
-              0.0);
+              detect.config.detection.verification.reduction.submap_path_m);
 }
 
 TEST_F(DetectionRun, ScansAreSubmapsWhenTheOdometryIsKnown) {
@@ -1275,18 +1277,29 @@ TEST_F(DetectionRun, ScansAreSubmapsWhenTheOdometryIsKnown) {
     EXPECT_GT(stored.scans.at(77).usable_points,
               registration::PrepareScan(dataset_->LoadScan(77), reduction).usable_points);
 
-    // Without odometry each scan is verified alone, also where the dataset has poses: in KITTI
-    // layout they are the ground truth the loops are scored against.
+    // Without odometry each scan's registration to the one before places the submaps, also
+    // where the dataset has poses: in KITTI layout they are the ground truth the loops are
+    // scored against. Every pair is registered once, and the submap holds its neighbours.
     request.odometry_file.clear();
-    request.out = dir_ / "alone";
-    const app::DetectOutcome alone = app::RunDetect(*dataset_, request);
+    request.out = dir_ / "by_neighbours";
+    const app::DetectOutcome by_neighbours = app::RunDetect(*dataset_, request);
     ASSERT_TRUE(dataset_->HasPoses());
-    ASSERT_EQ(alone.notes.size(), 1u);
-    EXPECT_TRUE(test::Contains(alone.notes.front(), "--odometry")) << alone.notes.front();
-    EXPECT_EQ(io::LoadPreparedScans(request.out / "database.scans").reduction.submap_path_m, 0.0);
+    ASSERT_EQ(by_neighbours.notes.size(), 1u);
+    EXPECT_TRUE(test::Contains(by_neighbours.notes.front(), "registration to the one before"))
+        << by_neighbours.notes.front();
+    const io::StoredPreparedScans chained = io::LoadPreparedScans(request.out / "database.scans");
+    EXPECT_EQ(chained.reduction.submap_path_m, reduction.submap_path_m);
     EXPECT_EQ(io::LoadConfigYaml(request.out / "config.yaml")
                   .detection.verification.reduction.submap_path_m,
-              0.0);
+              reduction.submap_path_m);
+    EXPECT_GT(chained.scans.at(77).usable_points,
+              registration::PrepareScan(dataset_->LoadScan(77), reduction).usable_points);
+
+    // With no submaps asked for, each scan is verified alone.
+    request.config.detection.verification.reduction.submap_path_m = 0.0;
+    request.out = dir_ / "alone";
+    const app::DetectOutcome alone = app::RunDetect(*dataset_, request);
+    EXPECT_TRUE(alone.notes.empty()) << alone.notes.front();
     EXPECT_EQ(io::LoadPreparedScans(request.out / "database.scans").scans.at(77).usable_points,
               registration::PrepareScan(dataset_->LoadScan(77), reduction).usable_points);
 }

@@ -13,6 +13,7 @@
 #include "lidarloop/pipeline/loop_detector.hpp"
 #include "lidarloop/pipeline/neighbour_overlaps.hpp"
 #include "lidarloop/pipeline/similarity_matrix.hpp"
+#include "lidarloop/registration/submap.hpp"
 #include "pipeline/detect_both_ways.hpp"
 #include "registration/registration_test_utils.hpp"
 
@@ -39,12 +40,39 @@ std::vector<core::PointCloud> TwoPlacesAndARevisit() {
             test::Transformed(first, test::PlanarTransform(1.0, -1.5, 170.0))};
 }
 
+// Two walls along a straight corridor 8 m wide and its floor: nothing pins a step along it.
+core::PointCloud Corridor() {
+    core::PointCloud corridor;
+    for (double x = -40.0; x <= 40.0; x += 0.25) {
+        for (double z = -1.7; z <= 3.0; z += 0.25) {
+            corridor.emplace_back(x, 4.0, z);
+            corridor.emplace_back(x, -4.0, z);
+        }
+        for (double y = -4.0; y <= 4.0; y += 0.5) corridor.emplace_back(x, y, -1.7);
+    }
+    return corridor;
+}
+
 std::vector<registration::CompactPreparedScan> Prepared(const std::vector<core::PointCloud>& scans,
                                                         const DetectorConfig& detector) {
     std::vector<registration::CompactPreparedScan> prepared;
     for (const auto& scan : scans)
         prepared.emplace_back(registration::PrepareScan(scan, detector.verification.reduction));
     return prepared;
+}
+
+// A corridor and the same corridor seen 1 m further along it and 0.3 m to the side.
+std::vector<registration::CompactPreparedScan> CorridorStep(const DetectorConfig& detector) {
+    const core::PointCloud corridor = Corridor();
+    return Prepared({corridor, test::Transformed(corridor, test::PlanarTransform(-1.0, 0.3, 0.0))},
+                    detector);
+}
+
+// The neighbour registrations of `prepared`, which must outlive them.
+NeighbourOverlaps NeighboursOf(const std::vector<registration::CompactPreparedScan>& prepared,
+                               const DetectorConfig& detector) {
+    return NeighbourOverlaps([&prepared](std::size_t i) { return prepared.at(i).Expand(); },
+                             [&prepared] { return prepared.size(); }, detector.verification);
 }
 
 DetectorConfig Verifying(double min_neighbour_overlap_ratio) {
@@ -112,24 +140,68 @@ TEST(NeighbourOverlaps, RegistersEachScanToTheOneBeforeOnce) {
 // Two walls along a straight corridor: a step along it is not pinned, so the pair is rejected
 // (no reference), but ICP registered it, and its heading and sideways offset are the corridor's.
 TEST(NeighbourOverlaps, ARegisteredPairGivesItsStepWhateverItsVerdict) {
-    core::PointCloud corridor;
-    for (double x = -40.0; x <= 40.0; x += 0.25) {
-        for (double z = -1.7; z <= 3.0; z += 0.25) {
-            corridor.emplace_back(x, 4.0, z);
-            corridor.emplace_back(x, -4.0, z);
-        }
-        for (double y = -4.0; y <= 4.0; y += 0.5) corridor.emplace_back(x, y, -1.7);
-    }
     const DetectorConfig detector = Verifying(0.5);
-    const auto prepared = Prepared(
-        {corridor, test::Transformed(corridor, test::PlanarTransform(-1.0, 0.3, 0.0))}, detector);
-    NeighbourOverlaps neighbours([&](std::size_t i) { return prepared.at(i).Expand(); },
-                                 [&] { return prepared.size(); }, detector.verification);
+    const auto prepared = CorridorStep(detector);
+    NeighbourOverlaps neighbours = NeighboursOf(prepared, detector);
     EXPECT_TRUE(std::isnan(neighbours.Of(1))) << "a corridor does not pin a step along it";
     const std::optional<core::Transform> step = neighbours.StepOf(1);
     ASSERT_TRUE(step.has_value());
     EXPECT_NEAR(step->translation().y(), -0.3, 0.05);
     EXPECT_LT(Eigen::AngleAxisd(step->linear()).angle(), 0.01);
+}
+
+// Without odometry the accepted steps place the submaps: scans 0-1 and 2-3 are two pieces (1 m
+// steps), scan 4 a third; each piece starts at the identity, and the path jumps by twice the
+// window and a metre between pieces, so no submap joins two of them and no pair of one piece
+// within twice the window may close.
+TEST(PosesFromNeighbours, ChainsTheAcceptedStepsIntoPiecesNoWindowJoins) {
+    const DetectorConfig detector = Verifying(0.5);
+    const auto prepared = Prepared(TwoPlacesAndARevisit(), detector);
+    NeighbourOverlaps neighbours = NeighboursOf(prepared, detector);
+    const double window_m = 10.0;
+    const std::vector<core::StampedPose> poses =
+        PosesFromNeighbours(neighbours, prepared.size(), window_m, Execution::kParallel);
+    ASSERT_EQ(poses.size(), prepared.size());
+    EXPECT_EQ(neighbours.registered(), 4U) << "every pair, once";
+    const std::vector<double> expected_path_m{0.0, 1.0, 22.0, 23.0, 44.0};
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+        ASSERT_TRUE(poses[i].path_m.has_value()) << i;
+        EXPECT_NEAR(*poses[i].path_m, expected_path_m[i], 0.05) << i;
+    }
+    for (const std::size_t start : {0U, 2U, 4U}) {
+        EXPECT_TRUE(poses[start].T_world_sensor.isApprox(core::Transform::Identity())) << start;
+    }
+    for (const std::size_t later : {1U, 3U}) {
+        EXPECT_LT(
+            (poses[later].T_world_sensor.translation() - Eigen::Vector3d(1.0, 0.0, 0.0)).norm(),
+            0.05)
+            << later;
+    }
+    const std::vector<double> path_m = registration::SubmapPathM(poses);
+    const registration::SubmapWindow window{window_m, 30, false};
+    EXPECT_EQ(registration::SubmapMembers(path_m, 1, window), (std::vector<std::size_t>{0, 1}));
+    EXPECT_EQ(registration::SubmapMembers(path_m, 2, window), (std::vector<std::size_t>{2, 3}));
+    EXPECT_EQ(registration::SubmapMembers(path_m, 4, window), (std::vector<std::size_t>{4}));
+
+    const LoopCheck apart = SubmapsApart(poses, window_m);
+    EXPECT_FALSE(apart.MayClose(1, 0, 10.0)) << "one piece, 1 m apart";
+    EXPECT_FALSE(apart.MayClose(3, 2, 10.0));
+    EXPECT_TRUE(apart.MayClose(2, 1, 10.0)) << "two pieces";
+    EXPECT_TRUE(apart.MayClose(4, 0, 10.0));
+    EXPECT_FALSE(static_cast<bool>(apart)) << "it rejects no verified loop";
+}
+
+// A pair ICP registered but verification did not accept (a corridor's step along it) places
+// nothing: the next scan starts a piece.
+TEST(PosesFromNeighbours, AStepNotAcceptedStartsAPiece) {
+    const DetectorConfig detector = Verifying(0.5);
+    const auto prepared = CorridorStep(detector);
+    NeighbourOverlaps neighbours = NeighboursOf(prepared, detector);
+    const std::vector<core::StampedPose> poses =
+        PosesFromNeighbours(neighbours, prepared.size(), 10.0, Execution::kSerial);
+    ASSERT_TRUE(neighbours.StepOf(1).has_value()) << "registered";
+    EXPECT_TRUE(poses[1].T_world_sensor.isApprox(core::Transform::Identity()));
+    EXPECT_DOUBLE_EQ(*poses[1].path_m, 21.0);
 }
 
 // VerifyQueries asks from several threads, in any order, while the cache grows: every thread
