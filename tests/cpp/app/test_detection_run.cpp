@@ -1198,20 +1198,9 @@ TEST_F(DetectionRun, SubmapsInOrderReadEachScanOnceAndEqualEachSubmapAlone) {
     EXPECT_GE(largest_submap, 3u);  // the windows reach across the blocks' ends
 }
 
-// evaluate --odometry verifies as detect --odometry does: the same submaps, the same gate.
-TEST_F(DetectionRun, EvaluateWithOdometryVerifiesAsDetectWithIt) {
-    LIDARLOOP_RELEASE_SUITE_ONLY();  // two verified runs with submaps, and an evaluation
-    app::DetectRequest detect = Request("detect", core::Method::kRange);
-    detect.config.detection.top_k = 1;
-    detect.odometry_file = dir_ / "sequence" / "poses_odometry.txt";
-    const app::DetectOutcome detected = app::RunDetect(*dataset_, detect);
-
-    app::EvaluationRequest evaluate = EvaluationLike(detect, "evaluate");
-    const app::EvaluationOutcome evaluated = app::RunEvaluation(*dataset_, evaluate);
-    EXPECT_TRUE(evaluated.notes.empty()) << evaluated.notes.front();
-    EXPECT_EQ(io::LoadConfigYaml(evaluate.out / "config.yaml")
-                  .detection.verification.reduction.submap_path_m,
-              detect.config.detection.verification.reduction.submap_path_m);
+// The verified loops of an evaluation's one method are detect's, at the same poses, and some.
+void ExpectTheSameLoops(const app::EvaluationOutcome& evaluated,
+                        const app::DetectOutcome& detected) {
     ASSERT_EQ(evaluated.methods.size(), 1u);
     ASSERT_TRUE(evaluated.methods[0].retrieval);
     const std::vector<pipeline::LoopQuery>& queries = evaluated.methods[0].retrieval->queries;
@@ -1226,6 +1215,34 @@ TEST_F(DetectionRun, EvaluateWithOdometryVerifiesAsDetectWithIt) {
         EXPECT_EQ(verdict.T_match_query.matrix(), detected_verdict.T_match_query.matrix()) << q;
     }
     EXPECT_GT(loops, 0u);
+}
+
+// evaluate without odometry verifies as detect without it: submaps placed by the neighbours.
+TEST_F(DetectionRun, EvaluateWithoutOdometryVerifiesAsDetectWithoutIt) {
+    LIDARLOOP_RELEASE_SUITE_ONLY();  // a verified run with submaps, and an evaluation
+    app::DetectRequest detect = Request("detect", core::Method::kRange);
+    detect.config.detection.top_k = 3;
+    const app::DetectOutcome detected = app::RunDetect(*dataset_, detect);
+    const app::EvaluationOutcome evaluated =
+        app::RunEvaluation(*dataset_, EvaluationLike(detect, "evaluate"));
+    ExpectTheSameLoops(evaluated, detected);
+}
+
+// evaluate --odometry verifies as detect --odometry does: the same submaps, the same gate.
+TEST_F(DetectionRun, EvaluateWithOdometryVerifiesAsDetectWithIt) {
+    LIDARLOOP_RELEASE_SUITE_ONLY();  // two verified runs with submaps, and an evaluation
+    app::DetectRequest detect = Request("detect", core::Method::kRange);
+    detect.config.detection.top_k = 1;
+    detect.odometry_file = dir_ / "sequence" / "poses_odometry.txt";
+    const app::DetectOutcome detected = app::RunDetect(*dataset_, detect);
+
+    app::EvaluationRequest evaluate = EvaluationLike(detect, "evaluate");
+    const app::EvaluationOutcome evaluated = app::RunEvaluation(*dataset_, evaluate);
+    EXPECT_TRUE(evaluated.notes.empty()) << evaluated.notes.front();
+    EXPECT_EQ(io::LoadConfigYaml(evaluate.out / "config.yaml")
+                  .detection.verification.reduction.submap_path_m,
+              detect.config.detection.verification.reduction.submap_path_m);
+    ExpectTheSameLoops(evaluated, detected);
 
     // The ground truth given as odometry is said to flatter the figures.
     evaluate.odometry_file = dir_ / "sequence" / "poses.txt";
