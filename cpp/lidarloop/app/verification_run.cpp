@@ -149,8 +149,8 @@ void PrepareSubmapsFromNeighbours(const io::Dataset& dataset,
     alone->clear();
     alone->shrink_to_fit();
     // Each scan's share of the registrations counts in its preparation.
-    for (double& seconds : prepared.prepare_seconds)
-        seconds += clock.Seconds() / static_cast<double>(std::max<std::size_t>(count, 1));
+    const double share_s = clock.Seconds() / static_cast<double>(std::max<std::size_t>(count, 1));
+    for (double& seconds : prepared.prepare_seconds) seconds += share_s;
     PrepareSubmaps(dataset, poses, verification.reduction, prepared, progress);
 }
 
