@@ -180,18 +180,13 @@ std::vector<core::StampedPose> ReadOdometryIfGiven(const std::filesystem::path& 
 
 namespace {
 
-// With submaps, replaces each prepared scan by its submap: placed by `poses`, or without them
-// by the scans' registrations to their neighbours.
+// With submaps, replaces each prepared scan by its submap.
 void PrepareSubmapsIfAsked(const io::Dataset& dataset, const io::RunConfig& config,
                            const std::vector<core::StampedPose>& poses,
                            const DetectRequest& request, PreparedScans& prepared) {
-    const auto& verification = config.detection.verification;
-    if (!config.detection.verify || verification.reduction.submap_path_m <= 0.0) return;
-    if (poses.empty()) {
-        PrepareSubmapsFromNeighbours(dataset, verification, prepared, request.progress);
-    } else {
-        PrepareSubmaps(dataset, poses, verification.reduction, prepared, request.progress);
-    }
+    if (!config.detection.verify) return;
+    app::PrepareSubmapsIfAsked(dataset, poses, config.detection.verification, prepared,
+                               request.progress);
 }
 
 }  // namespace

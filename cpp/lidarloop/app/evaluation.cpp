@@ -217,20 +217,15 @@ struct VerificationState {
     pipeline::VerificationCache cache;
 };
 
+const std::vector<core::StampedPose> kNoOdometry;
+
 // Scan i's submap replaces it once every scan has been read (skipped scans are then known),
 // placed by the odometry or, without it, by the scans' registrations to their neighbours.
 void CollectPrepared(const io::Dataset& dataset, const io::RunConfig& config,
                      const OdometryCheck* odometry, const Progress& progress,
                      VerificationState& verification) {
-    const auto& verification_config = config.detection.verification;
-    if (verification_config.reduction.submap_path_m <= 0.0) return;
-    if (odometry == nullptr) {
-        PrepareSubmapsFromNeighbours(dataset, verification_config, *verification.prepared,
-                                     progress);
-    } else {
-        PrepareSubmaps(dataset, odometry->odometry, verification_config.reduction,
-                       *verification.prepared, progress);
-    }
+    PrepareSubmapsIfAsked(dataset, odometry != nullptr ? odometry->odometry : kNoOdometry,
+                          config.detection.verification, *verification.prepared, progress);
 }
 
 MethodEvaluation EvaluateMethod(const EvaluationRequest& request, core::Method method,

@@ -154,6 +154,18 @@ void PrepareSubmapsFromNeighbours(const io::Dataset& dataset,
     PrepareSubmaps(dataset, poses, verification.reduction, prepared, progress);
 }
 
+void PrepareSubmapsIfAsked(const io::Dataset& dataset,
+                           const std::vector<core::StampedPose>& odometry,
+                           const registration::VerificationConfig& verification,
+                           PreparedScans& prepared, const Progress& progress) {
+    if (verification.reduction.submap_path_m <= 0.0) return;
+    if (odometry.empty()) {
+        PrepareSubmapsFromNeighbours(dataset, verification, prepared, progress);
+    } else {
+        PrepareSubmaps(dataset, odometry, verification.reduction, prepared, progress);
+    }
+}
+
 bool NeighboursPlaceSubmaps(const io::Dataset& dataset,
                             const std::vector<core::StampedPose>& odometry) {
     return odometry.empty() && !core::KnowsDrivePath(dataset.poses());

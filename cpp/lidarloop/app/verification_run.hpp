@@ -90,6 +90,14 @@ void PrepareSubmapsFromNeighbours(const io::Dataset& dataset,
                                   const registration::VerificationConfig& verification,
                                   PreparedScans& prepared, const Progress& progress);
 
+/// Replaces each prepared scan by its submap where `verification` asks for submaps
+/// (submap_path_m > 0): placed by `odometry` (PrepareSubmaps), or without it by the scans'
+/// registrations to their neighbours (PrepareSubmapsFromNeighbours).
+void PrepareSubmapsIfAsked(const io::Dataset& dataset,
+                           const std::vector<core::StampedPose>& odometry,
+                           const registration::VerificationConfig& verification,
+                           PreparedScans& prepared, const Progress& progress);
+
 /// Whether a run without `odometry` places submaps by the scans' registrations to their
 /// neighbours: none is given and the scans follow one another, not frames picked from a longer
 /// drive (whose poses name their frames: core::KnowsDrivePath of the dataset's poses).
