@@ -284,8 +284,8 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     DetectOutcome outcome;
     outcome.notes = FramesNotes(dataset, poses);
     const io::RunConfig config =
-        WithSubmapsWhereTheyApply(request.config, dataset.size(), poses, outcome.notes,
-                                  NeighboursPlaceSubmaps(dataset, poses));
+        WithSubmapsWhereTheyApply(request.config, dataset, poses, outcome.notes,
+                                  NeighboursPlaceSubmaps(dataset, poses), true);
     const double threshold = config.detection.ThresholdFor(config.descriptor.method);
     pipeline::MethodOf(config.descriptor.method).ValidateThreshold(threshold);
     RequireTimesForSeconds(config, dataset);
@@ -397,8 +397,8 @@ DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const Detec
     // side only shows much its partner never saw.
     const bool map_of_submaps = map.scans && map.scans->reduction.submap_path_m > 0.0;
     io::RunConfig config =
-        WithSubmapsWhereTheyApply(request.config, dataset.size(), poses, outcome.notes,
-                                  map_of_submaps && NeighboursPlaceSubmaps(dataset, poses));
+        WithSubmapsWhereTheyApply(request.config, dataset, poses, outcome.notes,
+                                  map_of_submaps && NeighboursPlaceSubmaps(dataset, poses), false);
     if (!config.detection.threshold) config.detection.threshold = map.detection.threshold;
     config.Validate();
     if (config.descriptor != map.database.config()) {

@@ -498,9 +498,8 @@ EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequ
     EvaluationRequest effective = request;
     // Submaps from the odometry or the scans themselves: placed by the dataset's poses, the
     // ground truth scored against here, they would flatter the verified recall.
-    effective.config =
-        WithSubmapsWhereTheyApply(request.config, dataset.size(), odometry, outcome.notes,
-                                  NeighboursPlaceSubmaps(dataset, odometry));
+    effective.config = WithSubmapsWhereTheyApply(request.config, dataset, odometry, outcome.notes,
+                                                 NeighboursPlaceSubmaps(dataset, odometry), true);
     const std::filesystem::path out_dir = PrepareOutputFolder(request.out);
     io::WriteConfigYaml(out_dir / "config.yaml", effective.config);
     VerificationState verification;

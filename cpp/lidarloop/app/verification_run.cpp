@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <utility>
 
 #include <tbb/parallel_for.h>
 
 #include "lidarloop/app/results_folder.hpp"
+#include "lidarloop/core/error.hpp"
 #include "lidarloop/core/min_gap.hpp"
 #include "lidarloop/io/scan_reader.hpp"
 #include "lidarloop/pipeline/expanded_scans.hpp"
@@ -192,17 +194,56 @@ bool SubmapsApply(const registration::ScanReductionConfig& reduction,
     return true;
 }
 
-io::RunConfig WithSubmapsWhereTheyApply(const io::RunConfig& config, std::size_t scans,
+io::RunConfig WithSubmapsWhereTheyApply(const io::RunConfig& config, const io::Dataset& dataset,
                                         const std::vector<core::StampedPose>& poses,
-                                        std::vector<std::string>& notes, bool neighbours_place) {
+                                        std::vector<std::string>& notes, bool neighbours_place,
+                                        bool alone_when_dense) {
     io::RunConfig effective = config;
     std::string note;
     auto& reduction = effective.detection.verification.reduction;
     if (!effective.detection.verify) return effective;
-    if (!SubmapsApply(reduction, poses, scans, note, neighbours_place))
+    if (!SubmapsApply(reduction, poses, dataset.size(), note, neighbours_place)) {
         reduction.submap_path_m = 0.0;
+    } else if (alone_when_dense && ScansFillTheStructureCap(dataset, reduction)) {
+        reduction.submap_path_m = 0.0;
+        note =
+            "no submaps (verification.reduction.submap_path_m): the typical scan fills the "
+            "structure cap alone (verification.reduction.max_structure_points), so its "
+            "neighbours would add cost, not density; each scan is verified alone";
+    }
     if (!note.empty()) notes.push_back(note);
     return effective;
+}
+
+namespace {
+
+// Scans prepared to judge a sequence's density: enough for a stable median, few enough to cost
+// less than one submap of dense scans.
+constexpr std::size_t kDensitySample = 15;
+
+}  // namespace
+
+bool ScansFillTheStructureCap(const io::Dataset& dataset,
+                              const registration::ScanReductionConfig& reduction) {
+    const std::size_t count = dataset.size();
+    const std::size_t sample = std::min(count, kDensitySample);
+    constexpr std::size_t kUnread = std::numeric_limits<std::size_t>::max();
+    std::vector<std::size_t> structure(sample, kUnread);
+    tbb::parallel_for(std::size_t{0}, sample, [&](std::size_t i) {
+        const std::size_t scan = (2 * i + 1) * count / (2 * sample);  // the middle of each share
+        try {
+            const registration::PreparedScan alone =
+                registration::PrepareScan(dataset.LoadScan(scan), reduction);
+            structure[i] = alone.structure ? alone.structure->size() : 0;
+        } catch (const core::Error&) {
+            // Unreadable: describing the sequence reports it (or skips it with --skip-bad).
+        }
+    });
+    std::erase(structure, kUnread);
+    if (structure.empty()) return false;
+    const auto median = structure.begin() + static_cast<std::ptrdiff_t>(structure.size() / 2);
+    std::nth_element(structure.begin(), median, structure.end());
+    return *median >= static_cast<std::size_t>(reduction.max_structure_points);
 }
 
 pipeline::VerificationTimes VerifyAll(std::vector<pipeline::LoopQuery>& queries,

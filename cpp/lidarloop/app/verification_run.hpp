@@ -112,12 +112,21 @@ bool SubmapsApply(const registration::ScanReductionConfig& reduction,
                   const std::vector<core::StampedPose>& poses, std::size_t scans, std::string& note,
                   bool neighbours_place = false);
 
-/// `config` as a run applies it: submaps only where SubmapsApply (else submap_path_m 0, with
-/// its note in `notes`), so that config.yaml and database.scans say what was done.
-io::RunConfig WithSubmapsWhereTheyApply(const io::RunConfig& config, std::size_t scans,
+/// `config` as a run on `dataset` applies it: submaps only where SubmapsApply and, with
+/// `alone_when_dense`, not where ScansFillTheStructureCap (the scans are verified alone: docs/
+/// verification.md, "Dense scans need no submaps"); else submap_path_m 0, with the reason in
+/// `notes`, so that config.yaml and database.scans say what was done.
+io::RunConfig WithSubmapsWhereTheyApply(const io::RunConfig& config, const io::Dataset& dataset,
                                         const std::vector<core::StampedPose>& poses,
-                                        std::vector<std::string>& notes,
-                                        bool neighbours_place = false);
+                                        std::vector<std::string>& notes, bool neighbours_place,
+                                        bool alone_when_dense);
+
+/// Whether the typical scan of `dataset` fills the reduction's structure cap alone
+/// (max_structure_points): the median over up to 15 scans spread evenly along the sequence,
+/// each prepared alone; scans that cannot be read are left out (false when none can). Such
+/// scans gain no density from their neighbours, only their cost.
+bool ScansFillTheStructureCap(const io::Dataset& dataset,
+                              const registration::ScanReductionConfig& reduction);
 
 /// pipeline::VerifyQueries over `queries`, telling `progress` as stage "verifying"; `check`
 /// (e.g. OdometryLoopCheck) runs on each verified query.

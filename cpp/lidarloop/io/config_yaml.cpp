@@ -128,7 +128,8 @@ void VisitFields(registration::ScanReductionConfig& c, Visitor& v) {
     v.Field("max_structure_points", c.max_structure_points, "structure points kept per scan");
     v.Field("max_ground_points", c.max_ground_points, "other (ground) points kept per scan");
     v.Field("submap_path_m", c.submap_path_m,
-            "with poses: a scan merged with its neighbours this much path either side (0: off)");
+            "a scan merged with its neighbours this much path either side (0: off; dense "
+            "scans stay alone)");
     v.Field("submap_max_scans", c.submap_max_scans, "neighbours merged per side, at most");
     v.Field("submap_max_points", c.submap_max_points,
             "points merged at most, nearest neighbours in path first");

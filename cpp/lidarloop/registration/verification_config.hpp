@@ -27,7 +27,8 @@ struct ScanReductionConfig {
     /// truth), else by each scan's accepted registration to the one before
     /// (pipeline::PosesFromNeighbours); 0: each scan alone. One sparse scan holds too little
     /// structure to pin a pose; a few neighbours, placed with little drift, give it
-    /// (docs/verification.md, "Submaps"). [0, 100]
+    /// (docs/verification.md, "Submaps"). A sequence whose typical scan fills
+    /// max_structure_points alone is verified alone (app::ScansFillTheStructureCap). [0, 100]
     double submap_path_m = 10.0;
     /// Neighbours per side at most, 0..1000: bounds the merge on a slow or standing platform.
     int submap_max_scans = 30;

@@ -1198,6 +1198,34 @@ TEST_F(DetectionRun, SubmapsInOrderReadEachScanOnceAndEqualEachSubmapAlone) {
     EXPECT_GE(largest_submap, 3u);  // the windows reach across the blocks' ends
 }
 
+// Scans whose median fills the structure cap alone are verified alone: the median of the
+// readable scans, against a brute-force median, at the cap and one point over it.
+TEST_F(DetectionRun, ScansThatFillTheStructureCapAloneAreVerifiedAlone) {
+    const std::filesystem::path folder = dir_ / "nine";
+    std::filesystem::create_directories(folder / "velodyne");
+    std::vector<std::size_t> structure;
+    registration::ScanReductionConfig reduction;
+    for (std::size_t i = 0; i < 9; ++i) {
+        const std::string name = std::string("00000") + std::to_string(i) + ".bin";
+        std::filesystem::copy_file(dir_ / "sequence" / "velodyne" / name,
+                                   folder / "velodyne" / name);
+        structure.push_back(
+            registration::PrepareScan(dataset_->LoadScan(i), reduction).structure->size());
+    }
+    // Unreadable scans are left out (counted as empty, they would lower the median).
+    test::WriteFile(folder / "velodyne" / "000009.bin", "corrupt");
+    test::WriteFile(folder / "velodyne" / "000010.bin", "corrupt");
+    const io::Dataset nine = io::OpenDataset(folder);
+    ASSERT_EQ(nine.size(), 11u);
+    std::sort(structure.begin(), structure.end());
+    const std::size_t median = structure[4];
+    ASSERT_LT(median, static_cast<std::size_t>(reduction.max_structure_points));  // sparse
+    reduction.max_structure_points = static_cast<int>(median);
+    EXPECT_TRUE(app::ScansFillTheStructureCap(nine, reduction));
+    reduction.max_structure_points = static_cast<int>(median + 1);
+    EXPECT_FALSE(app::ScansFillTheStructureCap(nine, reduction));
+}
+
 // The verified loops of an evaluation's one method are detect's, at the same poses, and some.
 void ExpectTheSameLoops(const app::EvaluationOutcome& evaluated,
                         const app::DetectOutcome& detected) {
@@ -1226,6 +1254,36 @@ TEST_F(DetectionRun, EvaluateWithoutOdometryVerifiesAsDetectWithoutIt) {
     const app::EvaluationOutcome evaluated =
         app::RunEvaluation(*dataset_, EvaluationLike(detect, "evaluate"));
     ExpectTheSameLoops(evaluated, detected);
+}
+
+// A run on scans that fill the structure cap alone says so, and config.yaml and database.scans
+// record no submaps; evaluate verifies them alone as detect does.
+TEST_F(DetectionRun, ARunOnScansThatFillTheStructureCapSaysItVerifiesThemAlone) {
+    LIDARLOOP_RELEASE_SUITE_ONLY();  // verified runs; the rule's median runs in both suites
+    registration::ScanReductionConfig reduction;
+    std::size_t fewest = std::numeric_limits<std::size_t>::max();
+    for (std::size_t i = 0; i < dataset_->size(); i += 20) {
+        fewest = std::min(
+            fewest, registration::PrepareScan(dataset_->LoadScan(i), reduction).structure->size());
+    }
+    app::DetectRequest request = Request("dense", core::Method::kRange);
+    request.config.detection.top_k = 1;
+    request.config.detection.verification.reduction.max_structure_points = static_cast<int>(fewest);
+    const app::DetectOutcome outcome = app::RunDetect(*dataset_, request);
+    ASSERT_EQ(outcome.notes.size(), 1u);
+    EXPECT_TRUE(test::Contains(outcome.notes.front(), "fills the structure cap alone"))
+        << outcome.notes.front();
+    EXPECT_EQ(io::LoadConfigYaml(request.out / "config.yaml")
+                  .detection.verification.reduction.submap_path_m,
+              0.0);
+    EXPECT_EQ(io::LoadPreparedScans(request.out / "database.scans").reduction.submap_path_m, 0.0);
+
+    const app::EvaluationRequest evaluate = EvaluationLike(request, "evaluate");
+    const app::EvaluationOutcome evaluated = app::RunEvaluation(*dataset_, evaluate);
+    EXPECT_EQ(io::LoadConfigYaml(evaluate.out / "config.yaml")
+                  .detection.verification.reduction.submap_path_m,
+              0.0);
+    ExpectTheSameLoops(evaluated, outcome);
 }
 
 // evaluate --odometry verifies as detect --odometry does: the same submaps, the same gate.
