@@ -393,11 +393,19 @@ DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const Detec
     const std::vector<core::StampedPose> poses = OdometryOfScans(request, dataset);
     DetectOutcome outcome;
     outcome.notes = FramesNotes(dataset, poses);
-    // Without odometry the queries are submaps only against a map of submaps: a submap on one
-    // side only shows much its partner never saw.
+    // The queries are prepared as the map's scans were, submaps or alone: a submap on one side
+    // only shows much its partner never saw.
     const bool map_of_submaps = map.scans && map.scans->reduction.submap_path_m > 0.0;
+    io::RunConfig asked = request.config;
+    if (map.scans && !map_of_submaps && asked.detection.verify &&
+        asked.detection.verification.reduction.submap_path_m > 0.0) {
+        asked.detection.verification.reduction.submap_path_m = 0.0;
+        outcome.notes.push_back(
+            "no submaps (verification.reduction.submap_path_m): the map's scans are alone, so "
+            "each query is verified alone too");
+    }
     io::RunConfig config =
-        WithSubmapsWhereTheyApply(request.config, dataset, poses, outcome.notes,
+        WithSubmapsWhereTheyApply(asked, dataset, poses, outcome.notes,
                                   map_of_submaps && NeighboursPlaceSubmaps(dataset, poses), false);
     if (!config.detection.threshold) config.detection.threshold = map.detection.threshold;
     config.Validate();

@@ -681,6 +681,28 @@ TEST_F(DetectionRun, LocalisingTheSequenceAgainstItsOwnMapFindsEveryScanItself) 
     EXPECT_EQ(outcome.accepted, dataset_->size());
 }
 
+// Against a map of scans alone the queries are verified alone, with the odometry too (a submap
+// on one side only is lopsided), and the run says why.
+TEST_F(DetectionRun, AgainstAMapOfScansAloneTheQueriesAreAlone) {
+    LIDARLOOP_RELEASE_SUITE_ONLY();  // two verified runs
+    app::DetectRequest detect = Request("detect", core::Method::kRange);
+    detect.config.detection.top_k = 1;
+    detect.config.detection.verification.reduction.submap_path_m = 0.0;
+    app::RunDetect(*dataset_, detect);
+    app::DetectRequest localise = Request("localise", core::Method::kRange);
+    localise.config.detection.top_k = 1;  // itself, verified at the identity
+    localise.odometry_file = dir_ / "sequence" / "poses_odometry.txt";
+    const app::DetectOutcome outcome =
+        app::RunLocalise(*dataset_, app::LoadMap(detect.out / "database.lldb"), localise);
+    EXPECT_TRUE(std::any_of(outcome.notes.begin(), outcome.notes.end(), [](const auto& note) {
+        return test::Contains(note, "the map's scans are alone");
+    }));
+    EXPECT_EQ(io::LoadConfigYaml(localise.out / "config.yaml")
+                  .detection.verification.reduction.submap_path_m,
+              0.0);
+    EXPECT_EQ(outcome.accepted, dataset_->size());
+}
+
 TEST_F(DetectionRun, LocalisationTakesTheMapsThresholdUnlessGivenOne) {
     app::DetectRequest detect = Request("detect", core::Method::kRange);
     detect.config.detection.threshold = 0.002;
