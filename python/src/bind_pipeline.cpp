@@ -269,17 +269,6 @@ std::unique_ptr<LoopDetector> LoadDetector(const path& file, std::optional<bool>
     return detector;
 }
 
-void SaveDetector(const LoopDetector& detector, const path& file) {
-    io::SaveDatabase(file, detector.database(), detector.detector_config());
-    const auto& scans = detector.prepared_scans();
-    const bool any =
-        std::any_of(scans.begin(), scans.end(), [](const auto& scan) { return scan.prepared(); });
-    if (any) {
-        io::SavePreparedScans(io::PreparedScansPathOf(file), scans,
-                              detector.detector_config().verification.reduction);
-    }
-}
-
 void BindDetector(py::module_& m) {
     py::class_<LoopDetector, std::unique_ptr<LoopDetector>>(
         m, "LoopDetector",
@@ -368,7 +357,7 @@ void BindDetector(py::module_& m) {
             "save",
             [](const LoopDetector& detector, const path& file) {
                 py::gil_scoped_release release;
-                SaveDetector(detector, file);
+                app::SaveDetectorMap(detector, file);
             },
             py::arg("file"),
             "Writes the stored scans as a map: FILE (.lldb, with the detection config) and, when "

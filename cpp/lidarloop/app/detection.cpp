@@ -240,9 +240,8 @@ std::vector<registration::PreparedScan> MapScansFor(LoadedMap& map,
                                 "detect` (which verifies by default), or localise with "
                                 "--no-verify");
     }
-    // Whether the map's scans are submaps is the map's affair: the queries are prepared as
-    // submaps where their odometry or their neighbours place them, and a scan registers to a
-    // submap in its frame.
+    // Whether the map's scans are submaps is the map's affair: RunLocalise prepares the queries
+    // as the map's scans were, and a scan registers to a submap in its frame.
     registration::ScanReductionConfig reduction = detection.verification.reduction;
     reduction.submap_path_m = map.scans->reduction.submap_path_m;
     reduction.submap_max_scans = map.scans->reduction.submap_max_scans;
@@ -386,6 +385,17 @@ LoadedMap LoadMap(const std::filesystem::path& file) {
     const std::filesystem::path scans_file = io::PreparedScansPathOf(file);
     if (std::filesystem::exists(scans_file)) scans = io::LoadPreparedScans(scans_file);
     return {file, std::move(stored.database), stored.detection, std::move(scans), clock.Seconds()};
+}
+
+void SaveDetectorMap(const pipeline::LoopDetector& detector, const std::filesystem::path& file) {
+    pipeline::DetectorConfig detection = detector.detector_config();
+    detection.verification.reduction.submap_path_m = 0.0;  // LoopDetector verifies scans alone
+    io::SaveDatabase(file, detector.database(), detection);
+    const auto& scans = detector.prepared_scans();
+    if (std::any_of(scans.begin(), scans.end(), [](const auto& scan) { return scan.prepared(); })) {
+        io::SavePreparedScans(io::PreparedScansPathOf(file), scans,
+                              detection.verification.reduction);
+    }
 }
 
 DetectOutcome RunLocalise(const io::Dataset& dataset, LoadedMap map, const DetectRequest& request) {

@@ -123,6 +123,12 @@ struct LoadedMap {
 /// (io::ReadError naming what is wrong).
 LoadedMap LoadMap(const std::filesystem::path& file);
 
+/// Writes `detector`'s stored scans as a map LoadMap reads: `file` (.lldb, with the detection
+/// config) and, when scans were kept for verification, io::PreparedScansPathOf(file). Both
+/// record submap_path_m 0: the online detector prepares every scan alone, and RunLocalise
+/// prepares its queries as the map's scans were. io::WriteError when it cannot write.
+void SaveDetectorMap(const pipeline::LoopDetector& detector, const std::filesystem::path& file);
+
 /// Localisation: every scan of `dataset` is searched in `map` and not added to it.
 /// request.config.descriptor must equal the map's (ConfigError otherwise): scans are described
 /// as the map's were; its detection keys apply, and without a threshold the map's saved one

@@ -703,6 +703,31 @@ TEST_F(DetectionRun, AgainstAMapOfScansAloneTheQueriesAreAlone) {
     EXPECT_EQ(outcome.accepted, dataset_->size());
 }
 
+// The online detector verifies scans alone, so the map saved from it records scans alone, and
+// a localisation against it, without odometry, prepares its queries alone and says why.
+TEST_F(DetectionRun, AnOnlineDetectorsMapIsOfScansAlone) {
+    LIDARLOOP_RELEASE_SUITE_ONLY();  // verified processing and a verified localisation
+    pipeline::DetectorConfig detection;
+    detection.min_gap.value = 10;
+    detection.top_k = 1;
+    pipeline::LoopDetector detector(core::DescriptorConfig{}, detection);
+    for (std::size_t i = 0; i < 30; ++i)
+        detector.Process(dataset_->LoadScan(i), static_cast<double>(i));
+    app::SaveDetectorMap(detector, dir_ / "online.lldb");
+    const app::LoadedMap map = app::LoadMap(dir_ / "online.lldb");
+    ASSERT_TRUE(map.scans);
+    EXPECT_EQ(map.scans->scans.size(), 30u);
+    EXPECT_EQ(map.scans->reduction.submap_path_m, 0.0);
+    EXPECT_EQ(map.detection.verification.reduction.submap_path_m, 0.0);
+    app::DetectRequest localise = Request("localise", core::Method::kRange);
+    localise.config.detection.top_k = 1;
+    const app::DetectOutcome outcome =
+        app::RunLocalise(*dataset_, app::LoadMap(dir_ / "online.lldb"), localise);
+    ASSERT_EQ(outcome.notes.size(), 1u);
+    EXPECT_TRUE(test::Contains(outcome.notes.front(), "the map's scans are alone"))
+        << outcome.notes.front();
+}
+
 TEST_F(DetectionRun, LocalisationTakesTheMapsThresholdUnlessGivenOne) {
     app::DetectRequest detect = Request("detect", core::Method::kRange);
     detect.config.detection.threshold = 0.002;
