@@ -150,7 +150,8 @@ void AddDetectCommand(CLI::App& app) {
     flags->odometry.AddTo(*command,
                           "the path a gap in metres and loops.csv's path_m are measured on "
                           "(default: the dataset's poses), what places each scan's neighbours in "
-                          "its submap (without it: each scan's registration to the one before), "
+                          "its submap (without it: each scan's registration to the one before; "
+                          "dense scans stay alone), "
                           "and what a registered loop must "
                           "agree with (reasons odometry_mismatch, unlike_fits, unlike_revisit)");
     command->add_flag("--overwrite", flags->overwrite,

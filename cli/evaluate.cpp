@@ -165,7 +165,8 @@ void AddEvaluateCommand(CLI::App& app) {
     flags->odometry.AddTo(*command,
                           "verification registers submaps placed by it and rejects loops it "
                           "contradicts, as detect --odometry (never the ground truth; without "
-                          "it each scan's registration to the one before places the submaps)");
+                          "it each scan's registration to the one before places the submaps; "
+                          "dense scans are verified alone)");
     command->add_option("--out", flags->out, "folder for the results (created)")->required();
     command->add_flag("--overwrite", flags->overwrite,
                       "write into a non-empty folder that holds no earlier lidarloop run");

@@ -182,7 +182,7 @@ def evaluate(
     each method's threshold on that dataset (with poses) instead of the first part; odometry
     (KITTI or TUM, never the ground truth): verification with submaps and the odometry gate,
     as detect's (odometry_calib as detect's); without it the scans' registrations to their
-    neighbours place the submaps, as detect's."""
+    neighbours place the submaps, as detect's (a sequence of dense scans: none either way)."""
 
 class OptimiseResult:
     @property

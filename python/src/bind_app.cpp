@@ -454,7 +454,8 @@ void BindEvaluate(py::module_& m) {
             "detect's). train_on (a folder or Dataset with poses) learns each method's threshold "
             "there instead of on the first part. odometry (a KITTI or TUM file, never the ground "
             "truth): verification with submaps and the odometry gate, as detect's; without it "
-            "the scans' registrations to their neighbours place the submaps. None keeps "
+            "the scans' registrations to their neighbours place the submaps (dense scans: "
+            "none either way). None keeps "
             "the default of app::EvaluationRequest or the config."));
 }
 

@@ -235,6 +235,8 @@ bool ScansFillTheStructureCap(const io::Dataset& dataset,
             const registration::PreparedScan alone =
                 registration::PrepareScan(dataset.LoadScan(scan), reduction);
             structure[i] = alone.structure ? alone.structure->size() : 0;
+        } catch (const core::ConfigError&) {
+            throw;  // a bad configuration is not a bad scan
         } catch (const core::Error&) {
             // Unreadable: describing the sequence reports it (or skips it with --skip-bad).
         }

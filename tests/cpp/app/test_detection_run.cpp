@@ -1309,7 +1309,7 @@ TEST_F(DetectionRun, ARunOnScansThatFillTheStructureCapSaysItVerifiesThemAlone) 
     LIDARLOOP_RELEASE_SUITE_ONLY();  // verified runs; the rule's median runs in both suites
     registration::ScanReductionConfig reduction;
     std::size_t fewest = std::numeric_limits<std::size_t>::max();
-    for (std::size_t i = 0; i < dataset_->size(); i += 20) {
+    for (std::size_t i = 0; i < dataset_->size(); ++i) {
         fewest = std::min(
             fewest, registration::PrepareScan(dataset_->LoadScan(i), reduction).structure->size());
     }
@@ -1327,6 +1327,9 @@ TEST_F(DetectionRun, ARunOnScansThatFillTheStructureCapSaysItVerifiesThemAlone) 
 
     const app::EvaluationRequest evaluate = EvaluationLike(request, "evaluate");
     const app::EvaluationOutcome evaluated = app::RunEvaluation(*dataset_, evaluate);
+    ASSERT_EQ(evaluated.notes.size(), 1u);
+    EXPECT_TRUE(test::Contains(evaluated.notes.front(), "fills the structure cap alone"))
+        << evaluated.notes.front();
     EXPECT_EQ(io::LoadConfigYaml(evaluate.out / "config.yaml")
                   .detection.verification.reduction.submap_path_m,
               0.0);
