@@ -551,6 +551,17 @@ TEST(OdometryAllowsALoop, TheSearchsBoundSaysTheSame) {
     EXPECT_FALSE(check.in_reach_bound(1, 0, kMaxLoopM));
 }
 
+// A run's one note, which must say `text` (fatal when there is not exactly one).
+void ExpectOneNoteSaying(const std::vector<std::string>& notes, const std::string& text) {
+    ASSERT_EQ(notes.size(), 1u);
+    EXPECT_TRUE(test::Contains(notes.front(), text)) << notes.front();
+}
+
+// The submap window, metres, that a run wrote into out/config.yaml.
+double WrittenSubmapPathM(const std::filesystem::path& out) {
+    return io::LoadConfigYaml(out / "config.yaml").detection.verification.reduction.submap_path_m;
+}
+
 class DetectionRun : public ::testing::Test {
 protected:
     void SetUp() override { dataset_.emplace(test::SmallSequence(dir_ / "sequence")); }
@@ -697,9 +708,7 @@ TEST_F(DetectionRun, AgainstAMapOfScansAloneTheQueriesAreAlone) {
     EXPECT_TRUE(std::any_of(outcome.notes.begin(), outcome.notes.end(), [](const auto& note) {
         return test::Contains(note, "the map's scans are alone");
     }));
-    EXPECT_EQ(io::LoadConfigYaml(localise.out / "config.yaml")
-                  .detection.verification.reduction.submap_path_m,
-              0.0);
+    EXPECT_EQ(WrittenSubmapPathM(localise.out), 0.0);
     EXPECT_EQ(outcome.accepted, dataset_->size());
 }
 
@@ -723,9 +732,7 @@ TEST_F(DetectionRun, AnOnlineDetectorsMapIsOfScansAlone) {
     localise.config.detection.top_k = 1;
     const app::DetectOutcome outcome =
         app::RunLocalise(*dataset_, app::LoadMap(dir_ / "online.lldb"), localise);
-    ASSERT_EQ(outcome.notes.size(), 1u);
-    EXPECT_TRUE(test::Contains(outcome.notes.front(), "the map's scans are alone"))
-        << outcome.notes.front();
+    ASSERT_NO_FATAL_FAILURE(ExpectOneNoteSaying(outcome.notes, "the map's scans are alone"));
 }
 
 TEST_F(DetectionRun, LocalisationTakesTheMapsThresholdUnlessGivenOne) {
@@ -1317,22 +1324,14 @@ TEST_F(DetectionRun, ARunOnScansThatFillTheStructureCapSaysItVerifiesThemAlone) 
     request.config.detection.top_k = 1;
     request.config.detection.verification.reduction.max_structure_points = static_cast<int>(fewest);
     const app::DetectOutcome outcome = app::RunDetect(*dataset_, request);
-    ASSERT_EQ(outcome.notes.size(), 1u);
-    EXPECT_TRUE(test::Contains(outcome.notes.front(), "fills the structure cap alone"))
-        << outcome.notes.front();
-    EXPECT_EQ(io::LoadConfigYaml(request.out / "config.yaml")
-                  .detection.verification.reduction.submap_path_m,
-              0.0);
+    ASSERT_NO_FATAL_FAILURE(ExpectOneNoteSaying(outcome.notes, "fills the structure cap alone"));
+    EXPECT_EQ(WrittenSubmapPathM(request.out), 0.0);
     EXPECT_EQ(io::LoadPreparedScans(request.out / "database.scans").reduction.submap_path_m, 0.0);
 
     const app::EvaluationRequest evaluate = EvaluationLike(request, "evaluate");
     const app::EvaluationOutcome evaluated = app::RunEvaluation(*dataset_, evaluate);
-    ASSERT_EQ(evaluated.notes.size(), 1u);
-    EXPECT_TRUE(test::Contains(evaluated.notes.front(), "fills the structure cap alone"))
-        << evaluated.notes.front();
-    EXPECT_EQ(io::LoadConfigYaml(evaluate.out / "config.yaml")
-                  .detection.verification.reduction.submap_path_m,
-              0.0);
+    ASSERT_NO_FATAL_FAILURE(ExpectOneNoteSaying(evaluated.notes, "fills the structure cap alone"));
+    EXPECT_EQ(WrittenSubmapPathM(evaluate.out), 0.0);
     ExpectTheSameLoops(evaluated, outcome);
 }
 
@@ -1347,8 +1346,7 @@ TEST_F(DetectionRun, EvaluateWithOdometryVerifiesAsDetectWithIt) {
     app::EvaluationRequest evaluate = EvaluationLike(detect, "evaluate");
     const app::EvaluationOutcome evaluated = app::RunEvaluation(*dataset_, evaluate);
     EXPECT_TRUE(evaluated.notes.empty()) << evaluated.notes.front();
-    EXPECT_EQ(io::LoadConfigYaml(evaluate.out / "config.yaml")
-                  .detection.verification.reduction.submap_path_m,
+    EXPECT_EQ(WrittenSubmapPathM(evaluate.out),
               detect.config.detection.verification.reduction.submap_path_m);
     ExpectTheSameLoops(evaluated, detected);
 
@@ -1356,19 +1354,16 @@ TEST_F(DetectionRun, EvaluateWithOdometryVerifiesAsDetectWithIt) {
     evaluate.odometry_file = dir_ / "sequence" / "poses.txt";
     evaluate.out = dir_ / "evaluate_truth";
     const app::EvaluationOutcome flattered = app::RunEvaluation(*dataset_, evaluate);
-    ASSERT_EQ(flattered.notes.size(), 1u);
-    EXPECT_TRUE(test::Contains(flattered.notes.front(), "ground truth")) << flattered.notes[0];
+    ASSERT_NO_FATAL_FAILURE(ExpectOneNoteSaying(flattered.notes, "ground truth"));
 
     // Without odometry the scans' registrations to their neighbours place the submaps, as in
     // detect, and a note says so.
     evaluate.odometry_file.clear();
     evaluate.out = dir_ / "evaluate_neighbours";
     const app::EvaluationOutcome by_neighbours = app::RunEvaluation(*dataset_, evaluate);
-    ASSERT_EQ(by_neighbours.notes.size(), 1u);
-    EXPECT_TRUE(test::Contains(by_neighbours.notes.front(), "registration to the one before"))
-        << by_neighbours.notes.front();
-    EXPECT_EQ(io::LoadConfigYaml(evaluate.out / "config.yaml")
-                  .detection.verification.reduction.submap_path_m,
+    ASSERT_NO_FATAL_FAILURE(
+        ExpectOneNoteSaying(by_neighbours.notes, "registration to the one before"));
+    EXPECT_EQ(WrittenSubmapPathM(evaluate.out),
               detect.config.detection.verification.reduction.submap_path_m);
 }
 
@@ -1409,14 +1404,11 @@ TEST_F(DetectionRun, ScansAreSubmapsWhenTheOdometryIsKnown) {
     request.out = dir_ / "by_neighbours";
     const app::DetectOutcome by_neighbours = app::RunDetect(*dataset_, request);
     ASSERT_TRUE(dataset_->HasPoses());
-    ASSERT_EQ(by_neighbours.notes.size(), 1u);
-    EXPECT_TRUE(test::Contains(by_neighbours.notes.front(), "registration to the one before"))
-        << by_neighbours.notes.front();
+    ASSERT_NO_FATAL_FAILURE(
+        ExpectOneNoteSaying(by_neighbours.notes, "registration to the one before"));
     const io::StoredPreparedScans chained = io::LoadPreparedScans(request.out / "database.scans");
     EXPECT_EQ(chained.reduction.submap_path_m, reduction.submap_path_m);
-    EXPECT_EQ(io::LoadConfigYaml(request.out / "config.yaml")
-                  .detection.verification.reduction.submap_path_m,
-              reduction.submap_path_m);
+    EXPECT_EQ(WrittenSubmapPathM(request.out), reduction.submap_path_m);
     EXPECT_GT(chained.scans.at(77).usable_points,
               registration::PrepareScan(dataset_->LoadScan(77), reduction).usable_points);
 
