@@ -50,6 +50,11 @@ io::RunConfig ResolveAgainstMap(const DetectFlags& flags, const app::LoadedMap& 
     return config;
 }
 
+// "1 scan", "2 scans".
+std::string Scans(std::size_t count) {
+    return std::to_string(count) + (count == 1 ? " scan" : " scans");
+}
+
 // "12.3", or "0.05" below 1.
 std::string FormatRate(double value) {
     char text[32];
@@ -68,13 +73,14 @@ std::string WrittenFiles(const std::filesystem::path& out) {
 
 void PrintOutcome(const io::Dataset& dataset, const app::DetectRequest& request,
                   const app::DetectOutcome& outcome, const std::string& map) {
-    std::cout << "lidarloop detect: " << dataset.size() << " scans (" << dataset.FormatName()
+    std::cout << "lidarloop detect: " << Scans(dataset.size()) << " (" << dataset.FormatName()
               << ")";
     if (!map.empty()) {
-        std::cout << " localised against the map " << map << " (" << outcome.map_scans << " scans)";
+        std::cout << " localised against the map " << map << " (" << Scans(outcome.map_scans)
+                  << ")";
     }
     std::cout << ", method " << core::ToString(request.config.descriptor.method) << ", threshold "
-              << outcome.threshold << ", " << outcome.accepted << " scans with an accepted "
+              << outcome.threshold << ", " << Scans(outcome.accepted) << " with an accepted "
               << (map.empty() ? "loop" : "match");
     if (!outcome.skipped.empty()) std::cout << ", " << outcome.skipped.size() << " skipped";
     if (outcome.total_s > 0.0) {

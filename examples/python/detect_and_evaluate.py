@@ -87,7 +87,8 @@ def main():
         plot_similarity(method, detection.loops, args.out / "similarity.png")
     plot_trajectory(T_world_sensor, detection.loops, args.out / "trajectory.png")
     print(f"{len(T_world_sensor)} scans, {evaluation.truth.describe()}")
-    print(f"detect ({args.method}): {detection.accepted} scans with an accepted loop")
+    scans = "scan" if detection.accepted == 1 else "scans"
+    print(f"detect ({args.method}): {detection.accepted} {scans} with an accepted loop")
     print(f"evaluate: best MCC {method.pairwise.best_mcc.score:.3f} "
           f"(tau {method.pairwise.best_mcc.threshold:.4g}), ROC AUC "
           f"{method.pairwise.roc_auc:.3f}, recall@1 {method.retrieval.recall_at_1:.3f}")
