@@ -2,7 +2,10 @@
 
 #include <atomic>
 #include <cmath>
+#include <filesystem>
 #include <optional>
+#include <string>
+#include <system_error>
 
 #include "lidarloop/app/describe_run.hpp"
 #include "lidarloop/app/optimisation.hpp"
@@ -110,6 +113,16 @@ std::vector<std::string> FramesNotes(const io::Dataset& dataset,
     if (std::string note = CameraFrameNote(odometry); !note.empty())
         notes.push_back(std::move(note));
     return notes;
+}
+
+std::string UnusedOdometryNote(const io::Dataset& dataset,
+                               const std::vector<core::StampedPose>& odometry) {
+    if (!odometry.empty()) return {};
+    std::error_code error;
+    const std::filesystem::path file = dataset.root() / "poses_odometry.txt";
+    if (!std::filesystem::is_regular_file(file, error)) return {};
+    return file.string() + " is not read: give --odometry " + file.string() +
+           " if it is the scans' odometry (it places submaps and checks loops, docs/cli.md)";
 }
 
 std::vector<core::StampedPose> ReadOdometry(const std::filesystem::path& file,
@@ -282,6 +295,9 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     const std::vector<core::StampedPose> poses = OdometryOfScans(request, dataset);
     DetectOutcome outcome;
     outcome.notes = FramesNotes(dataset, poses);
+    if (std::string note = UnusedOdometryNote(dataset, poses);
+        !note.empty() && request.config.detection.verify)
+        outcome.notes.push_back(std::move(note));
     const io::RunConfig config =
         WithSubmapsWhereTheyApply(request.config, dataset, poses, outcome.notes,
                                   NeighboursPlaceSubmaps(dataset, poses), true);

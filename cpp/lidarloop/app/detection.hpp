@@ -76,6 +76,13 @@ std::vector<core::StampedPose> ReadOdometry(
 std::vector<std::string> FramesNotes(const io::Dataset& dataset,
                                      const std::vector<core::StampedPose>& odometry);
 
+/// A note when no odometry is given but the dataset's folder holds a poses_odometry.txt (as
+/// `simulate` writes it beside the ground truth, and keyframe sets of a LIO front end ship it):
+/// it is not read unless named by --odometry. Empty otherwise. detect and evaluate give it when
+/// they verify (what the odometry serves).
+std::string UnusedOdometryNote(const io::Dataset& dataset,
+                               const std::vector<core::StampedPose>& odometry);
+
 /// Turns from the first pose smaller than this are not judged by CameraFrameNote (20 degrees).
 inline constexpr double kCameraFrameMinTurnRad = 0.35;
 /// The share of the turns' angles about the y axis that marks KITTI's camera frame.

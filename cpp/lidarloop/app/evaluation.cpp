@@ -495,6 +495,9 @@ EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequ
     }
     for (std::string& note : FramesNotes(dataset, odometry))
         outcome.notes.push_back(std::move(note));
+    if (std::string note = UnusedOdometryNote(dataset, odometry);
+        !note.empty() && request.config.detection.verify)
+        outcome.notes.push_back(std::move(note));
     EvaluationRequest effective = request;
     // Submaps from the odometry or the scans themselves: placed by the dataset's poses, the
     // ground truth scored against here, they would flatter the verified recall.
