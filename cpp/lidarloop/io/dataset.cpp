@@ -87,10 +87,14 @@ fs::path ExistingOr(const fs::path& given, const fs::path& fallback) {
     return fs::exists(fallback, ec) ? fallback : fs::path();
 }
 
+// A poses file given or found that holds no pose is an error: read as "no poses" it would
+// silently drop the path rule and the evaluation, and a --poses file would hide poses.txt.
 std::vector<core::StampedPose> ReadPosesFile(const fs::path& file,
                                              const core::Transform& T_cam0_velo,
                                              const fs::path& times_file) {
-    return ReadPoses(file, T_cam0_velo, times_file);
+    std::vector<core::StampedPose> poses = ReadPoses(file, T_cam0_velo, times_file);
+    if (poses.empty()) throw ReadError(file, "holds no poses");
+    return poses;
 }
 
 // A frame number too large for any drive: the names of longer numbers read as it.

@@ -270,6 +270,27 @@ TEST(Dataset, MissingPathFileAndEmptyForcedFormatAreErrors) {
               std::string::npos);
 }
 
+// An empty poses file, given or in the folder, is an error naming it, not "no poses" (a given
+// one would otherwise hide the folder's poses.txt).
+TEST(Dataset, APosesFileWithoutPosesIsAnError) {
+    test::TempDir dir;
+    fs::create_directories(dir / "velodyne");
+    WriteKittiBin(dir / "velodyne" / "000000.bin", test::RandomCloud(5, 1));
+    WriteKittiPoses(dir / "poses.txt", LinePoses(1));
+    test::WriteFile(dir / "empty.txt", "# only a comment\n\n");
+    DatasetOptions given;
+    given.poses_file = dir / "empty.txt";
+    EXPECT_NE(ErrorOf(dir.path(), given).find("empty.txt: holds no poses"), std::string::npos)
+        << ErrorOf(dir.path(), given);
+    test::WriteFile(dir / "poses.txt", "");
+    EXPECT_NE(ErrorOf(dir.path()).find("poses.txt: holds no poses"), std::string::npos)
+        << ErrorOf(dir.path());
+    test::TempDir folder;
+    WriteKittiBin(folder / "000000.bin", test::RandomCloud(5, 1));
+    test::WriteFile(folder / "poses.txt", "");
+    EXPECT_NE(ErrorOf(folder.path()).find("holds no poses"), std::string::npos);
+}
+
 TEST(Dataset, UnknownPoseFormatNamesTheLine) {
     test::TempDir dir;
     WritePcd(dir / "a.pcd", test::RandomCloud(5, 1), PcdEncoding::kAscii);
