@@ -61,6 +61,11 @@ sim::SimulationConfig ToConfig(const SimulateFlags& flags) {
         }
         if (config.trajectory.empty())
             throw io::ReadError(flags.trajectory, "holds no poses: nothing to drive");
+        try {
+            sim::PlanarTrajectory(config.trajectory);  // its checks, with the file named
+        } catch (const core::ConfigError& error) {
+            throw io::ReadError(flags.trajectory, error.what());
+        }
         config.scans = config.trajectory.size();
     }
     config.seed = flags.seed;

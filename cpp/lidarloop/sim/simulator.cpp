@@ -106,6 +106,15 @@ std::vector<RoutePoint> PlanarTrajectory(const std::vector<Eigen::Vector3d>& pos
         spread = std::max(spread, (p - positions.front()).norm());
     }
     if (spread < 1.0) throw core::ConfigError("the trajectory stays within 1 m: nothing to drive");
+    double path_m = 0.0;
+    for (std::size_t i = 1; i < positions.size(); ++i)
+        path_m += (positions[i] - positions[i - 1]).norm();
+    if (path_m > kMaxTrajectoryPathM) {
+        throw core::ConfigError(
+            "the trajectory's path is " + core::NumberText(std::round(path_m / 1000.0)) +
+            " km long, more than the " + core::NumberText(kMaxTrajectoryPathM / 1000.0) +
+            " km a simulated world is made for (a jump in the poses?)");
+    }
     const Eigen::Vector3d normal = PlaneNormal(centred);
     const Eigen::Vector3d e1 = normal.unitOrthogonal();
     const Eigen::Vector3d e2 = normal.cross(e1);

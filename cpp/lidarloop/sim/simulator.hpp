@@ -95,12 +95,16 @@ private:
     std::vector<RoutePoint> trajectory_;  // config_.trajectory in the plane; empty: the route
 };
 
+/// The longest path of a given trajectory, metres: the world is generated over its bounding box
+/// and the path sampled every metre (1,000 km took 1 GB), and a day's drive is 200 km.
+inline constexpr double kMaxTrajectoryPathM = 200'000.0;
+
 /// The points of a given trajectory in its best-fit plane: positions projected onto the two
 /// directions of largest spread, relative to the first position, seen from "up": the plane's
 /// normal on the side of the input's +z, or of its -y when z lies in the plane (a camera frame,
 /// y down, as KITTI's poses); heading along the direction of travel (central differences; a stop
 /// keeps the last heading). Throws core::ConfigError for fewer than 2 positions, all within
-/// 1 m of each other, or a non-finite one.
+/// 1 m of each other, a non-finite one, or a path longer than kMaxTrajectoryPathM.
 std::vector<RoutePoint> PlanarTrajectory(const std::vector<Eigen::Vector3d>& positions);
 
 /// The world of `type` generated over the streets around `path` with every object whose

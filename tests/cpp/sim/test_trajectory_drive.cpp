@@ -57,6 +57,11 @@ TEST(PlanarTrajectory, BadInput) {
                  core::ConfigError);
     EXPECT_THROW(PlanarTrajectory({Eigen::Vector3d::Zero(), Eigen::Vector3d(NAN, 0, 0)}),
                  core::ConfigError);
+    // A path the world cannot be made for (a jump in the poses) is refused before any memory is
+    // taken for it; one as long as allowed is driven.
+    const Eigen::Vector3d far(0.6 * kMaxTrajectoryPathM, 0.8 * kMaxTrajectoryPathM, 0.0);
+    EXPECT_THROW(PlanarTrajectory({Eigen::Vector3d::Zero(), far * 1.001}), core::ConfigError);
+    EXPECT_EQ(PlanarTrajectory({Eigen::Vector3d::Zero(), far}).size(), 2u);
     SimulationConfig config;
     config.trajectory = CameraFramePath();
     config.scans = 10;
