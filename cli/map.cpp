@@ -19,6 +19,7 @@ namespace {
 struct MapFlags {
     DatasetOptions dataset;
     std::string poses;
+    std::string calib;  // converts --poses from KITTI's camera frame
     std::string out;
     std::string config;
     std::optional<double> voxel_m;          // map.voxel_m when given
@@ -35,6 +36,7 @@ void RunMapCommand(const MapFlags& flags) {
     if (flags.max_points) config.map.max_points = *flags.max_points;
     app::MapRequest request;
     request.poses_file = flags.poses;
+    request.calib_file = flags.calib;
     request.config = config.map;
     request.out = flags.out;
     request.inputs = flags.dataset.Inputs();
@@ -62,6 +64,11 @@ void AddMapCommand(CLI::App& app) {
         ->add_option("--poses", flags->poses,
                      "trajectory, KITTI or TUM, one T_world_sensor per scan (as optimise's "
                      "--odometry and poses_optimised.txt); default: the dataset's poses")
+        ->check(CLI::ExistingFile);
+    command
+        ->add_option("--calib", flags->calib,
+                     "KITTI calib.txt whose Tr converts --poses from KITTI's camera frame to the "
+                     "LiDAR frame (KITTI's official poses are in the camera frame)")
         ->check(CLI::ExistingFile);
     command->add_option("--out", flags->out, "PLY file to write (binary, coloured by scan time)")
         ->required();

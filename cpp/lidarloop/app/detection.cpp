@@ -85,18 +85,22 @@ std::string NoCandidateNote(const std::vector<pipeline::LoopQuery>& queries,
 
 }  // namespace
 
-std::string CameraFrameNote(const std::vector<core::StampedPose>& odometry) {
+bool TurnsAboutItsYAxis(const std::vector<core::StampedPose>& poses) {
     // A ground vehicle turns about its up axis: z in the LiDAR frame, y in KITTI's camera frame
     // (y down). Each pose's turn from the first, weighted by its angle.
     double about_y = 0.0, about_any = 0.0;
-    for (std::size_t i = 1; i < odometry.size(); ++i) {
-        const Eigen::AngleAxisd turn(odometry.front().T_world_sensor.linear().transpose() *
-                                     odometry[i].T_world_sensor.linear());
+    for (std::size_t i = 1; i < poses.size(); ++i) {
+        const Eigen::AngleAxisd turn(poses.front().T_world_sensor.linear().transpose() *
+                                     poses[i].T_world_sensor.linear());
         if (!turn.axis().allFinite() || turn.angle() < kCameraFrameMinTurnRad) continue;
         about_y += turn.angle() * std::abs(turn.axis().y());
         about_any += turn.angle();
     }
-    if (about_any == 0.0 || about_y < kCameraFrameMinAlignment * about_any) return {};
+    return about_any > 0.0 && about_y >= kCameraFrameMinAlignment * about_any;
+}
+
+std::string CameraFrameNote(const std::vector<core::StampedPose>& odometry) {
+    if (!TurnsAboutItsYAxis(odometry)) return {};
     return "the odometry turns about its y axis, as poses of a vehicle in KITTI's camera frame "
            "(y down) do: give --odometry-calib CALIB to convert them to the LiDAR frame, or the "
            "odometry gate will reject right loops";

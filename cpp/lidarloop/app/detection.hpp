@@ -88,9 +88,11 @@ inline constexpr double kCameraFrameMinTurnRad = 0.35;
 /// The share of the turns' angles about the y axis that marks KITTI's camera frame.
 inline constexpr double kCameraFrameMinAlignment = 0.9;
 
-/// A note when `odometry`'s turns from its first pose (those over kCameraFrameMinTurnRad) are
-/// about its y axis, as a vehicle's poses in KITTI's camera frame (y down) are: --odometry-calib
-/// converts them. Empty otherwise (no turn, or about another axis).
+/// Whether the turns of `poses` from their first (those over kCameraFrameMinTurnRad) are about
+/// its y axis, as a vehicle's poses in KITTI's camera frame (y down) are. False without a turn.
+bool TurnsAboutItsYAxis(const std::vector<core::StampedPose>& poses);
+
+/// A note when `odometry` TurnsAboutItsYAxis: --odometry-calib converts it. Empty otherwise.
 std::string CameraFrameNote(const std::vector<core::StampedPose>& odometry);
 
 /// The odometry of `dataset` from `file`, or, when `topic` is given, from the nav_msgs/Odometry

@@ -1,8 +1,11 @@
 #include "lidarloop/app/map_building.hpp"
 
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <sstream>
+#include <string>
+#include <utility>
 
 #include <tbb/parallel_for.h>
 
@@ -68,8 +71,17 @@ std::optional<core::PointCloud> LoadScan(const io::Dataset& dataset, std::size_t
 }  // namespace
 
 std::vector<core::StampedPose> MapTrajectory(const io::Dataset& dataset,
-                                             const std::filesystem::path& poses_file) {
-    if (!poses_file.empty()) return ReadOdometry(poses_file, dataset);
+                                             const std::filesystem::path& poses_file,
+                                             const std::filesystem::path& calib_file) {
+    if (!poses_file.empty()) {
+        return ReadOdometry(poses_file, dataset, std::numeric_limits<double>::infinity(),
+                            calib_file);
+    }
+    if (!calib_file.empty()) {
+        throw core::ConfigError("a calibration (" + calib_file.string() +
+                                ") converts a given trajectory's KITTI poses; the dataset's own "
+                                "poses take its calib.txt");
+    }
     if (!dataset.HasPoses()) {
         throw core::ConfigError(dataset.root().string() +
                                 " has no poses: name the trajectory to place its scans with");
@@ -108,15 +120,24 @@ std::string CoarsenedMapNote(const core::MapCloud& map, const core::MapConfig& c
     return note.str();
 }
 
+std::string CameraFrameMapNote(const std::vector<core::StampedPose>& trajectory) {
+    if (!TurnsAboutItsYAxis(trajectory)) return {};
+    return "the trajectory turns about its y axis, as poses of a vehicle in KITTI's camera frame "
+           "(y down) do: the scans stand on their side in this map; give --calib CALIB (KITTI's "
+           "calib.txt) to convert the poses to the LiDAR frame";
+}
+
 MapOutcome RunMap(const io::Dataset& dataset, const MapRequest& request) {
     const Stopwatch total;
     request.config.Validate();
     std::vector<std::filesystem::path> inputs = request.inputs;
     inputs.push_back(dataset.root());
     inputs.push_back(request.poses_file);
+    inputs.push_back(request.calib_file);
     CheckOutputFile(request.out, inputs, request.overwrite);
+    const std::vector<core::StampedPose> poses =
+        MapTrajectory(dataset, request.poses_file, request.calib_file);
     if (request.out.has_parent_path()) PrepareOutputFolder(request.out.parent_path());
-    const std::vector<core::StampedPose> poses = MapTrajectory(dataset, request.poses_file);
     MapBuildOptions options;
     options.progress = request.progress;
     const core::MapCloud map = BuildMaps(dataset, {poses}, request.config, options).maps.front();
@@ -124,8 +145,9 @@ MapOutcome RunMap(const io::Dataset& dataset, const MapRequest& request) {
         io::WriteMapPly(temporary, map);
     });
     MapOutcome outcome{map.points.size(), map.voxel_m, map.scans, map.input_points, {}, 0.0};
-    const std::string note = CoarsenedMapNote(map, request.config);
-    if (!note.empty()) outcome.notes.push_back(note);
+    for (std::string note : {CameraFrameMapNote(poses), CoarsenedMapNote(map, request.config)}) {
+        if (!note.empty()) outcome.notes.push_back(std::move(note));
+    }
     outcome.total_s = total.Seconds();
     return outcome;
 }

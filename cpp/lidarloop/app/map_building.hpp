@@ -40,17 +40,26 @@ BuiltMaps BuildMaps(const io::Dataset& dataset,
 std::string CoarsenedMapNote(const core::MapCloud& map, const core::MapConfig& config);
 
 /// The trajectory of a map: `poses_file` (KITTI or TUM, T_world_sensor, read as optimise reads
-/// odometry: no calibration applied; io::ReadError naming the file and line of a bad pose, or the
-/// file when its pose count differs from the scans'), or without one the dataset's own poses
-/// (core::ConfigError when it has none).
+/// odometry, its KITTI poses converted by `calib_file`'s Tr when given; io::ReadError naming the
+/// file and line of a bad pose, or the file when its pose count differs from the scans'), or
+/// without one the dataset's own poses (core::ConfigError when it has none, or for a
+/// `calib_file` without `poses_file`: the dataset's poses take its own calibration).
 std::vector<core::StampedPose> MapTrajectory(const io::Dataset& dataset,
-                                             const std::filesystem::path& poses_file);
+                                             const std::filesystem::path& poses_file,
+                                             const std::filesystem::path& calib_file = {});
+
+/// A note when the map's `trajectory` TurnsAboutItsYAxis (KITTI's camera frame): its scans would
+/// stand on their side. Empty otherwise.
+std::string CameraFrameMapNote(const std::vector<core::StampedPose>& trajectory);
 
 /// What `lidarloop map` asks for.
 struct MapRequest {
-    /// KITTI or TUM, one pose per scan (T_world_sensor, read as optimise reads odometry: no
-    /// calibration applied). Empty: the dataset's own poses.
+    /// KITTI or TUM, one pose per scan (T_world_sensor, read as optimise reads odometry). Empty:
+    /// the dataset's own poses.
     std::filesystem::path poses_file;
+    /// A KITTI calib.txt whose Tr converts poses_file's KITTI poses from KITTI's camera frame to
+    /// the LiDAR frame (as --odometry-calib does for an odometry). Empty: taken as given.
+    std::filesystem::path calib_file;
     core::MapConfig config;
     std::filesystem::path out;  ///< the PLY file to write (io::WriteMapPly)
     /// Files and folders the run reads besides the dataset folder and the poses file, which `out`
@@ -66,7 +75,7 @@ struct MapOutcome {
     double voxel_m = 0.0;            ///< the voxel edge used (coarser than asked when capped)
     std::size_t scans = 0;           ///< scans placed
     std::size_t input_points = 0;    ///< finite points placed
-    std::vector<std::string> notes;  ///< a coarser voxel than asked
+    std::vector<std::string> notes;  ///< a coarser voxel than asked; a camera-frame trajectory
     double total_s = 0.0;
 };
 

@@ -222,6 +222,40 @@ TEST_F(MapRun, BadInputIsAClearError) {
     EXPECT_FALSE(io::ReadPly(dir_ / "mine.ply").empty());
 }
 
+// A trajectory written in KITTI's camera frame (P_i = Tr T_i Tr^-1) stands the scans on their
+// side: the map says so, and with its calib it is the LiDAR-frame map again.
+TEST_F(MapRun, ATrajectoryInKittisCameraFrameIsNotedOrConverted) {
+    const std::filesystem::path calib = dir_ / "calib.txt";
+    test::WriteFile(calib, "P0: 1 0 0 0 0 1 0 0 0 0 1 0\nTr: 0 -1 0 0 0 0 -1 0.1 1 0 0 -0.3\n");
+    const core::Transform Tr = io::ReadKittiCalibTr(calib);
+    std::vector<core::StampedPose> camera = io::ReadKittiPoses(Odometry());
+    for (core::StampedPose& pose : camera)
+        pose.T_world_sensor = Tr * pose.T_world_sensor * Tr.inverse();
+    io::WriteKittiPoses(dir_ / "camera.txt", camera);
+    const auto camera_notes = [](const app::MapOutcome& outcome) {
+        return std::count_if(outcome.notes.begin(), outcome.notes.end(), [](const auto& note) {
+            return test::Contains(note, "turns about its y axis") &&
+                   test::Contains(note, "--calib");
+        });
+    };
+
+    app::MapRequest request = Request("lidar.ply");
+    request.config.voxel_m = 0.5;
+    const app::MapOutcome lidar = app::RunMap(*dataset_, request);
+    EXPECT_EQ(camera_notes(lidar), 0);
+    request.poses_file = dir_ / "camera.txt";
+    request.out = dir_ / "camera.ply";
+    EXPECT_EQ(camera_notes(app::RunMap(*dataset_, request)), 1);
+    request.calib_file = calib;
+    request.out = dir_ / "converted.ply";
+    const app::MapOutcome converted = app::RunMap(*dataset_, request);
+    EXPECT_EQ(camera_notes(converted), 0);
+    EXPECT_EQ(converted.points, lidar.points);
+    // A calib converts a given trajectory only.
+    request.poses_file.clear();
+    EXPECT_THROW(app::RunMap(*dataset_, request), core::ConfigError);
+}
+
 TEST_F(MapRun, BuildMapsNamesBadTrajectoriesAndScans) {
     auto poses = dataset_->poses();
     auto expect_config_error = [&](const std::vector<std::vector<core::StampedPose>>& trajectories,
