@@ -70,6 +70,12 @@ void PrintSummary(const nlohmann::json& figures) {
     } else {
         PrintRow("retrieval (every scan compared)", "query", queries["brute_force_us"], 1e-3);
     }
+    if (figures.contains("scaled_queries")) {
+        const nlohmann::json& scaled = figures["scaled_queries"];
+        PrintRow("retrieval (index), " + std::to_string(scaled.value("stored_histograms", 0)) +
+                     " stored (synthetic)",
+                 "query", scaled["index_us"], 1e-3);
+    }
     double online_ms = 0.0;
     if (figures.contains("verification")) {
         const nlohmann::json& verification = figures["verification"];
@@ -83,8 +89,8 @@ void PrintSummary(const nlohmann::json& figures) {
             (verification.value("stop_at_first_loop", false) ? " until a loop" : " verified") +
             (verification.value("odometry", false) ? " (odometry)" : "");
         PrintRow("online step, " + verified, "scan", verification["online_step_ms_per_scan"]);
-        online_ms = verification["online_step_ms_per_scan"].value("median", 0.0);
         if (verification["online_rate_hz"].is_number()) {
+            online_ms = verification["online_step_ms_per_scan"]["median"].get<double>();
             std::printf(
                 "\nonline step: %s per scan on one core = %.1f Hz (describe, retrieve, prepare, "
                 "coarse images and the %s, over %d scans with candidates; file reading "
@@ -94,10 +100,12 @@ void PrintSummary(const nlohmann::json& figures) {
         } else {
             std::printf(
                 "\nonline step: not measured: no scan had candidates (a dataset shorter than "
-                "the gap, or --queries 0); the rows above are then no measurement either\n");
+                "the gap, or --queries 0)\n");
         }
-        std::printf("memory: %.0f bytes per prepared scan (median)\n",
-                    verification["bytes_per_prepared_scan"].value("median", 0.0));
+        if (const auto& bytes = verification["bytes_per_prepared_scan"]["median"];
+            bytes.is_number()) {
+            std::printf("memory: %.0f bytes per prepared scan (median)\n", bytes.get<double>());
+        }
     } else {
         const nlohmann::json& retrieval =
             queries.contains("index_us") ? queries["index_us"] : queries["brute_force_us"];

@@ -11,6 +11,7 @@
 #include "lidarloop/app/detection.hpp"
 #include "lidarloop/app/results_folder.hpp"
 #include "lidarloop/app/verification_run.hpp"
+#include "lidarloop/core/descriptor_config.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/core/stopwatch.hpp"
 #include "lidarloop/pipeline/expanded_scans.hpp"
@@ -202,6 +203,10 @@ void BenchRequest::Validate() const {
     check("queries", queries, kMaxQueries);
     check("verify_queries", verify_queries, kMaxQueries);
     check("scale_to", scale_to, kMaxScaleTo);
+    if (scale_to > 0 && !core::IsHistogramMethod(config.descriptor.method)) {
+        throw core::ConfigError("bench: scale_to times the histogram index, and method " +
+                                core::ToString(config.descriptor.method) + " has none");
+    }
 }
 
 nlohmann::json RunBench(const io::Dataset& dataset, const BenchRequest& request) {

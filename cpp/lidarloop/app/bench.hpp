@@ -29,7 +29,8 @@ struct BenchRequest {
     Progress progress;
 
     /// Throws core::ConfigError for counts no machine holds (queries, verify_queries over
-    /// kMaxQueries; scale_to over kMaxScaleTo histograms, gigabytes).
+    /// kMaxQueries; scale_to over kMaxScaleTo histograms, gigabytes), and for scale_to with a
+    /// method that has no histogram index (it would be ignored).
     void Validate() const;
     static constexpr std::size_t kMaxQueries = 1'000'000;
     static constexpr std::size_t kMaxScaleTo = 2'000'000;

@@ -26,6 +26,8 @@ double Quantile(std::vector<double> values, double q) {
 }
 
 nlohmann::json SummaryJson(const std::vector<double>& values, double scale) {
+    // Nothing measured is no figure, not a zero.
+    if (values.empty()) return {{"median", nullptr}, {"p95", nullptr}, {"max", nullptr}};
     return {{"median", scale * Quantile(values, 0.5)},
             {"p95", scale * Quantile(values, 0.95)},
             {"max", scale * Quantile(values, 1.0)}};

@@ -21,7 +21,8 @@ using core::ThreadCpuStopwatch;
 /// The q-quantile (0..1) of `values` (eval::Quantile after sorting); 0 for an empty list.
 double Quantile(std::vector<double> values, double q);
 
-/// {median, p95, max} of `values` times `scale`.
+/// {median, p95, max} of `values` times `scale`; all three null for an empty list (nothing
+/// measured is no figure).
 nlohmann::json SummaryJson(const std::vector<double>& values, double scale = 1.0);
 
 void WriteJson(const std::filesystem::path& file, const nlohmann::json& json);

@@ -85,6 +85,10 @@ TEST(BenchRun, AbsurdCountsAreRefusedBeforeAnyWork) {
     refused([](app::BenchRequest& r) { r.scale_to = app::BenchRequest::kMaxScaleTo + 1; });
     refused([](app::BenchRequest& r) { r.queries = std::size_t(-1); });
     refused([](app::BenchRequest& r) { r.verify_queries = app::BenchRequest::kMaxQueries + 1; });
+    refused([](app::BenchRequest& r) {  // no histogram index to scale: never silently ignored
+        r.config.descriptor.method = core::Method::kNdt;
+        r.scale_to = 100;
+    });
     app::BenchRequest largest;
     largest.scale_to = app::BenchRequest::kMaxScaleTo;
     largest.queries = app::BenchRequest::kMaxQueries;
@@ -140,6 +144,25 @@ TEST(BenchRun, VerificationFiguresAreRecountedIndependently) {
     }
     ExpectTimes(v["coarse_images_ms_per_query"], "coarse images");
     ExpectTimes(v["verify_ms_per_pair"], "pairs");
+}
+
+// A timed step with no sample (a gap longer than the sequence: no candidate pair) is no figure:
+// null, not a zero that reads as a measurement.
+TEST(BenchRun, WhatNothingTimedIsNull) {
+    test::TempDir dir;
+    const io::Dataset dataset = TinyRevisit(dir / "sequence");
+    app::BenchRequest request;
+    request.config.detection.min_gap.value = 1e6;
+    request.queries = 3;
+    request.verify_queries = 3;
+    const nlohmann::json v = app::RunBench(dataset, request)["verification"];
+    EXPECT_EQ(v["pairs"].get<std::size_t>(), 0U);
+    for (const char* statistic : {"median", "p95", "max"}) {
+        EXPECT_TRUE(v["verify_ms_per_pair"]["thread_cpu"][statistic].is_null()) << statistic;
+        EXPECT_TRUE(v["online_step_ms_per_scan"][statistic].is_null()) << statistic;
+        EXPECT_GT(v["prepare_ms_per_scan"][statistic].get<double>(), 0.0) << statistic;
+    }
+    EXPECT_TRUE(v["online_rate_hz"].is_null());
 }
 
 // With the odometry, the timed queries shortlist, register and gate with it: here it puts each
