@@ -1,6 +1,7 @@
 #include "lidarloop/io/poses.hpp"
 
 #include <limits>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -99,9 +100,17 @@ core::Transform ReadKittiCalibTr(const std::filesystem::path& calib_file) {
     detail::LineReader reader(calib_file);
     std::string line;
     Fields fields;
+    std::optional<core::Transform> Tr;
+    std::size_t Tr_line = 0;
     while (NextDataLine(reader, line, fields)) {
-        if (fields.front() == "Tr:") return ParseMatrix3x4(reader, fields, 1);
+        if (fields.front() != "Tr:") continue;
+        // Two calibrations in one file: which is meant cannot be told.
+        if (Tr)
+            reader.Fail("a second 'Tr:' line (the first is line " + std::to_string(Tr_line) + ")");
+        Tr = ParseMatrix3x4(reader, fields, 1);
+        Tr_line = reader.line_number();
     }
+    if (Tr) return *Tr;
     throw ReadError(calib_file,
                     "has no 'Tr:' line (velodyne to camera 0, 12 numbers); is it a KITTI odometry "
                     "calib.txt?");

@@ -10,7 +10,8 @@ namespace lidarloop::io {
 
 /// Reads the `Tr:` line (velodyne -> camera 0, 3x4 row-major) of a KITTI odometry `calib.txt`
 /// and returns T_cam0_velo. Other lines (P0: ... P3:) are not read. Throws ReadError when the line
-/// is missing (also for an empty file) or malformed (not 12 finite numbers, not a rotation).
+/// is missing (also for an empty file), malformed (not 12 finite numbers, not a rotation) or
+/// repeated (which one is meant cannot be told).
 core::Transform ReadKittiCalibTr(const std::filesystem::path& calib_file);
 
 /// Reads a KITTI odometry `poses.txt`: one 3x4 row-major matrix (12 numbers) per line giving

@@ -202,6 +202,9 @@ TEST(KittiCalib, MissingOrBadTrLineIsAReadError) {
         Contains(error_of(p0 + "Tr: 1 0 0 0 0 1 0 0 0 0 1 O\n"), "line 2: 'O' is not a number"));
     EXPECT_TRUE(Contains(error_of(p0 + "Tr: 1 0 0 inf 0 1 0 0 0 0 1 0\n"),
                          "line 2: 'inf' is not a finite number"));
+    const std::string identity = "Tr: 1 0 0 0 0 1 0 0 0 0 1 0\n";
+    EXPECT_TRUE(Contains(error_of(identity + p0 + identity),
+                         "line 3: a second 'Tr:' line (the first is line 1)"));
     EXPECT_TRUE(Contains(ReadErrorOf([&] { ReadKittiCalibTr(dir / "none.txt"); }), "no such file"));
 }
 
