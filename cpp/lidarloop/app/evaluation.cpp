@@ -124,8 +124,9 @@ std::string FirstPartName(const eval::ThresholdLearningConfig& learning) {
 // finite in the float matrix: overflowing to +inf would silently make it "never detected".
 void CheckResult(const std::filesystem::path& file, const io::ExternalResult& r,
                  std::size_t scans) {
-    const std::string pair =
-        "pair (" + std::to_string(r.query) + ", " + std::to_string(r.match) + ")";
+    const std::string pair = (r.line > 0 ? "line " + std::to_string(r.line) + ": " : "") +
+                             "pair (" + std::to_string(r.query) + ", " + std::to_string(r.match) +
+                             ")";
     if (r.query >= scans || r.match >= scans) {
         throw io::ReadError(
             file, pair + " names a scan beyond the " + std::to_string(scans) + " of the dataset");
@@ -466,6 +467,13 @@ eval::GroundTruthConfig GroundTruthRule(const EvaluationRequest& request) {
 EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequest& request,
                                 const io::Dataset* train_dataset) {
     request.learning.Validate();
+    for (const double threshold : request.fixed_thresholds) {
+        if (!(std::isfinite(threshold) && threshold >= 0.0)) {
+            throw core::ConfigError(
+                "fixed_thresholds must be finite numbers >= 0 (distances), got " +
+                core::NumberText(threshold));
+        }
+    }
     const auto& methods = request.methods;
     for (auto method = methods.begin(); method != methods.end(); ++method) {
         if (std::find(methods.begin(), method, *method) != method) {

@@ -73,6 +73,7 @@ std::vector<ExternalResult> ReadResultsCsv(const std::filesystem::path& file) {
         result.query = ParseIndex(reader, fields[columns.query], "query");
         result.match = ParseIndex(reader, fields[columns.match], "match");
         result.distance = ParseDistance(reader, fields[columns.distance]);
+        result.line = reader.line_number();
         results.push_back(result);
     }
     return results;

@@ -12,6 +12,7 @@ struct ExternalResult {
     std::size_t match = 0;
     /// Smaller = more similar (negate a similarity score first); +inf = rejected, never detected
     double distance = 0.0;
+    std::size_t line = 0;  ///< the line of the file it was read from (1: the header), 0: none
 };
 
 /// Reads a CSV with a header naming at least the columns `query`, `match` and `distance` (in any

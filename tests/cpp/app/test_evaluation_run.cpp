@@ -74,8 +74,26 @@ TEST(EvaluationRun, AResultsPairBeyondTheDatasetIsAReadError) {
         app::MatrixOfResults(dir / "r.csv", 4);
         FAIL() << "no error";
     } catch (const io::ReadError& e) {
-        EXPECT_NE(std::string(e.what()).find("beyond the 4 of the dataset"), std::string::npos);
+        EXPECT_NE(std::string(e.what()).find("r.csv: line 2: pair (4, 1) names a scan beyond "
+                                             "the 4 of the dataset"),
+                  std::string::npos)
+            << e.what();
     }
+}
+
+// Thresholds to report MCC and F1 at are distances: a negative or non-finite one is refused, as
+// --threshold is, not reported as an empty row.
+TEST(EvaluationRun, AFixedThresholdThatIsNoDistanceIsAConfigError) {
+    const test::TempDir dir;
+    const io::Dataset dataset = test::SmallSequence(dir / "sequence");
+    app::EvaluationRequest request;
+    request.methods = {core::Method::kHeight};
+    request.out = dir / "out";
+    for (const double threshold : {-1.0, std::numeric_limits<double>::quiet_NaN()}) {
+        request.fixed_thresholds = {0.01, threshold};
+        EXPECT_THROW(app::RunEvaluation(dataset, request), core::ConfigError) << threshold;
+    }
+    EXPECT_FALSE(std::filesystem::exists(dir / "out"));
 }
 
 TEST(EvaluationRun, ADatasetWithoutPosesIsAClearError) {
