@@ -12,6 +12,7 @@
 
 #include "lidarloop/core/enum_names.hpp"
 #include "lidarloop/core/error.hpp"
+#include "lidarloop/core/number_text.hpp"
 
 namespace lidarloop::core {
 namespace {
@@ -28,6 +29,12 @@ void RequireOrdered(double min_value, double max_value, const char* min_field,
         throw ConfigError(std::string("histogram.") + min_field + " (" + std::to_string(min_value) +
                           ") must be smaller than histogram." + max_field + " (" +
                           std::to_string(max_value) + ")");
+    }
+    // The buckets divide the span: one that overflows would put every value in the first.
+    if (!std::isfinite(max_value - min_value)) {
+        throw ConfigError(std::string("histogram.") + max_field + " - " + min_field +
+                          " must be a finite span, got " + NumberText(min_value) + " to " +
+                          NumberText(max_value));
     }
 }
 

@@ -69,8 +69,9 @@ Eigen::Vector3d EstimateUpVectorPca(PointsView cloud) {
     const Eigen::Vector3d spread = solver.eigenvalues();  // ascending
     if (!(spread(1) > kMinPlaneSpread * spread.sum())) {
         throw EmptyInputError("PCA up vector: the " + std::to_string(finite_count) +
-                              " finite points span no plane (they are identical or on one "
-                              "line); give the up axis instead");
+                              " finite points span no plane that PCA can tell (they are "
+                              "identical or on one line, or a point far from the rest "
+                              "outweighs them); give the up axis instead");
     }
     Eigen::Vector3d up = solver.eigenvectors().col(0);  // eigenvalues are sorted ascending
     if (up.z() < 0.0) up = -up;

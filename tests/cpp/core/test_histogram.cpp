@@ -238,6 +238,13 @@ TEST(HistogramConfig, RejectsAbsurdValues) {
     expect_invalid([](HistogramConfig& c) { c.height_max_m = NAN; }, "height_max_m");
     expect_invalid([](HistogramConfig& c) { c.sensor_height_m = INFINITY; }, "sensor_height_m");
     expect_invalid([](HistogramConfig& c) { c.sensor_height_m = 1e300; }, "sensor_height_m");
+    // A span that overflows would put every value in the first bucket.
+    expect_invalid(
+        [](HistogramConfig& c) {
+            c.height_min_m = -1e308;
+            c.height_max_m = 1e308;
+        },
+        "must be a finite span");
 }
 
 TEST(HistogramConfig, InvalidConfigIsRejectedByCompute) {

@@ -64,6 +64,18 @@ TEST(Projection, PcaOfPointsSpanningNoPlaneIsAnError) {
     EXPECT_THROW(EstimateUpVectorPca(line), EmptyInputError);
     PointCloud triangle{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};  // three points do span a plane
     EXPECT_NEAR(EstimateUpVectorPca(triangle).z(), 1.0, 1e-12);
+    // A plane of points with one far outlier: its spread outweighs the plane's, and the error
+    // says that may be why.
+    PointCloud outlier;
+    for (int i = 0; i < 100; ++i) outlier.emplace_back(float(i % 10), float(i / 10), 0.0f);
+    outlier.emplace_back(3e18f, 0.0f, 0.0f);
+    try {
+        EstimateUpVectorPca(outlier);
+        ADD_FAILURE() << "no error";
+    } catch (const EmptyInputError& e) {
+        EXPECT_NE(std::string(e.what()).find("a point far from the rest"), std::string::npos)
+            << e.what();
+    }
 }
 
 TEST(Projection, NamesRoundTripAndUnknownNamesAreErrors) {
