@@ -213,6 +213,11 @@ std::size_t FindCoordinate(const std::filesystem::path& file, const std::vector<
     if (it == fields.end()) {
         throw ReadError(file, "no " + Quoted(name) + " field (FIELDS: " + FieldNames(fields) + ")");
     }
+    // Which of two the writer meant cannot be told.
+    if (std::any_of(it + 1, fields.end(),
+                    [&](const PcdField& field) { return field.name == name; }))
+        throw ReadError(
+            file, "field " + Quoted(name) + " is named twice (FIELDS: " + FieldNames(fields) + ")");
     if (it->type != 'F' || (it->size != 4 && it->size != 8)) {
         throw ReadError(file, "field " + Quoted(name) + " has TYPE " + it->type + " SIZE " +
                                   std::to_string(it->size) +

@@ -187,6 +187,9 @@ std::vector<int> FindCoordinates(const std::filesystem::path& file, const PlyEle
         if (it == vertex.properties.end()) {
             throw ReadError(file, "element 'vertex' has no '" + name + "' property");
         }
+        if (std::any_of(it + 1, vertex.properties.end(),
+                        [&](const PlyProperty& p) { return p.name == name; }))
+            throw ReadError(file, "vertex property '" + name + "' is named twice");
         if (it->count_type) throw ReadError(file, "vertex property '" + name + "' is a list");
         // Integer coordinates usually carry a scale the file does not state: reading them as
         // metres would be silently wrong.

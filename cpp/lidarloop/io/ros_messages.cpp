@@ -1,5 +1,6 @@
 #include "lidarloop/io/ros_messages.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -66,6 +67,10 @@ struct Coordinate {
 
 Coordinate CoordinateOf(const PointCloud2Message& cloud, const char* name) {
     const PointField* field = FindField(cloud, name);
+    if (field != nullptr && std::count_if(cloud.fields.begin(), cloud.fields.end(),
+                                          [&](const PointField& f) { return f.name == name; }) > 1)
+        throw core::FormatError("the cloud names field " + std::string(name) +
+                                " twice: which one holds the coordinate cannot be told");
     if (field == nullptr) {
         std::string names;
         for (const PointField& f : cloud.fields) names += (names.empty() ? "" : " ") + f.name;

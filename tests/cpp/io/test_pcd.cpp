@@ -291,6 +291,12 @@ TEST_F(PcdErrors, MissingXField) {
     ExpectReadError(Write(text), "no 'x' field (FIELDS: 'a' 'y' 'z')");
 }
 
+TEST_F(PcdErrors, XFieldNamedTwice) {
+    std::string text = XyzHeader(1, "ascii") + "1 2 3\n";
+    ReplaceOnce(text, "FIELDS x y z", "FIELDS x y x");
+    ExpectReadError(Write(text), "field 'x' is named twice (FIELDS: 'x' 'y' 'x')");
+}
+
 TEST_F(PcdErrors, UnsignedXField) {
     std::string text = XyzHeader(1, "ascii") + "1 2 3\n";
     ReplaceOnce(text, "TYPE F F F", "TYPE U F F");

@@ -324,6 +324,12 @@ TEST_F(PlyErrors, MissingXProperty) {
     ExpectReadError(Write(text), "element 'vertex' has no 'x' property");
 }
 
+TEST_F(PlyErrors, XPropertyNamedTwice) {
+    std::string text = XyzHeader(PlyEncoding::kAscii, 1) + "1 2 3\n";
+    ReplaceOnce(text, "property float z", "property float x");
+    ExpectReadError(Write(text), "vertex property 'x' is named twice");
+}
+
 TEST_F(PlyErrors, UnsignedIntegerX) {
     std::string text = XyzHeader(PlyEncoding::kAscii, 1) + "1 2 3\n";
     ReplaceOnce(text, "property float x", "property uint x");

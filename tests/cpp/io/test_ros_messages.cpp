@@ -177,6 +177,13 @@ TEST(RosMessages, NamesAMissingCoordinateAndTheFieldsThereAre) {
     EXPECT_NE(error.find("'x y intensity'"), std::string::npos) << error;
 }
 
+TEST(RosMessages, RefusesACoordinateNamedTwice) {
+    CloudSpec spec = Float32Xyz();
+    spec.fields[2].name = "x";
+    const std::string error = DecodeError(spec);
+    EXPECT_NE(error.find("names field x twice"), std::string::npos) << error;
+}
+
 TEST(RosMessages, RefusesIntegerCoordinates) {
     CloudSpec spec = Float32Xyz();
     spec.fields[0].type = PointFieldType::kInt16;
