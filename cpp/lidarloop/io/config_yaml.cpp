@@ -2,10 +2,12 @@
 
 #include <charconv>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
 #include <sstream>
+#include <string>
 #include <type_traits>
 #include <vector>
 
@@ -372,13 +374,18 @@ private:
     std::string indent_;
 };
 
+// What a key of type T takes, for the message of a value it cannot: an integer type says its
+// range, since yaml-cpp refuses a number beyond it (-1 for a count) as "not an integer".
 template <typename T>
-const char* ExpectedKind() {
+std::string ExpectedKind() {
     if constexpr (std::is_same_v<T, std::optional<double>>) return "a number or 'default'";
     if constexpr (std::is_same_v<T, bool>) return "true or false";
     if constexpr (std::is_same_v<T, std::vector<double>>) return "a list of numbers";
     if constexpr (std::is_same_v<T, std::string>) return "a name";
-    if constexpr (std::is_integral_v<T>) return "an integer";
+    if constexpr (std::is_integral_v<T>) {
+        return "an integer in [" + std::to_string(std::numeric_limits<T>::min()) + ", " +
+               std::to_string(std::numeric_limits<T>::max()) + "]";
+    }
     return "a number";
 }
 

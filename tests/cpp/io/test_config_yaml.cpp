@@ -75,7 +75,11 @@ TEST(ConfigYaml, BadInputNamesFileKeyAndProblem) {
     };
     expect_error("histogram:\n  binz: 3\n", "key 'histogram.binz': unknown key");
     expect_error("colour: red\n", "key 'colour': unknown key");
-    expect_error("histogram:\n  bins: many\n", "expected an integer, got 'many'");
+    expect_error("histogram:\n  bins: many\n",
+                 "expected an integer in [-2147483648, 2147483647], got 'many'");
+    // A count out of its type's range says the range, not only "not an integer".
+    expect_error("output:\n  similarity_matrix_mib: -1\n",
+                 "expected an integer in [0, 18446744073709551615], got '-1'");
     expect_error("histogram:\n  bins: 2.5\n", "expected an integer");
     expect_error("detection:\n  threshold: [1, 2]\n", "expected a single value");
     expect_error("detection:\n  threshold: many\n", "expected a number or 'default', got 'many'");
