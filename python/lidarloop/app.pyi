@@ -278,7 +278,10 @@ def write_map(
 ) -> dict[str, Any]:
     """`lidarloop map DATASET --poses TRAJECTORY --out OUT`: a binary PLY coloured by scan time.
 
-    Returns out, points, voxel_m, scans, input_points, notes, total_s.
+    `calib` (a KITTI calib.txt) converts the trajectory's KITTI poses from KITTI's camera frame,
+    as `--calib` does; without a trajectory it converts the dataset's `poses`. A trajectory that
+    turns about its y axis (the camera frame) gets a note. Returns out, points, voxel_m, scans,
+    input_points, notes, total_s.
     """
 
 def keep_freed_memory_for_reuse() -> bool:

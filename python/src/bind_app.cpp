@@ -672,6 +672,9 @@ void BindMap(py::module_& m) {
             const PythonProgress python_progress(progress);
             app::MapRequest request;
             request.poses_file = trajectory.value_or(fs::path());
+            // As `lidarloop map --poses T --calib C`: with a trajectory, the calibration
+            // converts its KITTI poses (the dataset's poses are not used).
+            if (trajectory && calib) request.calib_file = *calib;
             request.config = MapConfigOf(config, voxel_m, max_points);
             request.out = out;
             request.inputs = InputsOf(data, poses, calib);
@@ -699,7 +702,8 @@ void BindMap(py::module_& m) {
         py::arg("progress") = py::none(), py::arg("format") = "auto", py::arg("poses") = py::none(),
         py::arg("calib") = py::none(),
         "`lidarloop map DATASET --poses TRAJECTORY --out OUT`: the map of the dataset placed "
-        "with `trajectory` (a KITTI or TUM file; None: the dataset's poses) written as a binary "
+        "with `trajectory` (a KITTI or TUM file, its KITTI poses converted from KITTI's camera "
+        "frame by `calib` when given, as --calib; None: the dataset's poses) written as a binary "
         "PLY coloured by scan time (app::RunMap: `out` is refused inside an input, and replaced "
         "only when lidarloop wrote it unless overwrite). A dict: out, points, voxel_m, scans, "
         "input_points, notes, total_s.");

@@ -234,6 +234,27 @@ def test_map_matches_the_cli(cli, sequence, tmp_path):
     assert (tmp_path / "mine.ply").read_text() == "my map"
 
 
+def test_map_of_a_camera_frame_trajectory_matches_the_cli(cli, sequence, tmp_path):
+    # The odometry in KITTI's camera frame, P_i = Tr T_i Tr^-1, and the calib that converts it.
+    tr = np.array([[0, -1, 0, 0], [0, 0, -1, 0.1], [1, 0, 0, -0.3], [0, 0, 0, 1]], float)
+    (tmp_path / "calib.txt").write_text("Tr: " + " ".join(map(str, tr[:3].ravel())) + "\n")
+    lidar = np.loadtxt(sequence / "poses_odometry.txt").reshape(-1, 3, 4)
+    poses = np.tile(np.eye(4), (len(lidar), 1, 1))
+    poses[:, :3, :] = lidar
+    camera = tr @ poses @ np.linalg.inv(tr)
+    np.savetxt(tmp_path / "camera.txt", camera[:, :3, :].reshape(len(camera), 12), "%.17g")
+    run_cli(cli, "map", sequence, "--poses", tmp_path / "camera.txt", "--calib",
+            tmp_path / "calib.txt", "--voxel", "0.5", "--out", tmp_path / "cli.ply")
+    converted = lidarloop.write_map(sequence, trajectory=tmp_path / "camera.txt",
+                                    calib=tmp_path / "calib.txt", voxel_m=0.5,
+                                    out=tmp_path / "py.ply")
+    assert (tmp_path / "py.ply").read_bytes() == (tmp_path / "cli.ply").read_bytes()
+    assert not any("y axis" in note for note in converted["notes"])
+    sideways = lidarloop.write_map(sequence, trajectory=tmp_path / "camera.txt", voxel_m=0.5,
+                                   out=tmp_path / "sideways.ply")
+    assert any("turns about its y axis" in note for note in sideways["notes"])
+
+
 def test_results_folders_are_guarded(sequence, tmp_path):
     with pytest.raises(lidarloop.WriteError):  # inside the dataset: its files would be scans
         lidarloop.detect(sequence, out=sequence / "results", verify=False)
