@@ -1,4 +1,4 @@
-from typing import Any, Optional, Sequence, Union
+from typing import Any, Mapping, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -59,7 +59,8 @@ class GroundTruth:
         """Per scan the nearest comparable scan passing the heading rule; -1: none."""
     @property
     def nearest_distance_m(self) -> npt.NDArray[np.float64]: ...
-    def is_loop(self, i: int, j: int) -> bool: ...
+    def is_loop(self, i: int, j: int) -> bool:
+        """IndexError for a scan out of range (also comparable, overlapping)."""
     def comparable(self, i: int, j: int) -> bool: ...
     def overlapping(self, scan: int) -> bool: ...
     @property
@@ -245,7 +246,7 @@ class LoopRetrievalEvaluation:
     loops: list[AcceptedLoop]
 
 def evaluate_loop_retrieval(
-    ranked: Sequence[tuple[int, Sequence[dict[str, Any]]]],
+    ranked: Sequence[tuple[int, Sequence[Mapping[str, Any]]]],
     truth: GroundTruth,
     times_s: FloatArray,
     T_world_sensor: FloatArray,

@@ -106,6 +106,15 @@ void BindGroundTruthConfig(py::module_& m) {
         .def("describe", &GroundTruthConfig::Describe);
 }
 
+// `scan` when the ground truth has it; IndexError otherwise (the C++ calls index unchecked).
+std::size_t ScanOf(const GroundTruth& truth, std::size_t scan) {
+    if (scan >= truth.size()) {
+        throw py::index_error("scan " + std::to_string(scan) + " out of range for " +
+                              std::to_string(truth.size()) + " scans");
+    }
+    return scan;
+}
+
 void BindGroundTruth(py::module_& m) {
     py::class_<GroundTruth>(m, "GroundTruth", "The positive pairs of a sequence under one rule")
         .def_readonly("config", &GroundTruth::config)
@@ -145,9 +154,22 @@ void BindGroundTruth(py::module_& m) {
             "(N,) per scan the nearest scan outside the gap passing the heading rule, -1: none")
         .def_property_readonly("nearest_distance_m",
                                [](const GroundTruth& t) { return ArrayOf(t.nearest_distance_m); })
-        .def("is_loop", &GroundTruth::IsLoop, py::arg("i"), py::arg("j"))
-        .def("comparable", &GroundTruth::Comparable, py::arg("i"), py::arg("j"))
-        .def("overlapping", &GroundTruth::Overlapping, py::arg("scan"))
+        .def(
+            "is_loop",
+            [](const GroundTruth& t, std::size_t i, std::size_t j) {
+                return t.IsLoop(ScanOf(t, i), ScanOf(t, j));
+            },
+            py::arg("i"), py::arg("j"))
+        .def(
+            "comparable",
+            [](const GroundTruth& t, std::size_t i, std::size_t j) {
+                return t.Comparable(ScanOf(t, i), ScanOf(t, j));
+            },
+            py::arg("i"), py::arg("j"))
+        .def(
+            "overlapping",
+            [](const GroundTruth& t, std::size_t scan) { return t.Overlapping(ScanOf(t, scan)); },
+            py::arg("scan"))
         .def_property_readonly("overlapping_count", &GroundTruth::OverlappingCount)
         .def_property_readonly("comparable_pair_count", &GroundTruth::ComparablePairCount)
         .def("describe", &GroundTruth::Describe);
@@ -505,6 +527,24 @@ void BindEm(py::module_& m) {
         "the crossing of its first two components.");
 }
 
+// Field `key` of a candidate of query `query` as T: a missing key is a KeyError, a value of
+// another kind a TypeError saying what it must be (not pybind11's "Unable to cast").
+template <typename T>
+T CandidateField(const py::dict& candidate, const char* key, std::size_t query, const char* what) {
+    if (!candidate.contains(key)) {
+        throw py::key_error("a candidate of query " + std::to_string(query) + " has no '" + key +
+                            "'");
+    }
+    const py::object value = candidate[key];
+    try {
+        return value.cast<T>();
+    } catch (const py::cast_error&) {
+        throw py::type_error("'" + std::string(key) + "' of a candidate of query " +
+                             std::to_string(query) + " must be " + what + ", got " +
+                             py::repr(value).cast<std::string>());
+    }
+}
+
 void BindRetrieval(py::module_& m) {
     py::class_<AcceptedLoop>(m, "AcceptedLoop", "One query's first accepted candidate")
         .def_readonly("query", &AcceptedLoop::query)
@@ -535,20 +575,26 @@ void BindRetrieval(py::module_& m) {
         .def_readonly("loops", &LoopRetrievalEvaluation::loops);
     m.def(
         "evaluate_loop_retrieval",
-        [](const std::vector<std::pair<std::size_t, py::list>>& ranked, const GroundTruth& truth,
-           const py::handle& times_s, const py::handle& T_world_sensor, std::size_t recall_k,
-           std::optional<double> wrong_pose_m, std::optional<double> wrong_pose_deg,
+        [](const std::vector<std::pair<std::size_t, py::sequence>>& ranked,
+           const GroundTruth& truth, const py::handle& times_s, const py::handle& T_world_sensor,
+           std::size_t recall_k, std::optional<double> wrong_pose_m,
+           std::optional<double> wrong_pose_deg,
            const std::optional<std::vector<double>>& detector_path_m) {
             std::vector<QueryCandidates> queries;
             for (const auto& [query, candidates] : ranked) {
                 QueryCandidates q{query, {}};
                 for (const py::handle c : candidates) {
-                    const py::dict d = py::reinterpret_borrow<py::dict>(c);
+                    // Any mapping (a dict, UserDict, mappingproxy) as a dict; else TypeError.
+                    const py::dict d = py::isinstance<py::dict>(c)
+                                           ? py::reinterpret_borrow<py::dict>(c)
+                                           : py::dict(py::reinterpret_borrow<py::object>(c));
                     RankedCandidate r;
-                    r.match = d["match"].cast<std::size_t>();
-                    r.distance = d["distance"].cast<double>();
-                    r.accepted = d["accepted"].cast<bool>();
-                    r.score = d.contains("score") ? d["score"].cast<double>() : -r.distance;
+                    r.match = CandidateField<std::size_t>(d, "match", query, "an index >= 0");
+                    r.distance = CandidateField<double>(d, "distance", query, "a number");
+                    r.accepted = CandidateField<bool>(d, "accepted", query, "True or False");
+                    r.score = d.contains("score")
+                                  ? CandidateField<double>(d, "score", query, "a number")
+                                  : -r.distance;
                     if (d.contains("T_match_query") && !d["T_match_query"].is_none())
                         r.T_match_query = TransformFromArray(d["T_match_query"], "T_match_query");
                     q.ranked.push_back(r);

@@ -1,5 +1,7 @@
 """Ground truth and the evaluation metrics against NumPy brute force on small random inputs."""
 
+import types
+
 import numpy as np
 import pytest
 
@@ -62,6 +64,10 @@ def test_ground_truth_matches_brute_force(max_heading_deg):
         else:
             assert truth.nearest[i] == -1
     assert truth.is_loop(*expected[0]) and truth.is_loop(expected[0][1], expected[0][0])
+    for call in (lambda: truth.is_loop(0, N), lambda: truth.comparable(N, 0),
+                 lambda: truth.overlapping(10**9)):
+        with pytest.raises(IndexError, match=f"out of range for {N} scans"):
+            call()
     config = lidarloop.GroundTruthConfig(distance_m=6.0, min_gap=3)
     assert lidarloop.build_ground_truth(times, T, config).loops.shape == \
         lidarloop.build_ground_truth(times, T, distance_m=6.0, min_gap=3).loops.shape
@@ -220,6 +226,14 @@ def test_loop_retrieval_recall_matches_brute_force():
     assert result.recall_at_1 == pytest.approx(hits1 / revisiting)
     assert (result.true_loops, result.false_loops) == (true_loops, false_loops)
     assert result.precision == pytest.approx(true_loops / (true_loops + false_loops))
+    # Any mapping and any sequence of candidates; a bad field is a TypeError that names it.
+    proxies = [(q, tuple(types.MappingProxyType(c) for c in cs)) for q, cs in ranked]
+    assert lidarloop.evaluate_loop_retrieval(proxies, truth, times, T).hits_at_k == hitsk
+    q, candidates = next((q, cs) for q, cs in ranked if cs)
+    for key, bad in (("match", -1), ("match", 1.5), ("distance", "x"), ("accepted", "no")):
+        with pytest.raises(TypeError, match=f"'{key}' of a candidate of query {q} must be"):
+            lidarloop.evaluate_loop_retrieval([(q, [dict(candidates[0], **{key: bad})])],
+                                              truth, times, T)
 
 
 def test_loop_retrieval_checks_a_gap_in_metres_on_the_detectors_path():
