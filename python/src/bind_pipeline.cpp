@@ -114,10 +114,12 @@ void BindDatabase(py::module_& m) {
             py::arg("i"))
         .def_property_readonly(
             "times_s",
-            [](const py::object& self) {
-                return ViewOf(self.cast<const DescriptorDatabase&>().times_s(), self);
+            [](const DescriptorDatabase& d) {
+                const std::vector<double>& times_s = d.times_s();
+                return py::array_t<double>(static_cast<py::ssize_t>(times_s.size()),
+                                           times_s.data());  // copies
             },
-            "The scans' times, seconds (a read-only view).")
+            "The scans' times, seconds (a copy: a view would dangle once the database grows).")
         .def(
             "distance",
             [](const DescriptorDatabase& d, std::size_t i, std::size_t j) {
@@ -339,10 +341,10 @@ void BindDetector(py::module_& m) {
             py::arg("descriptor"),
             "Localisation: every stored scan is a candidate and the query is not stored (not "
             "verified).")
-        .def_property_readonly("database", &LoopDetector::database,
-                               py::return_value_policy::reference_internal,
-                               "The stored scans' descriptors (a view; valid while the detector "
-                               "lives).")
+        .def_property_readonly(
+            "database", [](const LoopDetector& d) { return d.database(); },
+            "A copy of the stored scans' descriptors: changing it does not change the detector, "
+            "whose database grows only by process().")
         .def("__len__", [](const LoopDetector& d) { return d.database().size(); })
         .def_property_readonly("threshold", &LoopDetector::threshold,
                                "The decision threshold applied.")

@@ -165,6 +165,25 @@ def test_verifying_detector_keeps_and_saves_its_scans(sequence, tmp_path):
     detector.save(tmp_path / "map.lldb")
     assert (tmp_path / "map.scans").is_file()
     assert len(lidarloop.LoopDetector.load(tmp_path / "map.lldb")) == 15
+    # A map without scans saved over it removes the earlier scans, which would be taken for its.
+    plain = lidarloop.LoopDetector(method="range", min_gap=MIN_GAP, verify=False)
+    for i in range(15, 30):
+        plain.process(sequence[i])
+    plain.save(tmp_path / "map.lldb")
+    assert not (tmp_path / "map.scans").exists()
+
+
+def test_a_detectors_database_and_times_are_copies(sequence):
+    detector = lidarloop.LoopDetector(method="range", min_gap=MIN_GAP, verify=False)
+    for i in range(5):
+        detector.process(sequence[i])
+    database = detector.database
+    times = database.times_s
+    database.add(lidarloop.describe(sequence[6], "range"))
+    assert len(database) == 6 and len(detector) == 5  # the detector's own is unchanged
+    for i in range(5, 40):  # the database grows (and reallocates) under the copies
+        detector.process(sequence[i])
+    np.testing.assert_array_equal(times, detector.database.times_s[:5])
 
 
 def test_stopping_at_the_first_loop_closes_the_same_scans(sequence):

@@ -412,9 +412,13 @@ void SaveDetectorMap(const pipeline::LoopDetector& detector, const std::filesyst
     detection.verification.reduction.submap_path_m = 0.0;  // LoopDetector verifies scans alone
     io::SaveDatabase(file, detector.database(), detection);
     const auto& scans = detector.prepared_scans();
+    const std::filesystem::path scans_file = io::PreparedScansPathOf(file);
     if (std::any_of(scans.begin(), scans.end(), [](const auto& scan) { return scan.prepared(); })) {
-        io::SavePreparedScans(io::PreparedScansPathOf(file), scans,
-                              detection.verification.reduction);
+        io::SavePreparedScans(scans_file, scans, detection.verification.reduction);
+    } else {
+        // A map saved there before would otherwise be loaded as this one's prepared scans.
+        std::error_code ignored;
+        std::filesystem::remove(scans_file, ignored);
     }
 }
 

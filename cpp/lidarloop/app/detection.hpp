@@ -133,7 +133,8 @@ struct LoadedMap {
 LoadedMap LoadMap(const std::filesystem::path& file);
 
 /// Writes `detector`'s stored scans as a map LoadMap reads: `file` (.lldb, with the detection
-/// config) and, when scans were kept for verification, io::PreparedScansPathOf(file). Both
+/// config) and, when scans were kept for verification, io::PreparedScansPathOf(file) (else an
+/// earlier map's file there is removed, so that it is not loaded as this one's). Both
 /// record submap_path_m 0: the online detector prepares every scan alone, and RunLocalise
 /// prepares its queries as the map's scans were. io::WriteError when it cannot write.
 void SaveDetectorMap(const pipeline::LoopDetector& detector, const std::filesystem::path& file);
