@@ -91,7 +91,8 @@ io::RunConfig ConfigOf(const py::object& config, const std::optional<std::string
 std::vector<fs::path> InputsOf(const io::Dataset& data, const std::optional<fs::path>& poses,
                                const std::optional<fs::path>& calib,
                                std::vector<fs::path> files = {}) {
-    files.push_back(data.root());
+    // A Dataset object opened with poses or calib files names them too.
+    for (const fs::path& file : data.InputFiles()) files.push_back(file);
     files.push_back(poses.value_or(fs::path()));
     files.push_back(calib.value_or(fs::path()));
     return files;

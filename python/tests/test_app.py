@@ -280,6 +280,13 @@ def test_no_run_replaces_its_own_input_or_an_earlier_result(sequence, tmp_path):
         lidarloop.optimise(sequence, odometry=odometry, loops=res / "loops.csv", out=res)
     with pytest.raises(lidarloop.WriteError, match="holds the input"):
         lidarloop.evaluate(sequence, out=res, results=[res / "loops.csv"], methods=["range"])
+    # A Dataset object opened with poses from `out` names them as inputs too, even with overwrite.
+    (res / "poses_copy.txt").write_bytes((sequence / "poses.txt").read_bytes())
+    opened = lidarloop.open_dataset(sequence, poses=res / "poses_copy.txt")
+    with pytest.raises(lidarloop.WriteError, match="holds the input"):
+        lidarloop.detect(opened, out=res, verify=False, overwrite=True)
+    assert (res / "poses_copy.txt").is_file()
+    before["poses_copy.txt"] = (res / "poses_copy.txt").read_bytes()
 
     def interrupt(stage, done, total):
         raise KeyboardInterrupt

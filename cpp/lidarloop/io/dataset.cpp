@@ -392,7 +392,17 @@ double Dataset::ScanTime(std::size_t index) const {
 
 std::string Dataset::Topic() const { return bag_ ? bag_->topic() : std::string(); }
 
-Dataset OpenDataset(const fs::path& path, const DatasetOptions& options) {
+std::vector<fs::path> Dataset::InputFiles() const {
+    std::vector<fs::path> files{root_};
+    for (const fs::path& file : given_files_) {
+        if (!file.empty()) files.push_back(file);
+    }
+    return files;
+}
+
+namespace {
+
+Dataset OpenDatasetOf(const fs::path& path, const DatasetOptions& options) {
     std::error_code ec;
     if (!fs::exists(path, ec)) {
         throw ReadError(path, IsBagFile(path) ? "no such bag" : "no such dataset folder");
@@ -434,6 +444,14 @@ Dataset OpenDataset(const fs::path& path, const DatasetOptions& options) {
                                  ? PosesOfFramesHint(dataset.ScanPaths(), dataset.poses().size())
                                  : std::string()));
     }
+    return dataset;
+}
+
+}  // namespace
+
+Dataset OpenDataset(const fs::path& path, const DatasetOptions& options) {
+    Dataset dataset = OpenDatasetOf(path, options);
+    dataset.set_given_files({options.poses_file, options.calib_file});
     return dataset;
 }
 

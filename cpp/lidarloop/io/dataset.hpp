@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "lidarloop/core/point_cloud.hpp"
@@ -60,14 +61,21 @@ public:
     std::string Topic() const;
     /// One pose per scan (T_world_sensor); empty when the dataset has none.
     const std::vector<core::StampedPose>& poses() const { return poses_; }
+    /// What was read to open it, which no output may replace or lie inside: the folder or bag,
+    /// and the poses and calibration files given for it (OpenDataset; set_given_files).
+    std::vector<std::filesystem::path> InputFiles() const;
+    void set_given_files(std::vector<std::filesystem::path> files) {
+        given_files_ = std::move(files);
+    }
 
 private:
     DatasetFormat format_;
     std::filesystem::path root_;
     std::vector<std::filesystem::path> scan_files_;
     std::vector<core::StampedPose> poses_;
-    std::vector<double> times_s_;          ///< without poses: times.txt's, one a scan
-    std::shared_ptr<const BagScans> bag_;  ///< for kRosbag
+    std::vector<double> times_s_;                     ///< without poses: times.txt's, one a scan
+    std::shared_ptr<const BagScans> bag_;             ///< for kRosbag
+    std::vector<std::filesystem::path> given_files_;  ///< poses and calib files named for it
 };
 
 /// Opens a dataset folder, detecting its format unless `options.format` names one, or a ROS 1 bag
