@@ -94,15 +94,35 @@ double WhitenedResidual(const Edge& edge, const State& state) {
     return std::sqrt(std::max(0.0, e.dot(edge.information * e)));
 }
 
+// Farther than any Earth-fixed frame reaches, as the pose readers hold (io::ReadPoses): the
+// solver on coordinates of 1e200 m does not come back.
+constexpr double kMaxCoordinateM = 1e8;
+
+bool Reasonable(const core::Transform& T) {
+    return T.matrix().allFinite() && T.translation().norm() <= kMaxCoordinateM;
+}
+
 void CheckGraph(const PoseGraph& graph) {
     if (graph.poses.empty()) throw core::ConfigError("the pose graph has no pose");
     if (!graph.path_m.empty() && graph.path_m.size() != graph.poses.size())
         throw core::ConfigError("the pose graph's path has not one length per pose");
+    for (std::size_t i = 0; i < graph.poses.size(); ++i) {
+        if (!Reasonable(graph.poses[i])) {
+            throw core::ConfigError("pose " + std::to_string(i) +
+                                    " of the pose graph is not finite or lies more than 1e8 m "
+                                    "from the origin");
+        }
+    }
     for (const Edge& edge : graph.edges) {
         if (edge.from >= graph.poses.size() || edge.to >= graph.poses.size()) {
             throw core::ConfigError("an edge joins poses " + std::to_string(edge.from) + " and " +
                                     std::to_string(edge.to) + " of a graph of " +
                                     std::to_string(graph.poses.size()));
+        }
+        if (!Reasonable(edge.T_from_to) || !edge.information.allFinite()) {
+            throw core::ConfigError("the edge from pose " + std::to_string(edge.from) + " to " +
+                                    std::to_string(edge.to) +
+                                    " is not finite or spans more than 1e8 m");
         }
     }
 }

@@ -313,6 +313,15 @@ TEST(Optimise, BadInput) {
     EXPECT_THROW(BuildPoseGraph(poses, {{5, 5, core::Transform::Identity()}}, {}),
                  core::ConfigError);
     EXPECT_THROW(Optimise(PoseGraph{}, {}), core::ConfigError);
+    // Coordinates beyond any Earth-fixed frame (a wrong loop, a corrupt file) are refused before
+    // the solver, which does not come back from 1e200 m; so are non-finite edges.
+    PoseGraph far = BuildPoseGraph(poses, {}, {});
+    far.poses[3].translation().x() = 1e200;
+    EXPECT_THROW(Optimise(far, {}), core::ConfigError);
+    PoseGraph nan_edge = BuildPoseGraph(poses, {}, {});
+    nan_edge.edges.front().information(0, 0) = std::nan("");
+    EXPECT_THROW(Optimise(nan_edge, {}), core::ConfigError);
+    EXPECT_NO_THROW(Optimise(BuildPoseGraph(poses, {}, {}), {}));
     PoseGraphConfig config;
     config.robust.cauchy_scale = 0.0;
     try {
