@@ -467,6 +467,8 @@ eval::GroundTruthConfig GroundTruthRule(const EvaluationRequest& request) {
 EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequest& request,
                                 const io::Dataset* train_dataset) {
     request.learning.Validate();
+    if (request.methods.empty() && request.results_files.empty())
+        throw core::ConfigError("nothing to evaluate: give a method or a results file");
     for (const double threshold : request.fixed_thresholds) {
         if (!(std::isfinite(threshold) && threshold >= 0.0)) {
             throw core::ConfigError(

@@ -83,7 +83,7 @@ TEST(EvaluationRun, AResultsPairBeyondTheDatasetIsAReadError) {
 
 // Thresholds to report MCC and F1 at are distances: a negative or non-finite one is refused, as
 // --threshold is, not reported as an empty row.
-TEST(EvaluationRun, AFixedThresholdThatIsNoDistanceIsAConfigError) {
+TEST(EvaluationRun, NoMethodOrAFixedThresholdThatIsNoDistanceIsAConfigError) {
     const test::TempDir dir;
     const io::Dataset dataset = test::SmallSequence(dir / "sequence");
     app::EvaluationRequest request;
@@ -93,6 +93,9 @@ TEST(EvaluationRun, AFixedThresholdThatIsNoDistanceIsAConfigError) {
         request.fixed_thresholds = {0.01, threshold};
         EXPECT_THROW(app::RunEvaluation(dataset, request), core::ConfigError) << threshold;
     }
+    request.fixed_thresholds.clear();
+    request.methods.clear();  // nothing to evaluate is no empty report
+    EXPECT_THROW(app::RunEvaluation(dataset, request), core::ConfigError);
     EXPECT_FALSE(std::filesystem::exists(dir / "out"));
 }
 
