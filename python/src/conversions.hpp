@@ -250,9 +250,17 @@ inline io::RunConfig RunConfigFrom(const py::object& config) {
     io::RunConfig run;
     if (config.is_none()) return run;
     if (py::isinstance<py::dict>(config)) {
-        // JSON is YAML: the dict goes through the same parser as a config file.
-        const std::string text =
-            py::module_::import("json").attr("dumps")(config).cast<std::string>();
+        // JSON is YAML: the dict goes through the same parser as a config file. A NumPy scalar
+        // (np.float32(1.0), np.int64(50)) is written as the Python number it holds.
+        const py::object numpy_scalar = py::module_::import("numpy").attr("generic");
+        const py::cpp_function as_number([numpy_scalar](const py::object& value) -> py::object {
+            if (py::isinstance(value, numpy_scalar)) return value.attr("item")();
+            throw py::type_error("config: " + py::repr(value).cast<std::string>() +
+                                 " is no number, name, bool or list");
+        });
+        const std::string text = py::module_::import("json")
+                                     .attr("dumps")(config, py::arg("default") = as_number)
+                                     .cast<std::string>();
         io::ApplyConfigYaml(text, "config dict", run);
         return run;
     }

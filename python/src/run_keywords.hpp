@@ -17,32 +17,43 @@
 
 namespace lidarloop::python {
 
-/// A keyword's value as its option's type (app/run_options.hpp); TypeError naming it otherwise.
+/// A keyword's value as its option's type (app/run_options.hpp), NumPy scalars as the numbers
+/// they hold; TypeError naming it otherwise, also for an int beyond the option's int range.
 inline app::RunOptionValue RunValueOf(const app::RunOption& option, const py::handle& value) {
     using T = app::RunOptionType;
-    const bool is_bool = py::isinstance<py::bool_>(value);
-    const bool is_int = py::isinstance<py::int_>(value) && !is_bool;
-    switch (option.type) {
-        case T::kInt:
-            if (is_int) return value.cast<int>();
-            break;
-        case T::kNumber:
-            if (is_int || py::isinstance<py::float_>(value)) return value.cast<double>();
-            break;
-        case T::kName:
-            if (py::isinstance<py::str>(value)) return value.cast<std::string>();
-            break;
-        case T::kNumbers:
-            if (!is_bool && !py::isinstance<py::str>(value) && py::isinstance<py::sequence>(value))
-                return value.cast<std::vector<double>>();
-            break;
-        case T::kSwitch:
-        case T::kSwitchOff:
-            if (is_bool) return value.cast<bool>();
-            break;
+    const py::module_ numpy = py::module_::import("numpy");
+    const bool is_bool =
+        py::isinstance<py::bool_>(value) || py::isinstance(value, numpy.attr("bool_"));
+    const bool is_int = !is_bool && (py::isinstance<py::int_>(value) ||
+                                     py::isinstance(value, numpy.attr("integer")));
+    const bool is_float =
+        py::isinstance<py::float_>(value) || py::isinstance(value, numpy.attr("floating"));
+    try {
+        switch (option.type) {
+            case T::kInt:
+                if (is_int) return py::int_(py::reinterpret_borrow<py::object>(value)).cast<int>();
+                break;
+            case T::kNumber:
+                if (is_int || is_float) return value.cast<double>();
+                break;
+            case T::kName:
+                if (py::isinstance<py::str>(value)) return value.cast<std::string>();
+                break;
+            case T::kNumbers:
+                if (!is_bool && !py::isinstance<py::str>(value) &&
+                    py::isinstance<py::sequence>(value))
+                    return value.cast<std::vector<double>>();
+                break;
+            case T::kSwitch:
+            case T::kSwitchOff:
+                if (is_bool) return value.cast<bool>();
+                break;
+        }
+    } catch (const py::cast_error&) {
+        // An int too large for the option, or a list with a non-number: said as below.
     }
-    static constexpr const char* kKinds[] = {"an int", "a number", "a str", "a list of numbers",
-                                             "a bool", "a bool"};
+    static constexpr const char* kKinds[] = {"an int (32-bit)",   "a number", "a str",
+                                             "a list of numbers", "a bool",   "a bool"};
     throw py::type_error(std::string(option.keyword) + " must be " +
                          kKinds[static_cast<int>(option.type)] + ", got " +
                          py::repr(value).cast<std::string>());

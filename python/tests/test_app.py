@@ -427,3 +427,15 @@ def test_odometry_in_kittis_camera_frame_is_converted_as_the_cli(cli, sequence, 
 def test_keep_freed_memory_for_reuse_is_taken_by_glibc():
     # What the CLI does first; opt-in for a Python process (docs/python.md).
     assert lidarloop.keep_freed_memory_for_reuse() is True
+
+
+def test_numpy_scalars_are_the_numbers_they_hold(sequence, tmp_path):
+    plain = lidarloop.detect(sequence, out=tmp_path / "plain", verify=False, top_k=3,
+                             config={"histogram": {"bins": 50}})
+    numpy = lidarloop.detect(sequence, out=tmp_path / "numpy", verify=False, top_k=np.int64(3),
+                             config={"histogram": {"bins": np.int64(50)}})
+    assert (tmp_path / "numpy" / "loops.csv").read_bytes() == \
+        (tmp_path / "plain" / "loops.csv").read_bytes()
+    assert numpy.accepted == plain.accepted
+    with pytest.raises(TypeError, match="is no number"):
+        lidarloop.detect(sequence, out=tmp_path / "bad", config={"histogram": {"bins": object()}})

@@ -70,3 +70,9 @@ def test_a_keyword_that_is_not_declared_is_a_type_error(tmp_path):
         lidarloop.detect(tmp_path, out=tmp_path / "out", top_kk=3)
     with pytest.raises(TypeError, match="top_k must be an int"):
         lidarloop.detect(tmp_path, out=tmp_path / "out", top_k="3")
+    # Beyond the option's int, or a list with a non-number: a TypeError naming it too.
+    with pytest.raises(TypeError, match=r"top_k must be an int \(32-bit\), got 1099511627776"):
+        lidarloop.detect(tmp_path, out=tmp_path / "out", top_k=2**40)
+    with pytest.raises(TypeError, match="fixed_thresholds must be a list of numbers"):
+        lidarloop.evaluate(tmp_path, out=tmp_path / "out", fixed_thresholds=["a"])
+
