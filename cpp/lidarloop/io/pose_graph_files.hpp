@@ -34,7 +34,8 @@ std::vector<LoopRow> ReadLoopsCsv(const std::filesystem::path& file, std::size_t
 /// entries of the upper triangle of its information matrix, row by row, per edge in `edges`
 /// (g2o's order: translation, then the quaternion's x y z; see posegraph::EdgeError). Edges in
 /// `commented_edges` (loops the back end rejected) are written after a `# rejected ` prefix, so
-/// that g2o skips them. Full double precision. Throws WriteError.
+/// that g2o skips them. Full double precision. Throws WriteError, and core::ConfigError (before
+/// writing) for an edge to a pose beyond `poses`.
 void WriteG2o(const std::filesystem::path& file, const std::vector<core::Transform>& poses,
               const std::vector<posegraph::Edge>& edges,
               const std::vector<posegraph::Edge>& commented_edges = {});

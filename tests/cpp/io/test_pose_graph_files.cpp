@@ -1,4 +1,5 @@
 #include <cmath>
+#include <filesystem>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -6,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "io_test_utils.hpp"
+#include "lidarloop/core/error.hpp"
 #include "lidarloop/io/pose_graph_files.hpp"
 #include "lidarloop/io/poses.hpp"
 #include "lidarloop/posegraph/pose_graph.hpp"
@@ -173,6 +175,10 @@ TEST(WriteG2o, WritesVerticesEdgesAndTheUpperTriangleOfTheInformation) {
     ASSERT_EQ(g2o.other.size(), 3u);   // header comment, FIX 0, the rejected edge
     EXPECT_EQ(g2o.other[1], "FIX 0");
     EXPECT_EQ(g2o.other[2].rfind("# rejected EDGE_SE3:QUAT 1 0 ", 0), 0u);
+    // An edge to a vertex the file does not hold (g2o would add it as a free pose) is refused.
+    EXPECT_THROW(WriteG2o(dir / "short.g2o", {a}, {edge}), core::ConfigError);
+    EXPECT_THROW(WriteG2o(dir / "short.g2o", {a}, {}, {rejected}), core::ConfigError);
+    EXPECT_FALSE(std::filesystem::exists(dir / "short.g2o"));
 }
 
 TEST(ReadPoses, TellsKittiFromTum) {
