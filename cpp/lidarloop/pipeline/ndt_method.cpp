@@ -1,6 +1,7 @@
 #include "lidarloop/pipeline/ndt_method.hpp"
 
 #include <cmath>
+#include <string>
 
 #include "lidarloop/core/error.hpp"
 
@@ -63,13 +64,39 @@ struct NdtQuery : PreparedQuery {
 };
 
 class NdtStore : public DescriptorStore {
+    // Every descriptor of the store has one shape (range intervals x features): one of another
+    // config would make every later distance fail, so it is refused where it comes in.
+    void RequireShapeOfStored(const core::NdtDescriptorSet& set) const {
+        const core::NdtDescriptor* stored = nullptr;
+        for (const core::NdtDescriptorSet& s : sets_) {
+            if (!s.descriptors.empty()) {
+                stored = &s.descriptors.front();
+                break;
+            }
+        }
+        if (stored == nullptr) return;
+        for (const core::NdtDescriptor& f : set.descriptors) {
+            if (f.rows != stored->rows || f.cols != stored->cols) {
+                throw core::ConfigError("an NDT descriptor of " + std::to_string(f.rows) + " x " +
+                                        std::to_string(f.cols) + " into a database of " +
+                                        std::to_string(stored->rows) + " x " +
+                                        std::to_string(stored->cols) +
+                                        " (range intervals x features): describe it with the "
+                                        "database's config");
+            }
+        }
+    }
+
 public:
     const std::vector<core::NdtDescriptorSet>& sets() const { return sets_; }
 
     std::unique_ptr<DescriptorStore> Clone() const override {
         return std::make_unique<NdtStore>(*this);
     }
-    void Add(const core::Descriptor& descriptor) override { sets_.push_back(descriptor.ndt()); }
+    void Add(const core::Descriptor& descriptor) override {
+        RequireShapeOfStored(descriptor.ndt());
+        sets_.push_back(descriptor.ndt());
+    }
     void AddMissing() override { sets_.emplace_back(); }
     double Distance(std::size_t i, std::size_t j) const override {
         return core::NdtSetDifference(sets_[i], sets_[j]);

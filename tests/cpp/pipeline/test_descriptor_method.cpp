@@ -145,5 +145,21 @@ TEST(DescriptorDatabase, TypedViewsBelongToTheirMethodAndCopiesAreDeep) {
     ASSERT_NE(NdtSets(ndt), nullptr);
 }
 
+// An NDT descriptor of another shape (range intervals x features) is refused where it is added,
+// as a histogram of other bins is, not left to fail every later distance.
+TEST(DescriptorDatabase, AnNdtDescriptorOfAnotherShapeIsRefusedWhenAdded) {
+    core::DescriptorConfig config;
+    config.method = core::Method::kNdt;
+    DescriptorDatabase database(config);
+    const core::PointCloud cloud = GroundAndWall();
+    database.Add(ComputeDescriptor(cloud, config), 0.0);
+    core::DescriptorConfig other = config;
+    other.ndt.planar_classes += 1;
+    EXPECT_THROW(database.Add(ComputeDescriptor(cloud, other), 1.0), core::ConfigError);
+    database.Add(ComputeDescriptor(cloud, config), 2.0);
+    EXPECT_EQ(database.size(), 2U);
+    EXPECT_EQ(database.Distance(0, 1), 0.0);
+}
+
 }  // namespace
 }  // namespace lidarloop::pipeline
