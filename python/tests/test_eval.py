@@ -253,7 +253,7 @@ def test_loop_retrieval_checks_a_gap_in_metres_on_the_detectors_path():
         hits += positive[q, :q].any() and positive[q, earlier].any()
         inside_true_gap += sum(true_path[q] - true_path[j] <= 20.0 for j in earlier)
     assert inside_true_gap > 0
-    with pytest.raises(lidarloop.Error, match="outside the minimum gap"):
+    with pytest.raises(lidarloop.ConfigError, match="outside the minimum gap"):
         lidarloop.evaluate_loop_retrieval(ranked, truth, times, T)
     result = lidarloop.evaluate_loop_retrieval(ranked, truth, times, T,
                                                detector_path_m=odometry_path)
@@ -281,7 +281,7 @@ def test_em_threshold_lies_between_two_clusters():
 def test_bad_input_raises_typed_errors():
     times, T, _ = random_sequence(6, n=5)
     truth = lidarloop.build_ground_truth(times, T)
-    with pytest.raises(lidarloop.Error):
+    with pytest.raises(lidarloop.ConfigError):  # a ValueError, as the docs' table says
         lidarloop.collect_pairs(np.zeros(3, np.float32), truth)  # 5 scans have 10 pairs
     with pytest.raises(lidarloop.ShapeError):
         lidarloop.collect_pairs(np.zeros((5, 4), np.float32), truth)

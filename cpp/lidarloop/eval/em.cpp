@@ -201,11 +201,12 @@ MixtureFit FitGaussianMixture(std::span<const double> sample, const EmConfig& co
     }
     for (std::size_t i = 0; i < sample.size(); ++i) {
         if (!std::isfinite(sample[i])) {
-            throw core::Error("EM: value " + std::to_string(i) + " is not finite");
+            throw core::ConfigError("EM: value " + std::to_string(i) + " is not finite");
         }
     }
     const SampleStats stats = Describe(sample);
-    if (stats.sorted.front() == stats.sorted.back()) throw core::Error("EM: all values are equal");
+    if (stats.sorted.front() == stats.sorted.back())
+        throw core::ConfigError("EM: all values are equal");
     const double min_stddev = config.min_stddev_fraction * stats.stddev;
     std::mt19937_64 rng(config.seed);
     MixtureFit best;

@@ -54,7 +54,7 @@ struct MixtureFit {
 /// start weights and deviations come from assigning every value to its nearest start mean.
 /// Non-finite values must be removed
 /// by the caller. Throws core::ConfigError for an invalid config, core::EmptyInputError when
-/// the sample has fewer values than components, and core::Error when a value is not finite or
+/// the sample has fewer values than components, and core::ConfigError when a value is not finite or
 /// all values are equal. O(restarts * max_iterations * n * components). Thread-safe.
 MixtureFit FitGaussianMixture(std::span<const double> sample, const EmConfig& config = {});
 

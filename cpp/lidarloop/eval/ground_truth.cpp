@@ -50,8 +50,8 @@ double AngleDeg(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
 void CheckPoses(const std::vector<core::StampedPose>& poses) {
     for (std::size_t i = 0; i < poses.size(); ++i) {
         if (!std::isfinite(poses[i].time_s) || !poses[i].T_world_sensor.matrix().allFinite()) {
-            throw core::Error("ground truth: pose " + std::to_string(i) +
-                              " has a non-finite time or transform");
+            throw core::ConfigError("ground truth: pose " + std::to_string(i) +
+                                    " has a non-finite time or transform");
         }
     }
 }

@@ -126,7 +126,7 @@ struct GroundTruth {
 
 /// Builds the ground truth from the scans' poses with a k-d tree radius search (not all pairs):
 /// O(n log n + P) time for P positive pairs, plus the nearest-partner search; O(n) memory. Throws
-/// core::ConfigError for an invalid config and core::Error when a pose or time is not finite.
+/// core::ConfigError for an invalid config and when a pose or time is not finite.
 /// Thread-safe.
 GroundTruth BuildGroundTruth(const std::vector<core::StampedPose>& poses,
                              const GroundTruthConfig& config);

@@ -22,11 +22,11 @@ double Share(std::size_t numerator, std::size_t denominator) {
 }
 
 void CheckTransform(const core::Transform& T, const std::string& where) {
-    if (!T.matrix().allFinite()) throw core::Error(where + ": T_match_query is not finite");
+    if (!T.matrix().allFinite()) throw core::ConfigError(where + ": T_match_query is not finite");
     const Eigen::Matrix3d R = T.linear();
     const double off = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
     if (off > kRotationTolerance || R.determinant() <= 0.0) {
-        throw core::Error(where + ": the linear part of T_match_query is not a rotation");
+        throw core::ConfigError(where + ": the linear part of T_match_query is not a rotation");
     }
 }
 
@@ -47,10 +47,10 @@ void CheckCandidate(const QueryCandidates& q, std::size_t rank, const GroundTrut
                               std::to_string(rank) + " (scan " + std::to_string(c.match) + ")";
     if (c.match >= truth.size() || c.match >= q.query ||
         !OutsideDetectorGap(truth, detector_path_m, q.query, c.match)) {
-        throw core::Error(where + " is not an earlier scan outside the minimum gap");
+        throw core::ConfigError(where + " is not an earlier scan outside the minimum gap");
     }
-    if (std::isnan(c.distance)) throw core::Error(where + ": distance is NaN");
-    if (std::isnan(c.score)) throw core::Error(where + ": score is NaN");
+    if (std::isnan(c.distance)) throw core::ConfigError(where + ": distance is NaN");
+    if (std::isnan(c.score)) throw core::ConfigError(where + ": score is NaN");
     if (c.T_match_query) CheckTransform(*c.T_match_query, where);
 }
 
@@ -58,10 +58,10 @@ void CheckQuery(const QueryCandidates& q, const GroundTruth& truth,
                 std::span<const double> detector_path_m, std::vector<bool>& seen) {
     const std::string where = "loop retrieval: query " + std::to_string(q.query);
     if (q.query >= truth.size()) {
-        throw core::Error(where + " is out of range: the ground truth has " +
-                          std::to_string(truth.size()) + " scans");
+        throw core::ConfigError(where + " is out of range: the ground truth has " +
+                                std::to_string(truth.size()) + " scans");
     }
-    if (seen[q.query]) throw core::Error(where + " is given twice");
+    if (seen[q.query]) throw core::ConfigError(where + " is given twice");
     seen[q.query] = true;
     for (std::size_t rank = 0; rank < q.ranked.size(); ++rank)
         CheckCandidate(q, rank, truth, detector_path_m);
@@ -70,21 +70,22 @@ void CheckQuery(const QueryCandidates& q, const GroundTruth& truth,
     std::sort(matches.begin(), matches.end());
     const auto twice = std::adjacent_find(matches.begin(), matches.end());
     if (twice != matches.end()) {
-        throw core::Error(where + ": scan " + std::to_string(*twice) + " is a candidate twice");
+        throw core::ConfigError(where + ": scan " + std::to_string(*twice) +
+                                " is a candidate twice");
     }
 }
 
 void CheckInput(std::span<const QueryCandidates> queries, const GroundTruth& truth,
                 std::span<const core::StampedPose> poses, std::span<const double> detector_path_m) {
     if (poses.size() != truth.size()) {
-        throw core::Error("loop retrieval: " + std::to_string(poses.size()) +
-                          " poses for a ground truth of " + std::to_string(truth.size()) +
-                          " scans");
+        throw core::ConfigError("loop retrieval: " + std::to_string(poses.size()) +
+                                " poses for a ground truth of " + std::to_string(truth.size()) +
+                                " scans");
     }
     if (!detector_path_m.empty() && detector_path_m.size() != truth.size()) {
-        throw core::Error("loop retrieval: the detector's path has " +
-                          std::to_string(detector_path_m.size()) + " scans, the ground truth " +
-                          std::to_string(truth.size()));
+        throw core::ConfigError("loop retrieval: the detector's path has " +
+                                std::to_string(detector_path_m.size()) +
+                                " scans, the ground truth " + std::to_string(truth.size()));
     }
     core::CheckPathM(detector_path_m, "loop retrieval: the detector's path");
     std::vector<bool> seen(truth.size(), false);
@@ -204,9 +205,9 @@ RelativePoseError PoseError(const core::Transform& T_match_query_est,
 
 bool Revisiting(const GroundTruth& truth, std::size_t scan) {
     if (scan >= truth.size()) {
-        throw core::Error("loop retrieval: scan " + std::to_string(scan) +
-                          " is out of range: the ground truth has " + std::to_string(truth.size()) +
-                          " scans");
+        throw core::ConfigError("loop retrieval: scan " + std::to_string(scan) +
+                                " is out of range: the ground truth has " +
+                                std::to_string(truth.size()) + " scans");
     }
     // The first partner decides (kNoScan, none, is never smaller).
     return truth.first_partner[scan] < scan;

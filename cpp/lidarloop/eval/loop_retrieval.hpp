@@ -81,7 +81,7 @@ RelativePoseError PoseError(const core::Transform& T_match_query_est,
 /// True when `scan` has a ground-truth partner among the scans an online detector can match it
 /// to: an earlier scan (smaller index) outside the minimum gap. This is GroundTruth::Overlapping
 /// (Magnusson's "overlapping", partners before or after) restricted to earlier partners, the
-/// candidates of pipeline::LoopDetector. Throws core::Error for a scan out of range. O(1).
+/// candidates of pipeline::LoopDetector. Throws core::ConfigError for a scan out of range. O(1).
 bool Revisiting(const GroundTruth& truth, std::size_t scan);
 
 /// One query's loop: its first accepted candidate in ranked order.
@@ -167,7 +167,7 @@ struct LoopRetrievalEvaluation {
 /// always uses the ground truth's path: an accepted loop within distance_m that the truth does not
 /// count as a revisit (too little path back) is neither true nor false.
 ///
-/// Throws core::Error, naming the query and candidate, when: poses.size() != truth.size(); a
+/// Throws core::ConfigError, naming the query and candidate, when: poses.size() != truth.size(); a
 /// non-empty detector_path_m does not have truth.size() entries; a query index is out of range
 /// or given twice; a candidate is not an earlier scan outside the minimum gap of its query (the
 /// gap's unit, on detector_path_m for metres) or appears twice in one list; a distance or score

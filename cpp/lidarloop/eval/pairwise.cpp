@@ -24,13 +24,13 @@ struct Scored {
 
 void CheckDistance(const ScoredPair& pair) {
     if (std::isnan(pair.distance)) {
-        throw core::Error("pair-wise evaluation: distance of pair " +
-                          detail::PairName(pair.i, pair.j) + " is NaN");
+        throw core::ConfigError("pair-wise evaluation: distance of pair " +
+                                detail::PairName(pair.i, pair.j) + " is NaN");
     }
 }
 
 void CheckThreshold(double threshold) {
-    if (std::isnan(threshold)) throw core::Error("evaluation threshold must not be NaN");
+    if (std::isnan(threshold)) throw core::ConfigError("evaluation threshold must not be NaN");
 }
 
 bool DetectedAt(float distance, double threshold) {
@@ -106,12 +106,13 @@ void PairwiseConfig::Validate() const {
 std::vector<ScoredPair> CollectPairs(std::span<const float> condensed, const GroundTruth& truth) {
     const std::size_t n = truth.size();
     if (condensed.size() != CondensedSize(n)) {
-        throw core::Error("pair-wise evaluation: the distance matrix holds " +
-                          std::to_string(condensed.size()) + " pairs, the ground truth of " +
-                          std::to_string(n) + " scans needs " + std::to_string(CondensedSize(n)));
+        throw core::ConfigError("pair-wise evaluation: the distance matrix holds " +
+                                std::to_string(condensed.size()) + " pairs, the ground truth of " +
+                                std::to_string(n) + " scans needs " +
+                                std::to_string(CondensedSize(n)));
     }
     if (n > std::numeric_limits<std::uint32_t>::max()) {
-        throw core::Error("pair-wise evaluation: more than 2^32 scans");
+        throw core::ConfigError("pair-wise evaluation: more than 2^32 scans");
     }
     std::vector<ScoredPair> pairs;
     pairs.reserve(truth.ComparablePairCount());
@@ -121,8 +122,8 @@ std::vector<ScoredPair> CollectPairs(std::span<const float> condensed, const Gro
             if (!truth.Comparable(i, j)) continue;
             const float distance = condensed[at];
             if (std::isnan(distance)) {
-                throw core::Error("pair-wise evaluation: distance of pair " +
-                                  detail::PairName(i, j) + " is NaN");
+                throw core::ConfigError("pair-wise evaluation: distance of pair " +
+                                        detail::PairName(i, j) + " is NaN");
             }
             pairs.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j), distance,
                              truth.IsLoop(i, j)});

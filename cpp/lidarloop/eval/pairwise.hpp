@@ -31,8 +31,8 @@ struct ScoredPair {
 
 /// The pairs to evaluate from a full condensed distance matrix: every pair i < j that
 /// truth.Comparable(i, j) accepts (pairs inside the minimum gap are skipped), labelled by
-/// truth.IsLoop. `condensed` must hold CondensedSize(truth.size()) entries; throws core::Error
-/// otherwise or when a distance is NaN. O(n^2). Thread-safe.
+/// truth.IsLoop. `condensed` must hold CondensedSize(truth.size()) entries; throws
+/// core::ConfigError otherwise or when a distance is NaN. O(n^2). Thread-safe.
 std::vector<ScoredPair> CollectPairs(std::span<const float> condensed, const GroundTruth& truth);
 
 /// Options of EvaluatePairs.
@@ -86,17 +86,17 @@ struct PairwiseEvaluation {
 };
 
 /// Sweeps the threshold over all distinct finite distances of `pairs` in O(P log P) (one sort).
-/// Throws core::EmptyInputError when `pairs` is empty and core::Error when a distance is NaN.
+/// Throws core::EmptyInputError when `pairs` is empty and core::ConfigError when a distance is NaN.
 /// Thread-safe.
 PairwiseEvaluation EvaluatePairs(std::span<const ScoredPair> pairs,
                                  const PairwiseConfig& config = {});
 
 /// The confusion of L_tau (distance <= threshold is a loop; +inf never is) on `pairs`, O(P).
-/// Throws core::Error for a NaN threshold or distance. Thread-safe.
+/// Throws core::ConfigError for a NaN threshold or distance. Thread-safe.
 Confusion ConfusionAt(std::span<const ScoredPair> pairs, double threshold);
 
 /// ConfusionAt for several thresholds (Röhling table II), in the order given, in
-/// O((P + T) log T). Throws core::Error for a NaN threshold or distance. Thread-safe.
+/// O((P + T) log T). Throws core::ConfigError for a NaN threshold or distance. Thread-safe.
 std::vector<Confusion> ConfusionsAt(std::span<const ScoredPair> pairs,
                                     std::span<const double> thresholds);
 

@@ -25,21 +25,21 @@ ScanLabel LabelIfNotSimilar(std::size_t i, const GroundTruth& truth) {
 
 void CheckMatches(std::span<const BestMatch> matches, const GroundTruth& truth) {
     if (matches.size() != truth.size()) {
-        throw core::Error("per-scan evaluation: " + std::to_string(matches.size()) +
-                          " best matches for a ground truth of " + std::to_string(truth.size()) +
-                          " scans");
+        throw core::ConfigError("per-scan evaluation: " + std::to_string(matches.size()) +
+                                " best matches for a ground truth of " +
+                                std::to_string(truth.size()) + " scans");
     }
     for (std::size_t i = 0; i < matches.size(); ++i) {
         const BestMatch& m = matches[i];
         const std::string scan = "per-scan evaluation: scan " + std::to_string(i);
-        if (std::isnan(m.distance)) throw core::Error(scan + ": distance is NaN");
+        if (std::isnan(m.distance)) throw core::ConfigError(scan + ": distance is NaN");
         if (m.match == kNoScan) {
             if (m.distance != std::numeric_limits<double>::infinity()) {
-                throw core::Error(scan + ": no match but a finite distance");
+                throw core::ConfigError(scan + ": no match but a finite distance");
             }
         } else if (m.match >= truth.size() || !truth.Comparable(i, m.match)) {
-            throw core::Error(scan + ": match " + std::to_string(m.match) +
-                              " is not a scan outside the minimum gap");
+            throw core::ConfigError(scan + ": match " + std::to_string(m.match) +
+                                    " is not a scan outside the minimum gap");
         }
     }
 }
@@ -83,9 +83,10 @@ std::vector<BestMatch> BestMatchesFromCondensed(std::span<const float> condensed
                                                 const GroundTruth& truth) {
     const std::size_t n = truth.size();
     if (condensed.size() != CondensedSize(n)) {
-        throw core::Error("per-scan evaluation: the distance matrix holds " +
-                          std::to_string(condensed.size()) + " pairs, the ground truth of " +
-                          std::to_string(n) + " scans needs " + std::to_string(CondensedSize(n)));
+        throw core::ConfigError("per-scan evaluation: the distance matrix holds " +
+                                std::to_string(condensed.size()) + " pairs, the ground truth of " +
+                                std::to_string(n) + " scans needs " +
+                                std::to_string(CondensedSize(n)));
     }
     std::vector<BestMatch> best(n);
     // Offer (i, j) to both scans; j ascending per i and i ascending overall, so strict
@@ -105,8 +106,8 @@ std::vector<BestMatch> BestMatchesFromCondensed(std::span<const float> condensed
             if (!truth.Comparable(i, j)) continue;
             const double distance = condensed[at];
             if (std::isnan(distance)) {
-                throw core::Error("per-scan evaluation: distance of pair (" + std::to_string(i) +
-                                  ", " + std::to_string(j) + ") is NaN");
+                throw core::ConfigError("per-scan evaluation: distance of pair (" +
+                                        std::to_string(i) + ", " + std::to_string(j) + ") is NaN");
             }
             offer(best[i], j, distance);
             offer(best[j], i, distance);
@@ -117,7 +118,7 @@ std::vector<BestMatch> BestMatchesFromCondensed(std::span<const float> condensed
 
 std::vector<ScanLabel> LabelScans(std::span<const BestMatch> matches, const GroundTruth& truth,
                                   double t_d) {
-    if (std::isnan(t_d)) throw core::Error("per-scan evaluation: t_d must not be NaN");
+    if (std::isnan(t_d)) throw core::ConfigError("per-scan evaluation: t_d must not be NaN");
     CheckMatches(matches, truth);
     std::vector<ScanLabel> labels(matches.size());
     for (std::size_t i = 0; i < matches.size(); ++i) {

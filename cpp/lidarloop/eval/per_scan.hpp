@@ -26,7 +26,7 @@ struct BestMatch {
 /// Magnusson compares every scan with all others except S_{i-S} .. S_{i+S}). `condensed` is the
 /// upper triangle of the n x n distance matrix (see CondensedIndex). Ties go to the smaller scan
 /// index. A scan whose pairs are all +inf gets no match, so it is never similar (a false or
-/// true negative at every t_d), not a match to an arbitrary scan. Throws core::Error when the
+/// true negative at every t_d), not a match to an arbitrary scan. Throws core::ConfigError when the
 /// size does not match truth.size() or a distance is NaN.
 /// O(n^2). Thread-safe.
 std::vector<BestMatch> BestMatchesFromCondensed(std::span<const float> condensed,
@@ -71,8 +71,8 @@ struct TaxonomyCounts {
 
 /// Labels every scan by table I for the difference threshold `t_d` (similar: distance < t_d;
 /// t_d may be +inf). `matches[i]` must be scan i's best match: truth.size() entries, each match
-/// kNoScan (never similar) or a scan outside the gap; throws core::Error otherwise or for a NaN
-/// t_d or distance. O(n log degree). Thread-safe.
+/// kNoScan (never similar) or a scan outside the gap; throws core::ConfigError otherwise or for a
+/// NaN t_d or distance. O(n log degree). Thread-safe.
 std::vector<ScanLabel> LabelScans(std::span<const BestMatch> matches, const GroundTruth& truth,
                                   double t_d);
 

@@ -54,8 +54,8 @@ float FromKey(std::uint32_t key) {
 
 void CheckNotNan(std::size_t i, std::size_t j, float distance) {
     if (std::isnan(distance)) {
-        throw core::Error("pair-wise evaluation: distance of pair " + detail::PairName(i, j) +
-                          " is NaN");
+        throw core::ConfigError("pair-wise evaluation: distance of pair " + detail::PairName(i, j) +
+                                " is NaN");
     }
 }
 
@@ -769,9 +769,9 @@ namespace {
 // Throws for a NaN among the positives, naming its pair (found by enumerating them again).
 void CheckPositives(const GroundTruth& truth, const std::vector<float>& positives) {
     if (positives.size() != truth.loop_count) {
-        throw core::Error("pair-wise evaluation: " + std::to_string(positives.size()) +
-                          " positive distances for " + std::to_string(truth.loop_count) +
-                          " positive pairs");
+        throw core::ConfigError("pair-wise evaluation: " + std::to_string(positives.size()) +
+                                " positive distances for " + std::to_string(truth.loop_count) +
+                                " positive pairs");
     }
     if (std::none_of(positives.begin(), positives.end(), [](float d) { return std::isnan(d); }))
         return;
@@ -818,10 +818,10 @@ StreamedPairwise::StreamedPairwise(const GroundTruth& truth, std::vector<float> 
     }
     if (request.learning) request.learning->Validate();
     for (const double t : request.thresholds) {
-        if (std::isnan(t)) throw core::Error("evaluation threshold must not be NaN");
+        if (std::isnan(t)) throw core::ConfigError("evaluation threshold must not be NaN");
     }
     if (truth.size() > std::numeric_limits<std::uint32_t>::max())
-        throw core::Error("pair-wise evaluation: more than 2^32 scans");
+        throw core::ConfigError("pair-wise evaluation: more than 2^32 scans");
     CheckPositives(truth, positives);
     auto context = std::make_unique<Context>();
     Context& c = *context;

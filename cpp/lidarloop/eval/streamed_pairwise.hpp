@@ -20,7 +20,7 @@ using PairDistance = std::function<float(std::size_t i, std::size_t j)>;
 
 /// The distances of the loop pairs of `truth` (the positives of the pair-wise protocol), in the
 /// order of GroundTruth::ForEachLoop: O(P) calls of `distance`, 4 bytes a pair. Throws
-/// core::Error for a NaN distance. Thread-safe.
+/// core::ConfigError for a NaN distance. Thread-safe.
 std::vector<float> ScorePositives(const GroundTruth& truth, const PairDistance& distance);
 
 /// What StreamedPairwise computes besides the sweep over all pairs.
@@ -80,7 +80,7 @@ public:
         Sink& operator=(Sink&&) noexcept;
         ~Sink();
         /// One pair i < j and its distance; pairs the ground truth does not compare are
-        /// ignored. Throws core::Error for a NaN distance.
+        /// ignored. Throws core::ConfigError for a NaN distance.
         void Add(std::size_t i, std::size_t j, float distance);
 
     private:
@@ -91,7 +91,7 @@ public:
     };
 
     /// `positives`: ScorePositives(truth, distance), one per truth.loop_count. Throws
-    /// core::ConfigError for an invalid request, core::Error for a NaN threshold or positive
+    /// core::ConfigError for an invalid request, a NaN threshold or positive
     /// distance, a count of positives other than truth.loop_count, more than 2^32 scans, or
     /// fewer than 2 scans (no pair). `truth` must outlive this.
     StreamedPairwise(const GroundTruth& truth, std::vector<float> positives,

@@ -12,7 +12,7 @@ namespace lidarloop::eval {
 double Quantile(std::span<const double> sorted, double q) {
     if (sorted.empty()) throw core::EmptyInputError("quantile of no values");
     if (!(q >= 0.0 && q <= 1.0)) {
-        throw core::Error("quantile level must be in [0, 1], got " + std::to_string(q));
+        throw core::ConfigError("quantile level must be in [0, 1], got " + std::to_string(q));
     }
     const double position = q * static_cast<double>(sorted.size() - 1);
     const auto below = static_cast<std::size_t>(std::floor(position));
@@ -27,7 +27,7 @@ Summary Summarize(std::span<const double> values) {
     double sum = 0.0;
     for (std::size_t i = 0; i < sorted.size(); ++i) {
         if (!std::isfinite(sorted[i])) {
-            throw core::Error("summary: value " + std::to_string(i) + " is not finite");
+            throw core::ConfigError("summary: value " + std::to_string(i) + " is not finite");
         }
         sum += sorted[i];
     }
