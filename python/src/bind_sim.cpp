@@ -103,8 +103,11 @@ SimulationConfig ConfigFrom(const std::optional<std::string>& scene,
     if (const auto drift = Take<double>(options, "drift"))
         config.odometry = sim::ScaledOdometry(config.odometry, *drift);
     if (options.contains("trajectory")) {
-        config.trajectory = TrajectoryFrom(options["trajectory"]);
-        config.scans = config.trajectory.size();
+        // None keeps the route, as None keeps every other option's default.
+        if (!options["trajectory"].is_none()) {
+            config.trajectory = TrajectoryFrom(options["trajectory"]);
+            config.scans = config.trajectory.size();
+        }
         PyDict_DelItemString(options.ptr(), "trajectory");
     }
     if (!options.empty()) {

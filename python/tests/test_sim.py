@@ -85,6 +85,7 @@ def test_bad_options_raise_typed_errors(tmp_path):
         lidarloop.Simulator(drift=-1.0)
     with pytest.raises(lidarloop.ConfigError, match="drift factor .* out of its range"):
         lidarloop.Simulator(drift=1e9)
+    assert len(lidarloop.Simulator(**SMALL, trajectory=None)) == SMALL["scans"]
     with pytest.raises(TypeError, match="no_such_option"):
         lidarloop.Simulator(no_such_option=1)
     with pytest.raises(IndexError):
