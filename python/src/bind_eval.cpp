@@ -220,7 +220,9 @@ ScoredPairs PairsFromColumns(const py::handle& i, const py::handle& j, const py:
     }
     ScoredPairs out;
     for (py::ssize_t k = 0; k < is.size(); ++k) {
-        if (is.at(k) < 0 || js.at(k) < 0) throw ShapeError("scan indices must be >= 0");
+        constexpr long long kMaxScan = std::numeric_limits<std::uint32_t>::max();
+        if (is.at(k) < 0 || js.at(k) < 0 || is.at(k) > kMaxScan || js.at(k) > kMaxScan)
+            throw ShapeError("scan indices must be in [0, 2^32 - 1]: pairs hold 32-bit scans");
         out.pairs.push_back({static_cast<std::uint32_t>(is.at(k)),
                              static_cast<std::uint32_t>(js.at(k)), static_cast<float>(ds.at(k)),
                              ls.at(k)});

@@ -295,3 +295,6 @@ def test_bad_input_raises_typed_errors():
         lidarloop.build_ground_truth(times, bad)
     with pytest.raises(lidarloop.EmptyInputError):
         lidarloop.evaluate_pairs(lidarloop.ScoredPairs([], [], [], []))
+    for i in (-1, 2**40):  # not wrapped into a 32-bit scan index
+        with pytest.raises(lidarloop.ShapeError, match="scan indices must be in"):
+            lidarloop.ScoredPairs([i], [1], [0.5], [True])
