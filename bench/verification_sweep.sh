@@ -66,7 +66,7 @@ m = json.load(open(sys.argv[1]))
 def pct(x): return "–" if x is None else f"{100 * x:.1f} %"
 def mm(d, k):
     s = d["pose_error"][k]
-    return "–" if s is None or s['median'] is None else f"{s['median']:.3f} / {s['max']:.3f}"
+    return "–" if s is None else f"{s['median']:.3f} / {s['max']:.3f}"
 for method, e in m["methods"].items():
     r = e.get("retrieval")
     if not r: continue

@@ -275,12 +275,14 @@ def write_map(
     format: str = "auto",
     poses: Optional[PathLike] = None,
     calib: Optional[PathLike] = None,
+    trajectory_calib: Optional[PathLike] = None,
 ) -> dict[str, Any]:
-    """`lidarloop map DATASET --poses TRAJECTORY --out OUT`: a binary PLY coloured by scan time.
+    """`lidarloop map DATASET --poses TRAJECTORY --calib TRAJECTORY_CALIB --out OUT`: a binary
+    PLY coloured by scan time.
 
-    `calib` (a KITTI calib.txt) converts the trajectory's KITTI poses from KITTI's camera frame,
-    as `--calib` does; without a trajectory it converts the dataset's `poses`. A trajectory that
-    turns about its y axis (the camera frame) gets a note. Returns out, points, voxel_m, scans,
+    `trajectory_calib` (a KITTI calib.txt) converts the trajectory's KITTI poses from KITTI's
+    camera frame; `calib` is the dataset's, as for every dataset. A trajectory that turns about
+    its y axis (the camera frame) gets a note. Returns out, points, voxel_m, scans,
     input_points, notes, total_s.
     """
 

@@ -425,7 +425,9 @@ void BindEvaluate(py::module_& m) {
             EvaluateResult result;
             std::vector<fs::path> inputs = InputsOf(data, poses, calib);
             inputs.insert(inputs.end(), results.begin(), results.end());
-            if (train_data) inputs.push_back(train_data->root());
+            if (train_data) {
+                for (const fs::path& file : train_data->InputFiles()) inputs.push_back(file);
+            }
             if (odometry) inputs.push_back(*odometry);
             if (odometry_calib) inputs.push_back(*odometry_calib);
             result.outcome = RunInFolder(
@@ -668,14 +670,14 @@ void BindMap(py::module_& m) {
            const std::optional<fs::path>& trajectory, std::optional<double> voxel_m,
            std::optional<std::size_t> max_points, const py::object& config, bool overwrite,
            const py::object& progress, const std::string& format,
-           const std::optional<fs::path>& poses, const std::optional<fs::path>& calib) {
+           const std::optional<fs::path>& poses, const std::optional<fs::path>& calib,
+           const std::optional<fs::path>& trajectory_calib) {
             const io::Dataset data = DatasetOf(dataset, format, poses, calib);
             const PythonProgress python_progress(progress);
             app::MapRequest request;
             request.poses_file = trajectory.value_or(fs::path());
-            // As `lidarloop map --poses T --calib C`: with a trajectory, the calibration
-            // converts its KITTI poses (the dataset's poses are not used).
-            if (trajectory && calib) request.calib_file = *calib;
+            // `lidarloop map --poses T --calib C`: `calib` is the dataset's, as everywhere.
+            request.calib_file = trajectory_calib.value_or(fs::path());
             request.config = MapConfigOf(config, voxel_m, max_points);
             request.out = out;
             request.inputs = InputsOf(data, poses, calib);
@@ -701,10 +703,11 @@ void BindMap(py::module_& m) {
         py::arg("voxel_m") = py::none(), py::arg("max_points") = py::none(),
         py::arg("config") = py::none(), py::arg("overwrite") = false,
         py::arg("progress") = py::none(), py::arg("format") = "auto", py::arg("poses") = py::none(),
-        py::arg("calib") = py::none(),
+        py::arg("calib") = py::none(), py::arg("trajectory_calib") = py::none(),
         "`lidarloop map DATASET --poses TRAJECTORY --out OUT`: the map of the dataset placed "
         "with `trajectory` (a KITTI or TUM file, its KITTI poses converted from KITTI's camera "
-        "frame by `calib` when given, as --calib; None: the dataset's poses) written as a binary "
+        "frame by `trajectory_calib` when given, as map's --calib; None: the dataset's poses, "
+        "which `calib` converts as for every dataset) written as a binary "
         "PLY coloured by scan time (app::RunMap: `out` is refused inside an input, and replaced "
         "only when lidarloop wrote it unless overwrite). A dict: out, points, voxel_m, scans, "
         "input_points, notes, total_s.");

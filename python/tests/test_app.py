@@ -246,7 +246,7 @@ def test_map_of_a_camera_frame_trajectory_matches_the_cli(cli, sequence, tmp_pat
     run_cli(cli, "map", sequence, "--poses", tmp_path / "camera.txt", "--calib",
             tmp_path / "calib.txt", "--voxel", "0.5", "--out", tmp_path / "cli.ply")
     converted = lidarloop.write_map(sequence, trajectory=tmp_path / "camera.txt",
-                                    calib=tmp_path / "calib.txt", voxel_m=0.5,
+                                    trajectory_calib=tmp_path / "calib.txt", voxel_m=0.5,
                                     out=tmp_path / "py.ply")
     assert (tmp_path / "py.ply").read_bytes() == (tmp_path / "cli.ply").read_bytes()
     assert not any("y axis" in note for note in converted["notes"])
@@ -285,6 +285,8 @@ def test_no_run_replaces_its_own_input_or_an_earlier_result(sequence, tmp_path):
     opened = lidarloop.open_dataset(sequence, poses=res / "poses_copy.txt")
     with pytest.raises(lidarloop.WriteError, match="holds the input"):
         lidarloop.detect(opened, out=res, verify=False, overwrite=True)
+    with pytest.raises(lidarloop.WriteError, match="holds the input"):  # the training data too
+        lidarloop.evaluate(sequence, train_on=opened, out=res, overwrite=True, methods=["range"])
     assert (res / "poses_copy.txt").is_file()
     before["poses_copy.txt"] = (res / "poses_copy.txt").read_bytes()
 
