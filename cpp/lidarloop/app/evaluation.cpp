@@ -469,12 +469,11 @@ EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequ
     request.learning.Validate();
     if (request.methods.empty() && request.results_files.empty())
         throw core::ConfigError("nothing to evaluate: give a method or a results file");
+    // A threshold may be negative (a results file of negated similarities) or +inf (every
+    // finite pair detected), but a NaN decides nothing.
     for (const double threshold : request.fixed_thresholds) {
-        if (!(std::isfinite(threshold) && threshold >= 0.0)) {
-            throw core::ConfigError(
-                "fixed_thresholds must be finite numbers >= 0 (distances), got " +
-                core::NumberText(threshold));
-        }
+        if (std::isnan(threshold))
+            throw core::ConfigError("fixed_thresholds must be numbers, got nan");
     }
     const auto& methods = request.methods;
     for (auto method = methods.begin(); method != methods.end(); ++method) {
