@@ -96,7 +96,9 @@ class LoopDetector:
     def stop_at_first_loop(self) -> bool:
         """Candidates registered in rank order up to the first loop (detection.stop_at_first_loop,
         True by default); False: every candidate."""
-    def save(self, file: PathLike) -> None: ...
+    def save(self, file: PathLike) -> None:
+        """FILE (.lldb) and, with prepared scans, FILE.scans; else removes an earlier map's
+        prepared scans there (they would be taken for this map's)."""
     @staticmethod
     def load(file: PathLike, verify: Optional[bool] = None) -> LoopDetector: ...
 

@@ -363,8 +363,9 @@ void BindDetector(py::module_& m) {
             },
             py::arg("file"),
             "Writes the stored scans as a map: FILE (.lldb, with the detection config) and, when "
-            "scans were kept for verification, FILE with the extension .scans -- what "
-            "`lidarloop detect` writes and `lidarloop detect --map` reads.")
+            "scans were kept for verification, FILE with the extension .scans (else an earlier "
+            "map's prepared scans there are removed, which would be taken for this map's) -- "
+            "what `lidarloop detect` writes and `lidarloop detect --map` reads.")
         .def_static(
             "load",
             [](const path& file, std::optional<bool> verify) {

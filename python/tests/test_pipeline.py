@@ -171,6 +171,12 @@ def test_verifying_detector_keeps_and_saves_its_scans(sequence, tmp_path):
         plain.process(sequence[i])
     plain.save(tmp_path / "map.lldb")
     assert not (tmp_path / "map.scans").exists()
+    # A file of that name that is no map's prepared scans stays; a map is no .scans file.
+    (tmp_path / "map.scans").write_text("mine")
+    plain.save(tmp_path / "map.lldb")
+    assert (tmp_path / "map.scans").read_text() == "mine"
+    with pytest.raises(lidarloop.ConfigError, match="save the map as a .lldb file"):
+        detector.save(tmp_path / "other.scans")
 
 
 def test_a_detectors_database_and_times_are_copies(sequence):

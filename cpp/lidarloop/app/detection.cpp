@@ -125,8 +125,13 @@ std::string UnusedOdometryNote(const io::Dataset& dataset,
     std::error_code error;
     const std::filesystem::path file = dataset.root() / "poses_odometry.txt";
     if (!std::filesystem::is_regular_file(file, error)) return {};
-    return file.string() + " is not read: give --odometry " + file.string() +
-           " if it is the scans' odometry (it places submaps and checks loops, docs/cli.md)";
+    for (const std::filesystem::path& read : dataset.InputFiles()) {
+        if (std::filesystem::equivalent(read, file, error)) return {};  // given as the poses
+    }
+    return file.string() +
+           " is not read: give it as the odometry (--odometry FILE; odometry= "
+           "in Python) if it is the scans' odometry (it places submaps and "
+           "checks loops, docs/cli.md)";
 }
 
 std::vector<core::StampedPose> ReadOdometry(const std::filesystem::path& file,
@@ -408,6 +413,11 @@ LoadedMap LoadMap(const std::filesystem::path& file) {
 }
 
 void SaveDetectorMap(const pipeline::LoopDetector& detector, const std::filesystem::path& file) {
+    if (io::PreparedScansPathOf(file) == file) {
+        throw core::ConfigError(file.string() +
+                                " is where a map's prepared scans go; save the "
+                                "map as a .lldb file");
+    }
     pipeline::DetectorConfig detection = detector.detector_config();
     detection.verification.reduction.submap_path_m = 0.0;  // LoopDetector verifies scans alone
     io::SaveDatabase(file, detector.database(), detection);
@@ -415,10 +425,15 @@ void SaveDetectorMap(const pipeline::LoopDetector& detector, const std::filesyst
     const std::filesystem::path scans_file = io::PreparedScansPathOf(file);
     if (std::any_of(scans.begin(), scans.end(), [](const auto& scan) { return scan.prepared(); })) {
         io::SavePreparedScans(scans_file, scans, detection.verification.reduction);
-    } else {
-        // A map saved there before would otherwise be loaded as this one's prepared scans.
-        std::error_code ignored;
-        std::filesystem::remove(scans_file, ignored);
+    } else if (io::IsPreparedScansFile(scans_file)) {
+        // An earlier map's prepared scans would otherwise be loaded as this one's.
+        std::error_code error;
+        if (!std::filesystem::remove(scans_file, error) && error) {
+            throw io::WriteError(scans_file,
+                                 "an earlier map's prepared scans, which would be "
+                                 "taken for this map's, cannot be removed: " +
+                                     error.message());
+        }
     }
 }
 

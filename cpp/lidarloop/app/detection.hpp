@@ -134,7 +134,8 @@ LoadedMap LoadMap(const std::filesystem::path& file);
 
 /// Writes `detector`'s stored scans as a map LoadMap reads: `file` (.lldb, with the detection
 /// config) and, when scans were kept for verification, io::PreparedScansPathOf(file) (else an
-/// earlier map's file there is removed, so that it is not loaded as this one's). Both
+/// earlier map's prepared scans there are removed, so that they are not loaded as this one's;
+/// another file of that name stays). core::ConfigError for a `file` named .scans. Both
 /// record submap_path_m 0: the online detector prepares every scan alone, and RunLocalise
 /// prepares its queries as the map's scans were. io::WriteError when it cannot write.
 void SaveDetectorMap(const pipeline::LoopDetector& detector, const std::filesystem::path& file);

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <functional>
 #include <memory>
+#include <string_view>
 
 #include "lidarloop/io/config_yaml.hpp"
 #include "lidarloop/io/detail/byte_stream.hpp"
@@ -154,6 +155,12 @@ StoredPreparedScans LoadPreparedScans(const std::filesystem::path& file) {
 std::filesystem::path PreparedScansPathOf(const std::filesystem::path& database_file) {
     std::filesystem::path path = database_file;
     return path.replace_extension(".scans");
+}
+
+bool IsPreparedScansFile(const std::filesystem::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    char start[6] = {};
+    return in.read(start, sizeof(start)) && std::string_view(start, sizeof(start)) == "LLPS00";
 }
 
 }  // namespace lidarloop::io

@@ -37,4 +37,8 @@ StoredPreparedScans LoadPreparedScans(const std::filesystem::path& file);
 /// ".scans" (results/database.lldb -> results/database.scans).
 std::filesystem::path PreparedScansPathOf(const std::filesystem::path& database_file);
 
+/// Whether `file` begins as a file SavePreparedScans writes (of any version); false when it
+/// cannot be read.
+bool IsPreparedScansFile(const std::filesystem::path& file);
+
 }  // namespace lidarloop::io

@@ -565,7 +565,7 @@ void ExpectOneNoteSaying(const std::vector<std::string>& notes, const std::strin
 }
 
 // What a run without --odometry says of the small sequence's poses_odometry.txt.
-constexpr const char* kUnusedOdometry = "poses_odometry.txt is not read: give --odometry";
+constexpr const char* kUnusedOdometry = "poses_odometry.txt is not read: give it as the odometry";
 
 // The submap window, metres, that a run wrote into out/config.yaml.
 double WrittenSubmapPathM(const std::filesystem::path& out) {
@@ -1318,6 +1318,17 @@ TEST_F(DetectionRun, EvaluateWithoutOdometryVerifiesAsDetectWithoutIt) {
     const app::EvaluationOutcome evaluated =
         app::RunEvaluation(*dataset_, EvaluationLike(detect, "evaluate"));
     ExpectTheSameLoops(evaluated, detected);
+}
+
+// The note on an unread poses_odometry.txt: none when the run has an odometry, or when the
+// dataset was opened with that file as its poses (then it is read).
+TEST_F(DetectionRun, TheUnreadOdometryNoteIsGivenOnlyWhenTheFileIsUnread) {
+    const std::filesystem::path file = dir_ / "sequence" / "poses_odometry.txt";
+    EXPECT_TRUE(test::Contains(app::UnusedOdometryNote(*dataset_, {}), kUnusedOdometry));
+    EXPECT_EQ(app::UnusedOdometryNote(*dataset_, dataset_->poses()), "");
+    io::DatasetOptions as_poses;
+    as_poses.poses_file = file;
+    EXPECT_EQ(app::UnusedOdometryNote(io::OpenDataset(dir_ / "sequence", as_poses), {}), "");
 }
 
 // A run on scans that fill the structure cap alone says so, and config.yaml and database.scans
