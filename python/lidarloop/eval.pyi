@@ -60,7 +60,8 @@ class GroundTruth:
     @property
     def nearest_distance_m(self) -> npt.NDArray[np.float64]: ...
     def is_loop(self, i: int, j: int) -> bool:
-        """IndexError for a scan out of range (also comparable, overlapping)."""
+        """IndexError for a scan beyond the ground truth's, TypeError for a negative one (also
+        comparable, overlapping)."""
     def comparable(self, i: int, j: int) -> bool: ...
     def overlapping(self, scan: int) -> bool: ...
     @property

@@ -120,11 +120,16 @@ std::string CoarsenedMapNote(const core::MapCloud& map, const core::MapConfig& c
     return note.str();
 }
 
-std::string CameraFrameMapNote(const std::vector<core::StampedPose>& trajectory) {
+std::string CameraFrameMapNote(const std::vector<core::StampedPose>& trajectory,
+                               bool given_trajectory) {
     if (!TurnsAboutItsYAxis(trajectory)) return {};
-    return "the trajectory turns about its y axis, as poses of a vehicle in KITTI's camera frame "
-           "(y down) do: the scans stand on their side in this map; give --calib CALIB (KITTI's "
-           "calib.txt) to convert the poses to the LiDAR frame";
+    return std::string(
+               "the trajectory turns about its y axis, as poses of a vehicle in KITTI's "
+               "camera frame (y down) do: the scans stand on their side in this map; ") +
+           (given_trajectory ? "give --calib CALIB (KITTI's calib.txt) to convert the poses to "
+                               "the LiDAR frame"
+                             : "put KITTI's calib.txt beside the scans (KITTI layout) to convert "
+                               "the dataset's poses, or give them as --poses with --calib");
 }
 
 MapOutcome RunMap(const io::Dataset& dataset, const MapRequest& request) {
@@ -145,7 +150,8 @@ MapOutcome RunMap(const io::Dataset& dataset, const MapRequest& request) {
         io::WriteMapPly(temporary, map);
     });
     MapOutcome outcome{map.points.size(), map.voxel_m, map.scans, map.input_points, {}, 0.0};
-    for (std::string note : {CameraFrameMapNote(poses), CoarsenedMapNote(map, request.config)}) {
+    for (std::string note : {CameraFrameMapNote(poses, !request.poses_file.empty()),
+                             CoarsenedMapNote(map, request.config)}) {
         if (!note.empty()) outcome.notes.push_back(std::move(note));
     }
     outcome.total_s = total.Seconds();

@@ -49,8 +49,10 @@ std::vector<core::StampedPose> MapTrajectory(const io::Dataset& dataset,
                                              const std::filesystem::path& calib_file = {});
 
 /// A note when the map's `trajectory` TurnsAboutItsYAxis (KITTI's camera frame): its scans would
-/// stand on their side. Empty otherwise.
-std::string CameraFrameMapNote(const std::vector<core::StampedPose>& trajectory);
+/// stand on their side; the advice differs for a `given_trajectory` (--poses, which --calib
+/// converts) and the dataset's own poses. Empty otherwise.
+std::string CameraFrameMapNote(const std::vector<core::StampedPose>& trajectory,
+                               bool given_trajectory);
 
 /// What `lidarloop map` asks for.
 struct MapRequest {
