@@ -19,6 +19,7 @@
 #include "lidarloop/core/min_gap.hpp"
 #include "lidarloop/core/point_cloud.hpp"
 #include "lidarloop/io/config_yaml.hpp"
+#include "lidarloop/io/read_error.hpp"
 
 namespace lidarloop::python {
 
@@ -264,8 +265,11 @@ inline io::RunConfig RunConfigFrom(const py::object& config) {
         io::ApplyConfigYaml(text, "config dict", run);
         return run;
     }
-    const py::object path = py::module_::import("os").attr("fspath")(config);
-    return io::LoadConfigYaml(path.cast<std::string>(), run);
+    const std::string path = py::module_::import("os").attr("fspath")(config).cast<std::string>();
+    // The file calls would read the path up to the NUL: another file than the one named.
+    if (path.find('\0') != std::string::npos)
+        throw io::ReadError(path.substr(0, path.find('\0')), "the path holds a NUL character");
+    return io::LoadConfigYaml(path, run);
 }
 
 }  // namespace lidarloop::python

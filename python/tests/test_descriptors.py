@@ -256,6 +256,12 @@ def test_method_names_thresholds_and_config_dump(cli):
     assert lidarloop.dump_config() == run_cli(cli, "dump-config")
 
 
+def test_a_config_path_with_a_nul_is_refused_not_cut(tmp_path):
+    (tmp_path / "a").write_text("histogram:\n  bins: 7\n")  # what the cut path would read
+    with pytest.raises(lidarloop.ReadError, match="NUL"):
+        lidarloop.dump_config(str(tmp_path / "a") + "\0b.yaml")
+
+
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
 def test_a_scan_of_only_non_finite_points_raises_non_finite_error(dtype):
     points = np.full((5, 3), np.nan, dtype)
