@@ -106,15 +106,6 @@ void BindGroundTruthConfig(py::module_& m) {
         .def("describe", &GroundTruthConfig::Describe);
 }
 
-// `scan` when the ground truth has it; IndexError otherwise (the C++ calls index unchecked).
-std::size_t ScanOf(const GroundTruth& truth, std::size_t scan) {
-    if (scan >= truth.size()) {
-        throw py::index_error("scan " + std::to_string(scan) + " out of range for " +
-                              std::to_string(truth.size()) + " scans");
-    }
-    return scan;
-}
-
 void BindGroundTruth(py::module_& m) {
     py::class_<GroundTruth>(m, "GroundTruth", "The positive pairs of a sequence under one rule")
         .def_readonly("config", &GroundTruth::config)
@@ -157,18 +148,20 @@ void BindGroundTruth(py::module_& m) {
         .def(
             "is_loop",
             [](const GroundTruth& t, std::size_t i, std::size_t j) {
-                return t.IsLoop(ScanOf(t, i), ScanOf(t, j));
+                return t.IsLoop(CheckedScan(t, i), CheckedScan(t, j));
             },
             py::arg("i"), py::arg("j"))
         .def(
             "comparable",
             [](const GroundTruth& t, std::size_t i, std::size_t j) {
-                return t.Comparable(ScanOf(t, i), ScanOf(t, j));
+                return t.Comparable(CheckedScan(t, i), CheckedScan(t, j));
             },
             py::arg("i"), py::arg("j"))
         .def(
             "overlapping",
-            [](const GroundTruth& t, std::size_t scan) { return t.Overlapping(ScanOf(t, scan)); },
+            [](const GroundTruth& t, std::size_t scan) {
+                return t.Overlapping(CheckedScan(t, scan));
+            },
             py::arg("scan"))
         .def_property_readonly("overlapping_count", &GroundTruth::OverlappingCount)
         .def_property_readonly("comparable_pair_count", &GroundTruth::ComparablePairCount)

@@ -34,14 +34,6 @@ struct Index {
     const DescriptorDatabase* database = nullptr;
 };
 
-std::size_t CheckedIndex(const DescriptorDatabase& database, std::size_t i) {
-    if (i >= database.size()) {
-        throw py::index_error("scan " + std::to_string(i) + " out of range for " +
-                              std::to_string(database.size()) + " scans");
-    }
-    return i;
-}
-
 // A boolean mask over the database's scans as the index's eligibility test; empty: every scan.
 std::function<bool(std::size_t)> EligibleOf(const py::object& mask, std::size_t size,
                                             std::vector<std::uint8_t>& storage) {
@@ -108,22 +100,15 @@ void BindDatabase(py::module_& m) {
             "Appends a placeholder for a scan that could not be described (never matches).")
         .def(
             "is_valid",
-            [](const DescriptorDatabase& d, std::size_t i) {
-                return d.IsValid(CheckedIndex(d, i));
-            },
+            [](const DescriptorDatabase& d, std::size_t i) { return d.IsValid(CheckedScan(d, i)); },
             py::arg("i"))
         .def_property_readonly(
-            "times_s",
-            [](const DescriptorDatabase& d) {
-                const std::vector<double>& times_s = d.times_s();
-                return py::array_t<double>(static_cast<py::ssize_t>(times_s.size()),
-                                           times_s.data());  // copies
-            },
+            "times_s", [](const DescriptorDatabase& d) { return ArrayOf(d.times_s()); },
             "The scans' times, seconds (a copy: a view would dangle once the database grows).")
         .def(
             "distance",
             [](const DescriptorDatabase& d, std::size_t i, std::size_t j) {
-                return d.Distance(CheckedIndex(d, i), CheckedIndex(d, j));
+                return d.Distance(CheckedScan(d, i), CheckedScan(d, j));
             },
             py::arg("i"), py::arg("j"),
             "The distance between stored scans i and j; inf when one is a placeholder.")
@@ -169,7 +154,7 @@ void BindIndex(py::module_& m) {
         .def(
             "insert",
             [](Index& index, std::size_t id) {
-                index.index->Insert(CheckedIndex(*index.database, id));
+                index.index->Insert(CheckedScan(*index.database, id));
             },
             py::arg("id"), "Indexes stored scan `id` (each once).")
         .def(

@@ -4,6 +4,7 @@
 // They raise the Python layer's errors (errors.hpp) for arrays lidarloop cannot take, and must
 // run with the GIL held (they read Python objects); release it afterwards for the long work.
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <memory>
@@ -150,6 +151,25 @@ inline py::array_t<double> ViewOf(const std::vector<double>& values, const py::h
                               values.data(), owner);
     array.attr("setflags")(py::arg("write") = false);
     return array;
+}
+
+/// A 1-D array of `values` (a copy), of any arithmetic type.
+template <typename T>
+py::array_t<T> ArrayOf(const std::vector<T>& values) {
+    py::array_t<T> array(static_cast<py::ssize_t>(values.size()));
+    std::copy(values.begin(), values.end(), array.mutable_data());
+    return array;
+}
+
+/// `scan` when `scans` (anything with a size(): a database, a ground truth) has it; IndexError
+/// otherwise, for C++ calls that index unchecked.
+template <typename Scans>
+std::size_t CheckedScan(const Scans& scans, std::size_t scan) {
+    if (scan >= scans.size()) {
+        throw py::index_error("scan " + std::to_string(scan) + " out of range for " +
+                              std::to_string(scans.size()) + " scans");
+    }
+    return scan;
 }
 
 /// A copy of `matrix` as a float64 array of its shape.

@@ -63,14 +63,6 @@ inline std::vector<double> DoublesFrom(const py::handle& object, const std::stri
     return {array.data(), array.data() + array.shape(0)};
 }
 
-/// A 1-D array of `values` (a copy), of any arithmetic type.
-template <typename T>
-py::array_t<T> ArrayOf(const std::vector<T>& values) {
-    py::array_t<T> array(static_cast<py::ssize_t>(values.size()));
-    std::copy(values.begin(), values.end(), array.mutable_data());
-    return array;
-}
-
 /// Sets the attributes `kwargs` names on a default-constructed T (bound as `object`'s class),
 /// so that the defaults stay those of the C++ struct. Unknown names raise AttributeError (the
 /// bound classes have no __dict__), naming the key.
