@@ -8,7 +8,6 @@
 
 #include <Eigen/Geometry>
 
-#include "lidarloop/core/error.hpp"
 #include "lidarloop/io/detail/text_parsing.hpp"
 
 namespace lidarloop::io {
@@ -199,17 +198,8 @@ std::vector<LoopRow> ReadLoopsCsv(const std::filesystem::path& file, std::size_t
 void WriteG2o(const std::filesystem::path& file, const std::vector<core::Transform>& poses,
               const std::vector<posegraph::Edge>& edges,
               const std::vector<posegraph::Edge>& commented_edges) {
-    // An edge to a vertex the file does not hold would be read by g2o as a new, free pose.
-    for (const auto* list : {&edges, &commented_edges}) {
-        for (const posegraph::Edge& edge : *list) {
-            if (edge.from >= poses.size() || edge.to >= poses.size()) {
-                throw core::ConfigError("an edge joins poses " + std::to_string(edge.from) +
-                                        " and " + std::to_string(edge.to) + ", but " +
-                                        file.string() + " gets " + std::to_string(poses.size()) +
-                                        " poses");
-            }
-        }
-    }
+    posegraph::RequireEdgesWithin(edges, poses.size());
+    posegraph::RequireEdgesWithin(commented_edges, poses.size());
     std::string text = "# lidarloop pose graph: vertices T_world_sensor, edges T_from_to\n";
     for (std::size_t i = 0; i < poses.size(); ++i) {
         text += "VERTEX_SE3:QUAT " + std::to_string(i) + ' ';

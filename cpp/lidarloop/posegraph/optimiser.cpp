@@ -113,12 +113,8 @@ void CheckGraph(const PoseGraph& graph) {
                                     "from the origin");
         }
     }
+    RequireEdgesWithin(graph.edges, graph.poses.size());
     for (const Edge& edge : graph.edges) {
-        if (edge.from >= graph.poses.size() || edge.to >= graph.poses.size()) {
-            throw core::ConfigError("an edge joins poses " + std::to_string(edge.from) + " and " +
-                                    std::to_string(edge.to) + " of a graph of " +
-                                    std::to_string(graph.poses.size()));
-        }
         if (!Reasonable(edge.T_from_to) || !edge.information.allFinite()) {
             throw core::ConfigError("the edge from pose " + std::to_string(edge.from) + " to " +
                                     std::to_string(edge.to) +

@@ -52,6 +52,16 @@ Matrix6d LoopInformation(const LoopConstraint& loop, const InformationConfig& co
            DiagonalInformation(sigma_t, config.loop_rotation_sigma_deg * core::kRadiansPerDegree);
 }
 
+void RequireEdgesWithin(const std::vector<Edge>& edges, std::size_t pose_count) {
+    for (const Edge& edge : edges) {
+        if (edge.from >= pose_count || edge.to >= pose_count) {
+            throw core::ConfigError("an edge joins poses " + std::to_string(edge.from) + " and " +
+                                    std::to_string(edge.to) + " of a graph of " +
+                                    std::to_string(pose_count));
+        }
+    }
+}
+
 PoseGraph BuildPoseGraph(const std::vector<core::Transform>& odometry,
                          const std::vector<LoopConstraint>& loops, const PoseGraphConfig& config,
                          std::vector<double> path_m) {

@@ -68,6 +68,10 @@ Matrix6d OdometryInformation(const core::Transform& T_prev_next, const Informati
 /// The information of a loop from its verification quality (InformationConfig).
 Matrix6d LoopInformation(const LoopConstraint& loop, const InformationConfig& config);
 
+/// Throws core::ConfigError when an edge of `edges` joins a pose beyond the first `pose_count`:
+/// a solver would index past its poses, a g2o file would get a new, free vertex.
+void RequireEdgesWithin(const std::vector<Edge>& edges, std::size_t pose_count);
+
 /// The graph of a trajectory: one pose per scan (`odometry`, T_world_sensor), an odometry edge
 /// from every scan to the next (their relative pose), and an edge from match to query for every
 /// loop. `path_m`: per pose, the path travelled (PoseGraph::path_m), longer than the straight
