@@ -159,8 +159,10 @@ std::filesystem::path PreparedScansPathOf(const std::filesystem::path& database_
 
 bool IsPreparedScansFile(const std::filesystem::path& file) {
     std::ifstream in(file, std::ios::binary);
-    char start[6] = {};
-    return in.read(start, sizeof(start)) && std::string_view(start, sizeof(start)) == "LLPS00";
+    char start[sizeof(kPreparedScansMagic) - 1] = {};
+    if (!in.read(start, sizeof(start))) return false;
+    const std::string_view magic(start, sizeof(start));
+    return magic == kPreparedScansMagic || magic == kOldMagic;
 }
 
 }  // namespace lidarloop::io
