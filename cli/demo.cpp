@@ -112,7 +112,7 @@ void RunDemo(const DemoFlags& flags) {
     for (const app::MethodEvaluation& e : outcome.methods) PrintMethod(e);
     // The demo evaluates the scans alone on purpose and gives the odometry to the pose graph:
     // the note that its poses_odometry.txt is not read would mislead here.
-    const std::string unused_odometry = app::UnusedOdometryNote(dataset, {});
+    const std::string unused_odometry = app::UnusedOdometryNote(dataset, {}, true);
     for (const std::string& note : outcome.notes) {
         if (note != unused_odometry) std::cout << "  note: " << note << "\n";
     }

@@ -120,8 +120,8 @@ std::vector<std::string> FramesNotes(const io::Dataset& dataset,
 }
 
 std::string UnusedOdometryNote(const io::Dataset& dataset,
-                               const std::vector<core::StampedPose>& odometry) {
-    if (!odometry.empty()) return {};
+                               const std::vector<core::StampedPose>& odometry, bool verifies) {
+    if (!verifies || !odometry.empty()) return {};
     std::error_code error;
     const std::filesystem::path file = dataset.root() / "poses_odometry.txt";
     if (!std::filesystem::is_regular_file(file, error)) return {};
@@ -304,8 +304,8 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
     const std::vector<core::StampedPose> poses = OdometryOfScans(request, dataset);
     DetectOutcome outcome;
     outcome.notes = FramesNotes(dataset, poses);
-    if (std::string note = UnusedOdometryNote(dataset, poses);
-        !note.empty() && request.config.detection.verify)
+    if (std::string note = UnusedOdometryNote(dataset, poses, request.config.detection.verify);
+        !note.empty())
         outcome.notes.push_back(std::move(note));
     const io::RunConfig config =
         WithSubmapsWhereTheyApply(request.config, dataset, poses, outcome.notes,
@@ -413,7 +413,8 @@ LoadedMap LoadMap(const std::filesystem::path& file) {
 }
 
 void SaveDetectorMap(const pipeline::LoopDetector& detector, const std::filesystem::path& file) {
-    if (io::PreparedScansPathOf(file) == file) {
+    const std::filesystem::path scans_file = io::PreparedScansPathOf(file);
+    if (scans_file == file) {
         throw core::ConfigError(file.string() +
                                 " is where a map's prepared scans go; save the "
                                 "map as a .lldb file");
@@ -422,7 +423,6 @@ void SaveDetectorMap(const pipeline::LoopDetector& detector, const std::filesyst
     detection.verification.reduction.submap_path_m = 0.0;  // LoopDetector verifies scans alone
     io::SaveDatabase(file, detector.database(), detection);
     const auto& scans = detector.prepared_scans();
-    const std::filesystem::path scans_file = io::PreparedScansPathOf(file);
     if (std::any_of(scans.begin(), scans.end(), [](const auto& scan) { return scan.prepared(); })) {
         io::SavePreparedScans(scans_file, scans, detection.verification.reduction);
     } else if (io::IsPreparedScansFile(scans_file)) {

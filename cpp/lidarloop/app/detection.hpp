@@ -76,12 +76,12 @@ std::vector<core::StampedPose> ReadOdometry(
 std::vector<std::string> FramesNotes(const io::Dataset& dataset,
                                      const std::vector<core::StampedPose>& odometry);
 
-/// A note when no odometry is given but the dataset's folder holds a poses_odometry.txt (as
-/// `simulate` writes it beside the ground truth, and keyframe sets of a LIO front end ship it):
-/// it is not read unless named by --odometry. Empty otherwise. detect and evaluate give it when
-/// they verify (what the odometry serves).
+/// A note when a run that `verifies` (what the odometry serves) has no odometry but the
+/// dataset's folder holds a poses_odometry.txt (as `simulate` writes it beside the ground truth,
+/// and keyframe sets of a LIO front end ship it) that it did not read as its poses: it is not
+/// read unless named by --odometry. Empty otherwise.
 std::string UnusedOdometryNote(const io::Dataset& dataset,
-                               const std::vector<core::StampedPose>& odometry);
+                               const std::vector<core::StampedPose>& odometry, bool verifies);
 
 /// Turns from the first pose smaller than this are not judged by CameraFrameNote (20 degrees).
 inline constexpr double kCameraFrameMinTurnRad = 0.35;

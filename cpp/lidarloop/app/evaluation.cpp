@@ -504,8 +504,8 @@ EvaluationOutcome RunEvaluation(const io::Dataset& dataset, const EvaluationRequ
     }
     for (std::string& note : FramesNotes(dataset, odometry))
         outcome.notes.push_back(std::move(note));
-    if (std::string note = UnusedOdometryNote(dataset, odometry);
-        !note.empty() && request.config.detection.verify)
+    if (std::string note = UnusedOdometryNote(dataset, odometry, request.config.detection.verify);
+        !note.empty())
         outcome.notes.push_back(std::move(note));
     EvaluationRequest effective = request;
     // Submaps from the odometry or the scans themselves: placed by the dataset's poses, the

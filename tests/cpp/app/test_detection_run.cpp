@@ -1320,15 +1320,16 @@ TEST_F(DetectionRun, EvaluateWithoutOdometryVerifiesAsDetectWithoutIt) {
     ExpectTheSameLoops(evaluated, detected);
 }
 
-// The note on an unread poses_odometry.txt: none when the run has an odometry, or when the
-// dataset was opened with that file as its poses (then it is read).
+// The note on an unread poses_odometry.txt: none when the run does not verify, has an
+// odometry, or opened the dataset with that file as its poses (then it is read).
 TEST_F(DetectionRun, TheUnreadOdometryNoteIsGivenOnlyWhenTheFileIsUnread) {
     const std::filesystem::path file = dir_ / "sequence" / "poses_odometry.txt";
-    EXPECT_TRUE(test::Contains(app::UnusedOdometryNote(*dataset_, {}), kUnusedOdometry));
-    EXPECT_EQ(app::UnusedOdometryNote(*dataset_, dataset_->poses()), "");
+    EXPECT_TRUE(test::Contains(app::UnusedOdometryNote(*dataset_, {}, true), kUnusedOdometry));
+    EXPECT_EQ(app::UnusedOdometryNote(*dataset_, {}, false), "");  // a run that does not verify
+    EXPECT_EQ(app::UnusedOdometryNote(*dataset_, dataset_->poses(), true), "");
     io::DatasetOptions as_poses;
     as_poses.poses_file = file;
-    EXPECT_EQ(app::UnusedOdometryNote(io::OpenDataset(dir_ / "sequence", as_poses), {}), "");
+    EXPECT_EQ(app::UnusedOdometryNote(io::OpenDataset(dir_ / "sequence", as_poses), {}, true), "");
 }
 
 // A run on scans that fill the structure cap alone says so, and config.yaml and database.scans
