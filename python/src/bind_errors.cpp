@@ -47,6 +47,17 @@ PyObject* AddSubclass(py::module_& m, const char* name, const char* doc, PyObjec
 
 void Raise(PyObject* type, const std::exception& e) { PyErr_SetString(type, e.what()); }
 
+// The library's write errors name the CLI's flag; a Python caller passes a keyword.
+std::string InPythonTerms(std::string message) {
+    static const std::string flag = "give --overwrite";
+    static const std::string keyword = "pass overwrite=True";
+    for (std::size_t at = message.find(flag); at != std::string::npos;
+         at = message.find(flag, at + keyword.size())) {
+        message.replace(at, flag.size(), keyword);
+    }
+    return message;
+}
+
 void RaiseReadError(const io::ReadError& e) {
     py::object error = py::reinterpret_borrow<py::object>(Classes().read)(e.what());
     error.attr("file") = e.file().string();
@@ -61,7 +72,7 @@ void Translate(std::exception_ptr error) {
     } catch (const io::ReadError& e) {
         RaiseReadError(e);
     } catch (const io::WriteError& e) {
-        Raise(classes.write, e);
+        PyErr_SetString(classes.write, InPythonTerms(e.what()).c_str());
     } catch (const ShapeError& e) {
         Raise(classes.shape, e);
     } catch (const DtypeError& e) {

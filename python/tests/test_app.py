@@ -229,7 +229,7 @@ def test_map_matches_the_cli(cli, sequence, tmp_path):
     with pytest.raises(lidarloop.WriteError, match="lies inside the input"):
         lidarloop.write_map(sequence, out=sequence / "map.ply")
     (tmp_path / "mine.ply").write_text("my map")
-    with pytest.raises(lidarloop.WriteError, match="give --overwrite"):
+    with pytest.raises(lidarloop.WriteError, match="pass overwrite=True"):
         lidarloop.write_map(sequence, out=tmp_path / "mine.ply")
     assert (tmp_path / "mine.ply").read_text() == "my map"
 
@@ -261,7 +261,7 @@ def test_results_folders_are_guarded(sequence, tmp_path):
     foreign = tmp_path / "foreign"
     foreign.mkdir()
     (foreign / "notes.txt").write_text("mine")
-    with pytest.raises(lidarloop.WriteError, match="overwrite"):
+    with pytest.raises(lidarloop.WriteError, match="pass overwrite=True"):
         lidarloop.detect(sequence, out=foreign, verify=False)
     lidarloop.detect(sequence, out=foreign, verify=False, overwrite=True)
     assert (foreign / "notes.txt").read_text() == "mine" and (foreign / "loops.csv").is_file()
