@@ -1,6 +1,7 @@
 #include "lidarloop/pipeline/ndt_method.hpp"
 
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include "lidarloop/core/error.hpp"
@@ -65,26 +66,26 @@ struct NdtQuery : PreparedQuery {
 
 class NdtStore : public DescriptorStore {
     // Every descriptor of the store has one shape (range intervals x features): one of another
-    // config would make every later distance fail, so it is refused where it comes in.
-    void RequireShapeOfStored(const core::NdtDescriptorSet& set) const {
-        const core::NdtDescriptor* stored = nullptr;
+    // config would make every later distance fail, so it is refused where it comes in. The
+    // mismatch found, if any.
+    std::optional<std::string> ShapeMismatch(const core::NdtDescriptorSet& set) const {
+        const core::NdtDescriptor* reference =
+            set.descriptors.empty() ? nullptr : &set.descriptors.front();
         for (const core::NdtDescriptorSet& s : sets_) {
             if (!s.descriptors.empty()) {
-                stored = &s.descriptors.front();
+                reference = &s.descriptors.front();
                 break;
             }
         }
-        if (stored == nullptr) return;
         for (const core::NdtDescriptor& f : set.descriptors) {
-            if (f.rows != stored->rows || f.cols != stored->cols) {
-                throw core::ConfigError("an NDT descriptor of " + std::to_string(f.rows) + " x " +
-                                        std::to_string(f.cols) + " into a database of " +
-                                        std::to_string(stored->rows) + " x " +
-                                        std::to_string(stored->cols) +
-                                        " (range intervals x features): describe it with the "
-                                        "database's config");
+            if (f.rows != reference->rows || f.cols != reference->cols) {
+                return "an NDT descriptor of " + std::to_string(f.rows) + " x " +
+                       std::to_string(f.cols) + " beside ones of " +
+                       std::to_string(reference->rows) + " x " + std::to_string(reference->cols) +
+                       " (range intervals x features)";
             }
         }
+        return std::nullopt;
     }
 
 public:
@@ -94,7 +95,8 @@ public:
         return std::make_unique<NdtStore>(*this);
     }
     void Add(const core::Descriptor& descriptor) override {
-        RequireShapeOfStored(descriptor.ndt());
+        if (const auto mismatch = ShapeMismatch(descriptor.ndt()))
+            throw core::ConfigError(*mismatch + ": describe it with the database's config");
         sets_.push_back(descriptor.ndt());
     }
     void AddMissing() override { sets_.emplace_back(); }
@@ -128,7 +130,11 @@ public:
         return {candidates, cells};
     }
     void Encode(std::size_t i, core::ByteWriter& out) const override { PutNdtSet(out, sets_[i]); }
-    void Decode(core::ByteReader& in, bool /*valid*/) override { sets_.push_back(GetNdtSet(in)); }
+    void Decode(core::ByteReader& in, bool /*valid*/) override {
+        core::NdtDescriptorSet set = GetNdtSet(in);
+        if (const auto mismatch = ShapeMismatch(set)) in.Fail(*mismatch);
+        sets_.push_back(std::move(set));
+    }
 
 private:
     std::vector<core::NdtDescriptorSet> sets_;

@@ -265,6 +265,30 @@ TEST(DatabaseFile, ValuesNoDescriptorHasAreClearErrors) {
     check(Patched(ndt, rotation + 8, std::nan("")), "NDT rotation is not a rotation matrix");
 }
 
+// NDT scans of two shapes (range intervals x features) in one file are a damaged file: it loaded,
+// and every distance to the odd scans failed later.
+TEST(DatabaseFile, NdtScansOfTwoShapesAreAClearError) {
+    test::TempDir dir;
+    const auto saved = [&](int planar_classes, const char* name) {
+        core::DescriptorConfig config;
+        config.method = core::Method::kNdt;
+        config.ndt.planar_classes = planar_classes;
+        pipeline::DescriptorDatabase database(config);
+        for (unsigned i = 0; i < 4; ++i)
+            database.Add(pipeline::ComputeDescriptor(test::RandomCloud(3000, i, 5.0f), config),
+                         0.5 * i);
+        SaveDatabase(dir / name, database);
+        return test::ReadFile(dir / name);
+    };
+    const std::string nine = saved(9, "nine.bin");
+    const std::string ten = saved(10, "ten.bin");
+    EXPECT_EQ(LoadDatabase(dir / "nine.bin").size(), 4U);
+    // The first two scans of one, the last two of the other.
+    test::WriteFile(dir / "mixed.bin",
+                    nine.substr(0, ThirdScanAt(nine)) + ten.substr(ThirdScanAt(ten)));
+    test::ExpectReadError(LoadDatabase, dir / "mixed.bin", "beside ones of");
+}
+
 TEST(Png, WritesAValidFileWithTheRightSize) {
     test::TempDir dir;
     Image image{3, 2, 1, {0, 128, 255, 255, 128, 0}};
