@@ -16,6 +16,7 @@
 #include "lidarloop/io/kitti_bin.hpp"
 #include "lidarloop/registration/coarse_alignment.hpp"
 #include "lidarloop/registration/icp.hpp"
+#include "lidarloop/registration/layout_signature.hpp"
 #include "lidarloop/registration/neighbor_grid.hpp"
 #include "lidarloop/registration/point_tree.hpp"
 #include "lidarloop/registration/prepared_scan.hpp"
@@ -174,6 +175,23 @@ void BM_CoarseAlign(benchmark::State& state) {
     }
 }
 
+// A prepared scan's layout signature: its image and one FFT, once per scan.
+void BM_LayoutSignature(benchmark::State& state) {
+    const PairScans& scans = Scans(SensorOf(state));
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(
+            registration::ComputeLayoutSignature(scans.query.structure->points()));
+    }
+}
+
+// Two layouts compared at every yaw: the cost of ordering one candidate of a shortlist.
+void BM_LayoutSimilarity(benchmark::State& state) {
+    const PairScans& scans = Scans(SensorOf(state));
+    const auto a = registration::ComputeLayoutSignature(scans.query.structure->points());
+    const auto b = registration::ComputeLayoutSignature(scans.revisit.structure->points());
+    for (auto _ : state) benchmark::DoNotOptimize(registration::LayoutSimilarity(a, b));
+}
+
 // Point-to-plane ICP of the true pair from the ground truth (all stages, no abandoning).
 void BM_IcpFromTruth(benchmark::State& state) {
     const PairScans& scans = Scans(SensorOf(state));
@@ -229,6 +247,8 @@ LIDARLOOP_SENSORS(BM_IcpPartnersGrid);
 LIDARLOOP_SENSORS(BM_IcpPartnersTree);
 LIDARLOOP_SENSORS(BM_CoarseQuery);
 LIDARLOOP_SENSORS(BM_CoarseAlign);
+LIDARLOOP_SENSORS(BM_LayoutSignature);
+LIDARLOOP_SENSORS(BM_LayoutSimilarity);
 LIDARLOOP_SENSORS(BM_IcpFromTruth);
 LIDARLOOP_SENSORS(BM_MeasureOverlap);
 LIDARLOOP_SENSORS(BM_VerifyTrueLoop);

@@ -44,6 +44,7 @@
 #include "lidarloop/registration/coarse_alignment.hpp"
 #include "lidarloop/registration/compact_prepared_scan.hpp"
 #include "lidarloop/registration/icp.hpp"
+#include "lidarloop/registration/layout_signature.hpp"
 #include "lidarloop/registration/neighbor_grid.hpp"
 #include "lidarloop/registration/point_tree.hpp"
 #include "lidarloop/registration/prepared_scan.hpp"

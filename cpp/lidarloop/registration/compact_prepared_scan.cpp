@@ -61,15 +61,21 @@ CompactPreparedScan::Surface CompactPreparedScan::Encode(const SurfacePoints& po
     return surface;
 }
 
-std::shared_ptr<const SurfacePoints> CompactPreparedScan::Decode(const Surface& surface) {
-    std::vector<Eigen::Vector3f> points(surface.size()), normals(surface.size());
+std::vector<Eigen::Vector3f> CompactPreparedScan::Positions(const Surface& surface) {
+    std::vector<Eigen::Vector3f> points(surface.size());
     for (std::size_t i = 0; i < surface.size(); ++i) {
         points[i] = Eigen::Vector3f(surface.position[3 * i], surface.position[3 * i + 1],
                                     surface.position[3 * i + 2]) *
                     surface.step_m;
-        normals[i] = DecodeNormal(surface.normal[2 * i], surface.normal[2 * i + 1]);
     }
-    return std::make_shared<const SurfacePoints>(std::move(points), std::move(normals));
+    return points;
+}
+
+std::shared_ptr<const SurfacePoints> CompactPreparedScan::Decode(const Surface& surface) {
+    std::vector<Eigen::Vector3f> normals(surface.size());
+    for (std::size_t i = 0; i < surface.size(); ++i)
+        normals[i] = DecodeNormal(surface.normal[2 * i], surface.normal[2 * i + 1]);
+    return std::make_shared<const SurfacePoints>(Positions(surface), std::move(normals));
 }
 
 CompactPreparedScan::CompactPreparedScan(const PreparedScan& scan)
@@ -79,7 +85,12 @@ CompactPreparedScan::CompactPreparedScan(const PreparedScan& scan)
       usable_points_(scan.usable_points),
       structure_roughness_m_(scan.structure_roughness_m),
       view_centre_(scan.view_centre) {
-    if (scan.structure) structure_ = Encode(*scan.structure);
+    if (scan.structure) {
+        structure_ = Encode(*scan.structure);
+        // From the points as stored, as verification sees them: a map saved and loaded again
+        // has the same layouts.
+        layout_ = ComputeLayoutSignature(Positions(structure_));
+    }
     if (scan.ground) ground_ = Encode(*scan.ground);
     distinctive_bits_.assign((scan.structure_distinctive.size() + 7) / 8, 0);
     for (std::size_t i = 0; i < scan.structure_distinctive.size(); ++i) {
@@ -108,7 +119,8 @@ std::size_t CompactPreparedScan::MemoryBytes() const {
     const auto bytes = [](const Surface& surface) {
         return (surface.position.capacity() + surface.normal.capacity()) * sizeof(std::int16_t);
     };
-    return bytes(structure_) + bytes(ground_) + distinctive_bits_.capacity();
+    return bytes(structure_) + bytes(ground_) + distinctive_bits_.capacity() +
+           layout_.values.capacity() * sizeof(float);
 }
 
 }  // namespace lidarloop::registration

@@ -5,6 +5,7 @@
 #include <limits>
 #include <vector>
 
+#include "lidarloop/registration/layout_signature.hpp"
 #include "lidarloop/registration/prepared_scan.hpp"
 
 namespace lidarloop::registration {
@@ -26,6 +27,9 @@ public:
     bool prepared() const { return prepared_; }
     /// PreparedScan::view_centre, kept as it was (NaN for an empty scan).
     const Eigen::Vector3d& view_centre() const { return view_centre_; }
+    /// The layout of its structure (ComputeLayoutSignature of the stored, encoded points); empty
+    /// for an empty scan.
+    const LayoutSignature& layout() const { return layout_; }
     /// Heap bytes held (the figure bench and LoopDetector::prepared_bytes report).
     std::size_t MemoryBytes() const;
 
@@ -38,6 +42,7 @@ private:
         std::size_t size() const { return position.size() / 3; }
     };
     static Surface Encode(const SurfacePoints& points);
+    static std::vector<Eigen::Vector3f> Positions(const Surface& surface);
     static std::shared_ptr<const SurfacePoints> Decode(const Surface& surface);
 
     bool prepared_ = false;
@@ -48,6 +53,7 @@ private:
     std::size_t input_points_ = 0;
     std::size_t usable_points_ = 0;
     double structure_roughness_m_ = 0.0;
+    LayoutSignature layout_;
     Eigen::Vector3d view_centre_ =
         Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
 };

@@ -1,0 +1,101 @@
+#include "lidarloop/registration/layout_signature.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <cstddef>
+#include <limits>
+#include <numbers>
+
+#include "lidarloop/registration/coarse_alignment.hpp"
+#include "lidarloop/registration/detail/fft2d.hpp"
+
+namespace lidarloop::registration {
+namespace {
+
+constexpr int kFirstRadius = 2;
+// The norm of the centred log-magnitudes below which they are rounding, not a layout (those of a
+// real scan's image are of order 1).
+constexpr double kMinContrast = 1e-4;  // the lowest frequencies say how much structure, not where
+constexpr std::size_t kSize =
+    static_cast<std::size_t>(LayoutSignature::kRadii) * LayoutSignature::kAngles;
+
+// The image geometry of the signature: the coarse search's default cells and grid.
+const CoarseConfig& ImageGeometry() {
+    static const CoarseConfig geometry;
+    return geometry;
+}
+
+// Where the polar samples lie in the n x n spectrum (row-major, wrapped), radius-major.
+const std::vector<std::size_t>& SampleCells() {
+    static const std::vector<std::size_t> cells = [] {
+        const int n = ImageGeometry().grid_cells;
+        std::vector<std::size_t> result;
+        result.reserve(kSize);
+        for (int r = 0; r < LayoutSignature::kRadii; ++r) {
+            const double radius = kFirstRadius + r;
+            for (int a = 0; a < LayoutSignature::kAngles; ++a) {
+                const double angle = std::numbers::pi * a / LayoutSignature::kAngles;
+                const long x = (std::lround(radius * std::cos(angle)) % n + n) % n;
+                const long y = (std::lround(radius * std::sin(angle)) % n + n) % n;
+                result.push_back(static_cast<std::size_t>(y * n + x));
+            }
+        }
+        return result;
+    }();
+    return cells;
+}
+
+}  // namespace
+
+LayoutSignature ComputeLayoutSignature(const std::vector<Eigen::Vector3f>& structure_points) {
+    LayoutSignature signature;
+    if (structure_points.empty()) return signature;
+    const int n = ImageGeometry().grid_cells;
+    const std::vector<float> image = OccupancyImage(structure_points, 0.0, ImageGeometry());
+    std::vector<std::complex<float>> spectrum(image.begin(), image.end());
+    detail::Fft2dForward(spectrum, n);
+    std::vector<double> values;
+    values.reserve(kSize);
+    double mean = 0.0;
+    for (const std::size_t cell : SampleCells()) {
+        values.push_back(std::log1p(static_cast<double>(std::abs(spectrum[cell]))));
+        mean += values.back();
+    }
+    mean /= static_cast<double>(kSize);
+    double norm = 0.0;
+    for (double& value : values) {
+        value -= mean;
+        norm += value * value;
+    }
+    norm = std::sqrt(norm);
+    // An image without contrast (one cell: every magnitude 1) differs only by the FFT's rounding.
+    if (!(norm > kMinContrast)) return signature;
+    signature.values.reserve(kSize);
+    for (const double value : values) signature.values.push_back(static_cast<float>(value / norm));
+    return signature;
+}
+
+double LayoutSimilarity(const LayoutSignature& a, const LayoutSignature& b) {
+    if (a.values.size() != kSize || b.values.size() != kSize)
+        return std::numeric_limits<double>::quiet_NaN();
+    constexpr int kAngles = LayoutSignature::kAngles;
+    // Per shift, the sum over radii of the rows' circular correlation.
+    float shifted[kAngles] = {};
+    for (int r = 0; r < LayoutSignature::kRadii; ++r) {
+        const float* row_a = a.values.data() + static_cast<std::ptrdiff_t>(r) * kAngles;
+        const float* row_b = b.values.data() + static_cast<std::ptrdiff_t>(r) * kAngles;
+        float doubled[2 * kAngles];
+        for (int k = 0; k < kAngles; ++k) doubled[k] = doubled[k + kAngles] = row_b[k];
+        for (int shift = 0; shift < kAngles; ++shift) {
+            float sum = 0.0F;
+            for (int k = 0; k < kAngles; ++k) sum += row_a[k] * doubled[k + shift];
+            shifted[shift] += sum;
+        }
+    }
+    float best = shifted[0];
+    for (const float value : shifted) best = std::max(best, value);
+    return best;
+}
+
+}  // namespace lidarloop::registration

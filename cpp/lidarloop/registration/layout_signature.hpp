@@ -1,0 +1,34 @@
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace lidarloop::registration {
+
+/// A scan's layout seen from above, wherever in it the sensor stood: the magnitudes of the 2-D
+/// Fourier transform of its top-down structure image (the coarse search's image at its default
+/// geometry: 64 x 64 cells of 1.5 m), sampled on a polar grid of spatial frequencies (radii 2 to
+/// 15 cycles per image, 36 angles over half a turn, 5 degrees apart), as log(1 + |F|) with zero
+/// mean and unit norm. A translation changes only the transform's phase; a yaw turns the
+/// magnitudes, a circular shift in angle (the magnitudes of a real image repeat after half a
+/// turn). The geometry is fixed, not the run's coarse config, so that the signatures of a saved
+/// map compare with new ones. It orders a query's shortlist before registration where no
+/// odometry does (docs/verification.md, "The layout orders the shortlist").
+struct LayoutSignature {
+    static constexpr int kRadii = 14;
+    static constexpr int kAngles = 36;
+    /// values[r * kAngles + a]; empty for a scan without structure.
+    std::vector<float> values;
+
+    bool empty() const { return values.empty(); }
+};
+
+/// The signature of the structure points (sensor frame, metres) of a prepared scan.
+LayoutSignature ComputeLayoutSignature(const std::vector<Eigen::Vector3f>& structure_points);
+
+/// How alike two layouts are: the largest correlation of the signatures over their angle shifts
+/// (every yaw), in [-1, 1]; NaN when either is empty.
+double LayoutSimilarity(const LayoutSignature& a, const LayoutSignature& b);
+
+}  // namespace lidarloop::registration
