@@ -252,7 +252,7 @@ nlohmann::json RunBench(const io::Dataset& dataset, const BenchRequest& request)
                                 std::numeric_limits<double>::infinity(), request.odometry_calib);
         const std::vector<double> path_m = core::CumulativePathM(
             odometry.empty() && dataset.HasPoses() ? dataset.poses() : odometry);
-        pipeline::LoopCheck check;
+        pipeline::LoopCheck check = ScansOwnCheck(prepared);
         if (!odometry.empty())
             check = OdometryLoopCheck(odometry, path_m, config.posegraph, nullptr, &prepared);
         // The online step retrieves too: timed here when --queries 0 timed no retrieval.

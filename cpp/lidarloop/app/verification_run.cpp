@@ -306,6 +306,12 @@ pipeline::LoopCheck OdometryLoopCheck(const std::vector<core::StampedPose>& odom
                                           view_centre_of);
 }
 
+pipeline::LoopCheck ScansOwnCheck(const PreparedScans& prepared) {
+    pipeline::LoopCheck check = prepared.submaps_apart;
+    check.layout_similarity = pipeline::LayoutOrderOf(prepared.scans).layout_similarity;
+    return check;
+}
+
 std::size_t RejectLoopsAgainstOdometry(std::vector<pipeline::LoopQuery>& queries,
                                        const std::vector<core::StampedPose>& odometry,
                                        const std::vector<double>& path_m,

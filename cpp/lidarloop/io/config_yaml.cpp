@@ -109,6 +109,9 @@ void VisitFields(pipeline::DetectorConfig& c, Visitor& v) {
     v.Field("top_k", c.top_k, "candidates reported per query scan");
     v.Field("odometry_shortlist", c.odometry_shortlist,
             "with the odometry: top_k nearest view centres of this many best-ranked scans");
+    v.Field("layout_shortlist", c.layout_shortlist,
+            "verifying without odometry: top_k most alike layouts of this many best-ranked scans "
+            "(0: rank order)");
     v.Field("threshold", c.threshold, ThresholdHelp());
     v.Field("verify", c.verify,
             "register candidates and accept only verified loops (section verification)");

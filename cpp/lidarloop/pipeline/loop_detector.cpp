@@ -124,34 +124,61 @@ Reach ReachFrom(std::size_t i, const LoopCheck& check, const DetectorConfig& det
     return reach;
 }
 
-// How many best-ranked scans a query's top_k are taken from: odometry_shortlist where `check`
-// orders them by the odometry's view distance, else top_k.
-std::size_t ShortlistSize(const DetectorConfig& detector, const LoopCheck& check) {
-    const int size = check.view_distance_m ? std::max(detector.top_k, detector.odometry_shortlist)
-                                           : detector.top_k;
-    return static_cast<std::size_t>(size);
+// How a query's shortlist is ordered before its top_k are taken.
+enum class ShortlistOrder { kRank, kNearestView, kMostAlikeLayout };
+
+ShortlistOrder OrderOf(const DetectorConfig& detector, const LoopCheck& check) {
+    if (check.view_distance_m) return ShortlistOrder::kNearestView;
+    if (check.layout_similarity && detector.layout_shortlist > 0)
+        return ShortlistOrder::kMostAlikeLayout;
+    return ShortlistOrder::kRank;
 }
 
-// The top_k of `result`'s shortlist: where `check` knows the view distances, the nearest first
-// (a scan the odometry does not know last; equal ones in rank order).
-void NearestViewsFirst(LoopQuery& result, const LoopCheck& check, const DetectorConfig& detector) {
+// How many best-ranked scans a query's top_k are taken from: odometry_shortlist where `check`
+// orders them by the odometry's view distance, layout_shortlist where by their layouts, else
+// top_k.
+std::size_t ShortlistSize(const DetectorConfig& detector, const LoopCheck& check) {
+    switch (OrderOf(detector, check)) {
+        case ShortlistOrder::kNearestView:
+            return static_cast<std::size_t>(std::max(detector.top_k, detector.odometry_shortlist));
+        case ShortlistOrder::kMostAlikeLayout:
+            return static_cast<std::size_t>(std::max(detector.top_k, detector.layout_shortlist));
+        case ShortlistOrder::kRank:
+            break;
+    }
+    return static_cast<std::size_t>(detector.top_k);
+}
+
+// Per candidate, the key `check` orders the shortlist by, smallest first: the view distance, or
+// the layout similarity negated; a scan it cannot judge (NaN) last.
+std::vector<double> OrderKeys(const LoopQuery& result, const LoopCheck& check,
+                              ShortlistOrder order) {
+    std::vector<double> keys;
+    keys.reserve(result.candidates.size());
+    for (const Neighbor& c : result.candidates) {
+        const double key = order == ShortlistOrder::kNearestView
+                               ? check.view_distance_m(result.query, c.index)
+                               : -check.layout_similarity(result.query, c.index);
+        keys.push_back(std::isnan(key) ? std::numeric_limits<double>::infinity() : key);
+    }
+    return keys;
+}
+
+// The top_k of `result`'s shortlist: where `check` knows the view distances, the nearest first;
+// else where it knows the layouts, the most alike first (equal ones in rank order).
+void OrderShortlist(LoopQuery& result, const LoopCheck& check, const DetectorConfig& detector) {
     auto& candidates = result.candidates;
-    if (check.view_distance_m) {
-        std::vector<double> distance_m;
-        distance_m.reserve(candidates.size());
-        for (const Neighbor& c : candidates) {
-            const double d = check.view_distance_m(result.query, c.index);
-            distance_m.push_back(std::isnan(d) ? std::numeric_limits<double>::infinity() : d);
-        }
-        std::vector<std::size_t> order(candidates.size());
-        for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
-        std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-            return distance_m[a] < distance_m[b];
-        });
-        std::vector<Neighbor> nearest;
-        nearest.reserve(candidates.size());
-        for (const std::size_t k : order) nearest.push_back(candidates[k]);
-        candidates = std::move(nearest);
+    const ShortlistOrder order = OrderOf(detector, check);
+    if (order != ShortlistOrder::kRank) {
+        const std::vector<double> keys = OrderKeys(result, check, order);
+        std::vector<std::size_t> ranks(candidates.size());
+        for (std::size_t k = 0; k < ranks.size(); ++k) ranks[k] = k;
+        std::stable_sort(ranks.begin(), ranks.end(),
+                         [&](std::size_t a, std::size_t b) { return keys[a] < keys[b]; });
+        std::vector<Neighbor> ordered;
+        ordered.reserve(candidates.size());
+        for (const std::size_t k : ranks) ordered.push_back(candidates[k]);
+        candidates = std::move(ordered);
     }
     if (candidates.size() > static_cast<std::size_t>(detector.top_k))
         candidates.resize(static_cast<std::size_t>(detector.top_k));
@@ -160,7 +187,7 @@ void NearestViewsFirst(LoopQuery& result, const LoopCheck& check, const Detector
 // The candidates of query scan `query` among the scans `eligible` admits, offline (DetectOne)
 // and online (LoopDetector::Search) alike: the shortlist within `check`'s reach, the decision and
 // second_ratio (Finish; `along`: the scans' positions in the gap's unit, empty when unknown),
-// then the top_k, nearest views first where `check` orders them.
+// then the top_k in the order `check` gives them (OrderShortlist).
 LoopQuery RankCandidates(std::size_t query, const CandidateSearch& search, const Filter& eligible,
                          const std::vector<double>& along, const DetectorConfig& detector,
                          const DescriptorMethod& method, double threshold, const LoopCheck& check) {
@@ -172,7 +199,7 @@ LoopQuery RankCandidates(std::size_t query, const CandidateSearch& search, const
         return SearchReachable(
             search, 1, [&](std::size_t j) { return eligible(j) && other_place(j); }, reach);
     });
-    NearestViewsFirst(result, check, detector);
+    OrderShortlist(result, check, detector);
     return result;
 }
 
@@ -227,6 +254,10 @@ void DetectorConfig::Validate() const {
     if (odometry_shortlist < 1 || odometry_shortlist > 1000) {
         throw core::ConfigError("detection.odometry_shortlist must be in [1, 1000], got " +
                                 std::to_string(odometry_shortlist));
+    }
+    if (layout_shortlist < 0 || layout_shortlist > 1000) {
+        throw core::ConfigError("detection.layout_shortlist must be in [0, 1000], got " +
+                                std::to_string(layout_shortlist));
     }
     verification.Validate();
 }
@@ -588,6 +619,20 @@ std::vector<Neighbor> NearestCandidates(std::size_t count, std::size_t k,
     return best;
 }
 
+LoopCheck LayoutOrderOf(const std::vector<registration::CompactPreparedScan>& scans,
+                        const registration::CompactPreparedScan* query, std::size_t query_index) {
+    LoopCheck check;
+    check.layout_similarity = [&scans, query, query_index](std::size_t a, std::size_t b) {
+        static const registration::LayoutSignature kNone;
+        const auto layout_of = [&](std::size_t i) -> const registration::LayoutSignature& {
+            if (query != nullptr && i == query_index) return query->layout();
+            return i < scans.size() ? scans[i].layout() : kNone;
+        };
+        return registration::LayoutSimilarity(layout_of(a), layout_of(b));
+    };
+    return check;
+}
+
 LoopDetector::LoopDetector(const core::DescriptorConfig& descriptor, const DetectorConfig& detector)
     : LoopDetector(DescriptorDatabase(descriptor), detector) {}
 
@@ -739,6 +784,11 @@ LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_
     LoopCheck odometry_check;
     if (odometry_gate_ && query_path_m)
         odometry_check = CheckAgainstOdometry(pose_of, path_of, odometry_gate_, nullptr, view_of);
+    registration::CompactPreparedScan compact(scan);
+    LoopCheck search_check;
+    if (detector_.verify)
+        search_check =
+            odometry_check ? odometry_check : LayoutOrderOf(scans_, &compact, query_index);
     LoopQuery result = Search(
         *query, query_index,
         [&](std::size_t j) {
@@ -749,9 +799,7 @@ LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_
                 return j < session_start_ || gap.Allows(query_index, j, *query_path_m, path_of(j));
             return gap.Allows(query_index, j, time_s, times_s[j]);
         },
-        session_start_ == 0 ? path_m_ : std::vector<double>{},
-        detector_.verify ? odometry_check : LoopCheck{});
-    registration::CompactPreparedScan compact(scan);
+        session_start_ == 0 ? path_m_ : std::vector<double>{}, search_check);
     Verify(result, compact, odometry_check);
     database_.Add(descriptor, time_s);
     scans_.push_back(std::move(compact));
@@ -774,8 +822,10 @@ LoopQuery LoopDetector::Query(const PreparedQuery& query, std::size_t query_inde
                               const registration::CompactPreparedScan& scan) const {
     // Searched and judged as the scan after the stored ones (its neighbour is the last stored
     // scan); `query_index`, an index of another sequence, only labels the result.
-    LoopQuery result =
-        Search(query, database_.size(), [&](std::size_t j) { return database_.IsValid(j); });
+    const std::size_t searched_as = database_.size();
+    LoopQuery result = Search(
+        query, searched_as, [&](std::size_t j) { return database_.IsValid(j); }, {},
+        detector_.verify ? LayoutOrderOf(scans_, &scan, searched_as) : LoopCheck{});
     Verify(result, scan);
     result.query = query_index;
     return result;

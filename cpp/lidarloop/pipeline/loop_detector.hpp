@@ -42,6 +42,12 @@ struct DetectorConfig {
     /// drives and the real HKU_1, validated on the seed-7 drives and HKU_2 (docs/verification.md,
     /// "The odometry orders the shortlist").
     int odometry_shortlist = 50;
+    /// Where the scans are verified and no odometry orders them (a LoopCheck with
+    /// layout_similarity): the top_k are the scans among this many best-ranked ones whose layouts
+    /// are most alike the query's (registration::LayoutSimilarity), most alike first. 0: rank
+    /// order; else 1..1000. 50, as odometry_shortlist (docs/verification.md, "The layout orders
+    /// the shortlist").
+    int layout_shortlist = 50;
     /// The decision threshold, tau (W <= tau, Röhling eq. 7) or t_d (sigma' < t_d, Magnusson
     /// II-E); empty: the method's default (pipeline::DefaultThreshold).
     std::optional<double> threshold;
@@ -125,6 +131,11 @@ struct LoopCheck {
     /// of two scans, metres; NaN where it does not know both. A query's candidates are registered
     /// nearest first (DetectorConfig::odometry_shortlist). Empty: in rank order.
     std::function<double(std::size_t query, std::size_t match)> view_distance_m;
+    /// How alike the layouts of two scans are (registration::LayoutSimilarity; NaN where either
+    /// has none). Where view_distance_m does not order them, a query's candidates are the most
+    /// alike of its shortlist (DetectorConfig::layout_shortlist), most alike first. Empty: in rank
+    /// order.
+    std::function<double(std::size_t query, std::size_t match)> layout_similarity;
     /// The yaws of a loop from scan `query` to scan `match` that `reject` may keep: the coarse
     /// search looks there only (registration::Verify's `yaws`). The whole circle where it cannot
     /// judge the pair. Empty: every yaw.
@@ -252,6 +263,13 @@ LoopCheck CheckAgainstOdometry(std::function<core::Transform(std::size_t)> T_odo
                                std::function<double(std::size_t)> path_m_of, OdometryGate gate,
                                std::atomic<std::size_t>* rejected = nullptr,
                                std::function<Eigen::Vector3d(std::size_t)> view_centre_of = {});
+
+/// The layouts of prepared scans (registration::CompactPreparedScan::layout) as a LoopCheck's
+/// layout_similarity: scan i's is scans[i]'s, and with `query` scan query_index's is its (a
+/// query not stored yet); NaN for a scan without one. Refers to `scans` and `query`.
+LoopCheck LayoutOrderOf(const std::vector<registration::CompactPreparedScan>& scans,
+                        const registration::CompactPreparedScan* query = nullptr,
+                        std::size_t query_index = 0);
 
 /// The k nearest of the scans 0..count-1 for which `eligible(j)` holds, by (distance, index),
 /// with `distance_of(j)` (called for eligible scans only; +inf and NaN are never candidates):

@@ -349,12 +349,13 @@ DescriptorDatabase ClusteredDatabase() {
 bool InSyntheticReach(std::size_t query, std::size_t match) { return (query + 2 * match) % 3 != 0; }
 
 // Brute force over the matrix: the scans more than 30 before `query` in the synthetic reach, by
-// (distance, index), at most `count`.
+// (distance, index), at most `count` (all scans more than 30 before without `within_reach`).
 std::vector<Neighbor> RankedInReach(const SimilarityMatrix& matrix, std::size_t query,
-                                    std::size_t count) {
+                                    std::size_t count, bool within_reach = true) {
     std::vector<Neighbor> ranked;
     for (std::size_t j = 0; j + 30 < query; ++j) {
-        if (InSyntheticReach(query, j)) ranked.push_back({j, double{matrix.at(query, j)}});
+        if (!within_reach || InSyntheticReach(query, j))
+            ranked.push_back({j, double{matrix.at(query, j)}});
     }
     std::sort(ranked.begin(), ranked.end(), [](const Neighbor& a, const Neighbor& b) {
         return a.distance < b.distance || (a.distance == b.distance && a.index < b.index);
@@ -563,6 +564,62 @@ TEST(DetectFromMatrix, TheOdometryOrdersTheShortlistByViewDistance) {
         std::sort(ranked_scans.begin(), ranked_scans.end());
         EXPECT_EQ(reordered_scans, ranked_scans) << i;  // the same scans, nearest view first
     }
+}
+
+// Without odometry, where the check knows the layouts, the top k are the k most alike among the
+// layout_shortlist best-ranked scans, most alike first (a scan without a layout last, ties in
+// rank order): brute force over the matrix. The view distance, where known, orders instead.
+TEST(DetectFromMatrix, TheLayoutOrdersTheShortlistWithoutOdometry) {
+    const DescriptorDatabase database = ClusteredDatabase();
+    const SimilarityMatrix matrix = ComputeSimilarityMatrix(database);
+    DetectorConfig detector = Deciding(DetectorConfig{}, 0.01);
+    detector.top_k = 4;
+    detector.layout_shortlist = 12;
+    const auto similarity = [](std::size_t query, std::size_t match) {
+        if (match % 7 == 0) return std::numeric_limits<double>::quiet_NaN();
+        return 0.1 * static_cast<double>((query * 31 + match * 17) % 10);  // many ties
+    };
+    LoopCheck check;
+    check.layout_similarity = similarity;
+    const std::vector<LoopQuery> detected =
+        DetectFromMatrix(matrix, database.times_s(), detector, core::Method::kHeight, {}, check);
+    const std::vector<LoopQuery> ranked_only =
+        DetectFromMatrix(matrix, database.times_s(), detector, core::Method::kHeight);
+    std::size_t reordered = 0;
+    for (std::size_t i = 0; i < matrix.size(); ++i) {
+        std::vector<Neighbor> ranked = RankedInReach(matrix, i, 12, false);
+        const auto key = [&](const Neighbor& n) {
+            const double s = similarity(i, n.index);
+            return std::isnan(s) ? 1e9 : -s;
+        };
+        std::vector<Neighbor> expected = ranked;
+        std::stable_sort(expected.begin(), expected.end(),
+                         [&](const Neighbor& a, const Neighbor& b) { return key(a) < key(b); });
+        expected.resize(std::min<std::size_t>(expected.size(), 4));
+        ASSERT_EQ(IndicesOf(detected[i].candidates), IndicesOf(expected)) << i;
+        if (IndicesOf(ranked_only[i].candidates) != IndicesOf(expected)) ++reordered;
+        EXPECT_EQ(detected[i].accepted, ranked_only[i].accepted) << i;  // the descriptor decides
+    }
+    EXPECT_GT(reordered, 100u);
+    ExpectIdenticalQueries(DetectStreaming(database, detector, Execution::kParallel, {}, check),
+                           detected);
+    // layout_shortlist 0: the rank order.
+    detector.layout_shortlist = 0;
+    ExpectIdenticalQueries(
+        DetectFromMatrix(matrix, database.times_s(), detector, core::Method::kHeight, {}, check),
+        ranked_only);
+    // The odometry's view distance orders where it is known, whatever the layouts.
+    detector.layout_shortlist = 12;
+    LoopCheck both = check;
+    both.view_distance_m = [](std::size_t, std::size_t match) {
+        return static_cast<double>(match % 5);
+    };
+    LoopCheck views_only = both;
+    views_only.layout_similarity = {};
+    ExpectIdenticalQueries(
+        DetectFromMatrix(matrix, database.times_s(), detector, core::Method::kHeight, {}, both),
+        DetectFromMatrix(matrix, database.times_s(), detector, core::Method::kHeight, {},
+                         views_only));
 }
 
 // A prepared scan that looks at `centre`, with a few structure points there (too few to

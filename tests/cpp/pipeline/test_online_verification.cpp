@@ -56,8 +56,10 @@ TEST(OnlineVerification, EqualsVerifyingTheOfflineCandidates) {
         prepared.emplace_back(
             registration::PrepareScan(sequence.scans[i], detector.verification.reduction));
     }
-    std::vector<LoopQuery> offline = DetectFromMatrix(ComputeSimilarityMatrix(online.database()),
-                                                      times, detector, core::Method::kRange);
+    // Offline as online: the shortlists in the order of the scans' layouts.
+    std::vector<LoopQuery> offline =
+        DetectFromMatrix(ComputeSimilarityMatrix(online.database()), times, detector,
+                         core::Method::kRange, {}, LayoutOrderOf(prepared));
     VerifyQueries(offline, prepared, detector, core::Method::kRange, Execution::kSerial);
     for (std::size_t i = 0; i < offline.size(); ++i) {
         ASSERT_EQ(online_results[i].verifications.size(), offline[i].verifications.size()) << i;
@@ -444,6 +446,7 @@ TEST(StopAtFirstLoop, ALoopTheCheckRejectsLetsTheNextCandidateBeRegistered) {
                            {},
                            {},
                            {},
+                           {},
                            {}});
     EXPECT_EQ(checked_accepted, (std::vector<std::size_t>{1, 1}));  // one new loop a call
     EXPECT_EQ(first.verifications[1].reason, registration::RejectReason::kOdometryMismatch);
@@ -499,6 +502,7 @@ TEST(StopAtFirstLoop, RegisteringSeveralAtOnceGivesTheVerdictsOfOneAfterAnother)
             if (v.accepted)
                 v.accepted = false, v.reason = registration::RejectReason::kOdometryMismatch;
         },
+        {},
         {},
         {},
         {},
@@ -597,6 +601,7 @@ TEST(OdometryFloor, OnlyTheCandidatesWhosePoseTheCheckJudges) {
             if (match == 2) return any_pose;
             return {};
         },
+        {},
         {},
         {},
         {},
