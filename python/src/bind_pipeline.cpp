@@ -183,7 +183,9 @@ void BindLoopQuery(py::module_& m) {
     py::class_<LoopQuery>(m, "LoopQuery", "What the detector says about one query scan.")
         .def_readonly("query", &LoopQuery::query, "The query scan's index.")
         .def_readonly("candidates", &LoopQuery::candidates,
-                      "Up to top_k eligible stored scans (Neighbor), nearest first.")
+                      "Up to top_k eligible stored scans (Neighbor), nearest first; when "
+                      "verifying, in the order registration takes them (nearest views by "
+                      "the odometry, else most alike layouts, first).")
         .def_readonly("second_ratio", &LoopQuery::second_ratio,
                       "The best match's distance over the best candidate's outside the gap "
                       "around it (near 0: distinctive; NaN: no such candidate).")

@@ -83,8 +83,9 @@ struct DetectorConfig {
 /// What the detector says about one query scan.
 struct LoopQuery {
     std::size_t query = 0;
-    /// Up to top_k eligible scans, nearest by the descriptor first (where the odometry orders
-    /// them, DetectorConfig::odometry_shortlist: nearest view centre first).
+    /// Up to top_k eligible scans, nearest by the descriptor first; where a LoopCheck orders
+    /// them, in its order (the odometry's nearest view centres first,
+    /// DetectorConfig::odometry_shortlist; else the most alike layouts first, layout_shortlist).
     std::vector<Neighbor> candidates;
     /// Distinctiveness of the best match: its distance over the distance of the best candidate
     /// that lies outside the gap around the best match (another place). Near 1: ambiguous;

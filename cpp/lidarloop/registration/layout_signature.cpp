@@ -13,10 +13,11 @@
 namespace lidarloop::registration {
 namespace {
 
+// The lowest frequencies say how much structure there is, not where.
 constexpr int kFirstRadius = 2;
 // The norm of the centred log-magnitudes below which they are rounding, not a layout (those of a
 // real scan's image are of order 1).
-constexpr double kMinContrast = 1e-4;  // the lowest frequencies say how much structure, not where
+constexpr double kMinContrast = 1e-4;
 constexpr std::size_t kSize =
     static_cast<std::size_t>(LayoutSignature::kRadii) * LayoutSignature::kAngles;
 

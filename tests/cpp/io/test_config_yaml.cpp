@@ -100,6 +100,11 @@ TEST(ConfigYaml, BadInputNamesFileKeyAndProblem) {
     expect_error("detection:\n  odometry_shortlist: 1001\n",
                  "detection.odometry_shortlist must be in [1, 1000], got 1001");
     expect_error("detection:\n  odometry_shortlist: many\n", "odometry_shortlist");
+    expect_error("detection:\n  layout_shortlist: -1\n",
+                 "detection.layout_shortlist must be in [0, 1000], got -1");
+    expect_error("detection:\n  layout_shortlist: 1001\n",
+                 "detection.layout_shortlist must be in [0, 1000], got 1001");
+    expect_error("detection:\n  layout_shortlist: many\n", "layout_shortlist");
     expect_error("detection:\n  min_gap: -3\n", "detection.min_gap must be");
 }
 

@@ -84,6 +84,40 @@ TEST(OnlineVerification, EqualsVerifyingTheOfflineCandidates) {
     EXPECT_FALSE(online_results[2].accepted);
 }
 
+// Online, each shortlist is ordered by the scans' layouts as offline detection orders it with the
+// same layouts, and on these places that is not the descriptor's order.
+TEST(OnlineVerification, OrdersTheShortlistByLayoutAsOffline) {
+    DetectorConfig detector;
+    detector.min_gap = {1.0, core::MinGap::Unit::kScans};
+    detector.top_k = 3;
+    detector.layout_shortlist = 8;
+    core::DescriptorConfig config;
+    config.method = core::Method::kRange;
+    LoopDetector online(config, detector);
+    std::vector<LoopQuery> results;
+    std::vector<double> times;
+    for (std::uint64_t seed = 1; seed <= 12; ++seed) {
+        times.push_back(static_cast<double>(seed));
+        results.push_back(online.Process(test::SyntheticPlace(seed), times.back()));
+    }
+    const SimilarityMatrix matrix = ComputeSimilarityMatrix(online.database());
+    const std::vector<LoopQuery> offline = DetectFromMatrix(
+        matrix, times, detector, core::Method::kRange, {}, LayoutOrderOf(online.prepared_scans()));
+    const std::vector<LoopQuery> ranked =
+        DetectFromMatrix(matrix, times, detector, core::Method::kRange);
+    const auto indices = [](const LoopQuery& q) {
+        std::vector<std::size_t> result;
+        for (const Neighbor& c : q.candidates) result.push_back(c.index);
+        return result;
+    };
+    std::size_t reordered = 0;
+    for (std::size_t i = 0; i < results.size(); ++i) {
+        EXPECT_EQ(indices(results[i]), indices(offline[i])) << i;
+        if (indices(ranked[i]) != indices(offline[i])) ++reordered;
+    }
+    EXPECT_GT(reordered, 2U);
+}
+
 TEST(OnlineVerification, KeepsReducedScansAndCountsTheirBytes) {
     const Sequence sequence = MakeSequence();
     core::DescriptorConfig config;
