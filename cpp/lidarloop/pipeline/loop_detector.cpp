@@ -165,16 +165,23 @@ std::vector<double> OrderKeys(const LoopQuery& result, const LoopCheck& check,
 }
 
 // The top_k of `result`'s shortlist: where `check` knows the view distances, the nearest first;
-// else where it knows the layouts, the most alike first (equal ones in rank order).
-void OrderShortlist(LoopQuery& result, const LoopCheck& check, const DetectorConfig& detector) {
+// else where it knows the layouts, the most alike first (equal ones in rank order). Scans that
+// fail an explicit threshold come last: verification prunes them, and from a longer shortlist
+// they would push out scans it registers.
+void OrderShortlist(LoopQuery& result, const LoopCheck& check, const DetectorConfig& detector,
+                    const DescriptorMethod& method) {
     auto& candidates = result.candidates;
     const ShortlistOrder order = OrderOf(detector, check);
     if (order != ShortlistOrder::kRank) {
         const std::vector<double> keys = OrderKeys(result, check, order);
+        std::vector<char> pruned(candidates.size(), 0);
+        for (std::size_t k = 0; k < candidates.size() && detector.threshold; ++k)
+            pruned[k] = !method.IsMatch(candidates[k].distance, *detector.threshold);
         std::vector<std::size_t> ranks(candidates.size());
         for (std::size_t k = 0; k < ranks.size(); ++k) ranks[k] = k;
-        std::stable_sort(ranks.begin(), ranks.end(),
-                         [&](std::size_t a, std::size_t b) { return keys[a] < keys[b]; });
+        std::stable_sort(ranks.begin(), ranks.end(), [&](std::size_t a, std::size_t b) {
+            return pruned[a] != pruned[b] ? pruned[a] < pruned[b] : keys[a] < keys[b];
+        });
         std::vector<Neighbor> ordered;
         ordered.reserve(candidates.size());
         for (const std::size_t k : ranks) ordered.push_back(candidates[k]);
@@ -199,7 +206,7 @@ LoopQuery RankCandidates(std::size_t query, const CandidateSearch& search, const
         return SearchReachable(
             search, 1, [&](std::size_t j) { return eligible(j) && other_place(j); }, reach);
     });
-    OrderShortlist(result, check, detector);
+    OrderShortlist(result, check, detector, method);
     return result;
 }
 

@@ -528,9 +528,10 @@ TEST(DetectFromMatrix, TheOdometryOrdersTheShortlistByViewDistance) {
     std::size_t reordered = 0;
     for (std::size_t i = 0; i < matrix.size(); ++i) {
         std::vector<Neighbor> ranked = RankedInReach(matrix, i, 12);
+        // Scans the explicit threshold prunes come last.
         const auto key = [&](const Neighbor& n) {
             const double d = view_distance_m(i, n.index);
-            return std::isnan(d) ? 1e9 : d;
+            return (std::isnan(d) ? 1e9 : d) + (n.distance > 0.01 ? 1e12 : 0.0);
         };
         std::vector<Neighbor> expected = ranked;
         std::stable_sort(expected.begin(), expected.end(),
@@ -588,9 +589,10 @@ TEST(DetectFromMatrix, TheLayoutOrdersTheShortlistWithoutOdometry) {
     std::size_t reordered = 0;
     for (std::size_t i = 0; i < matrix.size(); ++i) {
         std::vector<Neighbor> ranked = RankedInReach(matrix, i, 12, false);
+        // Scans the explicit threshold prunes come last.
         const auto key = [&](const Neighbor& n) {
             const double s = similarity(i, n.index);
-            return std::isnan(s) ? 1e9 : -s;
+            return (std::isnan(s) ? 1e9 : -s) + (n.distance > 0.01 ? 1e12 : 0.0);
         };
         std::vector<Neighbor> expected = ranked;
         std::stable_sort(expected.begin(), expected.end(),
@@ -663,9 +665,13 @@ TEST(LoopDetector, TheOdometryOrdersTheCandidatesByViewAsOffline) {
                     laps.T_odom_sensor[n.index] * view_centres[n.index])
                 .norm();
         };
+        // Nearest first among the scans the threshold keeps, then among those it prunes.
+        const auto key = [&](const Neighbor& n) {
+            return view_distance(n) + (n.distance > online.threshold() ? 1e12 : 0.0);
+        };
         const auto& candidates = offline[i].candidates;
         for (std::size_t r = 1; r < candidates.size(); ++r)
-            EXPECT_LE(view_distance(candidates[r - 1]), view_distance(candidates[r])) << i;
+            EXPECT_LE(key(candidates[r - 1]), key(candidates[r])) << i;
         ordered += candidates.size() > 1 ? 1 : 0;
     }
     EXPECT_GT(ordered, 100u);
