@@ -627,13 +627,13 @@ std::vector<Neighbor> NearestCandidates(std::size_t count, std::size_t k,
 }
 
 LoopCheck LayoutOrderOf(const std::vector<registration::CompactPreparedScan>& scans,
-                        const registration::CompactPreparedScan* query, std::size_t query_index) {
+                        const registration::CompactPreparedScan* query) {
     LoopCheck check;
-    check.layout_similarity = [&scans, query, query_index](std::size_t a, std::size_t b) {
+    check.layout_similarity = [&scans, query](std::size_t a, std::size_t b) {
         static const registration::LayoutSignature kNone;
         const auto layout_of = [&](std::size_t i) -> const registration::LayoutSignature& {
-            if (query != nullptr && i == query_index) return query->layout();
-            return i < scans.size() ? scans[i].layout() : kNone;
+            if (i < scans.size()) return scans[i].layout();
+            return query != nullptr && i == scans.size() ? query->layout() : kNone;
         };
         return registration::LayoutSimilarity(layout_of(a), layout_of(b));
     };
@@ -794,8 +794,7 @@ LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_
     registration::CompactPreparedScan compact(scan);
     LoopCheck search_check;
     if (detector_.verify)
-        search_check =
-            odometry_check ? odometry_check : LayoutOrderOf(scans_, &compact, query_index);
+        search_check = odometry_check ? odometry_check : LayoutOrderOf(scans_, &compact);
     LoopQuery result = Search(
         *query, query_index,
         [&](std::size_t j) {
@@ -829,10 +828,9 @@ LoopQuery LoopDetector::Query(const PreparedQuery& query, std::size_t query_inde
                               const registration::CompactPreparedScan& scan) const {
     // Searched and judged as the scan after the stored ones (its neighbour is the last stored
     // scan); `query_index`, an index of another sequence, only labels the result.
-    const std::size_t searched_as = database_.size();
     LoopQuery result = Search(
-        query, searched_as, [&](std::size_t j) { return database_.IsValid(j); }, {},
-        detector_.verify ? LayoutOrderOf(scans_, &scan, searched_as) : LoopCheck{});
+        query, database_.size(), [&](std::size_t j) { return database_.IsValid(j); }, {},
+        detector_.verify ? LayoutOrderOf(scans_, &scan) : LoopCheck{});
     Verify(result, scan);
     result.query = query_index;
     return result;

@@ -266,11 +266,11 @@ LoopCheck CheckAgainstOdometry(std::function<core::Transform(std::size_t)> T_odo
                                std::function<Eigen::Vector3d(std::size_t)> view_centre_of = {});
 
 /// The layouts of prepared scans (registration::CompactPreparedScan::layout) as a LoopCheck's
-/// layout_similarity: scan i's is scans[i]'s, and with `query` scan query_index's is its (a
-/// query not stored yet); NaN for a scan without one. Refers to `scans` and `query`.
+/// layout_similarity: scan i's is scans[i]'s, and with `query` the scan after them (index
+/// scans.size(), a query not stored yet, as the detector searches it) is `query`'s; NaN for a
+/// scan without one. Refers to `scans` and `query`.
 LoopCheck LayoutOrderOf(const std::vector<registration::CompactPreparedScan>& scans,
-                        const registration::CompactPreparedScan* query = nullptr,
-                        std::size_t query_index = 0);
+                        const registration::CompactPreparedScan* query = nullptr);
 
 /// The k nearest of the scans 0..count-1 for which `eligible(j)` holds, by (distance, index),
 /// with `distance_of(j)` (called for eligible scans only; +inf and NaN are never candidates):
