@@ -505,6 +505,30 @@ TEST(LoopDetector, TheOdometrysReachLimitsTheCandidatesAsOffline) {
     EXPECT_LT(judged_bounded, judged_exactly / 2);
 }
 
+// A synthetic score of a pair for ordering a shortlist: many ties, and unknown (NaN) for every
+// 7th match.
+double TiedScore(std::size_t query, std::size_t match) {
+    if (match % 7 == 0) return std::numeric_limits<double>::quiet_NaN();
+    return static_cast<double>((query * 31 + match * 17) % 10);
+}
+
+// Brute force of an ordered shortlist: the first `count` of `ranked` by `key`, smallest first, a
+// NaN key after every known one, scans the explicit threshold `tau` prunes (distance above it)
+// after all others, ties in rank order.
+std::vector<Neighbor> OrderedShortlist(std::vector<Neighbor> ranked,
+                                       const std::function<double(const Neighbor&)>& key,
+                                       double tau, std::size_t count) {
+    const auto sort_key = [&](const Neighbor& n) {
+        const double k = key(n);
+        return (std::isnan(k) ? 1e9 : k) + (n.distance > tau ? 1e12 : 0.0);
+    };
+    std::stable_sort(ranked.begin(), ranked.end(), [&](const Neighbor& a, const Neighbor& b) {
+        return sort_key(a) < sort_key(b);
+    });
+    ranked.resize(std::min(ranked.size(), count));
+    return ranked;
+}
+
 // Where the check knows the view distances, the top k are the k nearest views among the
 // odometry_shortlist best-ranked scans within reach, nearest first (a scan of unknown distance
 // last, ties in rank order): brute force over the matrix.
@@ -514,10 +538,7 @@ TEST(DetectFromMatrix, TheOdometryOrdersTheShortlistByViewDistance) {
     DetectorConfig detector = Deciding(DetectorConfig{}, 0.01);
     detector.top_k = 4;
     detector.odometry_shortlist = 12;
-    const auto view_distance_m = [](std::size_t query, std::size_t match) {
-        if (match % 7 == 0) return std::numeric_limits<double>::quiet_NaN();
-        return static_cast<double>((query * 31 + match * 17) % 10);  // many ties
-    };
+    const auto view_distance_m = TiedScore;
     LoopCheck check;
     check.may_close = [](std::size_t query, std::size_t match, double) {
         return InSyntheticReach(query, match);
@@ -528,15 +549,8 @@ TEST(DetectFromMatrix, TheOdometryOrdersTheShortlistByViewDistance) {
     std::size_t reordered = 0;
     for (std::size_t i = 0; i < matrix.size(); ++i) {
         std::vector<Neighbor> ranked = RankedInReach(matrix, i, 12);
-        // Scans the explicit threshold prunes come last.
-        const auto key = [&](const Neighbor& n) {
-            const double d = view_distance_m(i, n.index);
-            return (std::isnan(d) ? 1e9 : d) + (n.distance > 0.01 ? 1e12 : 0.0);
-        };
-        std::vector<Neighbor> expected = ranked;
-        std::stable_sort(expected.begin(), expected.end(),
-                         [&](const Neighbor& a, const Neighbor& b) { return key(a) < key(b); });
-        expected.resize(std::min<std::size_t>(expected.size(), 4));
+        const std::vector<Neighbor> expected = OrderedShortlist(
+            ranked, [&](const Neighbor& n) { return view_distance_m(i, n.index); }, 0.01, 4);
         ASSERT_EQ(IndicesOf(detected[i].candidates), IndicesOf(expected)) << i;
         ranked.resize(std::min<std::size_t>(ranked.size(), 4));
         if (IndicesOf(ranked) != IndicesOf(expected)) ++reordered;
@@ -577,8 +591,7 @@ TEST(DetectFromMatrix, TheLayoutOrdersTheShortlistWithoutOdometry) {
     detector.top_k = 4;
     detector.layout_shortlist = 12;
     const auto similarity = [](std::size_t query, std::size_t match) {
-        if (match % 7 == 0) return std::numeric_limits<double>::quiet_NaN();
-        return 0.1 * static_cast<double>((query * 31 + match * 17) % 10);  // many ties
+        return 0.1 * TiedScore(query, match);
     };
     LoopCheck check;
     check.layout_similarity = similarity;
@@ -588,16 +601,9 @@ TEST(DetectFromMatrix, TheLayoutOrdersTheShortlistWithoutOdometry) {
         DetectFromMatrix(matrix, database.times_s(), detector, core::Method::kHeight);
     std::size_t reordered = 0;
     for (std::size_t i = 0; i < matrix.size(); ++i) {
-        std::vector<Neighbor> ranked = RankedInReach(matrix, i, 12, false);
-        // Scans the explicit threshold prunes come last.
-        const auto key = [&](const Neighbor& n) {
-            const double s = similarity(i, n.index);
-            return (std::isnan(s) ? 1e9 : -s) + (n.distance > 0.01 ? 1e12 : 0.0);
-        };
-        std::vector<Neighbor> expected = ranked;
-        std::stable_sort(expected.begin(), expected.end(),
-                         [&](const Neighbor& a, const Neighbor& b) { return key(a) < key(b); });
-        expected.resize(std::min<std::size_t>(expected.size(), 4));
+        const std::vector<Neighbor> ranked = RankedInReach(matrix, i, 12, false);
+        const std::vector<Neighbor> expected = OrderedShortlist(
+            ranked, [&](const Neighbor& n) { return -similarity(i, n.index); }, 0.01, 4);
         ASSERT_EQ(IndicesOf(detected[i].candidates), IndicesOf(expected)) << i;
         if (IndicesOf(ranked_only[i].candidates) != IndicesOf(expected)) ++reordered;
         EXPECT_EQ(detected[i].accepted, ranked_only[i].accepted) << i;  // the descriptor decides
