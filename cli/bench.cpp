@@ -79,6 +79,8 @@ void PrintSummary(const nlohmann::json& figures) {
     double online_ms = 0.0;
     if (figures.contains("verification")) {
         const nlohmann::json& verification = figures["verification"];
+        PrintRow("candidates found and ordered (CPU)", "query",
+                 verification["candidates_ms_per_query"]);
         PrintRow("prepare for verification (CPU)", "scan", verification["prepare_cpu_ms_per_scan"]);
         PrintRow("coarse images (CPU)", "query",
                  verification["coarse_images_ms_per_query"]["thread_cpu"]);
@@ -92,9 +94,9 @@ void PrintSummary(const nlohmann::json& figures) {
         if (verification["online_rate_hz"].is_number()) {
             online_ms = verification["online_step_ms_per_scan"]["median"].get<double>();
             std::printf(
-                "\nonline step: %s per scan on one core = %.1f Hz (describe, retrieve, prepare, "
-                "coarse images and the %s, over %d scans with candidates; file reading "
-                "excluded)\n",
+                "\nonline step: %s per scan on one core = %.1f Hz (describe, find and order the "
+                "candidates, prepare, coarse images and the %s, over %d scans with candidates; "
+                "file reading excluded)\n",
                 Duration(online_ms).c_str(), verification["online_rate_hz"].get<double>(),
                 verified.c_str(), verification.value("queries", 0));
         } else {

@@ -38,9 +38,6 @@ nlohmann::json TimedJson(const std::vector<double>& values) {
             {"p95", Quantile(values, 0.95)}};
 }
 
-// Retrievals timed for the online step's figure when the request times none (--queries 0).
-constexpr std::size_t kOnlineStepRetrievals = 50;
-
 // Times `queries` top-1 searches of stored scans (as queries) against the whole database,
 // through the index when there is one, and by comparing every scan.
 nlohmann::json TimeQueries(const pipeline::DescriptorDatabase& database, std::size_t queries) {
@@ -105,21 +102,62 @@ pipeline::DescriptorDatabase Scaled(const pipeline::DescriptorDatabase& source, 
 // The online step of one scan on one core, milliseconds: what a loop closer beside a SLAM front
 // end spends on it (the file read excluded: a live system gets the cloud in memory).
 double OnlineStepMs(const pipeline::SequenceDescriptors& described, const PreparedScans& prepared,
-                    std::size_t scan, double retrieval_ms, double verification_cpu_ms) {
-    return 1e3 * described.describe_seconds.at(scan) + retrieval_ms +
+                    std::size_t scan, double candidates_ms, double verification_cpu_ms) {
+    return 1e3 * described.describe_seconds.at(scan) + candidates_ms +
            1e3 * prepared.prepare_cpu_seconds.at(scan) + verification_cpu_ms;
 }
+
+// Times the online step's candidate search for a stored scan as the online detector makes it:
+// the shortlist among the scans before it (through the method's index when it has one, else by
+// comparing each), ordered and cut to the top k (pipeline::ShortlistSize, OrderShortlist: the
+// layouts or the odometry's view distances compared). The gap and the odometry's reach, which
+// only leave scans out, are not applied. Refers to its arguments.
+class CandidateSearchTimer {
+public:
+    CandidateSearchTimer(const pipeline::DescriptorDatabase& database,
+                         const pipeline::DetectorConfig& detector, const pipeline::LoopCheck& check)
+        : database_(database),
+          detector_(detector),
+          check_(check),
+          index_(database.store().MakeIndex()) {
+        if (index_) index_->InsertAll([&](std::size_t i) { return database.IsValid(i); });
+    }
+
+    // Thread-CPU milliseconds to find and order the candidates of scan `query` (valid).
+    double Ms(std::size_t query) const {
+        const core::ThreadCpuStopwatch clock;
+        pipeline::LoopQuery result;
+        result.query = query;
+        const std::size_t k = pipeline::ShortlistSize(detector_, check_);
+        const auto prepared = database_.PrepareStored(query);
+        const auto before = [&](std::size_t j) { return j < query && database_.IsValid(j); };
+        result.candidates =
+            index_ ? index_->Search(*prepared, k, before)
+                   : pipeline::NearestCandidates(
+                         query, k,
+                         [&](std::size_t j) { return database_.store().Distance(*prepared, j); },
+                         before);
+        pipeline::OrderShortlist(result, check_, detector_, database_.definition());
+        return 1e3 * clock.Seconds();
+    }
+
+private:
+    const pipeline::DescriptorDatabase& database_;
+    const pipeline::DetectorConfig& detector_;
+    const pipeline::LoopCheck& check_;
+    std::unique_ptr<pipeline::NeighborIndex> index_;
+};
 
 // Verifies the top-k candidates of `queries` evenly spaced scans that have candidates, one pair
 // at a time on this thread (in rank order up to the first accepted with
 // detection.stop_at_first_loop), and sums each query's online step. `path_m`: per scan, for a gap
 // in metres (empty: none known); `check`: the odometry's reach, order and gate (empty: none), as
-// the online detector with a gate applies them; `retrieval_ms`: the median candidate search.
+// the online detector with a gate applies them (and its candidate search, timed per query).
 nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
                                 const pipeline::SimilarityMatrix& matrix,
                                 const PreparedScans& prepared, const io::RunConfig& config,
                                 std::size_t queries, const std::vector<double>& path_m,
-                                const pipeline::LoopCheck& check, double retrieval_ms) {
+                                const pipeline::LoopCheck& check) {
     std::vector<pipeline::LoopQuery> all =
         pipeline::DetectFromMatrix(matrix, described.database.times_s(), config.detection,
                                    config.descriptor.method, path_m, check);
@@ -128,6 +166,8 @@ nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
     // those the odometry rules out answered without registering, the images of the yaws the
     // rest may take), on this thread.
     pipeline::VerificationTimes times;
+    const CandidateSearchTimer candidate_search(described.database, config.detection, check);
+    std::vector<double> candidates_ms;
     std::vector<double> online_ms;
     std::size_t accepted = 0;
     const std::size_t step =
@@ -155,8 +195,9 @@ nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
         accepted += static_cast<std::size_t>(
             std::count_if(all[q].verifications.begin(), all[q].verifications.end(),
                           [](const registration::Verification& v) { return v.accepted; }));
-        online_ms.push_back(
-            OnlineStepMs(described, prepared, all[q].query, retrieval_ms, verification_cpu_ms));
+        candidates_ms.push_back(candidate_search.Ms(all[q].query));
+        online_ms.push_back(OnlineStepMs(described, prepared, all[q].query, candidates_ms.back(),
+                                         verification_cpu_ms));
         times.Append(query_times);
     }
     const auto ms = [](const std::vector<double>& wall_s, const std::vector<double>& cpu_s) {
@@ -173,6 +214,7 @@ nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
     json["prepare_ms_per_scan"] = SummaryJson(prepared.prepare_seconds, 1e3);
     json["prepare_cpu_ms_per_scan"] = SummaryJson(prepared.prepare_cpu_seconds, 1e3);
     json["bytes_per_prepared_scan"] = SummaryJson(prepared.BytesPerScan());
+    json["candidates_ms_per_query"] = SummaryJson(candidates_ms);
     json["coarse_images_ms_per_query"] = ms(times.query_seconds, times.query_cpu_seconds);
     json["verify_ms_per_pair"] = ms(times.pair_seconds, times.pair_cpu_seconds);
     json["online_step_ms_per_scan"] = SummaryJson(online_ms);
@@ -181,14 +223,6 @@ nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
     json["online_rate_hz"] =
         median_ms > 0.0 ? nlohmann::json(1e3 / median_ms) : nlohmann::json(nullptr);
     return json;
-}
-
-// The median candidate search of TimeQueries' figures, milliseconds: through the index when
-// the method has one, else by comparing every scan.
-double RetrievalMs(const nlohmann::json& queries) {
-    const nlohmann::json& figures =
-        queries.contains("index_us") ? queries["index_us"] : queries["brute_force_us"];
-    return figures["median"].is_number() ? figures["median"].get<double>() / 1e3 : 0.0;
 }
 
 }  // namespace
@@ -255,14 +289,8 @@ nlohmann::json RunBench(const io::Dataset& dataset, const BenchRequest& request)
         pipeline::LoopCheck check = ScansOwnCheck(prepared);
         if (!odometry.empty())
             check = OdometryLoopCheck(odometry, path_m, config.posegraph, nullptr, &prepared);
-        // The online step retrieves too: timed here when --queries 0 timed no retrieval.
-        const double retrieval_ms =
-            json["queries"]["brute_force_us"]["count"].get<std::size_t>() > 0
-                ? RetrievalMs(json["queries"])
-                : RetrievalMs(TimeQueries(database, kOnlineStepRetrievals));
-        json["verification"] =
-            TimeVerification(described, matrix, prepared, config, request.verify_queries, path_m,
-                             check, retrieval_ms);
+        json["verification"] = TimeVerification(described, matrix, prepared, config,
+                                                request.verify_queries, path_m, check);
     }
     json["peak_memory_mib"] = PeakMemoryMiB();
     return json;

@@ -134,9 +134,8 @@ ShortlistOrder OrderOf(const DetectorConfig& detector, const LoopCheck& check) {
     return ShortlistOrder::kRank;
 }
 
-// How many best-ranked scans a query's top_k are taken from: odometry_shortlist where `check`
-// orders them by the odometry's view distance, layout_shortlist where by their layouts, else
-// top_k.
+}  // namespace
+
 std::size_t ShortlistSize(const DetectorConfig& detector, const LoopCheck& check) {
     switch (OrderOf(detector, check)) {
         case ShortlistOrder::kNearestView:
@@ -148,6 +147,8 @@ std::size_t ShortlistSize(const DetectorConfig& detector, const LoopCheck& check
     }
     return static_cast<std::size_t>(detector.top_k);
 }
+
+namespace {
 
 // Per candidate, the key `check` orders the shortlist by, smallest first: the view distance, or
 // the layout similarity negated; a scan it cannot judge (NaN) last.
@@ -164,10 +165,8 @@ std::vector<double> OrderKeys(const LoopQuery& result, const LoopCheck& check,
     return keys;
 }
 
-// The top_k of `result`'s shortlist: where `check` knows the view distances, the nearest first;
-// else where it knows the layouts, the most alike first (equal ones in rank order). Scans that
-// fail an explicit threshold come last: verification prunes them, and from a longer shortlist
-// they would push out scans it registers.
+}  // namespace
+
 void OrderShortlist(LoopQuery& result, const LoopCheck& check, const DetectorConfig& detector,
                     const DescriptorMethod& method) {
     auto& candidates = result.candidates;
@@ -190,6 +189,8 @@ void OrderShortlist(LoopQuery& result, const LoopCheck& check, const DetectorCon
     if (candidates.size() > static_cast<std::size_t>(detector.top_k))
         candidates.resize(static_cast<std::size_t>(detector.top_k));
 }
+
+namespace {
 
 // The candidates of query scan `query` among the scans `eligible` admits, offline (DetectOne)
 // and online (LoopDetector::Search) alike: the shortlist within `check`'s reach, the decision and

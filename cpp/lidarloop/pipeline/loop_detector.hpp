@@ -272,6 +272,19 @@ LoopCheck CheckAgainstOdometry(std::function<core::Transform(std::size_t)> T_odo
 LoopCheck LayoutOrderOf(const std::vector<registration::CompactPreparedScan>& scans,
                         const registration::CompactPreparedScan* query = nullptr);
 
+/// How many best-ranked scans a query's top_k are taken from: detector.odometry_shortlist where
+/// `check` orders them by the odometry's view distance, layout_shortlist where by their layouts
+/// (each at least top_k), else top_k.
+std::size_t ShortlistSize(const DetectorConfig& detector, const LoopCheck& check);
+
+/// Cuts `result`'s shortlist (ranked, ShortlistSize long at most) to its top_k in the order the
+/// detectors verify them: where `check` knows the view distances, the nearest first; else where
+/// it knows the layouts (and layout_shortlist > 0), the most alike first; equal ones and a
+/// `check` with neither in rank order. Scans that fail an explicit threshold come last:
+/// verification prunes them, and from a longer shortlist they would push out scans it registers.
+void OrderShortlist(LoopQuery& result, const LoopCheck& check, const DetectorConfig& detector,
+                    const DescriptorMethod& method);
+
 /// The k nearest of the scans 0..count-1 for which `eligible(j)` holds, by (distance, index),
 /// with `distance_of(j)` (called for eligible scans only; +inf and NaN are never candidates):
 /// the brute-force search both detectors share. O(k) memory (a bounded heap).

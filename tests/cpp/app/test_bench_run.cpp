@@ -144,6 +144,13 @@ TEST(BenchRun, VerificationFiguresAreRecountedIndependently) {
     }
     ExpectTimes(v["coarse_images_ms_per_query"], "coarse images");
     ExpectTimes(v["verify_ms_per_pair"], "pairs");
+    // Each timed query's candidates are searched and ordered, part of its online step.
+    for (const char* statistic : {"median", "p95", "max"}) {
+        const double candidates_ms = v["candidates_ms_per_query"][statistic].get<double>();
+        EXPECT_GT(candidates_ms, 0.0) << statistic;
+        EXPECT_GT(v["online_step_ms_per_scan"][statistic].get<double>(), candidates_ms)
+            << statistic;
+    }
 }
 
 // A timed step with no sample (a gap longer than the sequence: no candidate pair) is no figure:
@@ -160,6 +167,7 @@ TEST(BenchRun, WhatNothingTimedIsNull) {
     for (const char* statistic : {"median", "p95", "max"}) {
         EXPECT_TRUE(v["verify_ms_per_pair"]["thread_cpu"][statistic].is_null()) << statistic;
         EXPECT_TRUE(v["online_step_ms_per_scan"][statistic].is_null()) << statistic;
+        EXPECT_TRUE(v["candidates_ms_per_query"][statistic].is_null()) << statistic;
         EXPECT_GT(v["prepare_ms_per_scan"][statistic].get<double>(), 0.0) << statistic;
     }
     EXPECT_TRUE(v["online_rate_hz"].is_null());
