@@ -92,6 +92,9 @@ void RunDemoOptimisation(const io::Dataset& dataset, const DemoFlags& flags,
 void RunDemo(const DemoFlags& flags) {
     const std::filesystem::path out(flags.out);
     ProgressPrinter progress(flags.quiet);
+    // The results folders are checked before the sequence is simulated, not refused after it.
+    for (const char* stage : {"evaluation", "optimised"})
+        app::CheckRunFolder(out / stage, CommandRun({out / "sequence"}, flags.overwrite));
     const app::DemoSequence demo = app::PrepareDemoSequence(
         out / "sequence", CommandRun({}, flags.overwrite), progress.Callback());
     const io::Dataset dataset = io::OpenDataset(demo.folder);

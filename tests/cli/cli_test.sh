@@ -432,6 +432,13 @@ section_bench() {
 
 # --- demo ------------------------------------------------------------------------------------
 section_demo() {
+    # A results folder the demo may not write is refused before the sequence is simulated.
+    mkdir -p "$work/demo_refused/evaluation" && echo mine >"$work/demo_refused/evaluation/mine.txt"
+    expect_exit_1 "demo into a folder of the user's" "evaluation: is not empty" "$cli" demo \
+        --out "$work/demo_refused" --quiet
+    if [ ! -e "$work/demo_refused/sequence" ]; then pass; else
+        fail "demo simulated its sequence before refusing its evaluation folder"
+    fi
     expect_ok "demo" "(optimised); top view:" "$cli" demo --out "$work/demo" --quiet
     for file in metrics.json roc.csv pr.csv report.md ground_truth.png similarity_height.png \
         similarity_ndt.png config.yaml; do

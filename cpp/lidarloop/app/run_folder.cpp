@@ -321,6 +321,14 @@ RunInfo CommandRunInfo(std::string command, std::string command_line, std::vecto
     return info;
 }
 
+void CheckRunFolder(const fs::path& folder, const RunInfo& info) {
+    RefuseInputOverlap(folder, info.inputs);
+    std::error_code ec;
+    if (!fs::exists(folder, ec)) return;
+    if (!fs::is_directory(folder, ec)) throw io::WriteError(folder, "is not a folder");
+    RefuseForeignFolder(folder, io::ReadRunRecord(folder), info);
+}
+
 RunFolder::RunFolder(fs::path folder, RunInfo info)
     : folder_(std::move(folder)), info_(std::move(info)), started_(UtcNow()) {
     RefuseInputOverlap(folder_, info_.inputs);

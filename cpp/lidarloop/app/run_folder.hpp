@@ -89,6 +89,12 @@ private:
     bool finished_ = false;
 };
 
+/// RunFolder's refusals of `folder` for a run with `info`, without creating or changing
+/// anything: for a command that writes several folders (demo), so that a later folder is refused
+/// before the work for the earlier ones. A folder that does not exist yet passes. Throws
+/// io::WriteError naming the folder, as RunFolder would.
+void CheckRunFolder(const std::filesystem::path& folder, const RunInfo& info);
+
 /// While alive, `folder` is the process's running results folder, which AbandonActiveRun
 /// abandons (one at a time: a second ActiveRun replaces the first until it ends).
 class ActiveRun {

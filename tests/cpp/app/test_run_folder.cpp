@@ -314,6 +314,37 @@ TEST(RunFolder, AnotherCommandsResultsAreReplacedOnlyWhenToldTo) {
     EXPECT_NO_THROW(write(CommandRun("detect"), "after legacy"));
 }
 
+// A command that writes several folders (demo) checks them all before its work: CheckRunFolder
+// refuses what a run would refuse and creates or changes nothing.
+TEST(RunFolder, CheckRefusesWhatARunWouldAndChangesNothing) {
+    test::TempDir dir;
+    const fs::path fresh = dir / "new";
+    EXPECT_NO_THROW(CheckRunFolder(fresh, CommandRun("detect")));
+    EXPECT_FALSE(fs::exists(fresh));
+
+    const fs::path users = dir / "users";
+    fs::create_directories(users);
+    test::WriteFile(users / "mine.txt", "mine");
+    EXPECT_THROW(CheckRunFolder(users, CommandRun("detect")), io::WriteError);
+    EXPECT_NO_THROW(CheckRunFolder(users, CommandRun("detect", /*overwrite=*/true)));
+    EXPECT_THROW(CheckRunFolder(users / "mine.txt", CommandRun("detect", true)), io::WriteError);
+    EXPECT_EQ(Entries(users), std::vector<std::string>{"mine.txt"});
+
+    const fs::path results = dir / "results";
+    RunInFolder(results, CommandRun("detect"), [](const fs::path& staging) {
+        test::WriteFile(staging / "loops.csv", "loops");
+        return 0;
+    });
+    EXPECT_NO_THROW(CheckRunFolder(results, CommandRun("detect")));
+    EXPECT_THROW(CheckRunFolder(results, CommandRun("evaluate")), io::WriteError);
+
+    RunInfo reading_users = CommandRun("detect");
+    reading_users.inputs = {users};
+    EXPECT_THROW(CheckRunFolder(users / "out", reading_users), io::WriteError);
+    EXPECT_THROW(CheckRunFolder(dir.path(), reading_users), io::WriteError);
+    EXPECT_EQ(Entries(users), std::vector<std::string>{"mine.txt"});
+}
+
 // --overwrite replaces files of the same names; a folder of the user's is replaced as a whole,
 // so one that no run.json lists is refused even then (an empty one is no loss).
 TEST(RunFolder, AnUnlistedFolderOfTheSameNameIsNeverReplaced) {
