@@ -34,6 +34,8 @@ void RunOptionFlags::AddTo(CLI::App& command, app::RunCommand which) {
 
 void RunOptionFlags::ApplyTo(const app::RunTargets& targets) const {
     using T = app::RunOptionType;
+    // First the config as the file left it, so that an error of the file is not a flag's.
+    targets.config->Validate();
     for (const Slot& slot : slots_) {
         if (!*slot.flag) continue;
         app::RunOptionValue value;
@@ -59,7 +61,6 @@ void RunOptionFlags::ApplyTo(const app::RunTargets& targets) const {
         }
         app::ApplyRunOption(*slot.option, value, targets, /*by_keyword=*/false);
     }
-    targets.config->Validate();
 }
 
 }  // namespace lidarloop::cli

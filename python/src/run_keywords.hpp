@@ -75,6 +75,8 @@ inline void ApplyRunKeywords(app::RunCommand command, const py::kwargs& keywords
                                  "() got an unexpected keyword argument '" + name + "'");
         }
     }
+    // First the config as given, so that an error of its own is not a keyword's.
+    targets.config->Validate();
     for (const app::RunOption* option : options) {
         const std::string keyword(option->keyword);
         if (!keywords.contains(keyword) || keywords[keyword.c_str()].is_none()) continue;
@@ -82,7 +84,6 @@ inline void ApplyRunKeywords(app::RunCommand command, const py::kwargs& keywords
         app::ApplyRunOption(*option, RunValueOf(*option, value), targets, /*by_keyword=*/true);
         given[keyword.c_str()] = value;
     }
-    targets.config->Validate();
 }
 
 /// The docstring of a run function: `text`, then its run options, each with its help.

@@ -76,3 +76,14 @@ def test_a_keyword_that_is_not_declared_is_a_type_error(tmp_path):
     with pytest.raises(TypeError, match="fixed_thresholds must be a list of numbers"):
         lidarloop.evaluate(tmp_path, out=tmp_path / "out", fixed_thresholds=["a"])
 
+
+def test_a_bad_value_names_the_keyword_it_came_through(tmp_path):
+    # Checked when the keyword is applied, before the dataset is opened: the keyword, then the
+    # config's own words.
+    top_k = r"^top_k: detection.top_k must be in \[1, 1000\]"
+    with pytest.raises(lidarloop.ConfigError, match=top_k):
+        lidarloop.detect(tmp_path, out=tmp_path / "out", top_k=0)
+    distance = "^distance_m: ground_truth.distance_m must be"
+    with pytest.raises(lidarloop.ConfigError, match=distance):
+        lidarloop.evaluate(tmp_path, out=tmp_path / "out", distance_m=-3.0)
+

@@ -371,8 +371,10 @@ section_detect() {
     find "$seq_times" -name 'scan*' | awk '{ print 0.1 * (NR - 1) }' >"$seq_times/times.txt"
     expect_ok "detect seconds with times.txt" "scans (folder)" "$cli" detect "$seq_times" \
         --min-gap 0.15 --min-gap-unit seconds --quiet --out "$work/det4"
-    expect_error "detect bad top-k" "detection.top_k must be in" "$cli" detect "$seq" --top-k 0 \
-        --quiet --out "$work/det5"
+    expect_error "detect bad top-k" "--top-k: detection.top_k must be in" "$cli" detect "$seq" \
+        --top-k 0 --quiet --out "$work/det5"
+    expect_error "evaluate bad distance" "--distance: ground_truth.distance_m must be" "$cli" \
+        evaluate "$seq" --distance -3 --quiet --out "$work/eval_bad_distance"
     expect_error "detect missing dataset" "no such dataset folder" "$cli" detect "$work/none" \
         --quiet --out "$work/det6"
 }

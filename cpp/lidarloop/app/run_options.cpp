@@ -190,12 +190,14 @@ void ApplyRunOption(const RunOption& option, const RunOptionValue& value, const 
                     bool by_keyword) {
     try {
         option.apply(targets, value);
+        // The config was valid before: what is wrong now came through this option.
+        targets.config->Validate();
+        if (targets.evaluation) GroundTruthRule(*targets.evaluation).Validate();
     } catch (const core::ConfigError& e) {
-        // A name the option does not know: say which option it came through.
+        // Say which option the bad name or value came through, then what the config says.
         throw core::ConfigError(std::string(by_keyword ? option.keyword : option.flag) + ": " +
                                 e.what());
     }
-    targets.config->Validate();
 }
 
 std::string RunOptionsMarkdown() {

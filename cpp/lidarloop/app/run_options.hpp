@@ -66,8 +66,9 @@ const std::vector<RunOption>& RunOptions();
 /// The options `command` takes, in that order.
 std::vector<const RunOption*> RunOptionsOf(RunCommand command);
 
-/// Applies `value` (of the option's type) and validates the config; core::ConfigError naming
-/// the option (its keyword when `by_keyword`, else its flag) when the value is invalid.
+/// Applies `value` (of the option's type) and validates the config (valid before: what is wrong
+/// then is this option's); core::ConfigError naming the option (its keyword when `by_keyword`,
+/// else its flag) when the value is invalid.
 void ApplyRunOption(const RunOption& option, const RunOptionValue& value, const RunTargets& targets,
                     bool by_keyword);
 
