@@ -75,7 +75,7 @@ io::Dataset DatasetOf(const py::object& dataset, const std::string& format,
         throw py::type_error(
             "dataset must be a folder (str or os.PathLike) or a lidarloop.Dataset");
     }
-    return OpenDatasetOf(dataset.cast<fs::path>(), format, poses, calib);
+    return OpenDatasetOf(PathOf(dataset, "dataset"), format, poses, calib);
 }
 
 /// defaults < config (dict or YAML) < method, as DescriptorOptions::Resolve; the run options
@@ -592,7 +592,7 @@ core::MapConfig MapConfigOf(const py::object& config, std::optional<double> voxe
 std::vector<core::StampedPose> TrajectoryOf(const io::Dataset& data, const py::object& trajectory) {
     if (trajectory.is_none()) return app::MapTrajectory(data, {});
     if (py::isinstance<py::str>(trajectory) || py::hasattr(trajectory, "__fspath__"))
-        return app::MapTrajectory(data, trajectory.cast<fs::path>());
+        return app::MapTrajectory(data, PathOf(trajectory, "trajectory"));
     const std::vector<core::Transform> transforms = TransformsFromArray(trajectory, "trajectory");
     std::vector<core::StampedPose> poses(transforms.size());
     for (std::size_t i = 0; i < poses.size(); ++i)

@@ -162,7 +162,7 @@ Descriptor Describe(const py::object& points, const std::optional<std::string>& 
     io::RunConfig run = ResolveRunConfig(config, method, keywords);
     ApplyParameterKeywords(parameters, run);
     if (py::isinstance<py::str>(points) || py::hasattr(points, "__fspath__")) {
-        const std::filesystem::path file = points.cast<std::filesystem::path>();
+        const std::filesystem::path file = PathOf(points, "points");
         py::gil_scoped_release release;
         return app::DescribeScanFile(file, run.descriptor);
     }

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -15,6 +16,7 @@
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl/filesystem.h>
 
 #include "errors.hpp"
 #include "lidarloop/core/min_gap.hpp"
@@ -290,6 +292,25 @@ inline io::RunConfig RunConfigFrom(const py::object& config) {
     if (path.find('\0') != std::string::npos)
         throw io::ReadError(path.substr(0, path.find('\0')), "the path holds a NUL character");
     return io::LoadConfigYaml(path, run);
+}
+
+/// `value` (a str or os.PathLike, checked by the caller) as a path; ValueError naming `name`
+/// where pybind11 cannot convert it, as Python's own open() refuses an embedded null byte,
+/// rather than pybind11's bare "Unable to cast".
+inline std::filesystem::path PathOf(const py::object& value, const char* name) {
+    try {
+        return value.cast<std::filesystem::path>();
+    } catch (const py::cast_error&) {
+        const py::object text = py::module_::import("os").attr("fspath")(value);
+        const bool has_null =
+            py::isinstance<py::str>(text)
+                ? text.cast<std::string>().find('\0') != std::string::npos
+                : py::bytes(text).cast<std::string>().find('\0') != std::string::npos;
+        throw py::value_error(std::string(name) + ": " +
+                              (has_null ? "embedded null byte in the path"
+                                        : "not a path this system can encode: " +
+                                              py::repr(value).cast<std::string>()));
+    }
 }
 
 }  // namespace lidarloop::python

@@ -441,3 +441,11 @@ def test_numpy_scalars_are_the_numbers_they_hold(sequence, tmp_path):
     assert numpy.accepted == plain.accepted
     with pytest.raises(TypeError, match="is no number"):
         lidarloop.detect(sequence, out=tmp_path / "bad", config={"histogram": {"bins": object()}})
+
+
+def test_a_path_with_a_null_byte_is_a_value_error_naming_the_argument(tmp_path):
+    # As Python's own open() refuses it; not pybind11's "Unable to cast".
+    with pytest.raises(ValueError, match="^dataset: embedded null byte in the path"):
+        lidarloop.detect("a\x00b", out=tmp_path / "out")
+    with pytest.raises(ValueError, match="^points: embedded null byte in the path"):
+        lidarloop.describe("scan\x00.bin")
