@@ -102,7 +102,7 @@ void PrintSummary(const nlohmann::json& figures) {
         } else {
             std::printf(
                 "\nonline step: not measured: no scan had candidates (a dataset shorter than "
-                "the gap, or --queries 0)\n");
+                "the gap)\n");
         }
         if (const auto& bytes = verification["bytes_per_prepared_scan"]["median"];
             bytes.is_number()) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <memory>
 #include <random>
 #include <string>
 
@@ -107,52 +108,12 @@ double OnlineStepMs(const pipeline::SequenceDescriptors& described, const Prepar
            1e3 * prepared.prepare_cpu_seconds.at(scan) + verification_cpu_ms;
 }
 
-// Times the online step's candidate search for a stored scan as the online detector makes it:
-// the shortlist among the scans before it (through the method's index when it has one, else by
-// comparing each), ordered and cut to the top k (pipeline::ShortlistSize, OrderShortlist: the
-// layouts or the odometry's view distances compared). The gap and the odometry's reach, which
-// only leave scans out, are not applied. Refers to its arguments.
-class CandidateSearchTimer {
-public:
-    CandidateSearchTimer(const pipeline::DescriptorDatabase& database,
-                         const pipeline::DetectorConfig& detector, const pipeline::LoopCheck& check)
-        : database_(database),
-          detector_(detector),
-          check_(check),
-          index_(database.store().MakeIndex()) {
-        if (index_) index_->InsertAll([&](std::size_t i) { return database.IsValid(i); });
-    }
-
-    // Thread-CPU milliseconds to find and order the candidates of scan `query` (valid).
-    double Ms(std::size_t query) const {
-        const core::ThreadCpuStopwatch clock;
-        pipeline::LoopQuery result;
-        result.query = query;
-        const std::size_t k = pipeline::ShortlistSize(detector_, check_);
-        const auto prepared = database_.PrepareStored(query);
-        const auto before = [&](std::size_t j) { return j < query && database_.IsValid(j); };
-        result.candidates =
-            index_ ? index_->Search(*prepared, k, before)
-                   : pipeline::NearestCandidates(
-                         query, k,
-                         [&](std::size_t j) { return database_.store().Distance(*prepared, j); },
-                         before);
-        pipeline::OrderShortlist(result, check_, detector_, database_.definition());
-        return 1e3 * clock.Seconds();
-    }
-
-private:
-    const pipeline::DescriptorDatabase& database_;
-    const pipeline::DetectorConfig& detector_;
-    const pipeline::LoopCheck& check_;
-    std::unique_ptr<pipeline::NeighborIndex> index_;
-};
-
 // Verifies the top-k candidates of `queries` evenly spaced scans that have candidates, one pair
 // at a time on this thread (in rank order up to the first accepted with
 // detection.stop_at_first_loop), and sums each query's online step. `path_m`: per scan, for a gap
 // in metres (empty: none known); `check`: the odometry's reach, order and gate (empty: none), as
-// the online detector with a gate applies them (and its candidate search, timed per query).
+// the online detector with a gate applies them. Each timed query's candidates are searched again
+// as the online detector searches them (pipeline::StreamingDetection), timed, and verified.
 nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
                                 const pipeline::SimilarityMatrix& matrix,
                                 const PreparedScans& prepared, const io::RunConfig& config,
@@ -166,7 +127,10 @@ nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
     // those the odometry rules out answered without registering, the images of the yaws the
     // rest may take), on this thread.
     pipeline::VerificationTimes times;
-    const CandidateSearchTimer candidate_search(described.database, config.detection, check);
+    // The online step's candidate search, as the detectors make it (the index, the gap, the
+    // odometry's reach, the shortlist ordered and cut), timed per query.
+    const pipeline::StreamingDetection candidate_search(described.database, config.detection,
+                                                        path_m, check);
     std::vector<double> candidates_ms;
     std::vector<double> online_ms;
     std::size_t accepted = 0;
@@ -184,18 +148,21 @@ nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
     for (std::size_t q = 0; q < all.size() && timed < queries; q += step) {
         const registration::PreparedScan query = prepared.scans[all[q].query].Expand();
         if (!query.structure) continue;
+        // The query's candidates as the online detector searches them, timed, then verified.
+        const core::ThreadCpuStopwatch search_cpu;
+        pipeline::LoopQuery searched = candidate_search.Detect(all[q].query);
+        candidates_ms.push_back(1e3 * search_cpu.Seconds());
         pipeline::VerificationTimes query_times;
         // The whole call: the coarse images, the pairs, and without odometry the registrations
         // of the neighbours the loops are judged against.
         const core::ThreadCpuStopwatch verification_cpu;
-        pipeline::VerifyQuery(all[q], query, match_of, config.detection, config.descriptor.method,
+        pipeline::VerifyQuery(searched, query, match_of, config.detection, config.descriptor.method,
                               &query_times, nullptr, pipeline::Execution::kSerial, judge);
         const double verification_cpu_ms = 1e3 * verification_cpu.Seconds();
         ++timed;
         accepted += static_cast<std::size_t>(
-            std::count_if(all[q].verifications.begin(), all[q].verifications.end(),
+            std::count_if(searched.verifications.begin(), searched.verifications.end(),
                           [](const registration::Verification& v) { return v.accepted; }));
-        candidates_ms.push_back(candidate_search.Ms(all[q].query));
         online_ms.push_back(OnlineStepMs(described, prepared, all[q].query, candidates_ms.back(),
                                          verification_cpu_ms));
         times.Append(query_times);

@@ -134,8 +134,9 @@ ShortlistOrder OrderOf(const DetectorConfig& detector, const LoopCheck& check) {
     return ShortlistOrder::kRank;
 }
 
-}  // namespace
-
+// How many best-ranked scans a query's top_k are taken from: odometry_shortlist where `check`
+// orders them by the odometry's view distance, layout_shortlist where by their layouts, else
+// top_k.
 std::size_t ShortlistSize(const DetectorConfig& detector, const LoopCheck& check) {
     switch (OrderOf(detector, check)) {
         case ShortlistOrder::kNearestView:
@@ -147,8 +148,6 @@ std::size_t ShortlistSize(const DetectorConfig& detector, const LoopCheck& check
     }
     return static_cast<std::size_t>(detector.top_k);
 }
-
-namespace {
 
 // Per candidate, the key `check` orders the shortlist by, smallest first: the view distance, or
 // the layout similarity negated; a scan it cannot judge (NaN) last.
@@ -165,8 +164,10 @@ std::vector<double> OrderKeys(const LoopQuery& result, const LoopCheck& check,
     return keys;
 }
 
-}  // namespace
-
+// The top_k of `result`'s shortlist: where `check` knows the view distances, the nearest first;
+// else where it knows the layouts, the most alike first (equal ones in rank order). Scans that
+// fail an explicit threshold come last: verification prunes them, and from a longer shortlist
+// they would push out scans it registers.
 void OrderShortlist(LoopQuery& result, const LoopCheck& check, const DetectorConfig& detector,
                     const DescriptorMethod& method) {
     auto& candidates = result.candidates;
@@ -189,8 +190,6 @@ void OrderShortlist(LoopQuery& result, const LoopCheck& check, const DetectorCon
     if (candidates.size() > static_cast<std::size_t>(detector.top_k))
         candidates.resize(static_cast<std::size_t>(detector.top_k));
 }
-
-namespace {
 
 // The candidates of query scan `query` among the scans `eligible` admits, offline (DetectOne)
 // and online (LoopDetector::Search) alike: the shortlist within `check`'s reach, the decision and
@@ -880,49 +879,61 @@ std::vector<LoopQuery> DetectFromMatrix(const SimilarityMatrix& matrix,
     return results;
 }
 
+StreamingDetection::StreamingDetection(const DescriptorDatabase& database,
+                                       const DetectorConfig& detector,
+                                       const std::vector<double>& path_m, const LoopCheck& check)
+    : database_(database),
+      detector_(detector),
+      path_m_(path_m),
+      check_(check),
+      threshold_(CheckOfflineDetection(detector, database.method(), database.times_s(), path_m,
+                                       database.size())),
+      along_(detector.min_gap.Along(database.times_s(), path_m)),
+      index_(database.store().MakeIndex()) {
+    // Over the valid scans; candidates are filtered to j < i, so one index serves every query.
+    if (index_) index_->InsertAll([&](std::size_t j) { return database.IsValid(j); });
+}
+
+StreamingDetection::~StreamingDetection() = default;
+
+LoopQuery StreamingDetection::Detect(std::size_t i) const {
+    const std::unique_ptr<PreparedQuery> query =
+        index_ && database_.IsValid(i) ? database_.PrepareStored(i) : nullptr;
+    std::vector<float> row;  // the query's distances to the earlier scans, as the matrix holds
+    bool row_filled = false;
+    const auto fill_row = [&] {
+        row.resize(i);
+        for (std::size_t j = 0; j < i; ++j) {
+            // Distance(j, i) with j < i, rounded to float: the matrix's entry (j, i).
+            if (detector_.min_gap.Allows(i, j, along_[i], along_[j]))
+                row[j] = static_cast<float>(database_.Distance(j, i));
+        }
+        row_filled = true;
+    };
+    const CandidateSearch search = [&](std::size_t count, const Filter& filter) {
+        if (query) {
+            const std::size_t asked = count + kIndexMargin;
+            if (auto ranked =
+                    RankedAsTheMatrix(index_->Search(*query, asked, filter), count, asked))
+                return *ranked;
+        }
+        if (!row_filled) fill_row();
+        return NearestCandidates(
+            i, count, [&](std::size_t j) { return double{row[j]}; }, filter);
+    };
+    return DetectOne(i, search, along_, path_m_, detector_, database_.definition(), threshold_,
+                     check_);
+}
+
 std::vector<LoopQuery> DetectStreaming(const DescriptorDatabase& database,
                                        const DetectorConfig& detector, Execution execution,
                                        const std::vector<double>& path_m, const LoopCheck& check) {
-    const std::vector<double>& times_s = database.times_s();
-    const std::size_t n = database.size();
-    const double threshold = CheckOfflineDetection(detector, database.method(), times_s, path_m, n);
-    const std::vector<double>& along = detector.min_gap.Along(times_s, path_m);
-    // The method's index (histograms: exact), over the valid scans; candidates are filtered to
-    // j < i, so one index over all scans serves every query.
-    std::unique_ptr<NeighborIndex> index = database.store().MakeIndex();
-    if (index) index->InsertAll([&](std::size_t j) { return database.IsValid(j); });
-    std::vector<LoopQuery> results(n);
+    const StreamingDetection detection(database, detector, path_m, check);
+    std::vector<LoopQuery> results(database.size());
     const auto detect_rows = [&](const tbb::blocked_range<std::size_t>& rows) {
-        std::vector<float> row;  // the query's distances to the earlier scans, as the matrix holds
-        for (std::size_t i = rows.begin(); i < rows.end(); ++i) {
-            const std::unique_ptr<PreparedQuery> query =
-                index && database.IsValid(i) ? database.PrepareStored(i) : nullptr;
-            bool row_filled = false;
-            const auto fill_row = [&] {
-                row.resize(i);
-                for (std::size_t j = 0; j < i; ++j) {
-                    // Distance(j, i) with j < i, rounded to float: the matrix's entry (j, i).
-                    if (detector.min_gap.Allows(i, j, along[i], along[j]))
-                        row[j] = static_cast<float>(database.Distance(j, i));
-                }
-                row_filled = true;
-            };
-            const CandidateSearch search = [&](std::size_t count, const Filter& filter) {
-                if (query) {
-                    const std::size_t asked = count + kIndexMargin;
-                    if (auto ranked =
-                            RankedAsTheMatrix(index->Search(*query, asked, filter), count, asked))
-                        return *ranked;
-                }
-                if (!row_filled) fill_row();
-                return NearestCandidates(
-                    i, count, [&](std::size_t j) { return double{row[j]}; }, filter);
-            };
-            results[i] = DetectOne(i, search, along, path_m, detector, database.definition(),
-                                   threshold, check);
-        }
+        for (std::size_t i = rows.begin(); i < rows.end(); ++i) results[i] = detection.Detect(i);
     };
-    const tbb::blocked_range<std::size_t> all(0, n);
+    const tbb::blocked_range<std::size_t> all(0, database.size());
     if (execution == Execution::kSerial) {
         detect_rows(all);
     } else {

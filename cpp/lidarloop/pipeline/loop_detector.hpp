@@ -46,8 +46,8 @@ struct DetectorConfig {
     /// layout_similarity): the top_k are the scans among this many best-ranked ones whose layouts
     /// are most alike the query's (registration::LayoutSimilarity), most alike first. 0: rank
     /// order; else 1..1000. 200: chosen of 20, 50, 100 and 200 on the 29 gate sequences,
-    /// validated on five simulated sequences of other seeds (docs/verification.md, "The layout
-    /// orders the shortlist").
+    /// validated on five simulated sequences of other seeds (docs/verification.md, "200
+    /// best-ranked, not 50").
     int layout_shortlist = 200;
     /// The decision threshold, tau (W <= tau, Röhling eq. 7) or t_d (sigma' < t_d, Magnusson
     /// II-E); empty: the method's default (pipeline::DefaultThreshold).
@@ -273,19 +273,6 @@ LoopCheck CheckAgainstOdometry(std::function<core::Transform(std::size_t)> T_odo
 LoopCheck LayoutOrderOf(const std::vector<registration::CompactPreparedScan>& scans,
                         const registration::CompactPreparedScan* query = nullptr);
 
-/// How many best-ranked scans a query's top_k are taken from: detector.odometry_shortlist where
-/// `check` orders them by the odometry's view distance, layout_shortlist where by their layouts
-/// (each at least top_k), else top_k.
-std::size_t ShortlistSize(const DetectorConfig& detector, const LoopCheck& check);
-
-/// Cuts `result`'s shortlist (ranked, ShortlistSize long at most) to its top_k in the order the
-/// detectors verify them: where `check` knows the view distances, the nearest first; else where
-/// it knows the layouts (and layout_shortlist > 0), the most alike first; equal ones and a
-/// `check` with neither in rank order. Scans that fail an explicit threshold come last:
-/// verification prunes them, and from a longer shortlist they would push out scans it registers.
-void OrderShortlist(LoopQuery& result, const LoopCheck& check, const DetectorConfig& detector,
-                    const DescriptorMethod& method);
-
 /// The k nearest of the scans 0..count-1 for which `eligible(j)` holds, by (distance, index),
 /// with `distance_of(j)` (called for eligible scans only; +inf and NaN are never candidates):
 /// the brute-force search both detectors share. O(k) memory (a bounded heap).
@@ -424,5 +411,30 @@ std::vector<LoopQuery> DetectStreaming(const DescriptorDatabase& database,
                                        Execution execution = Execution::kParallel,
                                        const std::vector<double>& path_m = {},
                                        const LoopCheck& check = {});
+
+/// DetectStreaming a query at a time: Detect(i) gives scan i's LoopQuery as DetectStreaming
+/// gives it (and LoopDetector::Process online), from the method's index over the database's
+/// valid scans (built once) or by comparing the earlier scans. `bench` times it as the online
+/// step's candidate search. Detect is thread-safe. Refers to `database` (and keeps copies of
+/// the rest; what `check`'s functions refer to must outlive it); ConfigError as DetectStreaming.
+class StreamingDetection {
+public:
+    StreamingDetection(const DescriptorDatabase& database, const DetectorConfig& detector,
+                       const std::vector<double>& path_m = {}, const LoopCheck& check = {});
+    ~StreamingDetection();
+    StreamingDetection(const StreamingDetection&) = delete;
+    StreamingDetection& operator=(const StreamingDetection&) = delete;
+
+    LoopQuery Detect(std::size_t query) const;
+
+private:
+    const DescriptorDatabase& database_;
+    DetectorConfig detector_;
+    std::vector<double> path_m_;
+    LoopCheck check_;
+    double threshold_;
+    std::vector<double> along_;  ///< the scans' positions in the gap's unit (MinGap::Along)
+    std::unique_ptr<NeighborIndex> index_;
+};
 
 }  // namespace lidarloop::pipeline
