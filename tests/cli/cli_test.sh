@@ -375,6 +375,8 @@ section_detect() {
         --top-k 0 --quiet --out "$work/det5"
     expect_error "evaluate bad distance" "--distance: ground_truth.distance_m must be" "$cli" \
         evaluate "$seq" --distance -3 --quiet --out "$work/eval_bad_distance"
+    expect_error "evaluate bad train fraction" "--train-fraction: threshold_learning.train_fraction" \
+        "$cli" evaluate "$seq" --train-fraction 1.5 --quiet --out "$work/eval_bad_fraction"
     expect_error "detect missing dataset" "no such dataset folder" "$cli" detect "$work/none" \
         --quiet --out "$work/det6"
 }

@@ -192,7 +192,10 @@ void ApplyRunOption(const RunOption& option, const RunOptionValue& value, const 
         option.apply(targets, value);
         // The config was valid before: what is wrong now came through this option.
         targets.config->Validate();
-        if (targets.evaluation) GroundTruthRule(*targets.evaluation).Validate();
+        if (targets.evaluation) {
+            GroundTruthRule(*targets.evaluation);  // validates the rule
+            targets.evaluation->learning.Validate();
+        }
     } catch (const core::ConfigError& e) {
         // Say which option the bad name or value came through, then what the config says.
         throw core::ConfigError(std::string(by_keyword ? option.keyword : option.flag) + ": " +
