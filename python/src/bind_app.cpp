@@ -59,10 +59,11 @@ io::Dataset OpenDatasetOf(const fs::path& folder, const std::string& format,
     return io::OpenDataset(folder, options);
 }
 
-/// The dataset argument of a run: a lidarloop.Dataset (open_dataset) as it is, or a folder
-/// opened with the dataset keywords (which an opened Dataset does not take).
+/// The dataset argument of a run (`name` in messages): a lidarloop.Dataset (open_dataset) as it
+/// is, or a folder opened with the dataset keywords (which an opened Dataset does not take).
 io::Dataset DatasetOf(const py::object& dataset, const std::string& format,
-                      const std::optional<fs::path>& poses, const std::optional<fs::path>& calib) {
+                      const std::optional<fs::path>& poses, const std::optional<fs::path>& calib,
+                      const char* name = "dataset") {
     if (py::isinstance<io::Dataset>(dataset)) {
         if (format != "auto" || poses || calib) {
             throw core::ConfigError(
@@ -72,10 +73,10 @@ io::Dataset DatasetOf(const py::object& dataset, const std::string& format,
         return dataset.cast<io::Dataset>();
     }
     if (!py::isinstance<py::str>(dataset) && !py::hasattr(dataset, "__fspath__")) {
-        throw py::type_error(
-            "dataset must be a folder (str or os.PathLike) or a lidarloop.Dataset");
+        throw py::type_error(std::string(name) +
+                             " must be a folder (str or os.PathLike) or a lidarloop.Dataset");
     }
-    return OpenDatasetOf(PathOf(dataset, "dataset"), format, poses, calib);
+    return OpenDatasetOf(PathOf(dataset, name), format, poses, calib);
 }
 
 /// defaults < config (dict or YAML) < method, as DescriptorOptions::Resolve; the run options
@@ -421,7 +422,7 @@ void BindEvaluate(py::module_& m) {
             // --train-on: learn each method's threshold on another dataset (with poses).
             std::optional<io::Dataset> train_data;
             if (!train_on.is_none())
-                train_data = DatasetOf(train_on, "auto", std::nullopt, std::nullopt);
+                train_data = DatasetOf(train_on, "auto", std::nullopt, std::nullopt, "train_on");
             EvaluateResult result;
             std::vector<fs::path> inputs = InputsOf(data, poses, calib);
             inputs.insert(inputs.end(), results.begin(), results.end());

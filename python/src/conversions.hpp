@@ -301,11 +301,12 @@ inline std::filesystem::path PathOf(const py::object& value, const char* name) {
     try {
         return value.cast<std::filesystem::path>();
     } catch (const py::cast_error&) {
+        // Tested in Python: a str this system cannot encode does not convert to C++ either.
         const py::object text = py::module_::import("os").attr("fspath")(value);
-        const bool has_null =
-            py::isinstance<py::str>(text)
-                ? text.cast<std::string>().find('\0') != std::string::npos
-                : py::bytes(text).cast<std::string>().find('\0') != std::string::npos;
+        const py::object null_byte = py::isinstance<py::str>(text)
+                                         ? py::object(py::str(std::string(1, '\0')))
+                                         : py::object(py::bytes(std::string(1, '\0')));
+        const bool has_null = text.attr("__contains__")(null_byte).cast<bool>();
         throw py::value_error(std::string(name) + ": " +
                               (has_null ? "embedded null byte in the path"
                                         : "not a path this system can encode: " +

@@ -443,9 +443,13 @@ def test_numpy_scalars_are_the_numbers_they_hold(sequence, tmp_path):
         lidarloop.detect(sequence, out=tmp_path / "bad", config={"histogram": {"bins": object()}})
 
 
-def test_a_path_with_a_null_byte_is_a_value_error_naming_the_argument(tmp_path):
+def test_a_path_with_a_null_byte_is_a_value_error_naming_the_argument(sequence, tmp_path):
     # As Python's own open() refuses it; not pybind11's "Unable to cast".
     with pytest.raises(ValueError, match="^dataset: embedded null byte in the path"):
         lidarloop.detect("a\x00b", out=tmp_path / "out")
     with pytest.raises(ValueError, match="^points: embedded null byte in the path"):
         lidarloop.describe("scan\x00.bin")
+    with pytest.raises(ValueError, match="^train_on: embedded null byte in the path"):
+        lidarloop.evaluate(sequence, out=tmp_path / "out", train_on="a\x00b")
+    with pytest.raises(ValueError, match="^dataset: not a path this system can encode"):
+        lidarloop.detect("\ud800", out=tmp_path / "out")

@@ -86,4 +86,3 @@ def test_a_bad_value_names_the_keyword_it_came_through(tmp_path):
     distance = "^distance_m: ground_truth.distance_m must be"
     with pytest.raises(lidarloop.ConfigError, match=distance):
         lidarloop.evaluate(tmp_path, out=tmp_path / "out", distance_m=-3.0)
-
