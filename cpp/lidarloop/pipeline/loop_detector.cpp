@@ -182,13 +182,18 @@ void OrderShortlist(LoopQuery& result, const LoopCheck& check, const DetectorCon
         std::stable_sort(ranks.begin(), ranks.end(), [&](std::size_t a, std::size_t b) {
             return pruned[a] != pruned[b] ? pruned[a] < pruned[b] : keys[a] < keys[b];
         });
+        const std::size_t kept = std::min(ranks.size(), static_cast<std::size_t>(detector.top_k));
         std::vector<Neighbor> ordered;
-        ordered.reserve(candidates.size());
-        for (const std::size_t k : ranks) ordered.push_back(candidates[k]);
+        ordered.reserve(kept);
+        for (std::size_t k = 0; k < kept; ++k) ordered.push_back(candidates[ranks[k]]);
         candidates = std::move(ordered);
     }
-    if (candidates.size() > static_cast<std::size_t>(detector.top_k))
+    // Without the shortlist's capacity: offline every scan's query is kept (200 candidates
+    // held 3 kB a scan, 110 MB over 36,000 scans).
+    if (candidates.size() > static_cast<std::size_t>(detector.top_k)) {
         candidates.resize(static_cast<std::size_t>(detector.top_k));
+        candidates.shrink_to_fit();
+    }
 }
 
 // The candidates of query scan `query` among the scans `eligible` admits, offline (DetectOne)

@@ -605,6 +605,8 @@ TEST(DetectFromMatrix, TheLayoutOrdersTheShortlistWithoutOdometry) {
         const std::vector<Neighbor> expected = OrderedShortlist(
             ranked, [&](const Neighbor& n) { return -similarity(i, n.index); }, 0.01, 4);
         ASSERT_EQ(IndicesOf(detected[i].candidates), IndicesOf(expected)) << i;
+        // Offline every query is kept: no room left for the 12 of the shortlist.
+        EXPECT_EQ(detected[i].candidates.capacity(), detected[i].candidates.size()) << i;
         if (IndicesOf(ranked_only[i].candidates) != IndicesOf(expected)) ++reordered;
         EXPECT_EQ(detected[i].accepted, ranked_only[i].accepted) << i;  // the descriptor decides
     }
