@@ -301,7 +301,8 @@ inline std::filesystem::path PathOf(const py::object& value, const char* name) {
     try {
         return value.cast<std::filesystem::path>();
     } catch (const py::cast_error&) {
-        // Tested in Python: a str this system cannot encode does not convert to C++ either.
+        // Looked for on the Python side: a str this system cannot encode would fail to convert
+        // to C++ again.
         const py::object text = py::module_::import("os").attr("fspath")(value);
         const py::object null_byte = py::isinstance<py::str>(text)
                                          ? py::object(py::str(std::string(1, '\0')))
