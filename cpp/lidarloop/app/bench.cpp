@@ -253,7 +253,7 @@ nlohmann::json RunBench(const io::Dataset& dataset, const BenchRequest& request)
                                 std::numeric_limits<double>::infinity(), request.odometry_calib);
         const std::vector<double> path_m = core::CumulativePathM(
             odometry.empty() && dataset.HasPoses() ? dataset.poses() : odometry);
-        pipeline::LoopCheck check = ScansOwnCheck(prepared);
+        pipeline::LoopCheck check = ScansOwnCheck(prepared, config.detection.verification.coarse);
         if (!odometry.empty())
             check = OdometryLoopCheck(odometry, path_m, config.posegraph, nullptr, &prepared);
         json["verification"] = TimeVerification(described, matrix, prepared, config,

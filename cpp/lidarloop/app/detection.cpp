@@ -329,7 +329,9 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
 
     // Where the odometry judges the loops, the scans out of a loop's reach are no candidates.
     std::atomic<std::size_t> rejected{0};
-    pipeline::LoopCheck check = verify ? ScansOwnCheck(prepared) : pipeline::LoopCheck{};
+    pipeline::LoopCheck check = verify
+                                    ? ScansOwnCheck(prepared, config.detection.verification.coarse)
+                                    : pipeline::LoopCheck{};
     if (verify && !poses.empty())
         check = OdometryLoopCheck(poses, path_m, config.posegraph, &rejected, &prepared);
     // All pairs either way; the matrix only when it fits the budget (same results without).

@@ -51,7 +51,7 @@ pipeline::LoopCheck VerificationCheckOf(const OdometryCheck* odometry,
                                         const pipeline::DetectorConfig& detector,
                                         const PreparedScans* prepared) {
     if (!detector.verify || prepared == nullptr) return {};
-    if (odometry == nullptr) return ScansOwnCheck(*prepared);
+    if (odometry == nullptr) return ScansOwnCheck(*prepared, detector.verification.coarse);
     return OdometryLoopCheck(odometry->odometry, odometry->path_m, odometry->config, nullptr,
                              prepared);
 }

@@ -306,9 +306,12 @@ pipeline::LoopCheck OdometryLoopCheck(const std::vector<core::StampedPose>& odom
                                           view_centre_of);
 }
 
-pipeline::LoopCheck ScansOwnCheck(const PreparedScans& prepared) {
+pipeline::LoopCheck ScansOwnCheck(const PreparedScans& prepared,
+                                  const registration::CoarseConfig& coarse) {
     pipeline::LoopCheck check = prepared.submaps_apart;
-    check.layout_similarity = pipeline::LayoutOrderOf(prepared.scans).layout_similarity;
+    const pipeline::LoopCheck layouts = pipeline::LayoutOrderOf(prepared.scans, coarse);
+    check.layout_similarity = layouts.layout_similarity;
+    check.yaw_window = layouts.yaw_window;
     return check;
 }
 

@@ -169,9 +169,11 @@ pipeline::LoopCheck OdometryLoopCheck(const std::vector<core::StampedPose>& odom
                                       const PreparedScans* prepared = nullptr);
 
 /// The check of a run verifying without odometry: the submaps' (PreparedScans::submaps_apart),
-/// and a query's candidates ordered by how alike their layouts are to its own
-/// (pipeline::LoopCheck::layout_similarity, detection.layout_shortlist). Refers to `prepared`.
-pipeline::LoopCheck ScansOwnCheck(const PreparedScans& prepared);
+/// a query's candidates ordered by how alike their layouts are to its own
+/// (pipeline::LoopCheck::layout_similarity, detection.layout_shortlist), and the yaws the
+/// layouts suggest (coarse.layout_yaw_window_deg). Refers to `prepared`.
+pipeline::LoopCheck ScansOwnCheck(const PreparedScans& prepared,
+                                  const registration::CoarseConfig& coarse);
 
 /// The figures of a verification run for timings.json: per scan preparation (ms) and memory
 /// (bytes), per query coarse images (ms), per candidate pair (ms), counts.

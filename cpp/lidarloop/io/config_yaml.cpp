@@ -154,6 +154,8 @@ void VisitFields(registration::CoarseConfig& c, Visitor& v) {
     v.Field("rival_hypotheses", c.rival_hypotheses,
             "further coarse poses the ambiguity test registers after an acceptance");
     v.Field("peaks_per_yaw", c.peaks_per_yaw, "translation peaks kept per yaw");
+    v.Field("layout_yaw_window_deg", c.layout_yaw_window_deg,
+            "without odometry, yaws searched around the layouts' and half a turn from it");
 }
 
 template <typename Visitor>

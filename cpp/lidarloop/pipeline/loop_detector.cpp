@@ -629,16 +629,27 @@ std::vector<Neighbor> NearestCandidates(std::size_t count, std::size_t k,
 }
 
 LoopCheck LayoutOrderOf(const std::vector<registration::CompactPreparedScan>& scans,
+                        const registration::CoarseConfig& coarse,
                         const registration::CompactPreparedScan* query) {
-    LoopCheck check;
-    check.layout_similarity = [&scans, query](std::size_t a, std::size_t b) {
+    const auto layout_of = [&scans, query](std::size_t i) -> const registration::LayoutSignature& {
         static const registration::LayoutSignature kNone;
-        const auto layout_of = [&](std::size_t i) -> const registration::LayoutSignature& {
-            if (i < scans.size()) return scans[i].layout();
-            return query != nullptr && i == scans.size() ? query->layout() : kNone;
-        };
+        if (i < scans.size()) return scans[i].layout();
+        return query != nullptr && i == scans.size() ? query->layout() : kNone;
+    };
+    LoopCheck check;
+    check.layout_similarity = [layout_of](std::size_t a, std::size_t b) {
         return registration::LayoutSimilarity(layout_of(a), layout_of(b));
     };
+    if (coarse.layout_yaw_window_deg < 180.0) {
+        check.yaw_window = [layout_of, half_width_rad =
+                                           coarse.layout_yaw_window_deg * core::kRadiansPerDegree](
+                               std::size_t query_scan, std::size_t match) {
+            // NaN without both layouts: every yaw.
+            return registration::YawWindow{
+                registration::LayoutYaw(layout_of(query_scan), layout_of(match)), half_width_rad,
+                true};
+        };
+    }
     return check;
 }
 
@@ -796,7 +807,9 @@ LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_
     registration::CompactPreparedScan compact(scan);
     LoopCheck search_check;
     if (detector_.verify)
-        search_check = odometry_check ? odometry_check : LayoutOrderOf(scans_, &compact);
+        search_check = odometry_check
+                           ? odometry_check
+                           : LayoutOrderOf(scans_, detector_.verification.coarse, &compact);
     LoopQuery result = Search(
         *query, query_index,
         [&](std::size_t j) {
@@ -808,7 +821,8 @@ LoopQuery LoopDetector::Process(const core::Descriptor& descriptor, double time_
             return gap.Allows(query_index, j, time_s, times_s[j]);
         },
         session_start_ == 0 ? path_m_ : std::vector<double>{}, search_check);
-    Verify(result, compact, odometry_check);
+    // Without odometry the layouts bound the yaws the pairs search.
+    Verify(result, compact, search_check);
     database_.Add(descriptor, time_s);
     scans_.push_back(std::move(compact));
     if (query_path_m) odometry_.push_back(*T_odom_sensor), path_m_.push_back(*query_path_m);
@@ -830,10 +844,12 @@ LoopQuery LoopDetector::Query(const PreparedQuery& query, std::size_t query_inde
                               const registration::CompactPreparedScan& scan) const {
     // Searched and judged as the scan after the stored ones (its neighbour is the last stored
     // scan); `query_index`, an index of another sequence, only labels the result.
+    const LoopCheck layouts = detector_.verify
+                                  ? LayoutOrderOf(scans_, detector_.verification.coarse, &scan)
+                                  : LoopCheck{};
     LoopQuery result = Search(
-        query, database_.size(), [&](std::size_t j) { return database_.IsValid(j); }, {},
-        detector_.verify ? LayoutOrderOf(scans_, &scan) : LoopCheck{});
-    Verify(result, scan);
+        query, database_.size(), [&](std::size_t j) { return database_.IsValid(j); }, {}, layouts);
+    Verify(result, scan, layouts);
     result.query = query_index;
     return result;
 }

@@ -267,10 +267,13 @@ LoopCheck CheckAgainstOdometry(std::function<core::Transform(std::size_t)> T_odo
                                std::function<Eigen::Vector3d(std::size_t)> view_centre_of = {});
 
 /// The layouts of prepared scans (registration::CompactPreparedScan::layout) as a LoopCheck's
-/// layout_similarity: scan i's is scans[i]'s, and with `query` the scan after them (index
-/// scans.size(), a query not stored yet, as the detector searches it) is `query`'s; NaN for a
-/// scan without one. Refers to `scans` and `query`.
+/// layout_similarity and, where coarse.layout_yaw_window_deg is under 180, its yaw_window (the
+/// layouts' yaw and half a turn from it, registration::LayoutYaw; every yaw for a pair without
+/// both): scan i's is scans[i]'s, and with `query` the scan after them (index scans.size(), a
+/// query not stored yet, as the detector searches it) is `query`'s. Refers to `scans` and
+/// `query`.
 LoopCheck LayoutOrderOf(const std::vector<registration::CompactPreparedScan>& scans,
+                        const registration::CoarseConfig& coarse,
                         const registration::CompactPreparedScan* query = nullptr);
 
 /// The k nearest of the scans 0..count-1 for which `eligible(j)` holds, by (distance, index),

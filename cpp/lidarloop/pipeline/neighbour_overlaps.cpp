@@ -196,14 +196,20 @@ LoopCheck JudgeOf(const LoopCheck& odometry, std::function<double(std::size_t)> 
                                                   config.acceptance.min_neighbour_overlap_ratio);
     LoopCheck motion =
         step_of ? CheckAgainstMotion(std::move(step_of), config.acceptance) : LoopCheck{};
-    if (!motion) return neighbours;
-    if (!neighbours) return motion;
-    LoopCheck both;
-    both.reject = [neighbours = std::move(neighbours), motion = std::move(motion)](LoopQuery& q) {
-        neighbours(q);
-        motion(q);
-    };
-    return both;
+    LoopCheck judge;
+    if (!motion) {
+        judge = std::move(neighbours);
+    } else if (!neighbours) {
+        judge = std::move(motion);
+    } else {
+        judge.reject = [neighbours = std::move(neighbours),
+                        motion = std::move(motion)](LoopQuery& q) {
+            neighbours(q);
+            motion(q);
+        };
+    }
+    judge.yaw_window = odometry.yaw_window;  // the layouts' (LayoutOrderOf), where given
+    return judge;
 }
 
 }  // namespace lidarloop::pipeline

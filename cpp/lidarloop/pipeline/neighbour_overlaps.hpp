@@ -117,7 +117,8 @@ LoopCheck CheckAgainstNeighbours(std::function<double(std::size_t)> reference_of
 /// What judges a sequence's verified loops: `odometry` where given (non-empty), else, with no
 /// knowledge besides the scans, CheckAgainstNeighbours with `reference_of` (e.g.
 /// NeighbourOverlaps::Of) at config.acceptance.min_neighbour_overlap_ratio, then, given
-/// `step_of` (e.g. NeighbourOverlaps::StepOf; offline: VerifyQueries), CheckAgainstMotion.
+/// `step_of` (e.g. NeighbourOverlaps::StepOf; offline: VerifyQueries), CheckAgainstMotion; with
+/// `odometry`'s yaw_window (the layouts', LayoutOrderOf).
 LoopCheck JudgeOf(const LoopCheck& odometry, std::function<double(std::size_t)> reference_of,
                   StepOf step_of, const registration::VerificationConfig& config);
 

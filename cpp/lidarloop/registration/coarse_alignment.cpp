@@ -177,7 +177,8 @@ bool YawWindow::Whole() const {
 }
 
 bool YawWindow::Contains(double yaw_rad) const {
-    return Whole() || YawDistance(yaw_rad, centre_rad) <= half_width_rad;
+    return Whole() || YawDistance(yaw_rad, centre_rad) <= half_width_rad ||
+           (half_turn_too && YawDistance(yaw_rad, centre_rad + std::numbers::pi) <= half_width_rad);
 }
 
 YawWindow SearchedYaws(const YawWindow& allowed, const CoarseConfig& config) {

@@ -19,12 +19,14 @@ struct PlanarHypothesis {
     double score = 0.0;  ///< correlation of the occupancy images at the peak (higher: better)
 };
 
-/// The yaws of T_match_query (radians) that another source of the pose, the odometry's gate,
-/// allows a loop: within half_width_rad of centre_rad. The default, and a window with a NaN, is
-/// every yaw.
+/// The yaws of T_match_query (radians) that another source of the pose allows a loop: within
+/// half_width_rad of centre_rad (the odometry's gate), and with half_turn_too also of centre_rad
+/// plus pi (the layouts', which repeat after half a turn). The default, and a window with a NaN,
+/// is every yaw.
 struct YawWindow {
     double centre_rad = 0.0;
     double half_width_rad = std::numbers::pi;
+    bool half_turn_too = false;
 
     bool Whole() const;
     /// Whether `yaw_rad` lies within the window (angles wrapped).

@@ -1,9 +1,11 @@
 #include "lidarloop/registration/layout_signature.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <complex>
 #include <cstddef>
+#include <iterator>
 #include <limits>
 #include <numbers>
 
@@ -77,12 +79,13 @@ LayoutSignature ComputeLayoutSignature(const std::vector<Eigen::Vector3f>& struc
     return signature;
 }
 
-double LayoutSimilarity(const LayoutSignature& a, const LayoutSignature& b) {
-    if (a.values.size() != kSize || b.values.size() != kSize)
-        return std::numeric_limits<double>::quiet_NaN();
+namespace {
+
+// Per angle shift, the correlation of `a`'s rows with `b`'s shifted by it, summed over radii.
+std::array<float, LayoutSignature::kAngles> ShiftedCorrelations(const LayoutSignature& a,
+                                                                const LayoutSignature& b) {
     constexpr int kAngles = LayoutSignature::kAngles;
-    // Per shift, the sum over radii of the rows' circular correlation.
-    float shifted[kAngles] = {};
+    std::array<float, kAngles> shifted{};
     for (int r = 0; r < LayoutSignature::kRadii; ++r) {
         const float* row_a = a.values.data() + static_cast<std::ptrdiff_t>(r) * kAngles;
         const float* row_b = b.values.data() + static_cast<std::ptrdiff_t>(r) * kAngles;
@@ -91,12 +94,41 @@ double LayoutSimilarity(const LayoutSignature& a, const LayoutSignature& b) {
         for (int shift = 0; shift < kAngles; ++shift) {
             float sum = 0.0F;
             for (int k = 0; k < kAngles; ++k) sum += row_a[k] * doubled[k + shift];
-            shifted[shift] += sum;
+            shifted[static_cast<std::size_t>(shift)] += sum;
         }
     }
-    float best = shifted[0];
-    for (const float value : shifted) best = std::max(best, value);
-    return best;
+    return shifted;
+}
+
+bool BothHaveLayouts(const LayoutSignature& a, const LayoutSignature& b) {
+    return a.values.size() == kSize && b.values.size() == kSize;
+}
+
+}  // namespace
+
+double LayoutSimilarity(const LayoutSignature& a, const LayoutSignature& b) {
+    if (!BothHaveLayouts(a, b)) return std::numeric_limits<double>::quiet_NaN();
+    const auto shifted = ShiftedCorrelations(a, b);
+    return *std::max_element(shifted.begin(), shifted.end());
+}
+
+double LayoutYaw(const LayoutSignature& query, const LayoutSignature& match) {
+    if (!BothHaveLayouts(query, match)) return std::numeric_limits<double>::quiet_NaN();
+    constexpr int kAngles = LayoutSignature::kAngles;
+    const auto shifted = ShiftedCorrelations(query, match);
+    const auto best = static_cast<int>(
+        std::distance(shifted.begin(), std::max_element(shifted.begin(), shifted.end())));
+    const auto at = [&](int shift) {
+        return static_cast<double>(shifted[static_cast<std::size_t>((shift + kAngles) % kAngles)]);
+    };
+    const double before = at(best - 1), peak = at(best), after = at(best + 1);
+    const double curvature = before - 2.0 * peak + after;
+    // The vertex of the parabola through the peak and its neighbours, within half a shift.
+    const double offset =
+        curvature < 0.0 ? std::clamp(0.5 * (before - after) / curvature, -0.5, 0.5) : 0.0;
+    const double step_rad = std::numbers::pi / kAngles;
+    const double yaw_rad = (best + offset) * step_rad;
+    return std::fmod(yaw_rad + std::numbers::pi, std::numbers::pi);
 }
 
 }  // namespace lidarloop::registration

@@ -31,4 +31,10 @@ LayoutSignature ComputeLayoutSignature(const std::vector<Eigen::Vector3f>& struc
 /// (every yaw), in [-1, 1]; NaN when either is empty.
 double LayoutSimilarity(const LayoutSignature& a, const LayoutSignature& b);
 
+/// The yaw of T_match_query (radians, in [0, pi)) that turns `query`'s layout onto `match`'s: the
+/// angle shift of LayoutSimilarity's largest correlation, refined between the 5-degree shifts by
+/// a parabola. The magnitudes repeat after half a turn, so the loop's yaw is this or this plus
+/// pi. NaN when either is empty.
+double LayoutYaw(const LayoutSignature& query, const LayoutSignature& match);
+
 }  // namespace lidarloop::registration

@@ -160,8 +160,9 @@ using PoseAllowed = std::function<bool(const core::Transform& T_match_query)>;
 /// the degeneracy test asks for acceptance.min_constraining_points_with_odometry points instead of
 /// min_constraining_points, the RMSE may reach max_rmse_ratio_with_odometry, and only a rival pose
 /// it allows makes the place ambiguous (docs/verification.md, "The odometry pins the road").
-/// Given `yaws` (the yaws the odometry's gate allows), the coarse search looks there only
-/// (CoarseAlign): `coarse` must have been built with it among its windows.
+/// Given `yaws` (the yaws the odometry's gate allows, or without odometry those the layouts
+/// suggest), the coarse search looks there only (CoarseAlign): `coarse` must have been built
+/// with it among its windows.
 Verification Verify(const PreparedScan& query, const CoarseQuery& coarse, const PreparedScan& match,
                     const VerificationConfig& config, const PoseAllowed& allowed = {},
                     const YawWindow& yaws = {});

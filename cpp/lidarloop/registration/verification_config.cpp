@@ -56,6 +56,7 @@ void CoarseConfig::Validate() const {
     RequireIn(max_peak_beyond_loop_m, 0.0, 1000.0, "coarse.max_peak_beyond_loop_m");
     RequireIn(rival_hypotheses, 0, 32, "coarse.rival_hypotheses");
     RequireIn(peaks_per_yaw, 1, 8, "coarse.peaks_per_yaw");
+    RequireIn(layout_yaw_window_deg, 1.0, 180.0, "coarse.layout_yaw_window_deg");
 }
 
 void IcpConfig::Validate() const {

@@ -69,6 +69,10 @@ struct CoarseConfig {
     /// Translation peaks kept per yaw (3 cells apart at least), 1..8: repeating structure
     /// correlates at several offsets under one yaw.
     int peaks_per_yaw = 2;
+    /// Where no odometry bounds the yaws, a pair's coarse search looks only within this many
+    /// degrees of the yaw the two scans' layouts suggest and of that plus half a turn
+    /// (registration::LayoutYaw), [1, 180]; 180: every yaw.
+    double layout_yaw_window_deg = 15.0;
 
     int TotalHypotheses() const { return hypotheses + rival_hypotheses; }
     void Validate() const;

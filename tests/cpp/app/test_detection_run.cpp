@@ -31,6 +31,7 @@
 #include "lidarloop/pipeline/scancontext_method.hpp"
 #include "lidarloop/posegraph/optimiser.hpp"
 #include "lidarloop/registration/compact_prepared_scan.hpp"
+#include "lidarloop/registration/layout_signature.hpp"
 #include "lidarloop/registration/submap.hpp"
 #include "lidarloop/registration/verification.hpp"
 #include "test_utils.hpp"
@@ -886,18 +887,22 @@ void ExpectFilesStateTheVerdicts(const app::DetectRequest& request,
     }
 }
 
-// A pair registered on its own, its scans kept as detect keeps them (compact).
+// A pair registered on its own, its scans kept as detect keeps them (compact), its coarse search
+// within the yaws their layouts suggest, as detect searches without odometry.
 registration::Verification VerifyAsKept(const core::PointCloud& query,
                                         const core::PointCloud& match,
                                         const registration::VerificationConfig& config) {
     const auto kept = [&](const core::PointCloud& scan) {
-        return registration::CompactPreparedScan(registration::PrepareScan(scan, config.reduction))
-            .Expand();
+        return registration::CompactPreparedScan(registration::PrepareScan(scan, config.reduction));
     };
-    const registration::PreparedScan prepared_query = kept(query);
-    return registration::Verify(prepared_query,
-                                registration::CoarseQuery(*prepared_query.structure, config.coarse),
-                                kept(match), config);
+    const registration::CompactPreparedScan kept_query = kept(query), kept_match = kept(match);
+    const registration::YawWindow yaws{
+        registration::LayoutYaw(kept_query.layout(), kept_match.layout()),
+        config.coarse.layout_yaw_window_deg * core::kRadiansPerDegree, true};
+    const registration::PreparedScan prepared_query = kept_query.Expand();
+    return registration::Verify(
+        prepared_query, registration::CoarseQuery(*prepared_query.structure, config.coarse, {yaws}),
+        kept_match.Expand(), config, {}, yaws);
 }
 
 // Verification inside detect gives what registering each candidate on its own gives, and the

@@ -343,6 +343,25 @@ TEST(CheckAgainstNeighbours, RatioZeroIsNoCheck) {
     EXPECT_TRUE(query.verifications[0].accepted) << "the odometry's check ran, not the neighbours'";
 }
 
+// Without odometry, the yaws the layouts allow (LayoutOrderOf) still bound the coarse search.
+TEST(JudgeOf, KeepsTheGivenYawWindow) {
+    const auto reference_of = [](std::size_t) { return 1.0; };
+    registration::VerificationConfig config;
+    LoopCheck layouts;
+    layouts.yaw_window = [](std::size_t query, std::size_t match) {
+        return registration::YawWindow{0.1 * static_cast<double>(query + match), 0.2, true};
+    };
+    for (const double ratio : {0.0, 0.5}) {
+        config.acceptance.min_neighbour_overlap_ratio = ratio;
+        const LoopCheck judge = JudgeOf(layouts, reference_of, {}, config);
+        const registration::YawWindow window = judge.YawWindow(3, 1);
+        EXPECT_DOUBLE_EQ(window.centre_rad, 0.4) << ratio;
+        EXPECT_DOUBLE_EQ(window.half_width_rad, 0.2) << ratio;
+        EXPECT_TRUE(window.half_turn_too) << ratio;
+    }
+    EXPECT_TRUE(JudgeOf({}, reference_of, {}, config).YawWindow(3, 1).Whole());
+}
+
 // The revisit of place 1 (scan 4 -> 0 or 1) overlaps about as much as scans 0 and 1 do: kept at
 // the default ratio, rejected where a loop must overlap more than its neighbours, online and
 // offline alike.

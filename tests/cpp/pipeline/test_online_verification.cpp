@@ -41,9 +41,13 @@ DetectorConfig Verifying() {
     return detector;
 }
 
-TEST(OnlineVerification, EqualsVerifyingTheOfflineCandidates) {
+// With every yaw searched, and with the yaws the layouts suggest (coarse.layout_yaw_window_deg).
+class OnlineVerificationWindow : public ::testing::TestWithParam<double> {};
+
+TEST_P(OnlineVerificationWindow, EqualsVerifyingTheOfflineCandidates) {
     const Sequence sequence = MakeSequence();
-    const DetectorConfig detector = Verifying();
+    DetectorConfig detector = Verifying();
+    detector.verification.coarse.layout_yaw_window_deg = GetParam();
     core::DescriptorConfig config;
     config.method = core::Method::kRange;
     LoopDetector online(config, detector);
@@ -56,11 +60,14 @@ TEST(OnlineVerification, EqualsVerifyingTheOfflineCandidates) {
         prepared.emplace_back(
             registration::PrepareScan(sequence.scans[i], detector.verification.reduction));
     }
-    // Offline as online: the shortlists in the order of the scans' layouts.
+    // Offline as online: the shortlists in the order of the scans' layouts, their yaws searched.
+    const LoopCheck layouts = LayoutOrderOf(prepared, detector.verification.coarse);
+    EXPECT_EQ(static_cast<bool>(layouts.yaw_window), GetParam() < 180.0);
     std::vector<LoopQuery> offline =
         DetectFromMatrix(ComputeSimilarityMatrix(online.database()), times, detector,
-                         core::Method::kRange, {}, LayoutOrderOf(prepared));
-    VerifyQueries(offline, prepared, detector, core::Method::kRange, Execution::kSerial);
+                         core::Method::kRange, {}, layouts);
+    VerifyQueries(offline, prepared, detector, core::Method::kRange, Execution::kSerial, {},
+                  nullptr, layouts);
     for (std::size_t i = 0; i < offline.size(); ++i) {
         ASSERT_EQ(online_results[i].verifications.size(), offline[i].verifications.size()) << i;
         for (std::size_t c = 0; c < offline[i].verifications.size(); ++c) {
@@ -82,7 +89,17 @@ TEST(OnlineVerification, EqualsVerifyingTheOfflineCandidates) {
     EXPECT_LT(Eigen::AngleAxisd(error.linear()).angle(), 0.5 * M_PI / 180.0);
     // Scan 2 has only scan 0 as a candidate, another place: no loop.
     EXPECT_FALSE(online_results[2].accepted);
+    // The window holds the loop's yaw (-170 degrees) and not a quarter turn from it.
+    if (layouts.yaw_window) {
+        const double deg = M_PI / 180.0;
+        const registration::YawWindow window = layouts.YawWindow(3, 0);
+        EXPECT_TRUE(window.Contains(-170.0 * deg));
+        EXPECT_FALSE(window.Contains(-80.0 * deg));
+    }
 }
+
+INSTANTIATE_TEST_SUITE_P(EveryYawAndTheLayouts, OnlineVerificationWindow,
+                         ::testing::Values(180.0, 20.0));
 
 // Online, each shortlist is ordered by the scans' layouts as offline detection orders it with the
 // same layouts, and on these places that is not the descriptor's order.
@@ -101,8 +118,9 @@ TEST(OnlineVerification, OrdersTheShortlistByLayoutAsOffline) {
         results.push_back(online.Process(test::SyntheticPlace(seed), times.back()));
     }
     const SimilarityMatrix matrix = ComputeSimilarityMatrix(online.database());
-    const std::vector<LoopQuery> offline = DetectFromMatrix(
-        matrix, times, detector, core::Method::kRange, {}, LayoutOrderOf(online.prepared_scans()));
+    const std::vector<LoopQuery> offline =
+        DetectFromMatrix(matrix, times, detector, core::Method::kRange, {},
+                         LayoutOrderOf(online.prepared_scans(), {}));
     const std::vector<LoopQuery> ranked =
         DetectFromMatrix(matrix, times, detector, core::Method::kRange);
     const auto indices = [](const LoopQuery& q) {

@@ -141,6 +141,27 @@ TEST(LayoutSignature, APlaceSeenAgainIsMoreAlikeThanOtherPlaces) {
     }
 }
 
+// match = Rz(yaw) query + shift: LayoutYaw finds the yaw of T_match_query, modulo half a turn,
+// within a few degrees (the polar samples are 5 degrees apart, and coarser at low radii).
+TEST(LayoutSignature, YawTurnsTheQuerysLayoutOntoTheMatchs) {
+    const double deg = std::numbers::pi / 180.0;
+    for (unsigned seed : {1U, 3U}) {
+        const Points place = Place(seed);
+        const LayoutSignature query = ComputeLayoutSignature(place);
+        for (const double yaw_deg : {0.0, 12.0, 47.5, 90.0, 133.0, 200.0, 301.0, 358.0}) {
+            const LayoutSignature match = ComputeLayoutSignature(
+                Moved(place, static_cast<float>(yaw_deg * deg), {2.5F, -1.5F}));
+            const double found = LayoutYaw(query, match);
+            EXPECT_GE(found, 0.0);
+            EXPECT_LT(found, std::numbers::pi);
+            EXPECT_LT(std::abs(std::remainder(found - yaw_deg * deg, std::numbers::pi)), 3.0 * deg)
+                << seed << " " << yaw_deg << ": " << found / deg;
+        }
+        EXPECT_TRUE(std::isnan(LayoutYaw(query, {})));
+        EXPECT_TRUE(std::isnan(LayoutYaw({}, query)));
+    }
+}
+
 TEST(LayoutSignature, NoStructureNoSignature) {
     EXPECT_TRUE(ComputeLayoutSignature({}).empty());
     // One point: every magnitude is 1, no contrast.

@@ -514,6 +514,17 @@ TEST(YawWindow, WrapsAroundAndANanWindowIsWhole) {
     EXPECT_NEAR(SearchedYaws(window, CoarseConfig{}).half_width_rad, 15.0 * deg, 1e-12);
 }
 
+TEST(YawWindow, HalfATurnTooHoldsTheOppositeWindow) {
+    const double deg = std::numbers::pi / 180.0;
+    const YawWindow both{20.0 * deg, 10.0 * deg, true};
+    for (const double yaw_deg : {10.0, 29.0, 190.0, 209.0, -151.0})
+        EXPECT_TRUE(both.Contains(yaw_deg * deg)) << yaw_deg;
+    for (const double yaw_deg : {31.0, 100.0, 185.0 - 16.0, 215.0, -90.0})
+        EXPECT_FALSE(both.Contains(yaw_deg * deg)) << yaw_deg;
+    EXPECT_FALSE((YawWindow{20.0 * deg, 10.0 * deg}.Contains(200.0 * deg)));
+    EXPECT_TRUE(SearchedYaws(both, CoarseConfig{}).half_turn_too);
+}
+
 // The query turned by 60 degrees: the full search's best peak lies at 60 degrees. A window
 // there finds the same peak, bit for bit; a window elsewhere never looks at 60 degrees.
 TEST(CoarseAlign, AYawWindowSearchesWithinItAndFindsWhatTheFullSearchFindsThere) {

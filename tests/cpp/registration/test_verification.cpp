@@ -407,6 +407,9 @@ TEST(Verification, InvalidConfigIsAConfigError) {
     expect_error([](auto& c) { c.coarse.min_hypothesis_score_ratio = 1.5; });
     expect_error([](auto& c) { c.coarse.max_peak_beyond_loop_m = -1.0; });
     expect_error([](auto& c) { c.coarse.max_peak_beyond_loop_m = std::nan(""); });
+    expect_error([](auto& c) { c.coarse.layout_yaw_window_deg = 0.5; });
+    expect_error([](auto& c) { c.coarse.layout_yaw_window_deg = 181.0; });
+    expect_error([](auto& c) { c.coarse.layout_yaw_window_deg = std::nan(""); });
     expect_error(
         [](auto& c) { c.icp.final_correspondence_m = 2 * c.icp.initial_correspondence_m; });
     expect_error([](auto& c) { c.acceptance.min_overlap = 1.5; });
