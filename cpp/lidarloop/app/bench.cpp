@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <random>
 #include <string>
 
@@ -12,6 +13,7 @@
 #include "lidarloop/app/detection.hpp"
 #include "lidarloop/app/results_folder.hpp"
 #include "lidarloop/app/verification_run.hpp"
+#include "lidarloop/core/byte_codec.hpp"
 #include "lidarloop/core/descriptor_config.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/core/stopwatch.hpp"
@@ -100,6 +102,18 @@ pipeline::DescriptorDatabase Scaled(const pipeline::DescriptorDatabase& source, 
     return scaled;
 }
 
+// The first `count` scans of `database` as a database of their own (copied through the
+// encoding a saved map uses).
+pipeline::DescriptorDatabase FirstScans(const pipeline::DescriptorDatabase& database,
+                                        std::size_t count) {
+    core::ByteWriter out;
+    for (std::size_t i = 0; i < count; ++i) database.Encode(i, out);
+    core::ByteReader in(out.data());
+    pipeline::DescriptorDatabase first(database.config());
+    for (std::size_t i = 0; i < count; ++i) first.Decode(in);
+    return first;
+}
+
 // The online step of one scan on one core, milliseconds: what a loop closer beside a SLAM front
 // end spends on it (the file read excluded: a live system gets the cloud in memory).
 double OnlineStepMs(const pipeline::SequenceDescriptors& described, const PreparedScans& prepared,
@@ -115,13 +129,13 @@ double OnlineStepMs(const pipeline::SequenceDescriptors& described, const Prepar
 // the online detector with a gate applies them. Each timed query's candidates are searched again
 // as the online detector searches them (pipeline::StreamingDetection), timed, and verified.
 nlohmann::json TimeVerification(const pipeline::SequenceDescriptors& described,
-                                const pipeline::SimilarityMatrix& matrix,
                                 const PreparedScans& prepared, const io::RunConfig& config,
                                 std::size_t queries, const std::vector<double>& path_m,
                                 const pipeline::LoopCheck& check) {
-    std::vector<pipeline::LoopQuery> all =
-        pipeline::DetectFromMatrix(matrix, described.database.times_s(), config.detection,
-                                   config.descriptor.method, path_m, check);
+    // The scans with candidates, among which the timed ones are spaced (memory linear in the
+    // scans, as detect's own search without the matrix).
+    std::vector<pipeline::LoopQuery> all = pipeline::DetectStreaming(
+        described.database, config.detection, pipeline::Execution::kParallel, path_m, check);
     std::erase_if(all, [](const pipeline::LoopQuery& q) { return !q.has_match(); });
     // Each timed query verified as detect verifies it (VerifyQuery: one candidate after another,
     // those the odometry rules out answered without registering, the images of the yaws the
@@ -204,6 +218,11 @@ void BenchRequest::Validate() const {
     check("queries", queries, kMaxQueries);
     check("verify_queries", verify_queries, kMaxQueries);
     check("scale_to", scale_to, kMaxScaleTo);
+    check("matrix_scans", matrix_scans, kMaxQueries);
+    if (matrix_scans < 2) {
+        throw core::ConfigError("bench: matrix_scans must be at least 2, got " +
+                                std::to_string(matrix_scans));
+    }
     if (scale_to > 0 && !core::IsHistogramMethod(config.descriptor.method)) {
         throw core::ConfigError("bench: scale_to times the histogram index, and method " +
                                 core::ToString(config.descriptor.method) + " has none");
@@ -223,15 +242,23 @@ nlohmann::json RunBench(const io::Dataset& dataset, const BenchRequest& request)
     const auto described = DescribeDataset(dataset, config.descriptor, run);
     const auto& database = described.database;
 
+    // The first scans of a long sequence (4,000: 32 MB, 8 million comparisons; an hour at 10 Hz
+    // whole: 2.6 GB).
+    const std::size_t matrix_scans = std::min(database.size(), request.matrix_scans);
+    std::optional<pipeline::DescriptorDatabase> first;
+    if (matrix_scans < database.size()) first = FirstScans(database, matrix_scans);
+    const pipeline::DescriptorDatabase& timed = first ? *first : database;
     Stopwatch serial_clock;
-    const auto matrix = pipeline::ComputeSimilarityMatrix(database, pipeline::Execution::kSerial);
+    const std::size_t matrix_pairs =
+        pipeline::ComputeSimilarityMatrix(timed, pipeline::Execution::kSerial).condensed().size();
     const double serial_s = serial_clock.Seconds();
     Stopwatch parallel_clock;
-    pipeline::ComputeSimilarityMatrix(database, pipeline::Execution::kParallel);
+    pipeline::ComputeSimilarityMatrix(timed, pipeline::Execution::kParallel);
     const double parallel_s = parallel_clock.Seconds();
-    const double pairs = static_cast<double>(matrix.condensed().size());
+    const auto pairs = static_cast<double>(matrix_pairs);
 
-    nlohmann::json json = TimingsJson(described, matrix.condensed().size(), parallel_s);
+    nlohmann::json json = TimingsJson(described, matrix_pairs, parallel_s);
+    json["similarity_matrix_scans"] = matrix_scans;
     json["method"] = core::ToString(config.descriptor.method);
     json["ns_per_comparison_one_core"] = pairs > 0 ? 1e9 * serial_s / pairs : 0.0;
     json["similarity_matrix_one_core_s"] = serial_s;
@@ -256,8 +283,8 @@ nlohmann::json RunBench(const io::Dataset& dataset, const BenchRequest& request)
         pipeline::LoopCheck check = ScansOwnCheck(prepared, config.detection.verification.coarse);
         if (!odometry.empty())
             check = OdometryLoopCheck(odometry, path_m, config.posegraph, nullptr, &prepared);
-        json["verification"] = TimeVerification(described, matrix, prepared, config,
-                                                request.verify_queries, path_m, check);
+        json["verification"] =
+            TimeVerification(described, prepared, config, request.verify_queries, path_m, check);
     }
     json["peak_memory_mib"] = PeakMemoryMiB();
     return json;

@@ -26,17 +26,22 @@ struct BenchRequest {
     std::filesystem::path odometry_file;
     std::string odometry_topic;
     std::filesystem::path odometry_calib;  ///< as DetectRequest::odometry_calib
+    /// The similarity matrix is timed on at most this many scans, the first (2..kMaxQueries): a
+    /// comparison costs the same whatever the length, but the matrix grows with its square.
+    std::size_t matrix_scans = 4000;
     Progress progress;
 
-    /// Throws core::ConfigError for counts no machine holds (queries, verify_queries over
-    /// kMaxQueries; scale_to over kMaxScaleTo histograms, gigabytes), and for scale_to with a
-    /// method that has no histogram index (it would be ignored).
+    /// Throws core::ConfigError for counts no machine holds (queries, verify_queries,
+    /// matrix_scans over kMaxQueries; scale_to over kMaxScaleTo histograms, gigabytes), a
+    /// matrix of fewer than 2 scans, and scale_to with a method that has no histogram index (it
+    /// would be ignored).
     void Validate() const;
     static constexpr std::size_t kMaxQueries = 1'000'000;
     static constexpr std::size_t kMaxScaleTo = 2'000'000;
 };
 
-/// Times describing (one core), the similarity matrix (one core and all cores), and top-1
+/// Times describing (one core), the similarity matrix of the first matrix_scans scans (one core
+/// and all cores), and top-1
 /// queries through the index and by brute force on `dataset`; with scale_to, also queries
 /// against a synthetic database of that many perturbed histograms; and geometric verification on
 /// one core: preparing a scan, the query's coarse images, and each candidate pair (wall and

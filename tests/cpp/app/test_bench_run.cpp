@@ -85,6 +85,8 @@ TEST(BenchRun, AbsurdCountsAreRefusedBeforeAnyWork) {
     refused([](app::BenchRequest& r) { r.scale_to = app::BenchRequest::kMaxScaleTo + 1; });
     refused([](app::BenchRequest& r) { r.queries = std::size_t(-1); });
     refused([](app::BenchRequest& r) { r.verify_queries = app::BenchRequest::kMaxQueries + 1; });
+    refused([](app::BenchRequest& r) { r.matrix_scans = app::BenchRequest::kMaxQueries + 1; });
+    refused([](app::BenchRequest& r) { r.matrix_scans = 1; });
     refused([](app::BenchRequest& r) {  // no histogram index to scale: never silently ignored
         r.config.descriptor.method = core::Method::kNdt;
         r.scale_to = 100;
@@ -151,6 +153,31 @@ TEST(BenchRun, VerificationFiguresAreRecountedIndependently) {
         EXPECT_GT(v["online_step_ms_per_scan"][statistic].get<double>(), candidates_ms)
             << statistic;
     }
+}
+
+// On a long sequence the matrix is timed on its first scans (its memory grows with the square);
+// the rest of bench, the verified queries included, still covers every scan.
+TEST(BenchRun, TimesTheMatrixOfTheFirstScansOnly) {
+    test::TempDir dir;
+    const io::Dataset dataset = TinyRevisit(dir / "sequence");
+    app::BenchRequest request;
+    request.config.detection.min_gap.value = 10;
+    request.config.detection.top_k = 2;  // registration is the slow part under the sanitizers
+    request.queries = 3;
+    request.verify_queries = 3;
+    const nlohmann::json whole = app::RunBench(dataset, request);
+    request.matrix_scans = 5;
+    const nlohmann::json first = app::RunBench(dataset, request);
+    const std::size_t n = dataset.size();
+    EXPECT_EQ(whole["similarity_matrix_scans"].get<std::size_t>(), n);
+    EXPECT_EQ(whole["pairs"].get<std::size_t>(), n * (n - 1) / 2);
+    EXPECT_EQ(first["similarity_matrix_scans"].get<std::size_t>(), 5U);
+    EXPECT_EQ(first["pairs"].get<std::size_t>(), 10U);
+    EXPECT_EQ(first["scans"].get<std::size_t>(), n);
+    for (const char* key : {"queries", "pairs", "pairs_accepted"}) {
+        EXPECT_EQ(first["verification"][key], whole["verification"][key]) << key;
+    }
+    EXPECT_GT(whole["verification"]["pairs"].get<std::size_t>(), 0U);
 }
 
 // A timed step with no sample (a gap longer than the sequence: no candidate pair) is no figure:
