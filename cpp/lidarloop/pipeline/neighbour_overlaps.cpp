@@ -189,9 +189,9 @@ LoopCheck CheckAgainstMotion(StepOf step_of, const registration::AcceptanceConfi
     return check;
 }
 
-LoopCheck JudgeOf(const LoopCheck& odometry, std::function<double(std::size_t)> reference_of,
+LoopCheck JudgeOf(const LoopCheck& given, std::function<double(std::size_t)> reference_of,
                   StepOf step_of, const registration::VerificationConfig& config) {
-    if (odometry) return odometry;
+    if (given) return given;
     LoopCheck neighbours = CheckAgainstNeighbours(std::move(reference_of),
                                                   config.acceptance.min_neighbour_overlap_ratio);
     LoopCheck motion =
@@ -208,7 +208,7 @@ LoopCheck JudgeOf(const LoopCheck& odometry, std::function<double(std::size_t)> 
             motion(q);
         };
     }
-    judge.yaw_window = odometry.yaw_window;  // the layouts' (LayoutOrderOf), where given
+    judge.yaw_window = given.yaw_window;  // the layouts' (LayoutOrderOf), where given
     return judge;
 }
 

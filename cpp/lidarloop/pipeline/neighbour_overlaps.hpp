@@ -114,12 +114,12 @@ LoopCheck CheckAgainstMotion(StepOf step_of, const registration::AcceptanceConfi
 /// check rejects only: the candidates are searched, ordered and registered as without it.
 LoopCheck CheckAgainstNeighbours(std::function<double(std::size_t)> reference_of, double min_ratio);
 
-/// What judges a sequence's verified loops: `odometry` where given (non-empty), else, with no
-/// knowledge besides the scans, CheckAgainstNeighbours with `reference_of` (e.g.
-/// NeighbourOverlaps::Of) at config.acceptance.min_neighbour_overlap_ratio, then, given
+/// What judges a sequence's verified loops: `given` where it judges (non-empty: the odometry's
+/// check), else, with no knowledge besides the scans, CheckAgainstNeighbours with `reference_of`
+/// (e.g. NeighbourOverlaps::Of) at config.acceptance.min_neighbour_overlap_ratio, then, given
 /// `step_of` (e.g. NeighbourOverlaps::StepOf; offline: VerifyQueries), CheckAgainstMotion; with
-/// `odometry`'s yaw_window (the layouts', LayoutOrderOf).
-LoopCheck JudgeOf(const LoopCheck& odometry, std::function<double(std::size_t)> reference_of,
+/// `given`'s yaw_window (the layouts', LayoutOrderOf).
+LoopCheck JudgeOf(const LoopCheck& given, std::function<double(std::size_t)> reference_of,
                   StepOf step_of, const registration::VerificationConfig& config);
 
 }  // namespace lidarloop::pipeline

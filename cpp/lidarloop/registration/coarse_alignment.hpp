@@ -26,7 +26,7 @@ struct PlanarHypothesis {
 struct YawWindow {
     double centre_rad = 0.0;
     double half_width_rad = std::numbers::pi;
-    bool half_turn_too = false;
+    bool half_turn_too = false;  ///< also the window around centre_rad + pi
 
     bool Whole() const;
     /// Whether `yaw_rad` lies within the window (angles wrapped).

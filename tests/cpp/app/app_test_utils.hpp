@@ -5,7 +5,11 @@
 #include <filesystem>
 
 #include "lidarloop/app/simulation.hpp"
+#include "lidarloop/core/angles.hpp"
 #include "lidarloop/io/dataset.hpp"
+#include "lidarloop/registration/compact_prepared_scan.hpp"
+#include "lidarloop/registration/layout_signature.hpp"
+#include "lidarloop/registration/verification.hpp"
 
 namespace lidarloop::test {
 
@@ -42,6 +46,24 @@ inline io::Dataset SmallSequence(const std::filesystem::path& folder) {
 inline io::Dataset OtherSmallSequence(const std::filesystem::path& folder, std::uint64_t seed) {
     WriteSmallSequence(folder, seed);
     return io::OpenDataset(folder);
+}
+
+/// A pair registered on its own, its scans kept as detect keeps them (compact), its coarse search
+/// within the yaws their layouts suggest, as detect and bench search without odometry.
+inline registration::Verification VerifyAsKept(const core::PointCloud& query,
+                                               const core::PointCloud& match,
+                                               const registration::VerificationConfig& config) {
+    const auto kept = [&](const core::PointCloud& scan) {
+        return registration::CompactPreparedScan(registration::PrepareScan(scan, config.reduction));
+    };
+    const registration::CompactPreparedScan kept_query = kept(query), kept_match = kept(match);
+    const registration::YawWindow yaws{
+        registration::LayoutYaw(kept_query.layout(), kept_match.layout()),
+        config.coarse.layout_yaw_window_deg * core::kRadiansPerDegree, true};
+    const registration::PreparedScan prepared_query = kept_query.Expand();
+    return registration::Verify(
+        prepared_query, registration::CoarseQuery(*prepared_query.structure, config.coarse, {yaws}),
+        kept_match.Expand(), config, {}, yaws);
 }
 
 }  // namespace lidarloop::test

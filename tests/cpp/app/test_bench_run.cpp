@@ -6,10 +6,12 @@
 
 #include <gtest/gtest.h>
 
+#include "app_test_utils.hpp"
 #include "lidarloop/app/bench.hpp"
 #include "lidarloop/app/describe_run.hpp"
 #include "lidarloop/core/error.hpp"
 #include "lidarloop/io/kitti_bin.hpp"
+#include "lidarloop/pipeline/loop_detector.hpp"
 #include "lidarloop/pipeline/similarity_matrix.hpp"
 #include "lidarloop/registration/compact_prepared_scan.hpp"
 #include "lidarloop/registration/verification.hpp"
@@ -35,13 +37,19 @@ io::Dataset TinyRevisit(const std::filesystem::path& folder) {
 }
 
 // The pairs bench verifies: the candidates of `queries` evenly spaced scans that have any, as
-// docs/cli.md describes --verify-queries.
+// docs/cli.md describes --verify-queries, ordered by the scans' layouts (no odometry).
 std::vector<pipeline::LoopQuery> BenchedQueries(const io::Dataset& dataset,
                                                 const io::RunConfig& config, std::size_t queries) {
     const auto described = pipeline::DescribeSequence(app::SourceOf(dataset), config.descriptor);
+    std::vector<registration::CompactPreparedScan> kept;
+    for (std::size_t i = 0; i < dataset.size(); ++i) {
+        kept.emplace_back(registration::PrepareScan(dataset.LoadScan(i),
+                                                    config.detection.verification.reduction));
+    }
     std::vector<pipeline::LoopQuery> all = pipeline::DetectFromMatrix(
         pipeline::ComputeSimilarityMatrix(described.database), described.database.times_s(),
-        config.detection, config.descriptor.method);
+        config.detection, config.descriptor.method, {},
+        pipeline::LayoutOrderOf(kept, config.detection.verification.coarse));
     std::erase_if(all, [](const pipeline::LoopQuery& q) { return !q.has_match(); });
     std::vector<pipeline::LoopQuery> chosen;
     const std::size_t step = std::max<std::size_t>(1, all.size() / queries);
@@ -117,8 +125,8 @@ TEST(BenchRun, VerificationFiguresAreRecountedIndependently) {
     for (const pipeline::LoopQuery& q : queries) {
         for (const pipeline::Neighbor& candidate : q.candidates) {
             ++pairs;
-            const bool loop = registration::VerifyPair(dataset.LoadScan(q.query),
-                                                       dataset.LoadScan(candidate.index), config)
+            const bool loop = test::VerifyAsKept(dataset.LoadScan(q.query),
+                                                 dataset.LoadScan(candidate.index), config)
                                   .accepted;
             accepted += loop;
             if (loop) break;  // the online step stops at the first loop

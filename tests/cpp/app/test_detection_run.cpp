@@ -31,7 +31,6 @@
 #include "lidarloop/pipeline/scancontext_method.hpp"
 #include "lidarloop/posegraph/optimiser.hpp"
 #include "lidarloop/registration/compact_prepared_scan.hpp"
-#include "lidarloop/registration/layout_signature.hpp"
 #include "lidarloop/registration/submap.hpp"
 #include "lidarloop/registration/verification.hpp"
 #include "test_utils.hpp"
@@ -887,24 +886,6 @@ void ExpectFilesStateTheVerdicts(const app::DetectRequest& request,
     }
 }
 
-// A pair registered on its own, its scans kept as detect keeps them (compact), its coarse search
-// within the yaws their layouts suggest, as detect searches without odometry.
-registration::Verification VerifyAsKept(const core::PointCloud& query,
-                                        const core::PointCloud& match,
-                                        const registration::VerificationConfig& config) {
-    const auto kept = [&](const core::PointCloud& scan) {
-        return registration::CompactPreparedScan(registration::PrepareScan(scan, config.reduction));
-    };
-    const registration::CompactPreparedScan kept_query = kept(query), kept_match = kept(match);
-    const registration::YawWindow yaws{
-        registration::LayoutYaw(kept_query.layout(), kept_match.layout()),
-        config.coarse.layout_yaw_window_deg * core::kRadiansPerDegree, true};
-    const registration::PreparedScan prepared_query = kept_query.Expand();
-    return registration::Verify(
-        prepared_query, registration::CoarseQuery(*prepared_query.structure, config.coarse, {yaws}),
-        kept_match.Expand(), config, {}, yaws);
-}
-
 // Verification inside detect gives what registering each candidate on its own gives, and the
 // same verdicts and poses within a centimetre as the scans at full precision.
 TEST_F(DetectionRun, VerifiesEveryCandidateAsRegisteringThePairAlone) {
@@ -926,7 +907,7 @@ TEST_F(DetectionRun, VerifiesEveryCandidateAsRegisteringThePairAlone) {
             if (q.query % 17 != 0) continue;  // a sample: each pair is a registration
             const core::PointCloud query = dataset_->LoadScan(q.query);
             const core::PointCloud match = dataset_->LoadScan(q.candidates[r].index);
-            const registration::Verification alone = VerifyAsKept(query, match, config);
+            const registration::Verification alone = test::VerifyAsKept(query, match, config);
             EXPECT_EQ(v.accepted, alone.accepted) << q.query << " " << r;
             EXPECT_EQ(v.reason, alone.reason) << q.query << " " << r;
             EXPECT_TRUE(v.T_match_query.isApprox(alone.T_match_query, 1e-9));

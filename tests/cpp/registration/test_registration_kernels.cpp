@@ -519,7 +519,7 @@ TEST(YawWindow, HalfATurnTooHoldsTheOppositeWindow) {
     const YawWindow both{20.0 * deg, 10.0 * deg, true};
     for (const double yaw_deg : {10.0, 29.0, 190.0, 209.0, -151.0})
         EXPECT_TRUE(both.Contains(yaw_deg * deg)) << yaw_deg;
-    for (const double yaw_deg : {31.0, 100.0, 185.0 - 16.0, 215.0, -90.0})
+    for (const double yaw_deg : {31.0, 100.0, 169.0, 215.0, -90.0})
         EXPECT_FALSE(both.Contains(yaw_deg * deg)) << yaw_deg;
     EXPECT_FALSE((YawWindow{20.0 * deg, 10.0 * deg}.Contains(200.0 * deg)));
     EXPECT_TRUE(SearchedYaws(both, CoarseConfig{}).half_turn_too);
