@@ -218,7 +218,7 @@ void BenchRequest::Validate() const {
     check("queries", queries, kMaxQueries);
     check("verify_queries", verify_queries, kMaxQueries);
     check("scale_to", scale_to, kMaxScaleTo);
-    check("matrix_scans", matrix_scans, kMaxQueries);
+    check("matrix_scans", matrix_scans, kMaxMatrixScans);
     if (matrix_scans < 2) {
         throw core::ConfigError("bench: matrix_scans must be at least 2, got " +
                                 std::to_string(matrix_scans));

@@ -93,7 +93,7 @@ TEST(BenchRun, AbsurdCountsAreRefusedBeforeAnyWork) {
     refused([](app::BenchRequest& r) { r.scale_to = app::BenchRequest::kMaxScaleTo + 1; });
     refused([](app::BenchRequest& r) { r.queries = std::size_t(-1); });
     refused([](app::BenchRequest& r) { r.verify_queries = app::BenchRequest::kMaxQueries + 1; });
-    refused([](app::BenchRequest& r) { r.matrix_scans = app::BenchRequest::kMaxQueries + 1; });
+    refused([](app::BenchRequest& r) { r.matrix_scans = app::BenchRequest::kMaxMatrixScans + 1; });
     refused([](app::BenchRequest& r) { r.matrix_scans = 1; });
     refused([](app::BenchRequest& r) {  // no histogram index to scale: never silently ignored
         r.config.descriptor.method = core::Method::kNdt;
@@ -101,6 +101,7 @@ TEST(BenchRun, AbsurdCountsAreRefusedBeforeAnyWork) {
     });
     app::BenchRequest largest;
     largest.scale_to = app::BenchRequest::kMaxScaleTo;
+    largest.matrix_scans = app::BenchRequest::kMaxMatrixScans;
     largest.queries = app::BenchRequest::kMaxQueries;
     EXPECT_NO_THROW(largest.Validate());
 }
