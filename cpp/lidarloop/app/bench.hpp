@@ -31,11 +31,10 @@ struct BenchRequest {
     std::size_t matrix_scans = 4000;
     Progress progress;
 
-    /// Throws core::ConfigError for counts no machine holds (queries, verify_queries,
+    /// Throws core::ConfigError for counts no machine holds (queries, verify_queries over
     /// kMaxQueries; matrix_scans over kMaxMatrixScans; scale_to over kMaxScaleTo histograms,
-    /// gigabytes), a
-    /// matrix of fewer than 2 scans, and scale_to with a method that has no histogram index (it
-    /// would be ignored).
+    /// gigabytes), for a matrix of fewer than 2 scans, and for scale_to with a method that has no
+    /// histogram index (it would be ignored).
     void Validate() const;
     static constexpr std::size_t kMaxQueries = 1'000'000;
     static constexpr std::size_t kMaxScaleTo = 2'000'000;
