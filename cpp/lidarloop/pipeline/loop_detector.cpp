@@ -641,13 +641,8 @@ LoopCheck LayoutOrderOf(const std::vector<registration::CompactPreparedScan>& sc
         return registration::LayoutSimilarity(layout_of(a), layout_of(b));
     };
     if (coarse.layout_yaw_window_deg < 180.0) {
-        check.yaw_window = [layout_of, half_width_rad =
-                                           coarse.layout_yaw_window_deg * core::kRadiansPerDegree](
-                               std::size_t query_scan, std::size_t match) {
-            // NaN without both layouts: every yaw.
-            return registration::YawWindow{
-                registration::LayoutYaw(layout_of(query_scan), layout_of(match)), half_width_rad,
-                true};
+        check.yaw_window = [layout_of, coarse](std::size_t query_scan, std::size_t match) {
+            return registration::LayoutYawWindow(layout_of(query_scan), layout_of(match), coarse);
         };
     }
     return check;

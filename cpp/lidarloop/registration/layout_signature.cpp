@@ -9,6 +9,7 @@
 #include <limits>
 #include <numbers>
 
+#include "lidarloop/core/angles.hpp"
 #include "lidarloop/registration/coarse_alignment.hpp"
 #include "lidarloop/registration/detail/fft2d.hpp"
 
@@ -129,6 +130,13 @@ double LayoutYaw(const LayoutSignature& query, const LayoutSignature& match) {
     const double step_rad = std::numbers::pi / kAngles;
     const double yaw_rad = (best + offset) * step_rad;
     return std::fmod(yaw_rad + std::numbers::pi, std::numbers::pi);
+}
+
+YawWindow LayoutYawWindow(const LayoutSignature& query, const LayoutSignature& match,
+                          const CoarseConfig& config) {
+    // A NaN centre (no layout) is the whole circle.
+    return YawWindow{LayoutYaw(query, match),
+                     config.layout_yaw_window_deg * core::kRadiansPerDegree, true};
 }
 
 }  // namespace lidarloop::registration

@@ -4,6 +4,8 @@
 
 #include <Eigen/Core>
 
+#include "lidarloop/registration/coarse_alignment.hpp"
+
 namespace lidarloop::registration {
 
 /// A scan's layout seen from above, wherever in it the sensor stood: the magnitudes of the 2-D
@@ -36,5 +38,11 @@ double LayoutSimilarity(const LayoutSignature& a, const LayoutSignature& b);
 /// a parabola. The magnitudes repeat after half a turn, so the loop's yaw is this or this plus
 /// pi. NaN when either is empty.
 double LayoutYaw(const LayoutSignature& query, const LayoutSignature& match);
+
+/// The yaws of T_match_query a pair's coarse search looks at where no odometry bounds them:
+/// within config.layout_yaw_window_deg of LayoutYaw and of that plus half a turn; every yaw where
+/// either layout is empty (docs/verification.md, "The layouts bound the yaw search").
+YawWindow LayoutYawWindow(const LayoutSignature& query, const LayoutSignature& match,
+                          const CoarseConfig& config);
 
 }  // namespace lidarloop::registration

@@ -5,7 +5,6 @@
 #include <filesystem>
 
 #include "lidarloop/app/simulation.hpp"
-#include "lidarloop/core/angles.hpp"
 #include "lidarloop/io/dataset.hpp"
 #include "lidarloop/registration/compact_prepared_scan.hpp"
 #include "lidarloop/registration/layout_signature.hpp"
@@ -57,9 +56,8 @@ inline registration::Verification VerifyAsKept(const core::PointCloud& query,
         return registration::CompactPreparedScan(registration::PrepareScan(scan, config.reduction));
     };
     const registration::CompactPreparedScan kept_query = kept(query), kept_match = kept(match);
-    const registration::YawWindow yaws{
-        registration::LayoutYaw(kept_query.layout(), kept_match.layout()),
-        config.coarse.layout_yaw_window_deg * core::kRadiansPerDegree, true};
+    const registration::YawWindow yaws =
+        registration::LayoutYawWindow(kept_query.layout(), kept_match.layout(), config.coarse);
     const registration::PreparedScan prepared_query = kept_query.Expand();
     return registration::Verify(
         prepared_query, registration::CoarseQuery(*prepared_query.structure, config.coarse, {yaws}),

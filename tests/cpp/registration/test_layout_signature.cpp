@@ -156,9 +156,14 @@ TEST(LayoutSignature, YawTurnsTheQuerysLayoutOntoTheMatchs) {
             EXPECT_LT(found, std::numbers::pi);
             EXPECT_LT(std::abs(std::remainder(found - yaw_deg * deg, std::numbers::pi)), 3.0 * deg)
                 << seed << " " << yaw_deg << ": " << found / deg;
+            // The default window holds the turn, not a quarter turn from it.
+            const YawWindow window = LayoutYawWindow(query, match, CoarseConfig{});
+            EXPECT_TRUE(window.Contains(yaw_deg * deg)) << seed << " " << yaw_deg;
+            EXPECT_FALSE(window.Contains((yaw_deg + 90.0) * deg)) << seed << " " << yaw_deg;
         }
         EXPECT_TRUE(std::isnan(LayoutYaw(query, {})));
         EXPECT_TRUE(std::isnan(LayoutYaw({}, query)));
+        EXPECT_TRUE(LayoutYawWindow(query, {}, CoarseConfig{}).Whole());
     }
 }
 
