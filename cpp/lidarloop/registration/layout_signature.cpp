@@ -10,6 +10,7 @@
 #include <numbers>
 
 #include "lidarloop/core/angles.hpp"
+#include "lidarloop/core/detail/vector_clones.hpp"
 #include "lidarloop/registration/coarse_alignment.hpp"
 #include "lidarloop/registration/detail/fft2d.hpp"
 
@@ -83,6 +84,9 @@ LayoutSignature ComputeLayoutSignature(const std::vector<Eigen::Vector3f>& struc
 namespace {
 
 // Per angle shift, the correlation of `a`'s rows with `b`'s shifted by it, summed over radii.
+// Every shift's sum runs over k in order as a scalar loop would, so the result is the same to
+// the bit; the shifts are the vector lanes (GCC vectorises the inner loop, no reassociation).
+LIDARLOOP_VECTOR_CLONES
 std::array<float, LayoutSignature::kAngles> ShiftedCorrelations(const LayoutSignature& a,
                                                                 const LayoutSignature& b) {
     constexpr int kAngles = LayoutSignature::kAngles;
@@ -92,11 +96,14 @@ std::array<float, LayoutSignature::kAngles> ShiftedCorrelations(const LayoutSign
         const float* row_b = b.values.data() + static_cast<std::ptrdiff_t>(r) * kAngles;
         float doubled[2 * kAngles];
         for (int k = 0; k < kAngles; ++k) doubled[k] = doubled[k + kAngles] = row_b[k];
-        for (int shift = 0; shift < kAngles; ++shift) {
-            float sum = 0.0F;
-            for (int k = 0; k < kAngles; ++k) sum += row_a[k] * doubled[k + shift];
-            shifted[static_cast<std::size_t>(shift)] += sum;
+        float sums[kAngles] = {};
+        for (int k = 0; k < kAngles; ++k) {
+            const float weight = row_a[k];
+            const float* from = doubled + k;
+            for (int shift = 0; shift < kAngles; ++shift) sums[shift] += weight * from[shift];
         }
+        for (int shift = 0; shift < kAngles; ++shift)
+            shifted[static_cast<std::size_t>(shift)] += sums[shift];
     }
     return shifted;
 }
