@@ -173,6 +173,8 @@ void VisitFields(registration::IcpConfig& c, Visitor& v) {
             "query ground points the first stage pairs");
     v.Field("abandon_below_overlap", c.abandon_below_overlap,
             "a pose overlapping less after the first stage is abandoned");
+    v.Field("abandon_above_shifted_overlap", c.abandon_above_shifted_overlap,
+            "without odometry, a pose sliding more freely after the first stage is abandoned");
     v.Field("aligned_step_factor", c.aligned_step_factor,
             "a step along the previous one moves up to this many times as far (1: plain)");
     v.Field("rival_step_factor", c.rival_step_factor,

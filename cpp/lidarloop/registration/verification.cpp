@@ -250,19 +250,45 @@ bool SamePose(const core::Transform& a, const core::Transform& b) {
            Eigen::AngleAxisd(difference.linear()).angle() < 5.0 * std::numbers::pi / 180.0;
 }
 
+// Whether the first stage's pose slides: shifted along the direction the overlapping points
+// constrain least, more than `max_ratio` of those facing it still fit (every stride-th query
+// point: an estimate, as the abandonment check's overlap is).
+bool Slides(const PreparedScan& query, const PreparedScan& match,
+            const core::Transform& T_match_query, const AcceptanceConfig& config, double max_ratio,
+            std::size_t stride) {
+    if (max_ratio >= 1.0) return false;
+    const Eigen::Isometry3f T = T_match_query.cast<float>();
+    const OneWay forward = OverlapOneWay(*query.structure, query.structure_distinctive,
+                                         *match.structure, T, config, true, stride);
+    const Eigen::Vector2f d = WeakestDirection(forward.overlapping_partner_xy).cast<float>();
+    const std::vector<std::uint32_t> facing = PointsFacing(forward, d, kFacingWithin60Degrees);
+    return ShiftedOverlapRatio(*query.structure, *match.structure, T, d, facing, config) >
+           max_ratio;
+}
+
 // ICP from `initial` with `icp`, abandoned after its first stage when the pose overlaps too
-// little to ever pass (IcpConfig::abandon_below_overlap) or, searching for a rival of the
+// little to ever pass (IcpConfig::abandon_below_overlap), when it slides and `slid` is given
+// (IcpConfig::abandon_above_shifted_overlap; `*slid` says so) or, searching for a rival of the
 // `accepted` pose, when it has come to that pose: the later stages only refine toward it
 // (docs/verification.md, "No half-way rivals").
 IcpResult Refine(const PreparedScan& query, const PreparedScan& match,
                  const core::Transform& initial, const VerificationConfig& config,
                  const IcpConfig& icp,
-                 const std::optional<core::Transform>& accepted = std::nullopt) {
+                 const std::optional<core::Transform>& accepted = std::nullopt,
+                 bool* slid = nullptr) {
     return RefinePointToPlane(
         query, match, initial, icp, [&](const core::Transform& T_match_query) {
             if (accepted && SamePose(T_match_query, *accepted)) return false;
-            return OverlapReaches(query, match, T_match_query, config.acceptance,
-                                  config.icp.abandon_below_overlap, kAbandonCheckStride);
+            if (!OverlapReaches(query, match, T_match_query, config.acceptance,
+                                config.icp.abandon_below_overlap, kAbandonCheckStride))
+                return false;
+            if (slid != nullptr &&
+                Slides(query, match, T_match_query, config.acceptance,
+                       config.icp.abandon_above_shifted_overlap, kAbandonCheckStride)) {
+                *slid = true;
+                return false;
+            }
+            return true;
         });
 }
 
@@ -270,7 +296,10 @@ IcpResult Refine(const PreparedScan& query, const PreparedScan& match,
 Verification RegisterFrom(const PreparedScan& query, const PreparedScan& match,
                           const PlanarHypothesis& hypothesis, const VerificationConfig& config,
                           bool odometry_judges) {
-    const IcpResult icp = Refine(query, match, PlanarPose(hypothesis), config, config.icp);
+    // Where the odometry judges, its looser degeneracy test decides at the end.
+    bool slid = false;
+    const IcpResult icp = Refine(query, match, PlanarPose(hypothesis), config, config.icp,
+                                 std::nullopt, odometry_judges ? nullptr : &slid);
     Verification result;
     result.T_match_query = icp.T_match_query;
     result.overlap =
@@ -278,9 +307,10 @@ Verification RegisterFrom(const PreparedScan& query, const PreparedScan& match,
     result.coarse_score = hypothesis.score;
     result.icp_iterations = icp.iterations;
     result.shifted_overlap_ratio = result.overlap.shifted_overlap_ratio;
-    result.reason = icp.abandoned ? RejectReason::kLowOverlap
-                                  : Judge(query, match, result, icp.converged, config.acceptance,
-                                          odometry_judges);
+    result.reason = slid            ? RejectReason::kDegenerate
+                    : icp.abandoned ? RejectReason::kLowOverlap
+                                    : Judge(query, match, result, icp.converged, config.acceptance,
+                                            odometry_judges);
     result.accepted = result.reason == RejectReason::kNone;
     return result;
 }

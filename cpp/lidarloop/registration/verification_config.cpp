@@ -69,6 +69,7 @@ void IcpConfig::Validate() const {
     RequireIn(first_stage_structure_points, 10, 1'000'000, "icp.first_stage_structure_points");
     RequireIn(first_stage_ground_points, 10, 1'000'000, "icp.first_stage_ground_points");
     RequireIn(abandon_below_overlap, 0.0, 1.0, "icp.abandon_below_overlap");
+    RequireIn(abandon_above_shifted_overlap, 0.0, 1.0, "icp.abandon_above_shifted_overlap");
     RequireIn(aligned_step_factor, 1.0, 4.0, "icp.aligned_step_factor");
     RequireIn(rival_step_factor, 1.0, 4.0, "icp.rival_step_factor");
 }

@@ -107,6 +107,14 @@ struct IcpConfig {
     /// measured on simulated urban and rural sequences, every pair that was finally accepted
     /// overlapped at least 0.24 there, most wrong pairs less than 0.15 (saves the later stages).
     double abandon_below_overlap = 0.15;
+    /// Where no odometry judges the pose, a hypothesis is also abandoned after the first stage
+    /// when it slides: shifted by AcceptanceConfig::degeneracy_shift_m along the direction its
+    /// overlap constrains least, more than this share of the points facing that direction still
+    /// fits (the degeneracy test's measure, on every 4th point; none facing it counts as all).
+    /// On the gate's runs without odometry a pose sliding so after the first stage ended
+    /// rejected in all but 1 of 14,863 cases, and their later stages were 15 % of ICP's
+    /// iterations (docs/verification.md, "Poses that slide are dropped early"). [0, 1]; 1: never.
+    double abandon_above_shifted_overlap = 0.8;
     /// Longer steps along a sliding direction: when a step points within 37 degrees (cosine 0.8)
     /// of the previous one in the same stage, the pose moves 1 / (1 - r) times it, r the ratio of
     /// their lengths (where a series of such steps would end), at most this many times (Besl &

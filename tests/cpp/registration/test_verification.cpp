@@ -236,9 +236,9 @@ TEST(Verification, ScoreRatioKeepsAPoseFromTheBestPeak) {
 }
 
 // Two long parallel walls and a floor: every shift along the corridor fits as well.
-core::PointCloud Corridor() {
+core::PointCloud Corridor(double half_length_m = 40.0) {
     core::PointCloud cloud;
-    for (double x = -40; x <= 40; x += 0.2) {
+    for (double x = -half_length_m; x <= half_length_m; x += 0.2) {
         for (double z = -1.7; z <= 2.5; z += 0.2) {
             cloud.emplace_back(static_cast<float>(x), 3.0F, static_cast<float>(z));
             cloud.emplace_back(static_cast<float>(x), -3.0F, static_cast<float>(z));
@@ -257,6 +257,51 @@ TEST(Verification, CorridorIsDegenerate) {
     EXPECT_EQ(v.reason, RejectReason::kDegenerate);
     // Nothing pins the position along the corridor but its far ends.
     EXPECT_LT(v.overlap.constraining_points, 20u);
+}
+
+// Without odometry a pose that slides after ICP's first stage is dropped there
+// (IcpConfig::abandon_above_shifted_overlap): a corridor whose ends lie out of the overlap's
+// range ends `degenerate` as when every stage runs, after fewer iterations. Where the odometry
+// judges the pose, every stage runs.
+TEST(Verification, APoseThatSlidesIsDroppedAfterTheFirstStage) {
+    const core::PointCloud match = Corridor(60.0);
+    VerificationConfig every_stage;
+    every_stage.icp.abandon_above_shifted_overlap = 1.0;
+    const VerificationConfig config;
+    const PreparedScan q =
+        PrepareScan(QueryOf(match, test::PlanarTransform(4.0, 0.0, 0.0)), config.reduction);
+    const PreparedScan t = PrepareScan(match, config.reduction);
+    const CoarseQuery coarse(*q.structure, config.coarse);
+    const Verification dropped = Verify(q, coarse, t, config);
+    const Verification refined = Verify(q, coarse, t, every_stage);
+    EXPECT_EQ(dropped.reason, RejectReason::kDegenerate) << ToString(dropped.reason);
+    EXPECT_EQ(refined.reason, RejectReason::kDegenerate) << ToString(refined.reason);
+    EXPECT_LT(dropped.icp_iterations, refined.icp_iterations);
+
+    const PoseAllowed any = [](const core::Transform&) { return true; };
+    const Verification judged = Verify(q, coarse, t, config, any);
+    const Verification judged_every_stage = Verify(q, coarse, t, every_stage, any);
+    EXPECT_EQ(judged.icp_iterations, judged_every_stage.icp_iterations);
+    EXPECT_EQ(judged.reason, judged_every_stage.reason) << ToString(judged.reason);
+}
+
+// A place with structure facing every way does not slide: its loops are the same to the bit
+// with and without the check.
+TEST(Verification, TheSlideCheckLeavesLoopsAsTheyWere) {
+    const core::PointCloud match = test::SyntheticPlace();
+    VerificationConfig every_stage;
+    every_stage.icp.abandon_above_shifted_overlap = 1.0;
+    for (const auto& truth :
+         {test::PlanarTransform(2.0, -1.0, 120.0), test::PlanarTransform(-4.0, 3.0, -60.0),
+          test::PlanarTransform(6.0, 0.5, 180.0)}) {
+        const core::PointCloud query = QueryOf(match, truth);
+        const Verification checked = VerifyPair(query, match, VerificationConfig{});
+        const Verification refined = VerifyPair(query, match, every_stage);
+        EXPECT_TRUE(checked.accepted) << ToString(checked.reason);
+        EXPECT_EQ(checked.reason, refined.reason);
+        EXPECT_EQ(checked.icp_iterations, refined.icp_iterations);
+        EXPECT_TRUE(checked.T_match_query.isApprox(refined.T_match_query, 0.0));
+    }
 }
 
 // A street whose walls are teeth of irregular length, every face 20 degrees off the street's
