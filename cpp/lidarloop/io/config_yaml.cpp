@@ -156,6 +156,8 @@ void VisitFields(registration::CoarseConfig& c, Visitor& v) {
     v.Field("peaks_per_yaw", c.peaks_per_yaw, "translation peaks kept per yaw");
     v.Field("layout_yaw_window_deg", c.layout_yaw_window_deg,
             "without odometry, yaws searched around the layouts' and half a turn from it");
+    v.Field("better_half_turn_only", c.better_half_turn_only,
+            "without odometry, search only the layouts' half turn whose centre correlates better");
 }
 
 template <typename Visitor>

@@ -243,6 +243,66 @@ std::size_t CoarseQuery::PositionOf(int x, int y) const {
     return static_cast<std::size_t>(x) * computed_rows_.size() + static_cast<std::size_t>(slot);
 }
 
+namespace {
+
+// The correlations of the yaws at `indices` with the match, two per inverse transform, and their
+// peaks into `peaks`.
+void CorrelateYaws(const CoarseQuery& query, const Spectrum& match, const std::vector<int>& indices,
+                   std::vector<PlanarHypothesis>& peaks) {
+    const CoarseConfig& config = query.config();
+    const int n = config.grid_cells;
+    detail::SplitGrid product{std::vector<float>(match.size()), std::vector<float>(match.size())};
+    detail::SplitGrid correlations;  // the computed rows, column by column
+    for (std::size_t k = 0; k < indices.size(); k += 2) {
+        const int a = indices[k];
+        const bool pair = k + 1 < indices.size();
+        const int b = pair ? indices[k + 1] : a;
+        if (!query.Has(a) || !query.Has(b))
+            throw std::invalid_argument("CoarseAlign: the query's images lack a searched yaw");
+        MultiplyPair(query.spectrum(a), query.spectrum(b), match, product);
+        detail::Fft2dInverseRows(product, n, query.computed_rows(), correlations);
+        AddPeaks(correlations.re, query, query.YawOf(a), config.peaks_per_yaw, peaks);
+        if (pair) AddPeaks(correlations.im, query, query.YawOf(b), config.peaks_per_yaw, peaks);
+    }
+}
+
+int NearestYaw(const CoarseQuery& query, double yaw_rad) {
+    const int yaws = query.yaw_count();
+    const double steps = yaw_rad / (2.0 * std::numbers::pi) * yaws;
+    return static_cast<int>(((std::lround(steps) % yaws) + yaws) % yaws);
+}
+
+// The best score of the peaks at `yaw_rad`.
+double BestScoreAt(const std::vector<PlanarHypothesis>& peaks, double yaw_rad) {
+    double best = 0.0;
+    for (const auto& peak : peaks) {
+        if (peak.yaw_rad == yaw_rad) best = std::max(best, peak.score);
+    }
+    return best;
+}
+
+// The windows of `allowed` to search: with a half turn and CoarseConfig::better_half_turn_only,
+// the one whose centre yaw correlates better (both on a tie). Both centres are correlated in one
+// transform, their peaks go into `peaks` and their indices into `done`.
+std::vector<YawWindow> HalvesToSearch(const CoarseQuery& query, const Spectrum& match,
+                                      const YawWindow& allowed,
+                                      std::vector<PlanarHypothesis>& peaks,
+                                      std::vector<int>& done) {
+    if (!allowed.half_turn_too || allowed.Whole() || !query.config().better_half_turn_only)
+        return {allowed};
+    const YawWindow half{allowed.centre_rad, allowed.half_width_rad, false};
+    const YawWindow other{allowed.centre_rad + std::numbers::pi, allowed.half_width_rad, false};
+    done = {NearestYaw(query, half.centre_rad), NearestYaw(query, other.centre_rad)};
+    // Both centres' peaks stay: the worse one may still be a rival of the better's pose.
+    CorrelateYaws(query, match, done, peaks);
+    const double centre_score = BestScoreAt(peaks, query.YawOf(done[0]));
+    const double opposite_score = BestScoreAt(peaks, query.YawOf(done[1]));
+    if (centre_score == opposite_score) return {allowed};
+    return {centre_score > opposite_score ? half : other};
+}
+
+}  // namespace
+
 std::vector<PlanarHypothesis> CoarseAlign(const CoarseQuery& query,
                                           const SurfacePoints& match_structure,
                                           const YawWindow& allowed) {
@@ -252,22 +312,20 @@ std::vector<PlanarHypothesis> CoarseAlign(const CoarseQuery& query,
     const Spectrum match =
         ToSpectrum(Spread(OccupancyImage(match_structure.points(), 0.0, config), n), n);
     std::vector<PlanarHypothesis> peaks;
-    detail::SplitGrid product{std::vector<float>(match.size()), std::vector<float>(match.size())};
-    detail::SplitGrid correlations;  // the computed rows, column by column
-    // Two yaws per inverse FFT: both correlations are real, so yaw b rides in the imaginary part.
-    const YawWindow searched = SearchedYaws(allowed, config);
-    for (int a = 0; a < query.yaw_count(); a += 2) {
-        const int b = std::min(a + 1, query.yaw_count() - 1);
-        const bool want_a = searched.Contains(query.YawOf(a));
-        const bool want_b = b != a && searched.Contains(query.YawOf(b));
-        if (!want_a && !want_b) continue;
-        if (!query.Has(a) || !query.Has(b))
-            throw std::invalid_argument("CoarseAlign: the query's images lack a searched yaw");
-        MultiplyPair(query.spectrum(a), query.spectrum(b), match, product);
-        detail::Fft2dInverseRows(product, n, query.computed_rows(), correlations);
-        if (want_a) AddPeaks(correlations.re, query, query.YawOf(a), config.peaks_per_yaw, peaks);
-        if (want_b) AddPeaks(correlations.im, query, query.YawOf(b), config.peaks_per_yaw, peaks);
+    std::vector<int> done;
+    const std::vector<YawWindow> windows = HalvesToSearch(query, match, allowed, peaks, done);
+    std::vector<int> indices;
+    for (int i = 0; i < query.yaw_count(); ++i) {
+        const double yaw_rad = query.YawOf(i);
+        const bool wanted = std::any_of(windows.begin(), windows.end(), [&](const auto& window) {
+            return SearchedYaws(window, config).Contains(yaw_rad);
+        });
+        if (wanted && std::find(done.begin(), done.end(), i) == done.end()) indices.push_back(i);
     }
+    CorrelateYaws(query, match, indices, peaks);
+    // Tied peaks in yaw order, whichever yaw was correlated first (Distinct).
+    std::stable_sort(peaks.begin(), peaks.end(),
+                     [](const auto& a, const auto& b) { return a.yaw_rad < b.yaw_rad; });
     return Distinct(std::move(peaks), config);
 }
 

@@ -574,6 +574,56 @@ TEST(CoarseAlign, AYawWindowSearchesWithinItAndFindsWhatTheFullSearchFindsThere)
     for (int i = 0; i < whole.yaw_count(); ++i) ASSERT_TRUE(whole.Has(i));
 }
 
+// The layouts give the yaw modulo half a turn. The query turned by 190 or 10 degrees, the
+// window at 10 degrees and its half turn: the search correlates the yaw nearest each centre and
+// searches the better one's window only, where the full search's best peak lies, bit for bit;
+// of the other half it keeps the centre's peaks alone (possible rivals). Searching both halves
+// (better_half_turn_only off) finds that peak too, among the other half's.
+TEST(CoarseAlign, AHalfTurnWindowSearchesTheHalfWhoseCentreCorrelatesBetter) {
+    const double deg = std::numbers::pi / 180.0;
+    const core::PointCloud place = test::SyntheticPlace();
+    const PreparedScan match = PrepareScan(place, ScanReductionConfig{});
+    const YawWindow window{10.0 * deg, 15.0 * deg, true};
+    CoarseConfig both_halves;
+    both_halves.better_half_turn_only = false;
+    for (const double truth_deg : {190.0, 10.0}) {
+        const PreparedScan query =
+            PrepareScan(test::Transformed(place, test::PlanarTransform(0.0, 0.0, -truth_deg)),
+                        ScanReductionConfig{});
+        const CoarseConfig config;
+        const auto everywhere =
+            CoarseAlign(CoarseQuery(*query.structure, config), *match.structure);
+        ASSERT_FALSE(everywhere.empty());
+        ASSERT_NEAR(everywhere.front().yaw_rad, truth_deg * deg, 1e-9);
+        const auto better =
+            CoarseAlign(CoarseQuery(*query.structure, config, {window}), *match.structure, window);
+        ASSERT_FALSE(better.empty());
+        const YawWindow right = SearchedYaws(YawWindow{truth_deg * deg, 15.0 * deg}, config);
+        const double other_centre_rad = (truth_deg + 180.0) * deg;
+        for (const PlanarHypothesis& h : better) {
+            EXPECT_TRUE(right.Contains(h.yaw_rad) ||
+                        std::abs(std::remainder(h.yaw_rad - other_centre_rad,
+                                                2.0 * std::numbers::pi)) < 1e-9)
+                << truth_deg << " " << h.yaw_rad / deg;
+        }
+        EXPECT_EQ(better.front().yaw_rad, everywhere.front().yaw_rad);
+        EXPECT_EQ(better.front().translation_m, everywhere.front().translation_m);
+        EXPECT_EQ(better.front().score, everywhere.front().score);
+
+        const auto both = CoarseAlign(CoarseQuery(*query.structure, both_halves, {window}),
+                                      *match.structure, window);
+        ASSERT_FALSE(both.empty());
+        EXPECT_EQ(both.front().yaw_rad, everywhere.front().yaw_rad) << truth_deg;
+        EXPECT_TRUE(std::any_of(both.begin(), both.end(),
+                                [&](const PlanarHypothesis& h) {
+                                    return !right.Contains(h.yaw_rad) &&
+                                           std::abs(std::remainder(h.yaw_rad - other_centre_rad,
+                                                                   2.0 * std::numbers::pi)) > 1e-9;
+                                }))
+            << "the other half has peaks off its centre too: " << truth_deg;
+    }
+}
+
 // 45 yaws of 8 degrees: the last one has no partner in the paired transforms, and a window
 // around it wraps past 0. Searched: within 1 + 16 degrees of 352, the yaws 336-360 and 0-8.
 TEST(CoarseAlign, AWindowWrapsAroundAnOddYawCount) {
