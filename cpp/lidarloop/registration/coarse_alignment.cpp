@@ -1,8 +1,10 @@
 
 #include "lidarloop/registration/coarse_alignment.hpp"
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <mutex>
 #include <numbers>
 #include <optional>
 #include <stdexcept>
@@ -192,6 +194,20 @@ std::vector<float> OccupancyImage(const std::vector<Eigen::Vector3f>& points, do
     return detail::OccupancyImage(detail::PlanarPoints(points), yaw_rad, config);
 }
 
+struct CoarseQuery::Spectra {
+    Spectra(const std::vector<Eigen::Vector3f>& points, int yaws)
+        : planar(points),
+          spectra(static_cast<std::size_t>(yaws)),
+          pair_once(static_cast<std::size_t>(yaws + 1) / 2),
+          pair_done(static_cast<std::size_t>(yaws + 1) / 2) {}
+    detail::PlanarPoints planar;  // read once per yaw
+    std::vector<Spectrum> spectra;
+    // Yaws 2k and 2k + 1 share a transform (the images are real: detail::Fft2dForwardRealPair),
+    // a fixed pairing so that a yaw's spectrum does not depend on which pair asked first.
+    std::vector<std::once_flag> pair_once;
+    std::vector<std::atomic<bool>> pair_done;
+};
+
 CoarseQuery::CoarseQuery(const SurfacePoints& query_structure, const CoarseConfig& config,
                          const std::vector<YawWindow>& windows)
     : config_(config) {
@@ -217,22 +233,38 @@ CoarseQuery::CoarseQuery(const SurfacePoints& query_structure, const CoarseConfi
         search_positions_.push_back(static_cast<std::uint32_t>(PositionOf(x, y)));
     }
     const int yaws = static_cast<int>(std::lround(360.0 / config.yaw_step_deg));
-    spectra_.resize(static_cast<std::size_t>(yaws));
-    const detail::PlanarPoints planar(query_structure.points());  // read once per yaw
-    const auto image_at = [&](int i) {
-        return detail::OccupancyImage(planar, YawAt(i, yaws), config);
-    };
-    const std::vector<bool> wanted = YawsWithin(windows, config, yaws);
-    // Two yaws per transform: the images are real (detail::Fft2dForwardRealPair). The pairs are
-    // fixed, so that a yaw's spectrum does not depend on the windows.
-    for (int a = 0; a < yaws; a += 2) {
-        const int b = std::min(a + 1, yaws - 1);
-        if (!wanted[static_cast<std::size_t>(a)] && !wanted[static_cast<std::size_t>(b)]) continue;
-        detail::Fft2dForwardRealPair(image_at(a), image_at(b), n, spectra_[a], spectra_[b]);
-    }
-    for (auto& spectrum : spectra_) {
-        for (auto& value : spectrum) value = std::conj(value);
-    }
+    wanted_ = YawsWithin(windows, config, yaws);
+    spectra_ = std::make_unique<Spectra>(query_structure.points(), yaws);
+}
+
+CoarseQuery::~CoarseQuery() = default;
+CoarseQuery::CoarseQuery(CoarseQuery&&) noexcept = default;
+CoarseQuery& CoarseQuery::operator=(CoarseQuery&&) noexcept = default;
+
+const std::vector<std::complex<float>>& CoarseQuery::spectrum(int index) const {
+    if (index < 0 || index >= yaw_count() || !Has(index))
+        throw std::invalid_argument("CoarseAlign: the query's images lack a searched yaw");
+    const auto pair = static_cast<std::size_t>(index / 2);
+    std::call_once(spectra_->pair_once[pair], [&] {
+        const int n = config_.grid_cells;
+        const int a = 2 * (index / 2), b = std::min(a + 1, yaw_count() - 1);
+        const auto image_at = [&](int i) {
+            return detail::OccupancyImage(spectra_->planar, YawOf(i), config_);
+        };
+        auto& spectra = spectra_->spectra;
+        detail::Fft2dForwardRealPair(image_at(a), image_at(b), n, spectra[a], spectra[b]);
+        const auto conjugate = [&](int i) {
+            for (auto& value : spectra[static_cast<std::size_t>(i)]) value = std::conj(value);
+        };
+        conjugate(a);
+        if (b != a) conjugate(b);  // the last of an odd count has no partner
+        spectra_->pair_done[pair].store(true, std::memory_order_release);
+    });
+    return spectra_->spectra[static_cast<std::size_t>(index)];
+}
+
+bool CoarseQuery::Computed(int index) const {
+    return spectra_->pair_done[static_cast<std::size_t>(index / 2)].load(std::memory_order_acquire);
 }
 
 double CoarseQuery::YawOf(int index) const { return YawAt(index, yaw_count()); }
@@ -257,8 +289,6 @@ void CorrelateYaws(const CoarseQuery& query, const Spectrum& match, const std::v
         const int a = indices[k];
         const bool pair = k + 1 < indices.size();
         const int b = pair ? indices[k + 1] : a;
-        if (!query.Has(a) || !query.Has(b))
-            throw std::invalid_argument("CoarseAlign: the query's images lack a searched yaw");
         MultiplyPair(query.spectrum(a), query.spectrum(b), match, product);
         detail::Fft2dInverseRows(product, n, query.computed_rows(), correlations);
         AddPeaks(correlations.re, query, query.YawOf(a), config.peaks_per_yaw, peaks);

@@ -2,6 +2,7 @@
 
 #include <complex>
 #include <cstdint>
+#include <memory>
 #include <numbers>
 #include <vector>
 
@@ -37,21 +38,29 @@ struct YawWindow {
 /// peak's yaw is off by up to half a step and ICP turns the pose by a few degrees.
 YawWindow SearchedYaws(const YawWindow& allowed, const CoarseConfig& config);
 
-/// The query's side of the coarse search, computed once per query scan and shared by all its
-/// candidates: the spectrum of its top-down structure image at every searched yaw.
+/// The query's side of the coarse search, shared by all its candidates: the spectrum of its
+/// top-down structure image at each searched yaw, computed when a pair first needs it (two yaws
+/// per transform), so that a query whose search stops early pays for the yaws it searched only.
 class CoarseQuery {
 public:
-    /// The spectra of the yaws SearchedYaws of some of `windows` holds (the candidates'
-    /// windows), of every yaw when `windows` is empty or one of them is whole.
+    /// For the yaws SearchedYaws of some of `windows` holds (the candidates' windows), of every
+    /// yaw when `windows` is empty or one of them is whole.
     CoarseQuery(const SurfacePoints& query_structure, const CoarseConfig& config,
                 const std::vector<YawWindow>& windows = {});
+    ~CoarseQuery();
+    CoarseQuery(CoarseQuery&&) noexcept;
+    CoarseQuery& operator=(CoarseQuery&&) noexcept;
 
     const CoarseConfig& config() const { return config_; }
-    int yaw_count() const { return static_cast<int>(spectra_.size()); }
+    int yaw_count() const { return static_cast<int>(wanted_.size()); }
     double YawOf(int index) const;
-    /// Whether the spectrum of yaw `index` was computed.
-    bool Has(int index) const { return !spectra_[index].empty(); }
-    const std::vector<std::complex<float>>& spectrum(int index) const { return spectra_[index]; }
+    /// Whether yaw `index` is one the windows hold (CoarseAlign throws for any other).
+    bool Has(int index) const { return wanted_[static_cast<std::size_t>(index)]; }
+    /// The conjugate spectrum of yaw `index`, computed on first use; thread-safe. Throws
+    /// std::invalid_argument for a yaw it does not have.
+    const std::vector<std::complex<float>>& spectrum(int index) const;
+    /// Whether the spectrum of yaw `index` has been computed yet.
+    bool Computed(int index) const;
     /// Cells of the correlation grid within max_translation_m (wrapped indices, row-major).
     const std::vector<std::uint32_t>& search_cells() const { return search_cells_; }
     /// The rows of the correlation grid the inverse transforms compute: those of the searched
@@ -70,7 +79,9 @@ private:
     std::vector<int> computed_rows_;
     std::vector<int> slot_of_row_;  // per grid row, its index in computed_rows_, or -1
     std::vector<std::uint32_t> search_positions_;
-    std::vector<std::vector<std::complex<float>>> spectra_;  // one grid_cells^2 spectrum per yaw
+    std::vector<bool> wanted_;  // per yaw
+    struct Spectra;             // the query's points and the spectra computed so far
+    std::unique_ptr<Spectra> spectra_;
 };
 
 /// The top-down occupancy image of `points` after Rz(yaw_rad): grid_cells^2 values, row-major

@@ -555,17 +555,26 @@ TEST(CoarseAlign, AYawWindowSearchesWithinItAndFindsWhatTheFullSearchFindsThere)
             EXPECT_EQ(found[i].score, from_full[i].score);
         }
     }
-    const auto there = CoarseAlign(windowed, *match.structure, right);
+    // A query's spectra are computed as its pairs need them: searching the right window first
+    // computes its yaws and their partners in the paired transforms (8-9 ... 16-17) only.
+    const CoarseQuery lazy(*query.structure, config, {wrong, right});
+    for (int i = 0; i < lazy.yaw_count(); ++i) ASSERT_FALSE(lazy.Computed(i)) << i;
+    const auto there = CoarseAlign(lazy, *match.structure, right);
     EXPECT_EQ(there.front().yaw_rad, everywhere.front().yaw_rad);
     EXPECT_EQ(there.front().translation_m, everywhere.front().translation_m);
     EXPECT_EQ(there.front().score, everywhere.front().score);
-    // Only the windows' yaws and their partners in the paired transforms (8-9 ... 16-17,
-    // 26-27 ... 34-35) were computed.
-    int computed = 0;
-    for (int i = 0; i < windowed.yaw_count(); ++i) computed += windowed.Has(i) ? 1 : 0;
-    EXPECT_EQ(computed, 20);
-    EXPECT_TRUE(windowed.Has(17) && windowed.Has(26));
-    EXPECT_FALSE(windowed.Has(0));
+    std::vector<int> computed;
+    for (int i = 0; i < lazy.yaw_count(); ++i) {
+        if (lazy.Computed(i)) computed.push_back(i);
+    }
+    EXPECT_EQ(computed, (std::vector<int>{8, 9, 10, 11, 12, 13, 14, 15, 16, 17}));
+    // It has the windows' yaws (40-80 and 130-170 degrees), nothing else.
+    int held = 0;
+    for (int i = 0; i < windowed.yaw_count(); ++i) held += windowed.Has(i) ? 1 : 0;
+    EXPECT_EQ(held, 18);
+    EXPECT_TRUE(windowed.Has(8) && windowed.Has(16) && windowed.Has(26) && windowed.Has(34));
+    EXPECT_FALSE(windowed.Has(0) || windowed.Has(17) || windowed.Has(25));
+    EXPECT_THROW(windowed.spectrum(0), std::invalid_argument);
     EXPECT_THROW(CoarseAlign(windowed, *match.structure, YawWindow{}), std::invalid_argument);
     EXPECT_THROW(CoarseAlign(windowed, *match.structure, YawWindow{-90.0 * deg, 10.0 * deg}),
                  std::invalid_argument);
