@@ -512,8 +512,12 @@ public:
     }
 
 private:
+    // A known key is named whole (the longest are over Quoted's 40 characters); a user's
+    // unknown one is quoted safely.
     [[noreturn]] void Fail(const std::string& key, const std::string& problem) const {
-        throw ReadError(source_, "key " + Quoted(prefix_ + key) + ": " + problem);
+        const std::string named =
+            known_.count(key) != 0 ? "'" + prefix_ + key + "'" : Quoted(prefix_ + key);
+        throw ReadError(source_, "key " + named + ": " + problem);
     }
     // A key that is a list, a map or empty (`[a]: 1`, `{x: 1}: 2`, `? :`) names no setting.
     [[noreturn]] void FailKeyNotAName(const YAML::Node& key) const {

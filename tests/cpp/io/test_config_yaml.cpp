@@ -167,6 +167,20 @@ TEST(ConfigYaml, NdtSectionWithListsAndBooleans) {
               std::string::npos);
 }
 
+// A bad value names its key whole, however long; an unknown key of the user's is quoted safely
+// (cut at 40 characters).
+TEST(ConfigYaml, ABadValueNamesItsKnownKeyWhole) {
+    const std::string bad_value =
+        ErrorOf("verification:\n  coarse:\n    better_half_turn_only: maybe\n");
+    EXPECT_NE(bad_value.find("key 'verification.coarse.better_half_turn_only': expected true or "
+                             "false"),
+              std::string::npos)
+        << bad_value;
+    const std::string unknown =
+        ErrorOf("verification:\n  coarse:\n    " + std::string(60, 'z') + ": 1\n");
+    EXPECT_NE(unknown.find("...' (80 characters)"), std::string::npos) << unknown;
+}
+
 TEST(ConfigYaml, ScanContextSectionRoundTripsAndRejectsUnknownKeys) {
     RunConfig config;
     ApplyConfigYaml(
