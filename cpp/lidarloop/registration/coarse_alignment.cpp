@@ -252,12 +252,16 @@ const std::vector<std::complex<float>>& CoarseQuery::spectrum(int index) const {
             return detail::OccupancyImage(spectra_->planar, YawOf(i), config_);
         };
         auto& spectra = spectra_->spectra;
-        detail::Fft2dForwardRealPair(image_at(a), image_at(b), n, spectra[a], spectra[b]);
+        // The last of an odd count has no partner: its twin output goes elsewhere, not into the
+        // same vector (the transform's outputs must not alias).
+        Spectrum twin;
+        detail::Fft2dForwardRealPair(image_at(a), image_at(b), n, spectra[a],
+                                     b == a ? twin : spectra[b]);
         const auto conjugate = [&](int i) {
             for (auto& value : spectra[static_cast<std::size_t>(i)]) value = std::conj(value);
         };
         conjugate(a);
-        if (b != a) conjugate(b);  // the last of an odd count has no partner
+        if (b != a) conjugate(b);
         spectra_->pair_done[pair].store(true, std::memory_order_release);
     });
     return spectra_->spectra[static_cast<std::size_t>(index)];

@@ -250,43 +250,43 @@ bool SamePose(const core::Transform& a, const core::Transform& b) {
            Eigen::AngleAxisd(difference.linear()).angle() < 5.0 * std::numbers::pi / 180.0;
 }
 
-// Whether the first stage's pose slides: shifted along the direction the overlapping points
-// constrain least, more than `max_ratio` of those facing it still fit (every stride-th query
-// point: an estimate, as the abandonment check's overlap is).
-bool Slides(const PreparedScan& query, const PreparedScan& match,
-            const core::Transform& T_match_query, const AcceptanceConfig& config, double max_ratio,
-            std::size_t stride) {
-    if (max_ratio >= 1.0) return false;
+// How freely the first stage's pose slides: shifted along the direction the overlapping points
+// constrain least, the share of those facing it that still fit (1 when none face it), from
+// every stride-th query point: an estimate, as the abandonment check's overlap is.
+double SlidingShare(const PreparedScan& query, const PreparedScan& match,
+                    const core::Transform& T_match_query, const AcceptanceConfig& config,
+                    std::size_t stride) {
     const Eigen::Isometry3f T = T_match_query.cast<float>();
     const OneWay forward = OverlapOneWay(*query.structure, query.structure_distinctive,
                                          *match.structure, T, config, true, stride);
     const Eigen::Vector2f d = WeakestDirection(forward.overlapping_partner_xy).cast<float>();
     const std::vector<std::uint32_t> facing = PointsFacing(forward, d, kFacingWithin60Degrees);
-    return ShiftedOverlapRatio(*query.structure, *match.structure, T, d, facing, config) >
-           max_ratio;
+    return ShiftedOverlapRatio(*query.structure, *match.structure, T, d, facing, config);
 }
 
 // ICP from `initial` with `icp`, abandoned after its first stage when the pose overlaps too
 // little to ever pass (IcpConfig::abandon_below_overlap), when it slides and `slid` is given
-// (IcpConfig::abandon_above_shifted_overlap; `*slid` says so) or, searching for a rival of the
-// `accepted` pose, when it has come to that pose: the later stages only refine toward it
+// (IcpConfig::abandon_above_shifted_overlap; `*slid` gets the share) or, searching for a rival of
+// the `accepted` pose, when it has come to that pose: the later stages only refine toward it
 // (docs/verification.md, "No half-way rivals").
 IcpResult Refine(const PreparedScan& query, const PreparedScan& match,
                  const core::Transform& initial, const VerificationConfig& config,
                  const IcpConfig& icp,
                  const std::optional<core::Transform>& accepted = std::nullopt,
-                 bool* slid = nullptr) {
+                 std::optional<double>* slid = nullptr) {
     return RefinePointToPlane(
         query, match, initial, icp, [&](const core::Transform& T_match_query) {
             if (accepted && SamePose(T_match_query, *accepted)) return false;
             if (!OverlapReaches(query, match, T_match_query, config.acceptance,
                                 config.icp.abandon_below_overlap, kAbandonCheckStride))
                 return false;
-            if (slid != nullptr &&
-                Slides(query, match, T_match_query, config.acceptance,
-                       config.icp.abandon_above_shifted_overlap, kAbandonCheckStride)) {
-                *slid = true;
-                return false;
+            if (slid != nullptr && config.icp.abandon_above_shifted_overlap < 1.0) {
+                const double share = SlidingShare(query, match, T_match_query, config.acceptance,
+                                                  kAbandonCheckStride);
+                if (share > config.icp.abandon_above_shifted_overlap) {
+                    *slid = share;
+                    return false;
+                }
             }
             return true;
         });
@@ -297,13 +297,15 @@ Verification RegisterFrom(const PreparedScan& query, const PreparedScan& match,
                           const PlanarHypothesis& hypothesis, const VerificationConfig& config,
                           bool odometry_judges) {
     // Where the odometry judges, its looser degeneracy test decides at the end.
-    bool slid = false;
+    std::optional<double> slid;
     const IcpResult icp = Refine(query, match, PlanarPose(hypothesis), config, config.icp,
                                  std::nullopt, odometry_judges ? nullptr : &slid);
     Verification result;
     result.T_match_query = icp.T_match_query;
     result.overlap =
         MeasureOverlap(query, match, icp.T_match_query, config.acceptance, odometry_judges);
+    // The share that dropped it, not the full test's at that unfinished pose.
+    if (slid) result.overlap.shifted_overlap_ratio = *slid;
     result.coarse_score = hypothesis.score;
     result.icp_iterations = icp.iterations;
     result.shifted_overlap_ratio = result.overlap.shifted_overlap_ratio;

@@ -105,6 +105,9 @@ void VerificationConfig::Validate() const {
     coarse.Validate();
     icp.Validate();
     acceptance.Validate();
+    // Below the acceptance's own bar the check would drop poses the degeneracy test passes.
+    RequireIn(icp.abandon_above_shifted_overlap, acceptance.max_shifted_overlap_ratio, 1.0,
+              "icp.abandon_above_shifted_overlap (at least acceptance.max_shifted_overlap_ratio)");
 }
 
 }  // namespace lidarloop::registration

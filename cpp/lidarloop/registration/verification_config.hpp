@@ -119,7 +119,8 @@ struct IcpConfig {
     /// fits (the degeneracy test's measure, on every 4th point; none facing it counts as all).
     /// On the gate's runs without odometry a pose sliding so after the first stage ended
     /// rejected in all but 1 of 14,863 cases, and their later stages were 15 % of ICP's
-    /// iterations (docs/verification.md, "Poses that slide are dropped early"). [0, 1]; 1: never.
+    /// iterations (docs/verification.md, "Poses that slide are dropped early").
+    /// [AcceptanceConfig::max_shifted_overlap_ratio, 1]; 1: never.
     double abandon_above_shifted_overlap = 0.8;
     /// Longer steps along a sliding direction: when a step points within 37 degrees (cosine 0.8)
     /// of the previous one in the same stage, the pose moves 1 / (1 - r) times it, r the ratio of

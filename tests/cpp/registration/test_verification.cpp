@@ -277,6 +277,9 @@ TEST(Verification, APoseThatSlidesIsDroppedAfterTheFirstStage) {
     EXPECT_EQ(dropped.reason, RejectReason::kDegenerate) << ToString(dropped.reason);
     EXPECT_EQ(refined.reason, RejectReason::kDegenerate) << ToString(refined.reason);
     EXPECT_LT(dropped.icp_iterations, refined.icp_iterations);
+    // It reports the share that dropped it.
+    EXPECT_GT(dropped.shifted_overlap_ratio, config.icp.abandon_above_shifted_overlap);
+    EXPECT_EQ(dropped.overlap.shifted_overlap_ratio, dropped.shifted_overlap_ratio);
 
     const PoseAllowed any = [](const core::Transform&) { return true; };
     const Verification judged = Verify(q, coarse, t, config, any);
@@ -469,6 +472,10 @@ TEST(Verification, InvalidConfigIsAConfigError) {
     expect_error([](auto& c) { c.icp.rival_step_factor = 4.5; });
     expect_error([](auto& c) { c.icp.first_stage_structure_points = 0; });
     expect_error([](auto& c) { c.icp.first_stage_ground_points = -5; });
+    expect_error([](auto& c) { c.icp.abandon_above_shifted_overlap = 1.5; });
+    expect_error([](auto& c) { c.icp.abandon_above_shifted_overlap = std::nan(""); });
+    // Under the acceptance's bar it would drop poses the degeneracy test passes.
+    expect_error([](auto& c) { c.icp.abandon_above_shifted_overlap = 0.3; });
     expect_error([](auto& c) { c.acceptance.overlap_confidence_z = -1.0; });
     expect_error([](auto& c) { c.acceptance.overlap_confidence_z = std::nan(""); });
     expect_error([](auto& c) { c.acceptance.min_neighbour_overlap_ratio = -0.1; });
