@@ -6,7 +6,9 @@
 #include <numbers>
 #include <random>
 #include <stdexcept>
+#include <thread>
 #include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <Eigen/Eigenvalues>
@@ -414,6 +416,27 @@ TEST(CoarseQuery, HoldsTheConjugateSpectrumOfTheRotatedImageAtEveryYaw) {
         for (std::size_t k = 0; k < expected.size(); ++k)
             ASSERT_NEAR(std::abs(query.spectrum(i)[k] - std::conj(expected[k])), 0.0, 1e-2)
                 << "yaw " << i << " frequency " << k;
+    }
+}
+
+// A query's pairs are registered on several threads, each asking for the spectra it needs:
+// threads asking for the same yaws at once get what one thread computes alone.
+TEST(CoarseQuery, SpectraAskedByThreadsAtOnceAreThoseOfOneThread) {
+    const PreparedScan scan = PrepareScan(test::SyntheticPlace(), ScanReductionConfig{});
+    const CoarseConfig config;
+    const CoarseQuery alone(*scan.structure, config);
+    const CoarseQuery shared(*scan.structure, config);
+    std::vector<std::thread> threads;
+    for (int t = 0; t < 4; ++t) {
+        threads.emplace_back([&shared, t] {
+            for (int k = 0; k < shared.yaw_count(); ++k)
+                (void)shared.spectrum((k * 7 + t * 5) % shared.yaw_count());
+        });
+    }
+    for (auto& thread : threads) thread.join();
+    for (int i = 0; i < alone.yaw_count(); ++i) {
+        ASSERT_TRUE(shared.Computed(i)) << i;
+        ASSERT_EQ(shared.spectrum(i), alone.spectrum(i)) << i;
     }
 }
 
