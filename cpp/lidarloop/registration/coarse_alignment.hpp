@@ -92,8 +92,10 @@ std::vector<float> OccupancyImage(const std::vector<Eigen::Vector3f>& points, do
 /// The best distinct planar poses of the query in the match's frame, best first (at most
 /// config.TotalHypotheses()): for every yaw, the translations (up to peaks_per_yaw, 3 cells
 /// apart) that maximise the cross-correlation of the query's rotated structure image with the
-/// match's (FFT), within max_translation_m, at the yaws SearchedYaws(`allowed`) holds. A yaw's
-/// peaks do not depend on the window (peaks of equal score may come in another order).
+/// match's (FFT), within max_translation_m, at the yaws SearchedYaws(`allowed`) holds; of a
+/// window with a half turn (the layouts'), with CoarseConfig::better_half_turn_only, only the
+/// half whose centre yaw correlates better, and the other centre's yaw. A yaw's peaks do not
+/// depend on the window (peaks of equal score may come in another order).
 /// Empty when either scan has no structure points. Throws std::invalid_argument when `query`
 /// lacks a searched yaw (it was built for other windows). Thread-safe.
 std::vector<PlanarHypothesis> CoarseAlign(const CoarseQuery& query,
