@@ -348,13 +348,12 @@ std::vector<PlanarHypothesis> CoarseAlign(const CoarseQuery& query,
     std::vector<PlanarHypothesis> peaks;
     std::vector<int> done;
     const std::vector<YawWindow> windows = HalvesToSearch(query, match, allowed, peaks, done);
+    const std::vector<bool> wanted = YawsWithin(windows, config, query.yaw_count());
     std::vector<int> indices;
     for (int i = 0; i < query.yaw_count(); ++i) {
-        const double yaw_rad = query.YawOf(i);
-        const bool wanted = std::any_of(windows.begin(), windows.end(), [&](const auto& window) {
-            return SearchedYaws(window, config).Contains(yaw_rad);
-        });
-        if (wanted && std::find(done.begin(), done.end(), i) == done.end()) indices.push_back(i);
+        if (wanted[static_cast<std::size_t>(i)] &&
+            std::find(done.begin(), done.end(), i) == done.end())
+            indices.push_back(i);
     }
     CorrelateYaws(query, match, indices, peaks);
     // Tied peaks in yaw order, whichever yaw was correlated first (Distinct).

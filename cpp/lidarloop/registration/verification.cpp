@@ -83,6 +83,18 @@ double Fraction(std::size_t part, std::size_t whole) {
     return whole == 0 ? 0.0 : static_cast<double>(part) / static_cast<double>(whole);
 }
 
+// Given the query's side, `forward`, whether both sides overlap at least `min_overlap` (the
+// match's side measured only when the query's reaches it).
+bool BothWaysReach(const PreparedScan& query, const PreparedScan& match,
+                   const Eigen::Isometry3f& T_match_query, const OneWay& forward,
+                   const AcceptanceConfig& config, double min_overlap, std::size_t stride) {
+    if (Fraction(forward.overlapping, forward.in_view) < min_overlap) return false;
+    const OneWay backward =
+        OverlapOneWay(*match.structure, match.structure_distinctive, *query.structure,
+                      T_match_query.inverse(), config, false, stride);
+    return Fraction(backward.overlapping, backward.in_view) >= min_overlap;
+}
+
 // The horizontal direction the overlapping surfaces constrain least: the eigenvector of the
 // smallest eigenvalue of the sum of n n^T over their horizontal normals.
 Eigen::Vector2d WeakestDirection(const std::vector<Eigen::Vector2f>& normals_xy) {
@@ -251,17 +263,15 @@ bool SamePose(const core::Transform& a, const core::Transform& b) {
 }
 
 // How freely the first stage's pose slides: shifted along the direction the overlapping points
-// constrain least, the share of those facing it that still fit (1 when none face it), from
-// every stride-th query point: an estimate, as the abandonment check's overlap is.
+// of `forward` (the query's side, its points kept) constrain least, the share of those facing it
+// that still fit (1 when none face it).
 double SlidingShare(const PreparedScan& query, const PreparedScan& match,
-                    const core::Transform& T_match_query, const AcceptanceConfig& config,
-                    std::size_t stride) {
-    const Eigen::Isometry3f T = T_match_query.cast<float>();
-    const OneWay forward = OverlapOneWay(*query.structure, query.structure_distinctive,
-                                         *match.structure, T, config, true, stride);
+                    const Eigen::Isometry3f& T_match_query, const OneWay& forward,
+                    const AcceptanceConfig& config) {
     const Eigen::Vector2f d = WeakestDirection(forward.overlapping_partner_xy).cast<float>();
     const std::vector<std::uint32_t> facing = PointsFacing(forward, d, kFacingWithin60Degrees);
-    return ShiftedOverlapRatio(*query.structure, *match.structure, T, d, facing, config);
+    return ShiftedOverlapRatio(*query.structure, *match.structure, T_match_query, d, facing,
+                               config);
 }
 
 // ICP from `initial` with `icp`, abandoned after its first stage when the pose overlaps too
@@ -277,12 +287,18 @@ IcpResult Refine(const PreparedScan& query, const PreparedScan& match,
     return RefinePointToPlane(
         query, match, initial, icp, [&](const core::Transform& T_match_query) {
             if (accepted && SamePose(T_match_query, *accepted)) return false;
-            if (!OverlapReaches(query, match, T_match_query, config.acceptance,
-                                config.icp.abandon_below_overlap, kAbandonCheckStride))
+            // The overlap check and the slide check read one pass over every 4th query point.
+            const bool slide_check =
+                slid != nullptr && config.icp.abandon_above_shifted_overlap < 1.0;
+            const Eigen::Isometry3f T = T_match_query.cast<float>();
+            const OneWay forward =
+                OverlapOneWay(*query.structure, query.structure_distinctive, *match.structure, T,
+                              config.acceptance, slide_check, kAbandonCheckStride);
+            if (!BothWaysReach(query, match, T, forward, config.acceptance,
+                               config.icp.abandon_below_overlap, kAbandonCheckStride))
                 return false;
-            if (slid != nullptr && config.icp.abandon_above_shifted_overlap < 1.0) {
-                const double share = SlidingShare(query, match, T_match_query, config.acceptance,
-                                                  kAbandonCheckStride);
+            if (slide_check) {
+                const double share = SlidingShare(query, match, T, forward, config.acceptance);
                 if (share > config.icp.abandon_above_shifted_overlap) {
                     *slid = share;
                     return false;
@@ -431,10 +447,7 @@ bool OverlapReaches(const PreparedScan& query, const PreparedScan& match,
     const Eigen::Isometry3f T = T_match_query.cast<float>();
     const OneWay forward = OverlapOneWay(*query.structure, query.structure_distinctive,
                                          *match.structure, T, config, false, stride);
-    if (Fraction(forward.overlapping, forward.in_view) < min_overlap) return false;
-    const OneWay backward = OverlapOneWay(*match.structure, match.structure_distinctive,
-                                          *query.structure, T.inverse(), config, false, stride);
-    return Fraction(backward.overlapping, backward.in_view) >= min_overlap;
+    return BothWaysReach(query, match, T, forward, config, min_overlap, stride);
 }
 
 Verification Verify(const PreparedScan& query, const CoarseQuery& coarse, const PreparedScan& match,
