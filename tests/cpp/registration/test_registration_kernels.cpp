@@ -327,7 +327,7 @@ TEST(Fft2d, MatchesTheDefinitionAndInverts) {
 // The batched kernel against Eigen's FFT, one 1-D transform at a time, at the sizes the coarse
 // search allows.
 TEST(Fft2d, EqualsEigensFftOnRowsThenColumns) {
-    for (const int n : {16, 64, 256}) {
+    for (const int n : {16, 32, 64, 128, 256}) {
         std::mt19937_64 rng(static_cast<unsigned>(n));
         std::uniform_real_distribution<float> u(-1.0F, 1.0F);
         std::vector<std::complex<float>> grid(static_cast<std::size_t>(n * n));

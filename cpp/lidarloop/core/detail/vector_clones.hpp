@@ -9,3 +9,11 @@
 #else
 #define LIDARLOOP_VECTOR_CLONES
 #endif
+
+// For the kernels such a function calls: inlined into each copy, so they are compiled for its
+// target too (a kernel left out of line would run SSE2 code in the AVX2 copy).
+#if defined(__GNUC__)
+#define LIDARLOOP_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define LIDARLOOP_ALWAYS_INLINE inline
+#endif

@@ -10,12 +10,6 @@
 #include "lidarloop/core/detail/vector_clones.hpp"
 #include "lidarloop/core/eigen3x3.hpp"
 
-#if defined(__GNUC__)
-#define LIDARLOOP_ALWAYS_INLINE inline __attribute__((always_inline))
-#else
-#define LIDARLOOP_ALWAYS_INLINE inline
-#endif
-
 namespace lidarloop::core {
 namespace {
 
