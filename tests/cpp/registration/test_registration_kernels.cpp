@@ -656,6 +656,38 @@ TEST(CoarseAlign, AHalfTurnWindowSearchesTheHalfWhoseCentreCorrelatesBetter) {
     }
 }
 
+// A place that is the same after half a turn (each structure point's mirror through the sensor
+// is one too): the two centres correlate alike, so both halves are searched, and tied peaks come
+// in the order of their yaws, as when both halves are searched from the start, although the
+// centres were correlated first (the window at 350 degrees: its half turn, 170, is the lower).
+TEST(CoarseAlign, TiedHalfTurnsAreBothSearchedAndTheirPeaksKeepTheYawOrder) {
+    const double deg = std::numbers::pi / 180.0;
+    const PreparedScan place = PrepareScan(test::SyntheticPlace(), ScanReductionConfig{});
+    std::vector<Eigen::Vector3f> points = place.structure->points();
+    for (std::size_t i = 0, count = points.size(); i < count; ++i)
+        points.emplace_back(-points[i].x(), -points[i].y(), points[i].z());
+    const Eigen::Isometry3f turned = test::PlanarTransform(0.0, 0.0, -350.0).cast<float>();
+    std::vector<Eigen::Vector3f> query_points;
+    for (const auto& point : points) query_points.push_back(turned * point);
+    const std::vector<Eigen::Vector3f> normals(points.size(), Eigen::Vector3f::UnitX());
+    const SurfacePoints match(points, normals), query(query_points, normals);
+    const YawWindow window{350.0 * deg, 15.0 * deg, true};
+    CoarseConfig both_halves;
+    both_halves.better_half_turn_only = false;
+    const auto better = CoarseAlign(CoarseQuery(query, CoarseConfig{}, {window}), match, window);
+    const auto both = CoarseAlign(CoarseQuery(query, both_halves, {window}), match, window);
+    ASSERT_GE(better.size(), 2U);
+    EXPECT_NEAR(better[0].yaw_rad, 170.0 * deg, 1e-9);
+    EXPECT_NEAR(better[1].yaw_rad, 350.0 * deg, 1e-9);
+    EXPECT_EQ(better[0].score, better[1].score);
+    ASSERT_EQ(better.size(), both.size());
+    for (std::size_t i = 0; i < better.size(); ++i) {
+        EXPECT_EQ(better[i].yaw_rad, both[i].yaw_rad) << i;
+        EXPECT_EQ(better[i].translation_m, both[i].translation_m) << i;
+        EXPECT_EQ(better[i].score, both[i].score) << i;
+    }
+}
+
 // 45 yaws of 8 degrees: the last one has no partner in the paired transforms, and a window
 // around it wraps past 0. Searched: within 1 + 16 degrees of 352, the yaws 336-360 and 0-8.
 TEST(CoarseAlign, AWindowWrapsAroundAnOddYawCount) {
