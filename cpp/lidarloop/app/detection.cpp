@@ -373,9 +373,8 @@ DetectOutcome RunDetect(const io::Dataset& dataset, const DetectRequest& request
                      "in candidates.csv; verification.acceptance.min_neighbour_overlap_ratio)");
         NoteRejected(outcome, registration::RejectReason::kUnlikeMotion,
                      " registered candidates rejected: the scans between match and query, each "
-                     "registered to the one before, went on without turning and put them too far "
-                     "apart for a loop (reason unlike_motion in candidates.csv; "
-                     "verification.acceptance.motion_max_turn_deg)");
+                     "registered to the one before, put them too far apart for a loop (reason "
+                     "unlike_motion in candidates.csv; verification.acceptance.motion_*)");
         NoteRejected(outcome, registration::RejectReason::kUnlikeFits,
                      " registered candidates rejected: more of their query's fits on candidates "
                      "ranked before them place the query elsewhere by the odometry (reason "

@@ -39,20 +39,45 @@ Chain Straight(int steps, double step_m) {
 }
 
 TEST(MotionRulesOutLoop, AChainThatGoesStraightOnCannotComeBack) {
-    const registration::AcceptanceConfig config;  // 30 degrees; 10 m + 3 m + 0.2 x path
+    const registration::AcceptanceConfig config;  // every chain; 10 m + 3 m + 0.2 x path
     const Chain chain = Straight(20, 2.0);        // 40 m straight on: 40 > 10 + 3 + 8
     EXPECT_TRUE(MotionRulesOutLoop(20, 0, chain.Of(), config));
     // 15 m on is still within 10 + 3 + 0.2 x 15 = 16 m: the chain may be off by that much.
     EXPECT_FALSE(MotionRulesOutLoop(10, 0, Straight(10, 1.5).Of(), config));
     EXPECT_TRUE(MotionRulesOutLoop(11, 0, Straight(11, 1.5).Of(), config)) << "16.5 m > 16.3 m";
-    // A wobbling heading within 30 degrees is still straight on.
+    // A wobbling heading.
     Chain wobbling;
     for (int i = 0; i < 20; ++i) wobbling.Add(2.0, i % 2 == 0 ? 20.0 : -20.0);
     EXPECT_TRUE(MotionRulesOutLoop(20, 0, wobbling.Of(), config));
 }
 
-TEST(MotionRulesOutLoop, AChainThatTurnsIsNotJudgedAndWalkedNoFurther) {
+// At the default every chain is judged, however it turns: a U-turn and a block driven round
+// come back, a corner and 40 m on does not.
+TEST(MotionRulesOutLoop, AChainThatTurnsIsJudgedByWhereItEnds) {
     const registration::AcceptanceConfig config;
+    Chain u_turn;  // 20 m out, a half turn in five steps, 20 m back: 3.1 m from the start
+    for (int i = 0; i < 10; ++i) u_turn.Add(2.0, 0.0);
+    for (int i = 0; i < 5; ++i) u_turn.Add(1.0, i == 0 ? 0.0 : 45.0);
+    for (int i = 0; i < 10; ++i) u_turn.Add(2.0, 0.0);
+    EXPECT_FALSE(MotionRulesOutLoop(25, 0, u_turn.Of(), config));
+    EXPECT_EQ(u_turn.asked.back(), 25U) << "walked to the query";
+    Chain block;  // four sides of 40 m, turning 90 degrees at each corner: back at the start
+    for (int side = 0; side < 4; ++side) {
+        for (int i = 0; i < 20; ++i) block.Add(2.0, i == 0 && side > 0 ? 90.0 : 0.0);
+    }
+    EXPECT_FALSE(MotionRulesOutLoop(80, 0, block.Of(), config));
+    EXPECT_TRUE(MotionRulesOutLoop(40, 0, block.Of(), config))
+        << "one side on from the corner: 56.6 m > 10 + 3 + 0.2 x 80 m";
+    Chain corner = Straight(10, 2.0);  // 22 m on, a right angle, 20 m: 29.7 m > 10 + 3 + 8.4
+    corner.Add(2.0, 90.0);
+    for (int i = 0; i < 10; ++i) corner.Add(2.0, 0.0);
+    EXPECT_TRUE(MotionRulesOutLoop(21, 0, corner.Of(), config));
+}
+
+// A smaller bound judges only chains that stay within it of the match's heading.
+TEST(MotionRulesOutLoop, AChainThatTurnsPastTheBoundIsNotJudgedAndWalkedNoFurther) {
+    registration::AcceptanceConfig config;
+    config.motion_max_turn_deg = 30.0;
     Chain u_turn;  // 20 m out, a half turn in five steps, 20 m back
     for (int i = 0; i < 10; ++i) u_turn.Add(2.0, 0.0);
     for (int i = 0; i < 5; ++i) u_turn.Add(1.0, i == 0 ? 25.0 : 38.75);
@@ -150,7 +175,7 @@ std::vector<core::PointCloud> RepeatingStreetDrivenStraight() {
 
 TEST(MotionRule, OfflineDetectionRejectsALookAlikeReachedStraightOn) {
     const std::vector<core::PointCloud> scans = RepeatingStreetDrivenStraight();
-    for (const double max_turn_deg : {0.0, 30.0}) {
+    for (const double max_turn_deg : {0.0, registration::AcceptanceConfig{}.motion_max_turn_deg}) {
         DetectorConfig detector;
         detector.min_gap = {5.0, core::MinGap::Unit::kScans};
         detector.min_path_m = 0.0;
