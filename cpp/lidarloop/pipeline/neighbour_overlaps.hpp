@@ -90,13 +90,12 @@ LoopCheck SubmapsApart(const std::vector<core::StampedPose>& chained, double win
 using StepOf = std::function<std::optional<core::Transform>(std::size_t scan)>;
 
 /// Whether the scans from `match` to `query` (match < query), chained by their steps, rule out a
-/// loop between the two: a sensor that goes on without turning cannot come back. They do when
-/// the chain never turns more than acceptance.motion_max_turn_deg from the match's heading and
-/// puts the query farther from the match than max_loop_distance_m + motion_drift_m +
-/// motion_drift_ratio times the chain's path (docs/verification.md, "The scans' own motion").
-/// False when the rule is off (0 degrees), match >= query, or a step is unknown; the chain is
-/// walked from the match and left at its first turn, so a revisit registers the steps up to
-/// that turn only, once (they are cached).
+/// loop between the two: they do when the chain puts the query farther from the match than
+/// max_loop_distance_m + motion_drift_m + motion_drift_ratio times the chain's path, and never
+/// turns more than acceptance.motion_max_turn_deg from the match's heading (180, the default:
+/// any chain) (docs/verification.md, "The scans' own motion"). False when the rule is off (0
+/// degrees), match >= query, or a step is unknown; a chain that turns past the bound is left at
+/// that turn, so it registers the steps up to there only, once (they are cached).
 bool MotionRulesOutLoop(std::size_t query, std::size_t match, const StepOf& step_of,
                         const registration::AcceptanceConfig& config);
 

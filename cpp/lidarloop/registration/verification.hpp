@@ -44,8 +44,8 @@ enum class RejectReason {
     /// (pipeline::RejectLoopsUnlikeEarlierFits)
     kUnlikeFits,
     /// registered, but without odometry the scans between match and query, each registered to
-    /// the one before, went on without turning and put the two too far apart for a loop
-    /// (AcceptanceConfig::motion_max_turn_deg; pipeline::MotionRulesOutLoop)
+    /// the one before, put the two too far apart for a loop (AcceptanceConfig::motion_*;
+    /// pipeline::MotionRulesOutLoop)
     kUnlikeMotion,
 };
 
