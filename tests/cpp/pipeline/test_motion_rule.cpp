@@ -61,7 +61,8 @@ TEST(MotionRulesOutLoop, AChainThatTurnsIsJudgedByWhereItEnds) {
     for (int i = 0; i < 10; ++i) u_turn.Add(2.0, 0.0);
     EXPECT_FALSE(MotionRulesOutLoop(25, 0, u_turn.Of(), config));
     EXPECT_EQ(u_turn.asked.back(), 25U) << "walked to the query";
-    Chain block;  // four sides of 40 m, turning 90 degrees at each corner: back at the start
+    Chain
+        block;  // four sides of about 40 m, turning 90 degrees at each corner: 2.8 m from the start
     for (int side = 0; side < 4; ++side) {
         for (int i = 0; i < 20; ++i) block.Add(2.0, i == 0 && side > 0 ? 90.0 : 0.0);
     }

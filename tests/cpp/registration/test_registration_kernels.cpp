@@ -286,40 +286,43 @@ TEST(NeighborGrid, NearestWithinKeepsAnEquallyNearHintAndRejectsBadInput) {
     EXPECT_EQ(NeighborGrid(none, 0.5F).NearestWithin(near, 10.0F, 0), -1);
 }
 
+// n = 8 and 32: an even and an odd number of stages (the result ends in the scratch buffers).
 TEST(Fft2d, MatchesTheDefinitionAndInverts) {
-    const int n = 8;
-    std::mt19937_64 rng(5);
-    std::uniform_real_distribution<float> u(-1.0F, 1.0F);
-    std::vector<std::complex<float>> grid(n * n);
-    for (auto& v : grid) v = {u(rng), u(rng)};
-    auto spectrum = grid;
-    detail::Fft2dForward(spectrum, n);
-    for (int ky = 0; ky < n; ++ky) {
-        for (int kx = 0; kx < n; ++kx) {
-            std::complex<double> sum = 0.0;
-            for (int y = 0; y < n; ++y)
-                for (int x = 0; x < n; ++x)
-                    sum += std::complex<double>(grid[y * n + x]) *
-                           std::polar(1.0, -2.0 * M_PI * (kx * x + ky * y) / n);
-            EXPECT_NEAR(spectrum[ky * n + kx].real(), sum.real(), 1e-4);
-            EXPECT_NEAR(spectrum[ky * n + kx].imag(), sum.imag(), 1e-4);
+    for (const int n : {8, 32}) {
+        std::mt19937_64 rng(5);
+        std::uniform_real_distribution<float> u(-1.0F, 1.0F);
+        std::vector<std::complex<float>> grid(n * n);
+        for (auto& v : grid) v = {u(rng), u(rng)};
+        auto spectrum = grid;
+        detail::Fft2dForward(spectrum, n);
+        for (int ky = 0; ky < n; ++ky) {
+            for (int kx = 0; kx < n; ++kx) {
+                std::complex<double> sum = 0.0;
+                for (int y = 0; y < n; ++y)
+                    for (int x = 0; x < n; ++x)
+                        sum += std::complex<double>(grid[y * n + x]) *
+                               std::polar(1.0, -2.0 * M_PI * (kx * x + ky * y) / n);
+                EXPECT_NEAR(spectrum[ky * n + kx].real(), sum.real(), 1e-4);
+                EXPECT_NEAR(spectrum[ky * n + kx].imag(), sum.imag(), 1e-4);
+            }
         }
-    }
-    auto back = spectrum;
-    detail::Fft2dInverse(back, n);
-    for (int i = 0; i < n * n; ++i) EXPECT_NEAR(std::abs(back[i] - grid[i]), 0.0, 1e-5);
-    // The partial inverse computes the listed rows only, column by column; they equal the full
-    // one's.
-    detail::SplitGrid partial, narrow;
-    for (const auto& v : spectrum) partial.re.push_back(v.real()), partial.im.push_back(v.imag());
-    const std::vector<int> rows = {1, 5};
-    detail::Fft2dInverseRows(partial, n, rows, narrow);
-    ASSERT_EQ(narrow.re.size(), rows.size() * n);
-    for (std::size_t j = 0; j < rows.size(); ++j) {
-        for (int x = 0; x < n; ++x) {
-            const std::size_t at = x * rows.size() + j;
-            EXPECT_NEAR(narrow.re[at], grid[rows[j] * n + x].real(), 1e-5);
-            EXPECT_NEAR(narrow.im[at], grid[rows[j] * n + x].imag(), 1e-5);
+        auto back = spectrum;
+        detail::Fft2dInverse(back, n);
+        for (int i = 0; i < n * n; ++i) EXPECT_NEAR(std::abs(back[i] - grid[i]), 0.0, 1e-5);
+        // The partial inverse computes the listed rows only, column by column; they equal the full
+        // one's.
+        detail::SplitGrid partial, narrow;
+        for (const auto& v : spectrum)
+            partial.re.push_back(v.real()), partial.im.push_back(v.imag());
+        const std::vector<int> rows = {1, 5};
+        detail::Fft2dInverseRows(partial, n, rows, narrow);
+        ASSERT_EQ(narrow.re.size(), rows.size() * n);
+        for (std::size_t j = 0; j < rows.size(); ++j) {
+            for (int x = 0; x < n; ++x) {
+                const std::size_t at = x * rows.size() + j;
+                EXPECT_NEAR(narrow.re[at], grid[rows[j] * n + x].real(), 1e-5);
+                EXPECT_NEAR(narrow.im[at], grid[rows[j] * n + x].imag(), 1e-5);
+            }
         }
     }
 }
@@ -357,20 +360,22 @@ TEST(Fft2d, EqualsEigensFftOnRowsThenColumns) {
 }
 
 TEST(Fft2d, ARealPairSplitsIntoTheSpectraOfEachImage) {
-    const int n = 16;
-    std::mt19937_64 rng(6);
-    std::uniform_real_distribution<float> u(0.0F, 1.0F);
-    std::vector<float> a(n * n), b(n * n);
-    for (auto& v : a) v = u(rng);
-    for (auto& v : b) v = u(rng) > 0.7F ? 1.0F : 0.0F;
-    std::vector<std::complex<float>> spectrum_a, spectrum_b;
-    detail::Fft2dForwardRealPair(a, b, n, spectrum_a, spectrum_b);
-    for (const auto& [image, spectrum] : {std::pair{&a, &spectrum_a}, std::pair{&b, &spectrum_b}}) {
-        std::vector<std::complex<float>> expected(image->begin(), image->end());
-        detail::Fft2dForward(expected, n);
-        ASSERT_EQ(spectrum->size(), expected.size());
-        for (std::size_t i = 0; i < expected.size(); ++i)
-            EXPECT_NEAR(std::abs((*spectrum)[i] - expected[i]), 0.0, 1e-3) << i;
+    for (const int n : {16, 32}) {
+        std::mt19937_64 rng(6);
+        std::uniform_real_distribution<float> u(0.0F, 1.0F);
+        std::vector<float> a(n * n), b(n * n);
+        for (auto& v : a) v = u(rng);
+        for (auto& v : b) v = u(rng) > 0.7F ? 1.0F : 0.0F;
+        std::vector<std::complex<float>> spectrum_a, spectrum_b;
+        detail::Fft2dForwardRealPair(a, b, n, spectrum_a, spectrum_b);
+        for (const auto& [image, spectrum] :
+             {std::pair{&a, &spectrum_a}, std::pair{&b, &spectrum_b}}) {
+            std::vector<std::complex<float>> expected(image->begin(), image->end());
+            detail::Fft2dForward(expected, n);
+            ASSERT_EQ(spectrum->size(), expected.size());
+            for (std::size_t i = 0; i < expected.size(); ++i)
+                EXPECT_NEAR(std::abs((*spectrum)[i] - expected[i]), 0.0, 1e-3) << n << " " << i;
+        }
     }
 }
 
@@ -674,8 +679,11 @@ TEST(CoarseAlign, TiedHalfTurnsAreBothSearchedAndTheirPeaksKeepTheYawOrder) {
     const YawWindow window{350.0 * deg, 15.0 * deg, true};
     CoarseConfig both_halves;
     both_halves.better_half_turn_only = false;
-    const auto better = CoarseAlign(CoarseQuery(query, CoarseConfig{}, {window}), match, window);
+    const CoarseQuery searched(query, CoarseConfig{}, {window});
+    const auto better = CoarseAlign(searched, match, window);
     const auto both = CoarseAlign(CoarseQuery(query, both_halves, {window}), match, window);
+    // Yaws off either centre were transformed: 160 and 340 degrees.
+    EXPECT_TRUE(searched.Computed(32) && searched.Computed(68));
     ASSERT_GE(better.size(), 2U);
     EXPECT_NEAR(better[0].yaw_rad, 170.0 * deg, 1e-9);
     EXPECT_NEAR(better[1].yaw_rad, 350.0 * deg, 1e-9);

@@ -11,7 +11,7 @@ struct SplitGrid {
 };
 
 /// In-place 2-D discrete Fourier transform of an n x n row-major grid, n a power of two (columns,
-/// then rows; a batched radix-2 kernel checked against Eigen's FFT in the tests). The inverse is
+/// then rows; a batched radix-4 kernel checked against Eigen's FFT in the tests). The inverse is
 /// scaled by 1 / n^2, so Inverse(Forward(x)) == x. Thread-safe.
 void Fft2dForward(std::vector<std::complex<float>>& grid, int n);
 void Fft2dInverse(std::vector<std::complex<float>>& grid, int n);
