@@ -164,6 +164,8 @@ bool MotionRulesOutLoop(std::size_t query, std::size_t match, const StepOf& step
                         const registration::AcceptanceConfig& config) {
     if (!(config.motion_max_turn_deg > 0.0) || match >= query) return false;
     const double max_turn_rad = config.motion_max_turn_deg * core::kRadiansPerDegree;
+    // At 180 degrees (the default) no heading exceeds the bound: skip an atan2 per step.
+    const bool heading_bounded = config.motion_max_turn_deg < 180.0;
     core::Transform T_match_scan = core::Transform::Identity();
     double path_m = 0.0;
     for (std::size_t scan = match + 1; scan <= query; ++scan) {
@@ -171,6 +173,7 @@ bool MotionRulesOutLoop(std::size_t query, std::size_t match, const StepOf& step
         if (!step) return false;
         T_match_scan = T_match_scan * *step;
         path_m += step->translation().norm();
+        if (!heading_bounded) continue;
         const Eigen::Matrix3d& R = T_match_scan.linear();
         if (std::abs(std::atan2(R(1, 0), R(0, 0))) > max_turn_rad) return false;  // it turned
     }
