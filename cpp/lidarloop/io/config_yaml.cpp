@@ -204,6 +204,8 @@ void VisitFields(registration::AcceptanceConfig& c, Visitor& v) {
             "overlapping points facing the weakest direction, at least");
     v.Field("min_constraining_points_with_odometry", c.min_constraining_points_with_odometry,
             "the same where the odometry judges the loop (--odometry)");
+    v.Field("min_constraining_points_with_motion", c.min_constraining_points_with_motion,
+            "the same where the scans' own registered motion judges the loop (offline)");
     v.Field("degeneracy_shift_m", c.degeneracy_shift_m, "shift along the weakest direction");
     v.Field("max_shifted_overlap_ratio", c.max_shifted_overlap_ratio,
             "share of the points pinning that direction still overlapping there, at most");

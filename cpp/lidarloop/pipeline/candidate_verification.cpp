@@ -145,6 +145,10 @@ void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
     std::vector<registration::YawWindow> yaws;  // each candidate's, where the check gives them
     for (const Neighbor& candidate : query.candidates)
         yaws.push_back(check.YawWindow(query.query, candidate.index));
+    // Where the scans' own motion judges a pair, its looser degeneracy floor.
+    registration::VerificationConfig judged_by_motion = detector.verification;
+    judged_by_motion.acceptance.min_constraining_points =
+        detector.verification.acceptance.min_constraining_points_with_motion;
     std::optional<registration::CoarseQuery> coarse;  // the query's images, shared by its pairs
     std::vector<double> pair_seconds(query.candidates.size(), -1.0);
     std::vector<double> pair_cpu_seconds(query.candidates.size(), -1.0);
@@ -152,8 +156,10 @@ void VerifyQuery(LoopQuery& query, const registration::PreparedScan& prepared,
         const std::size_t match = query.candidates[c].index;
         const core::Stopwatch pair_wall;
         const core::ThreadCpuStopwatch pair_cpu;
+        const registration::VerificationConfig& config =
+            check.MotionJudges(query.query, match) ? judged_by_motion : detector.verification;
         query.verifications[c] =
-            registration::Verify(prepared, *coarse, match_of(match), detector.verification,
+            registration::Verify(prepared, *coarse, match_of(match), config,
                                  check.AllowedPoses(query.query, match), yaws[c]);
         pair_cpu_seconds[c] = pair_cpu.Seconds();
         pair_seconds[c] = pair_wall.Seconds();
@@ -227,7 +233,8 @@ VerificationTimes VerifyQueries(std::vector<LoopQuery>& queries,
     }
     const LoopCheck judge = JudgeOf(
         check, [neighbours](std::size_t scan) { return neighbours->Of(scan); },
-        [neighbours](std::size_t scan) { return neighbours->StepOf(scan); }, detector.verification);
+        [neighbours](std::size_t scan) { return neighbours->StepOf(scan); }, detector.verification,
+        [neighbours](std::size_t scan) { return neighbours->ChainStart(scan); });
     std::vector<VerificationTimes> per_query(queries.size());
     ProgressCounter done(progress, queries.size());
     const auto run = [&](std::size_t i) {

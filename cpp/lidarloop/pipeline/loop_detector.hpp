@@ -118,6 +118,11 @@ struct LoopCheck {
     /// verified with them (registration::Verify's `allowed`): the odometry stands in for the
     /// points that pin the position along a road. Empty: no pair is judged.
     std::function<registration::PoseAllowed(std::size_t query, std::size_t match)> allowed_poses;
+    /// Without odometry: whether the scans' own motion will judge a loop from scan `query` to scan
+    /// `match` (a chain of registered steps joins them: CheckAgainstMotion). The pair is then
+    /// verified with acceptance.min_constraining_points_with_motion (VerificationFor). Empty: no
+    /// pair is judged so.
+    std::function<bool(std::size_t query, std::size_t match)> motion_judges;
 
     /// Whether some loop from scan `query` to scan `match`, its sensors at most
     /// `max_loop_distance_m` apart (AcceptanceConfig), is one `reject` would keep; true where it
@@ -157,6 +162,9 @@ struct LoopCheck {
     }
     registration::YawWindow YawWindow(std::size_t query, std::size_t match) const {
         return yaw_window ? yaw_window(query, match) : registration::YawWindow{};
+    }
+    bool MotionJudges(std::size_t query, std::size_t match) const {
+        return motion_judges && motion_judges(query, match);
     }
 };
 

@@ -15,6 +15,7 @@ namespace lidarloop::pipeline {
 namespace {
 
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+constexpr std::size_t kUnknownChainStart = std::numeric_limits<std::size_t>::max();
 
 }  // namespace
 
@@ -43,6 +44,28 @@ double NeighbourOverlaps::Of(std::size_t scan) {
 std::optional<core::Transform> NeighbourOverlaps::StepOf(std::size_t scan) {
     if (scan == 0 || scan >= count_of_()) return std::nullopt;
     return PairOf(scan).T_earlier_later;
+}
+
+std::size_t NeighbourOverlaps::ChainStart(std::size_t scan) {
+    if (scan >= count_of_()) return scan;  // not there yet: nothing remembered
+    std::vector<std::size_t> walked;       // scans whose chain starts where the walk ends
+    std::size_t start = scan;
+    for (;;) {
+        {
+            const std::lock_guard lock(mutex_);
+            if (start < chain_start_.size() && chain_start_[start] != kUnknownChainStart) {
+                start = chain_start_[start];
+                break;
+            }
+        }
+        walked.push_back(start);
+        if (start == 0 || !StepOf(start)) break;
+        --start;
+    }
+    const std::lock_guard lock(mutex_);
+    if (scan >= chain_start_.size()) chain_start_.resize(scan + 1, kUnknownChainStart);
+    for (const std::size_t s : walked) chain_start_[s] = start;
+    return start;
 }
 
 NeighbourOverlaps::Pair NeighbourOverlaps::PairOf(std::size_t later) {
@@ -193,12 +216,14 @@ LoopCheck CheckAgainstMotion(StepOf step_of, const registration::AcceptanceConfi
 }
 
 LoopCheck JudgeOf(const LoopCheck& given, std::function<double(std::size_t)> reference_of,
-                  StepOf step_of, const registration::VerificationConfig& config) {
+                  StepOf step_of, const registration::VerificationConfig& config,
+                  ChainStartOf chain_start_of) {
     if (given) return given;
     LoopCheck neighbours = CheckAgainstNeighbours(std::move(reference_of),
                                                   config.acceptance.min_neighbour_overlap_ratio);
     LoopCheck motion =
         step_of ? CheckAgainstMotion(std::move(step_of), config.acceptance) : LoopCheck{};
+    const bool motion_judges = motion && chain_start_of;
     LoopCheck judge;
     if (!motion) {
         judge = std::move(neighbours);
@@ -209,6 +234,12 @@ LoopCheck JudgeOf(const LoopCheck& given, std::function<double(std::size_t)> ref
                         motion = std::move(motion)](LoopQuery& q) {
             neighbours(q);
             motion(q);
+        };
+    }
+    if (motion_judges) {
+        judge.motion_judges = [chain_start_of = std::move(chain_start_of)](std::size_t query,
+                                                                           std::size_t match) {
+            return match < query && chain_start_of(query) <= match;
         };
     }
     judge.yaw_window = given.yaw_window;  // the layouts' (LayoutOrderOf), where given

@@ -48,6 +48,12 @@ public:
     /// registration as Of; none for scan 0, a pair ICP did not register, or one not there yet.
     std::optional<core::Transform> StepOf(std::size_t scan);
 
+    /// The first scan of the chain that ends at `scan`: the smallest s <= scan such that every
+    /// scan from s + 1 to `scan` has a step (StepOf); `scan` itself for one not there yet.
+    /// Registers the steps it walks back over until a known chain or a missing step; remembered, so
+    /// a whole sequence costs one walk.
+    std::size_t ChainStart(std::size_t scan);
+
     /// `later` registered to `earlier` as Of registers a scan to its neighbour: a scan not
     /// stored in the sequence yet, e.g. an online query with the last stored scan.
     static Pair Between(const registration::PreparedScan& later,
@@ -68,6 +74,7 @@ private:
     mutable std::mutex mutex_;
     std::vector<Pair> known_;  ///< by neighbour pair (its later scan); valid where computed
     std::vector<bool> computed_;
+    std::vector<std::size_t> chain_start_;  ///< by scan; kUnknownChainStart where not walked
 };
 
 /// Every scan's pose from the scans alone, where no odometry places submaps (offline, when every
@@ -88,6 +95,9 @@ LoopCheck SubmapsApart(const std::vector<core::StampedPose>& chained, double win
 
 /// Scan i in the frame of scan i - 1 (NeighbourOverlaps::StepOf): none where unknown.
 using StepOf = std::function<std::optional<core::Transform>(std::size_t scan)>;
+
+/// The first scan of the chain of steps that ends at a scan (NeighbourOverlaps::ChainStart).
+using ChainStartOf = std::function<std::size_t(std::size_t scan)>;
 
 /// Whether the scans from `match` to `query` (match < query), chained by their steps, rule out a
 /// loop between the two: they do when the chain puts the query farther from the match than
@@ -116,9 +126,11 @@ LoopCheck CheckAgainstNeighbours(std::function<double(std::size_t)> reference_of
 /// What judges a sequence's verified loops: `given` where it judges (non-empty: the odometry's
 /// check), else, with no knowledge besides the scans, CheckAgainstNeighbours with `reference_of`
 /// (e.g. NeighbourOverlaps::Of) at config.acceptance.min_neighbour_overlap_ratio, then, given
-/// `step_of` (e.g. NeighbourOverlaps::StepOf; offline: VerifyQueries), CheckAgainstMotion; with
-/// `given`'s yaw_window (the layouts', LayoutOrderOf).
+/// `step_of` (e.g. NeighbourOverlaps::StepOf; offline: VerifyQueries), CheckAgainstMotion, which
+/// judges the pairs a chain joins (LoopCheck::motion_judges, given `chain_start_of`, e.g.
+/// NeighbourOverlaps::ChainStart); with `given`'s yaw_window (the layouts', LayoutOrderOf).
 LoopCheck JudgeOf(const LoopCheck& given, std::function<double(std::size_t)> reference_of,
-                  StepOf step_of, const registration::VerificationConfig& config);
+                  StepOf step_of, const registration::VerificationConfig& config,
+                  ChainStartOf chain_start_of = {});
 
 }  // namespace lidarloop::pipeline

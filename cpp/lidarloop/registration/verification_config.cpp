@@ -89,6 +89,8 @@ void AcceptanceConfig::Validate() const {
     RequireIn(min_constraining_points, 1, 1'000'000, "acceptance.min_constraining_points");
     RequireIn(min_constraining_points_with_odometry, 1, 1'000'000,
               "acceptance.min_constraining_points_with_odometry");
+    RequireIn(min_constraining_points_with_motion, 1, 1'000'000,
+              "acceptance.min_constraining_points_with_motion");
     RequireIn(degeneracy_shift_m, 0.0, 100.0, "acceptance.degeneracy_shift_m");
     RequireIn(max_shifted_overlap_ratio, 0.0, 1.0, "acceptance.max_shifted_overlap_ratio");
     RequireIn(max_rival_overlap_ratio, 0.0, 10.0, "acceptance.max_rival_overlap_ratio");

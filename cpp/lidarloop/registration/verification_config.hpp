@@ -198,6 +198,12 @@ struct AcceptanceConfig {
     /// few metres, and 5 points are the fewest whose shifted share tells sliding from breaking
     /// (docs/verification.md, "The odometry pins the road").
     int min_constraining_points_with_odometry = 5;
+    /// The same floor without odometry, offline, where the scans' own motion judges the loop:
+    /// every scan from match to query registered to the one before (pipeline::CheckAgainstMotion
+    /// then rejects a pose slid to a look-alike place farther than the chain allows, the shifted
+    /// test one slid by a few metres). 5 as with the odometry; elsewhere min_constraining_points
+    /// (docs/verification.md, "The scans' own motion pins the road").
+    int min_constraining_points_with_motion = 5;
     double degeneracy_shift_m = 2.0;
     double max_shifted_overlap_ratio = 0.5;
     /// Ambiguity test: ICP from the other coarse hypotheses; a pose at least 1 m or 5 degrees

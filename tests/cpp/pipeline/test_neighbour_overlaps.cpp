@@ -204,6 +204,49 @@ TEST(PosesFromNeighbours, AStepNotAcceptedStartsAPiece) {
     EXPECT_DOUBLE_EQ(*poses[1].path_m, 21.0);
 }
 
+// A chain of steps runs back to the first scan without a step: a scan without structure (scan 2)
+// breaks it on both sides. Each step is registered once, however often the chain is asked for.
+TEST(NeighbourOverlaps, AChainStartsWhereAStepIsMissing) {
+    const DetectorConfig detector = Verifying(0.5);
+    const auto corridor = CorridorStep(detector);
+    const std::vector<registration::CompactPreparedScan> prepared = {
+        corridor[0], corridor[1], registration::CompactPreparedScan{}, corridor[0], corridor[1]};
+    NeighbourOverlaps neighbours = NeighboursOf(prepared, detector);
+    EXPECT_EQ(neighbours.ChainStart(4), 3U);
+    EXPECT_EQ(neighbours.ChainStart(1), 0U);
+    EXPECT_EQ(neighbours.registered(), 3U) << "steps 4, 3 and 1: the walks stop at a break";
+    const std::vector<std::size_t> expected = {0, 0, 2, 3, 3};
+    for (std::size_t scan = 0; scan < prepared.size(); ++scan)
+        EXPECT_EQ(neighbours.ChainStart(scan), expected[scan]) << scan;
+    EXPECT_EQ(neighbours.registered(), 4U);
+    EXPECT_EQ(neighbours.ChainStart(7), 7U) << "not there yet";
+}
+
+// The motion rule judges a pair where one chain joins match to query, and only where the rule is
+// on, the scans alone judge (no given check) and the chains are known.
+TEST(JudgeOf, TheMotionJudgesThePairsAChainJoins) {
+    const auto reference_of = [](std::size_t) { return 1.0; };
+    const StepOf step_of = [](std::size_t) { return core::Transform::Identity(); };
+    const ChainStartOf chain_start_of = [](std::size_t scan) {
+        return std::vector<std::size_t>{0, 0, 0, 3, 3, 3}.at(scan);
+    };
+    registration::VerificationConfig config;
+    const LoopCheck judge = JudgeOf({}, reference_of, step_of, config, chain_start_of);
+    EXPECT_TRUE(judge.MotionJudges(2, 0));
+    EXPECT_TRUE(judge.MotionJudges(5, 3));
+    EXPECT_FALSE(judge.MotionJudges(5, 2)) << "the chain breaks at scan 3";
+    EXPECT_FALSE(judge.MotionJudges(0, 2)) << "a match after its query";
+    EXPECT_FALSE(judge.MotionJudges(3, 3));
+    EXPECT_FALSE(JudgeOf({}, reference_of, step_of, config).MotionJudges(2, 0));
+    EXPECT_FALSE(JudgeOf({}, reference_of, {}, config, chain_start_of).MotionJudges(2, 0));
+    LoopCheck odometry;
+    odometry.reject = [](LoopQuery& /*unused*/) {};
+    EXPECT_FALSE(
+        JudgeOf(odometry, reference_of, step_of, config, chain_start_of).MotionJudges(2, 0));
+    config.acceptance.motion_max_turn_deg = 0.0;
+    EXPECT_FALSE(JudgeOf({}, reference_of, step_of, config, chain_start_of).MotionJudges(2, 0));
+}
+
 // VerifyQueries asks from several threads, in any order, while the cache grows: every thread
 // must read the pairs one thread alone reads, and each pair is kept once.
 TEST(NeighbourOverlaps, ThreadsAskingInAnyOrderReadWhatOneThreadReads) {

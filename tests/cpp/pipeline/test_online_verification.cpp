@@ -499,6 +499,7 @@ TEST(StopAtFirstLoop, ALoopTheCheckRejectsLetsTheNextCandidateBeRegistered) {
                            {},
                            {},
                            {},
+                           {},
                            {}});
     EXPECT_EQ(checked_accepted, (std::vector<std::size_t>{1, 1}));  // one new loop a call
     EXPECT_EQ(first.verifications[1].reason, registration::RejectReason::kOdometryMismatch);
@@ -554,6 +555,7 @@ TEST(StopAtFirstLoop, RegisteringSeveralAtOnceGivesTheVerdictsOfOneAfterAnother)
             if (v.accepted)
                 v.accepted = false, v.reason = registration::RejectReason::kOdometryMismatch;
         },
+        {},
         {},
         {},
         {},
@@ -658,6 +660,7 @@ TEST(OdometryFloor, OnlyTheCandidatesWhosePoseTheCheckJudges) {
         {},
         {},
         {},
+        {},
         {}};
     const LoopQuery verified = Verified(ranked, detector, judges_candidate_2);
     EXPECT_EQ(verified.verifications[1].reason, registration::RejectReason::kDegenerate);
@@ -665,6 +668,35 @@ TEST(OdometryFloor, OnlyTheCandidatesWhosePoseTheCheckJudges) {
     EXPECT_FALSE(verified.verifications[0].accepted || verified.verifications[3].accepted);
     ASSERT_EQ(verified.loop(), 2u);
     // The verdict of the floor it was given, the same pose.
+    DetectorConfig floor_1 = detector;
+    floor_1.verification.acceptance.min_constraining_points = 1;
+    ExpectSameVerdict(verified.verifications[2], Verified(ranked, floor_1).verifications[2], 2);
+    std::sort(asked.begin(), asked.end());
+    EXPECT_EQ(asked,
+              (std::vector<std::pair<std::size_t, std::size_t>>{{4, 0}, {4, 1}, {4, 2}, {4, 3}}));
+}
+
+// VerifyQuery registers with the motion's degeneracy floor exactly the candidates the scans' own
+// motion judges (LoopCheck::motion_judges), and with min_constraining_points the others.
+TEST(MotionFloor, OnlyTheCandidatesAChainJoinsToTheQuery) {
+    DetectorConfig detector = Verifying();
+    detector.stop_at_first_loop = false;
+    detector.verification.acceptance.min_constraining_points = 1'000'000;
+    detector.verification.acceptance.min_constraining_points_with_motion = 1;
+    const RankedCandidates ranked = MakeRankedCandidates(detector);
+    std::vector<std::pair<std::size_t, std::size_t>> asked;
+    LoopCheck chain_joins_2;
+    chain_joins_2.reject = [](LoopQuery& /*unused*/) {};
+    chain_joins_2.motion_judges = [&](std::size_t query, std::size_t match) {
+        asked.emplace_back(query, match);
+        return match == 2;
+    };
+    const LoopQuery verified = Verified(ranked, detector, chain_joins_2);
+    EXPECT_EQ(verified.verifications[1].reason, registration::RejectReason::kDegenerate);
+    EXPECT_TRUE(verified.verifications[2].accepted);
+    EXPECT_FALSE(verified.verifications[0].accepted || verified.verifications[3].accepted);
+    ASSERT_EQ(verified.loop(), 2u);
+    // The verdict of the floor it was given, the same pose; no odometry's looser tests.
     DetectorConfig floor_1 = detector;
     floor_1.verification.acceptance.min_constraining_points = 1;
     ExpectSameVerdict(verified.verifications[2], Verified(ranked, floor_1).verifications[2], 2);
