@@ -39,12 +39,12 @@ Chain Straight(int steps, double step_m) {
 }
 
 TEST(MotionRulesOutLoop, AChainThatGoesStraightOnCannotComeBack) {
-    const registration::AcceptanceConfig config;  // every chain; 10 m + 3 m + 0.2 x path
-    const Chain chain = Straight(20, 2.0);        // 40 m straight on: 40 > 10 + 3 + 8
+    const registration::AcceptanceConfig config;  // every chain; 10 m + 3 m + 0.1 x path
+    const Chain chain = Straight(20, 2.0);        // 40 m straight on: 40 > 10 + 3 + 4
     EXPECT_TRUE(MotionRulesOutLoop(20, 0, chain.Of(), config));
-    // 15 m on is still within 10 + 3 + 0.2 x 15 = 16 m: the chain may be off by that much.
-    EXPECT_FALSE(MotionRulesOutLoop(10, 0, Straight(10, 1.5).Of(), config));
-    EXPECT_TRUE(MotionRulesOutLoop(11, 0, Straight(11, 1.5).Of(), config)) << "16.5 m > 16.3 m";
+    // 13.5 m on is still within 10 + 3 + 0.1 x 13.5 = 14.35 m: the chain may be off by that much.
+    EXPECT_FALSE(MotionRulesOutLoop(9, 0, Straight(9, 1.5).Of(), config));
+    EXPECT_TRUE(MotionRulesOutLoop(10, 0, Straight(10, 1.5).Of(), config)) << "15 m > 14.5 m";
     // A wobbling heading.
     Chain wobbling;
     for (int i = 0; i < 20; ++i) wobbling.Add(2.0, i % 2 == 0 ? 20.0 : -20.0);
@@ -68,7 +68,7 @@ TEST(MotionRulesOutLoop, AChainThatTurnsIsJudgedByWhereItEnds) {
     }
     EXPECT_FALSE(MotionRulesOutLoop(80, 0, block.Of(), config));
     EXPECT_TRUE(MotionRulesOutLoop(40, 0, block.Of(), config))
-        << "one side on from the corner: 56.6 m > 10 + 3 + 0.2 x 80 m";
+        << "one side on from the corner: 56.6 m > 10 + 3 + 0.1 x 80 m";
     Chain corner = Straight(10, 2.0);  // 22 m on, a right angle, 20 m: 29.7 m > 10 + 3 + 8.4
     corner.Add(2.0, 90.0);
     for (int i = 0; i < 10; ++i) corner.Add(2.0, 0.0);
