@@ -466,6 +466,8 @@ TEST(Verification, InvalidConfigIsAConfigError) {
     expect_error([](auto& c) { c.acceptance.max_loop_distance_m = 0.0; });
     expect_error([](auto& c) { c.acceptance.min_constraining_points = 0; });
     expect_error([](auto& c) { c.acceptance.min_constraining_points_with_odometry = -1; });
+    expect_error([](auto& c) { c.acceptance.min_constraining_points_with_motion = 0; });
+    expect_error([](auto& c) { c.acceptance.min_constraining_points_with_motion = 2'000'000; });
     expect_error([](auto& c) { c.acceptance.max_rmse_ratio_with_odometry = -0.5; });
     expect_error([](auto& c) { c.icp.aligned_step_factor = 0.5; });
     expect_error([](auto& c) { c.icp.aligned_step_factor = std::nan(""); });
