@@ -120,8 +120,8 @@ struct LoopCheck {
     std::function<registration::PoseAllowed(std::size_t query, std::size_t match)> allowed_poses;
     /// Without odometry: whether the scans' own motion will judge a loop from scan `query` to scan
     /// `match` (a chain of registered steps joins them: CheckAgainstMotion). The pair is then
-    /// verified with acceptance.min_constraining_points_with_motion (VerificationFor). Empty: no
-    /// pair is judged so.
+    /// verified with acceptance.min_constraining_points_with_motion (VerifyQuery). Empty: no pair
+    /// is judged so.
     std::function<bool(std::size_t query, std::size_t match)> motion_judges;
 
     /// Whether some loop from scan `query` to scan `match`, its sensors at most

@@ -223,7 +223,9 @@ LoopCheck JudgeOf(const LoopCheck& given, std::function<double(std::size_t)> ref
                                                   config.acceptance.min_neighbour_overlap_ratio);
     LoopCheck motion =
         step_of ? CheckAgainstMotion(std::move(step_of), config.acceptance) : LoopCheck{};
-    const bool motion_judges = motion && chain_start_of;
+    // With a turn bound the rule leaves chains that turn past it unjudged: no pair is sure to be.
+    const bool motion_judges =
+        motion && chain_start_of && config.acceptance.motion_max_turn_deg >= 180.0;
     LoopCheck judge;
     if (!motion) {
         judge = std::move(neighbours);

@@ -128,7 +128,8 @@ LoopCheck CheckAgainstNeighbours(std::function<double(std::size_t)> reference_of
 /// (e.g. NeighbourOverlaps::Of) at config.acceptance.min_neighbour_overlap_ratio, then, given
 /// `step_of` (e.g. NeighbourOverlaps::StepOf; offline: VerifyQueries), CheckAgainstMotion, which
 /// judges the pairs a chain joins (LoopCheck::motion_judges, given `chain_start_of`, e.g.
-/// NeighbourOverlaps::ChainStart); with `given`'s yaw_window (the layouts', LayoutOrderOf).
+/// NeighbourOverlaps::ChainStart, and every chain judged: motion_max_turn_deg 180); with
+/// `given`'s yaw_window (the layouts', LayoutOrderOf).
 LoopCheck JudgeOf(const LoopCheck& given, std::function<double(std::size_t)> reference_of,
                   StepOf step_of, const registration::VerificationConfig& config,
                   ChainStartOf chain_start_of = {});

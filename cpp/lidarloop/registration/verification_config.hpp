@@ -239,8 +239,9 @@ struct AcceptanceConfig {
     /// from the match than max_loop_distance_m + motion_drift_m + motion_drift_ratio times the
     /// chain's path (pipeline::MotionRulesOutLoop). 0: off. Judging chains that turn too halved
     /// the gate's false loops without odometry (60 -> 31: look-alike crossings reached round a
-    /// corner) and lost no true loop on the gate or validation sequences, nor at half the drift
-    /// ratio (a quarter lost 4 revisits; docs/verification.md, "The scans' own motion").
+    /// corner) and lost no true loop on the gate or validation sequences (at a drift ratio of 0.2
+    /// then; a quarter of it lost 4 revisits; docs/verification.md, "The scans' own motion").
+    /// Below 180 no pair gets min_constraining_points_with_motion: a chain may turn unjudged.
     double motion_max_turn_deg = 180.0;
     double motion_drift_m = 3.0;  ///< what the chain may be off by besides its share, metres
     /// and this share of its path. 0.1: chosen on the gate sequences (0.2 let two look-alike

@@ -243,6 +243,8 @@ TEST(JudgeOf, TheMotionJudgesThePairsAChainJoins) {
     odometry.reject = [](LoopQuery& /*unused*/) {};
     EXPECT_FALSE(
         JudgeOf(odometry, reference_of, step_of, config, chain_start_of).MotionJudges(2, 0));
+    config.acceptance.motion_max_turn_deg = 30.0;  // a chain that turns more goes unjudged
+    EXPECT_FALSE(JudgeOf({}, reference_of, step_of, config, chain_start_of).MotionJudges(2, 0));
     config.acceptance.motion_max_turn_deg = 0.0;
     EXPECT_FALSE(JudgeOf({}, reference_of, step_of, config, chain_start_of).MotionJudges(2, 0));
 }
