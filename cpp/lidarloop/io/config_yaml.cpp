@@ -1,5 +1,6 @@
 #include "lidarloop/io/config_yaml.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <iterator>
 #include <limits>
@@ -29,6 +30,46 @@ constexpr double kLegacyHistogramThreshold = 0.005;
 constexpr double kLegacyNdtThreshold = 0.0737;
 // What an optional number that is not set reads and writes as.
 constexpr char kUnsetValue[] = "default";
+
+// An unknown key's message lists the section's keys up to this length; a longer section (the
+// acceptance rule's) names the nearest key instead, so the message stays short.
+constexpr std::size_t kMaxListedKeyChars = 300;
+// Keys longer than this are no typo of a setting: no nearest key is looked for.
+constexpr std::size_t kMaxTypoKeyChars = 80;
+
+// Levenshtein distance: single-character insertions, deletions and substitutions.
+std::size_t EditDistance(const std::string& a, const std::string& b) {
+    std::vector<std::size_t> row(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+        std::size_t diagonal = row[0];
+        row[0] = i;
+        for (std::size_t j = 1; j <= b.size(); ++j) {
+            const std::size_t above = row[j];
+            row[j] = std::min({above + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1])});
+            diagonal = above;
+        }
+    }
+    return row[b.size()];
+}
+
+// What an unknown key's message says of the keys valid in its section.
+std::string ValidKeysHint(const std::string& unknown, const std::set<std::string>& known) {
+    std::string listed;
+    for (const auto& k : known) listed += (listed.empty() ? "" : ", ") + k;
+    if (listed.size() <= kMaxListedKeyChars) return "valid here: " + listed;
+    std::string hint;
+    if (unknown.size() <= kMaxTypoKeyChars) {
+        const auto nearest =
+            std::min_element(known.begin(), known.end(), [&](const auto& a, const auto& b) {
+                return EditDistance(unknown, a) < EditDistance(unknown, b);
+            });
+        if (nearest != known.end() && 2 * EditDistance(unknown, *nearest) <= unknown.size())
+            hint = "did you mean '" + *nearest + "'? ";
+    }
+    return hint + "`lidarloop dump-config` lists the " + std::to_string(known.size()) +
+           " valid here";
+}
 
 std::string ThresholdHelp() {
     using detail::ShortNumber;
@@ -507,9 +548,7 @@ public:
         for (const auto& entry : node_) {
             const std::string& key = entry.first.Scalar();
             if (known_.count(key) != 0) continue;
-            std::string valid;
-            for (const auto& k : known_) valid += (valid.empty() ? "" : ", ") + k;
-            Fail(key, "unknown key (valid here: " + valid + ")");
+            Fail(key, "unknown key (" + ValidKeysHint(key, known_) + ")");
         }
     }
 

@@ -67,6 +67,21 @@ TEST(ConfigYaml, EmptyDocumentChangesNothing) {
     EXPECT_EQ(DumpConfigYaml(config), DumpConfigYaml({}));
 }
 
+// A short section lists its keys; the acceptance rule's has too many to list in a short message
+// (a fuzzer's read of a database.scans grew past 600 characters): the nearest key is named.
+TEST(ConfigYaml, AnUnknownKeyOfALongSectionNamesTheNearestKey) {
+    const std::string typo =
+        ErrorOf("verification:\n  acceptance:\n    min_constraining_points_with_motoin: 3\n");
+    EXPECT_NE(typo.find("did you mean 'min_constraining_points_with_motion'?"), std::string::npos)
+        << typo;
+    EXPECT_NE(typo.find("`lidarloop dump-config` lists the"), std::string::npos) << typo;
+    EXPECT_LT(typo.size(), 300U) << typo;
+    const std::string unlike = ErrorOf("verification:\n  acceptance:\n    colour: red\n");
+    EXPECT_EQ(unlike.find("did you mean"), std::string::npos) << unlike;
+    EXPECT_NE(unlike.find("unknown key (`lidarloop dump-config`"), std::string::npos) << unlike;
+    EXPECT_NE(ErrorOf("histogram:\n  binz: 3\n").find("(valid here: bins, "), std::string::npos);
+}
+
 TEST(ConfigYaml, BadInputNamesFileKeyAndProblem) {
     const auto expect_error = [](const std::string& yaml, const std::string& phrase) {
         const std::string message = ErrorOf(yaml);
