@@ -60,11 +60,16 @@ std::string ValidKeysHint(const std::string& unknown, const std::set<std::string
     if (listed.size() <= kMaxListedKeyChars) return "valid here: " + listed;
     std::string hint;
     if (unknown.size() <= kMaxTypoKeyChars) {
-        const auto nearest =
-            std::min_element(known.begin(), known.end(), [&](const auto& a, const auto& b) {
-                return EditDistance(unknown, a) < EditDistance(unknown, b);
-            });
-        if (nearest != known.end() && 2 * EditDistance(unknown, *nearest) <= unknown.size())
+        std::size_t nearest_distance = std::numeric_limits<std::size_t>::max();
+        const std::string* nearest = nullptr;
+        for (const auto& k : known) {
+            const std::size_t distance = EditDistance(unknown, k);
+            if (distance < nearest_distance) {
+                nearest_distance = distance;
+                nearest = &k;
+            }
+        }
+        if (nearest && 2 * nearest_distance <= unknown.size())
             hint = "did you mean '" + *nearest + "'? ";
     }
     return hint + "`lidarloop dump-config` lists the " + std::to_string(known.size()) +
