@@ -640,6 +640,25 @@ TEST(OnlineVerification, PreparedScansMustMatchTheDatabase) {
     EXPECT_THROW(LoopDetector(database, Verifying(), two), core::ConfigError);
 }
 
+// `check` gave candidate 2 of query 4 a looser degeneracy floor than `detector`'s (which no
+// candidate passes): only it is accepted, with the verdict and pose of that floor alone (no other
+// looser test), and the check was asked about every candidate.
+void ExpectOnlyCandidate2HadTheLooserFloor(
+    const RankedCandidates& ranked, const DetectorConfig& detector, const LoopCheck& check,
+    std::vector<std::pair<std::size_t, std::size_t>>& asked) {
+    const LoopQuery verified = Verified(ranked, detector, check);
+    EXPECT_EQ(verified.verifications[1].reason, registration::RejectReason::kDegenerate);
+    EXPECT_TRUE(verified.verifications[2].accepted);
+    EXPECT_FALSE(verified.verifications[0].accepted || verified.verifications[3].accepted);
+    ASSERT_EQ(verified.loop(), 2u);
+    DetectorConfig floor_1 = detector;
+    floor_1.verification.acceptance.min_constraining_points = 1;
+    ExpectSameVerdict(verified.verifications[2], Verified(ranked, floor_1).verifications[2], 2);
+    std::sort(asked.begin(), asked.end());
+    EXPECT_EQ(asked,
+              (std::vector<std::pair<std::size_t, std::size_t>>{{4, 0}, {4, 1}, {4, 2}, {4, 3}}));
+}
+
 // VerifyQuery registers with the poses the check allows, and so with the odometry's degeneracy
 // floor, exactly the candidates whose pose the check judges.
 TEST(OdometryFloor, OnlyTheCandidatesWhosePoseTheCheckJudges) {
@@ -662,18 +681,7 @@ TEST(OdometryFloor, OnlyTheCandidatesWhosePoseTheCheckJudges) {
         {},
         {},
         {}};
-    const LoopQuery verified = Verified(ranked, detector, judges_candidate_2);
-    EXPECT_EQ(verified.verifications[1].reason, registration::RejectReason::kDegenerate);
-    EXPECT_TRUE(verified.verifications[2].accepted);
-    EXPECT_FALSE(verified.verifications[0].accepted || verified.verifications[3].accepted);
-    ASSERT_EQ(verified.loop(), 2u);
-    // The verdict of the floor it was given, the same pose.
-    DetectorConfig floor_1 = detector;
-    floor_1.verification.acceptance.min_constraining_points = 1;
-    ExpectSameVerdict(verified.verifications[2], Verified(ranked, floor_1).verifications[2], 2);
-    std::sort(asked.begin(), asked.end());
-    EXPECT_EQ(asked,
-              (std::vector<std::pair<std::size_t, std::size_t>>{{4, 0}, {4, 1}, {4, 2}, {4, 3}}));
+    ExpectOnlyCandidate2HadTheLooserFloor(ranked, detector, judges_candidate_2, asked);
 }
 
 // VerifyQuery registers with the motion's degeneracy floor exactly the candidates the scans' own
@@ -691,18 +699,7 @@ TEST(MotionFloor, OnlyTheCandidatesAChainJoinsToTheQuery) {
         asked.emplace_back(query, match);
         return match == 2;
     };
-    const LoopQuery verified = Verified(ranked, detector, chain_joins_2);
-    EXPECT_EQ(verified.verifications[1].reason, registration::RejectReason::kDegenerate);
-    EXPECT_TRUE(verified.verifications[2].accepted);
-    EXPECT_FALSE(verified.verifications[0].accepted || verified.verifications[3].accepted);
-    ASSERT_EQ(verified.loop(), 2u);
-    // The verdict of the floor it was given, the same pose; no odometry's looser tests.
-    DetectorConfig floor_1 = detector;
-    floor_1.verification.acceptance.min_constraining_points = 1;
-    ExpectSameVerdict(verified.verifications[2], Verified(ranked, floor_1).verifications[2], 2);
-    std::sort(asked.begin(), asked.end());
-    EXPECT_EQ(asked,
-              (std::vector<std::pair<std::size_t, std::size_t>>{{4, 0}, {4, 1}, {4, 2}, {4, 3}}));
+    ExpectOnlyCandidate2HadTheLooserFloor(ranked, detector, chain_joins_2, asked);
 }
 
 }  // namespace
